@@ -1,0 +1,19 @@
+#pragma once
+// Each subcommand registers itself on the CLI11 app and leaves a function to run after parsing.
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+#include "core/error.h"
+
+namespace dynbench::cli {
+
+using CommandRun = std::function<Expected<void>()>;
+
+// Registers `stats`; sets `run` when the user picked it.
+void addStatsCommand(CLI::App& app, CommandRun& run);
+
+// Exit status for an error (docs/cli.md lists them).
+int exitCode(const Error& error);
+
+}  // namespace dynbench::cli

@@ -1,0 +1,35 @@
+#pragma once
+// Errors as values: library code returns Expected<T> and never exits; only the CLI maps an
+// ErrorCode to a process exit code (see src/cli/main.cpp and docs/cli.md).
+#include <expected>
+#include <string>
+#include <utility>
+
+#include <fmt/format.h>
+
+namespace dynbench {
+
+enum class ErrorCode {
+  kUsage = 2,          // bad command-line arguments
+  kIo = 3,             // a file could not be read or written
+  kParse = 4,          // a file is not valid syntax (JSON, GLB container, OBJ, ...)
+  kInvalidData = 5,    // well-formed but violates the format (glTF spec, ranges, keyframes)
+  kUnsupported = 6,    // valid, but uses something dynbench does not implement
+  kExternalTool = 7,   // a helper program (gnuplot) is missing or failed
+};
+
+struct Error {
+  ErrorCode code;
+  std::string message;  // complete sentence naming the file and location: "a.gltf: /accessors/3: ..."
+};
+
+template <typename T>
+using Expected = std::expected<T, Error>;
+
+template <typename... Args>
+[[nodiscard]] std::unexpected<Error> fail(ErrorCode code, fmt::format_string<Args...> format,
+                                          Args&&... args) {
+  return std::unexpected(Error{code, fmt::format(format, std::forward<Args>(args)...)});
+}
+
+}  // namespace dynbench

@@ -1,0 +1,70 @@
+#include "core/files.h"
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <system_error>
+
+#include <unistd.h>
+
+namespace dynbench {
+
+Expected<std::string> readWholeFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return fail(ErrorCode::kIo, "{}: cannot open: {}", path.string(), std::strerror(errno));
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < 0) return fail(ErrorCode::kIo, "{}: cannot read (not a regular file?)", path.string());
+  std::string data(static_cast<std::size_t>(size), '\0');
+  in.seekg(0, std::ios::beg);
+  in.read(data.data(), size);
+  if (!in) return fail(ErrorCode::kIo, "{}: read failed after {} bytes", path.string(), in.gcount());
+  return data;
+}
+
+std::filesystem::path temporarySibling(const std::filesystem::path& path) {
+  auto tmp = path;
+  tmp += fmt::format(".tmp-{}", ::getpid());
+  return tmp;
+}
+
+Expected<void> commitTemporary(const std::filesystem::path& temporary,
+                               const std::filesystem::path& path) {
+  std::error_code ec;
+  std::filesystem::rename(temporary, path, ec);
+  if (ec) {
+    std::filesystem::remove(temporary, ec);
+    return fail(ErrorCode::kIo, "{}: cannot move finished file into place: {}", path.string(),
+                ec.message());
+  }
+  return {};
+}
+
+Expected<void> writeFileAtomic(const std::filesystem::path& path, std::string_view contents) {
+  std::error_code ec;
+  if (path.has_parent_path()) {
+    std::filesystem::create_directories(path.parent_path(), ec);
+    if (ec) return fail(ErrorCode::kIo, "{}: cannot create folder: {}", path.parent_path().string(), ec.message());
+  }
+  const auto tmp = temporarySibling(path);
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) return fail(ErrorCode::kIo, "{}: cannot write: {}", tmp.string(), std::strerror(errno));
+    out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
+    out.flush();
+    if (!out) {
+      std::filesystem::remove(tmp, ec);
+      return fail(ErrorCode::kIo, "{}: write failed", tmp.string());
+    }
+  }
+  return commitTemporary(tmp, path);
+}
+
+Expected<std::uint64_t> fileSize(const std::filesystem::path& path) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) return fail(ErrorCode::kIo, "{}: {}", path.string(), ec.message());
+  return static_cast<std::uint64_t>(size);
+}
+
+}  // namespace dynbench

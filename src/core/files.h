@@ -1,0 +1,28 @@
+#pragma once
+// File helpers: whole-file reads and atomic writes (temporary name, then rename), so that an
+// interrupted run never leaves a half-written output that looks complete.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "core/error.h"
+
+namespace dynbench {
+
+Expected<std::string> readWholeFile(const std::filesystem::path& path);
+
+// Writes `contents` to `<path>.tmp-<pid>` and renames it over `path`. Creates parent folders.
+Expected<void> writeFileAtomic(const std::filesystem::path& path, std::string_view contents);
+
+// Size in bytes, or an error naming the file.
+Expected<std::uint64_t> fileSize(const std::filesystem::path& path);
+
+// A temporary sibling name for `path` for writers that cannot go through writeFileAtomic.
+std::filesystem::path temporarySibling(const std::filesystem::path& path);
+
+// Moves a finished temporary file into place.
+Expected<void> commitTemporary(const std::filesystem::path& temporary,
+                               const std::filesystem::path& path);
+
+}  // namespace dynbench

@@ -1,0 +1,49 @@
+#pragma once
+// Rotation math for camera-motion metrics. Linear algebra itself comes from GLM (libglm-dev);
+// only the conventions that the thesis's metrics need are written here.
+//
+// Conventions (docs/metrics.md): right-handed, +Y up, a camera looks down its local -Z with +Y up
+// (glTF §3.10). Angles in this header are radians unless the name says Degrees.
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+namespace dynbench {
+
+inline constexpr double kPi = 3.14159265358979323846;
+inline double degrees(double radians) { return radians * (180.0 / kPi); }
+inline double radians(double degrees) { return degrees * (kPi / 180.0); }
+
+// Position and orientation of a world matrix with scale (and shear) removed.
+struct RigidPose {
+  glm::dvec3 position{0.0};
+  glm::dquat rotation{1.0, 0.0, 0.0, 0.0};  // glm order: (w, x, y, z)
+};
+
+// Rotation part of an affine matrix: columns normalised; a mirrored basis (det < 0) has its
+// X column negated so that the result is a proper rotation.
+RigidPose decomposeRigid(const glm::dmat4& world);
+
+// Thesis Eq. (2.4): d_r = || ln(q_{i-1}^{-1} q_i) ||. For a unit quaternion q = (cos(θ/2), u sin(θ/2))
+// ln q = u θ/2, so Eq. (2.4) is half the rotation angle θ. We return θ itself, in [0, π]: the angle
+// a viewer sees the camera turn (docs/metrics.md). The relative rotation is taken on the shortest
+// arc, so q and -q (the same rotation) give 0.
+double geodesicAngle(const glm::dquat& previous, const glm::dquat& current);
+
+// Game-camera Euler angles (docs/metrics.md): R = Ry(yaw) * Rx(pitch) * Rz(roll), applied to a camera
+// that looks down -Z with +Y up. yaw turns about world +Y (positive turns left, counter-clockwise seen
+// from above), pitch about the camera's X axis after yaw (positive looks up), roll about the viewing
+// axis last (positive rolls the camera counter-clockwise about +Z, its backward axis).
+// Ranges: yaw, roll in (-π, π]; pitch in [-π/2, π/2]. At pitch ±90° roll is set to 0.
+struct EulerYawPitchRoll {
+  double yaw = 0.0;
+  double pitch = 0.0;
+  double roll = 0.0;
+};
+EulerYawPitchRoll eulerYawPitchRoll(const glm::dquat& rotation);
+glm::dquat quatFromYawPitchRoll(double yaw, double pitch, double roll);
+
+// Wraps an angle difference in degrees into (-180, 180], so a yaw going from 179° to -179° changes
+// by 2°, not 358°.
+double wrapDegrees(double degreesValue);
+
+}  // namespace dynbench

@@ -1,0 +1,116 @@
+#include "metrics/camera_motion.h"
+
+#include <algorithm>
+#include <cmath>
+#include <charconv>
+
+#include "metrics/properties.h"
+#include "scene/evaluate.h"
+
+namespace dynbench::metrics {
+
+using namespace dynbench::scene;
+
+Summary summarize(const std::vector<double>& values) {
+  Summary s;
+  if (values.empty()) return s;
+  double sum = 0.0;
+  for (double v : values) sum += v;
+  s.mean = sum / static_cast<double>(values.size());
+  double squares = 0.0;  // two passes: exact enough for 10^6 frames, unlike E[x^2] - E[x]^2
+  for (double v : values) squares += (v - s.mean) * (v - s.mean);
+  s.variance = squares / static_cast<double>(values.size());
+  s.max = *std::max_element(values.begin(), values.end());
+  return s;
+}
+
+Expected<int> selectCameraNode(const Scene& scene, const std::optional<std::string>& selector) {
+  std::vector<int> cameraNodes;
+  for (std::size_t i = 0; i < scene.nodes.size(); ++i)
+    if (scene.nodes[i].camera >= 0) cameraNodes.push_back(static_cast<int>(i));
+  auto available = [&] {
+    std::string list;
+    for (int n : cameraNodes) {
+      const auto& node = scene.nodes[static_cast<std::size_t>(n)];
+      const auto& camera = scene.cameras[static_cast<std::size_t>(node.camera)];
+      list += fmt::format("{}{} (camera {} '{}')", list.empty() ? "" : ", ", node.name.empty() ? "<unnamed node>" : node.name,
+                          node.camera, camera.name);
+    }
+    return list.empty() ? std::string("none") : list;
+  };
+  if (!selector) {
+    if (cameraNodes.empty()) return -1;
+    const auto dynamic = dynamicNodes(scene);
+    for (int n : cameraNodes)
+      if (dynamic[static_cast<std::size_t>(n)]) return n;
+    return cameraNodes.front();
+  }
+  int index = -1;
+  const auto& s = *selector;
+  if (!s.empty() && std::from_chars(s.data(), s.data() + s.size(), index).ec == std::errc() &&
+      std::all_of(s.begin(), s.end(), ::isdigit)) {
+    for (int n : cameraNodes)
+      if (scene.nodes[static_cast<std::size_t>(n)].camera == index) return n;
+    return fail(ErrorCode::kUsage, "{}: --camera {}: no node uses camera {} (cameras in the file: {})",
+                scene.source.path.string(), s, index, available());
+  }
+  for (int n : cameraNodes) {
+    const auto& node = scene.nodes[static_cast<std::size_t>(n)];
+    if (node.name == s || scene.cameras[static_cast<std::size_t>(node.camera)].name == s) return n;
+  }
+  return fail(ErrorCode::kUsage, "{}: --camera '{}' names no camera (cameras in the file: {})", scene.source.path.string(),
+              s, available());
+}
+
+Expected<CameraMotion> measureCameraMotion(const Scene& scene, double fps, const std::optional<std::string>& cameraSelector) {
+  if (!(fps > 0)) return fail(ErrorCode::kUsage, "--fps must be positive (got {})", fps);
+  auto node = selectCameraNode(scene, cameraSelector);
+  if (!node) return std::unexpected(node.error());
+  CameraMotion motion;
+  motion.fps = fps;
+  if (*node < 0) return motion;
+  motion.hasCamera = true;
+  motion.cameraNode = *node;
+  const auto& cameraNode = scene.nodes[static_cast<std::size_t>(*node)];
+  motion.cameraName = !cameraNode.name.empty() ? cameraNode.name : scene.cameras[static_cast<std::size_t>(cameraNode.camera)].name;
+
+  const auto range = scene.timeRange();
+  bool animated = false;
+  for (const auto& a : scene.animations) animated = animated || !a.channels.empty();
+  const std::size_t count = std::max<std::size_t>(1, frameCount(range, animated, fps));
+  const Evaluator evaluator(scene);
+  motion.frames.resize(count);
+  std::vector<double> dPosition, dRotation, dPitch, dYaw, dRoll;
+  for (std::size_t i = 0; i < count; ++i) {
+    CameraFrame& f = motion.frames[i];
+    f.frame = i;
+    f.time = range.start + static_cast<double>(i) / fps;
+    const RigidPose pose = decomposeRigid(evaluator.worldMatrix(*node, f.time));
+    f.position = pose.position;
+    f.rotation = pose.rotation;
+    const EulerYawPitchRoll euler = eulerYawPitchRoll(pose.rotation);
+    f.yawDegrees = degrees(euler.yaw);
+    f.pitchDegrees = degrees(euler.pitch);
+    f.rollDegrees = degrees(euler.roll);
+    if (i == 0) continue;
+    const CameraFrame& prev = motion.frames[i - 1];
+    f.positionDelta = glm::length(f.position - prev.position);                      // Eq. (3.1)
+    f.rotationDelta = degrees(geodesicAngle(prev.rotation, f.rotation));            // Eq. (2.4)
+    f.yawDelta = std::abs(wrapDegrees(f.yawDegrees - prev.yawDegrees));             // Eq. (3.2)
+    f.pitchDelta = std::abs(wrapDegrees(f.pitchDegrees - prev.pitchDegrees));
+    f.rollDelta = std::abs(wrapDegrees(f.rollDegrees - prev.rollDegrees));
+    dPosition.push_back(f.positionDelta);
+    dRotation.push_back(f.rotationDelta);
+    dYaw.push_back(f.yawDelta);
+    dPitch.push_back(f.pitchDelta);
+    dRoll.push_back(f.rollDelta);
+  }
+  motion.position = summarize(dPosition);
+  motion.rotation = summarize(dRotation);
+  motion.pitch = summarize(dPitch);
+  motion.yaw = summarize(dYaw);
+  motion.roll = summarize(dRoll);
+  return motion;
+}
+
+}  // namespace dynbench::metrics

@@ -1,0 +1,21 @@
+#pragma once
+// Camera rotation plots drawn by gnuplot (Debian gnuplot-nox): the thesis's Figure A.1 (change in
+// pitch, yaw and roll per frame) and Figure A.2 (geodesic change in rotation per frame), each as
+// PNG and SVG. gnuplot is the one place this module talks to; its errors come back as Error.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "metrics/camera_motion.h"
+
+namespace dynbench::report {
+
+// Writes <dir>/<stem>_rotation_per_axis.{png,svg} (A.1) and <dir>/<stem>_rotation_geodesic.{png,svg}
+// (A.2). Returns the paths written.
+Expected<std::vector<std::filesystem::path>> writeRotationPlots(const metrics::CameraMotion& motion,
+                                                                const std::string& title,
+                                                                const std::filesystem::path& dir,
+                                                                const std::string& stem);
+
+}  // namespace dynbench::report
