@@ -16,17 +16,17 @@ struct Segment {
 
 enum class Clamp { kBefore, kInside, kAfter };
 
+// Key times are floats (glTF stores them so). The sample time is compared in float too: a frame at
+// t = k / fps computed in double then lands exactly on a key written as the float nearest k / fps,
+// instead of just before it, which would make STEP keys one frame late.
 Clamp locate(const std::vector<float>& times, double t, Segment& seg) {
-  if (times.size() < 2 || t <= times.front()) return t <= times.front() ? Clamp::kBefore : Clamp::kAfter;
-  if (t >= times.back()) return Clamp::kAfter;
-  const auto it = std::upper_bound(times.begin(), times.end(), static_cast<float>(t),
-                                   [](float value, float key) { return value < key; });
+  const auto tf = static_cast<float>(t);
+  if (tf <= times.front()) return Clamp::kBefore;
+  if (tf >= times.back()) return Clamp::kAfter;
+  const auto it = std::upper_bound(times.begin(), times.end(), tf);
   seg.k = static_cast<std::size_t>(it - times.begin()) - 1;
-  // upper_bound on floats: make sure times[k] <= t < times[k+1] in double precision too.
-  while (seg.k + 1 < times.size() - 1 && t >= times[seg.k + 1]) ++seg.k;
-  while (seg.k > 0 && t < times[seg.k]) --seg.k;
   seg.dt = static_cast<double>(times[seg.k + 1]) - times[seg.k];
-  seg.s = (t - times[seg.k]) / seg.dt;
+  seg.s = std::clamp((t - times[seg.k]) / seg.dt, 0.0, 1.0);
   return Clamp::kInside;
 }
 

@@ -60,21 +60,31 @@ std::optional<glm::dmat4> viewFrame(const aiVector3D& position, const aiVector3D
   return m;
 }
 
+// The workflow a material was authored in. assimp maps every importer onto its own keys, and its
+// FBX importer derives a roughness factor even for Phong materials, so only explicit PBR signals
+// count: glTF-style factors, PBR texture slots, and the raw parameters of 3ds Max / Maya PBR
+// materials ("...|glossiness" with useGlossiness set means specular-glossiness).
 MaterialWorkflow detectWorkflow(const aiMaterial& material) {
-  int shading = 0;
-  const bool pbrShading = material.Get(AI_MATKEY_SHADING_MODEL, shading) == AI_SUCCESS && shading == aiShadingMode_PBR_BRDF;
   float value = 0;
-  if (material.Get(AI_MATKEY_GLOSSINESS_FACTOR, value) == AI_SUCCESS ||
-      material.Get(AI_MATKEY_SPECULAR_FACTOR, value) == AI_SUCCESS)
-    if (pbrShading || material.GetTextureCount(aiTextureType_METALNESS) == 0) {
-      if (material.Get(AI_MATKEY_GLOSSINESS_FACTOR, value) == AI_SUCCESS) return MaterialWorkflow::kSpecularGlossiness;
-    }
-  if (material.Get(AI_MATKEY_METALLIC_FACTOR, value) == AI_SUCCESS ||
-      material.Get(AI_MATKEY_ROUGHNESS_FACTOR, value) == AI_SUCCESS ||
-      material.GetTextureCount(aiTextureType_METALNESS) > 0 ||
-      material.GetTextureCount(aiTextureType_DIFFUSE_ROUGHNESS) > 0)
+  if (material.Get(AI_MATKEY_GLOSSINESS_FACTOR, value) == AI_SUCCESS) return MaterialWorkflow::kSpecularGlossiness;
+  bool rawGlossiness = false, rawMetalRough = false;
+  int useGlossiness = -1;
+  for (unsigned i = 0; i < material.mNumProperties; ++i) {
+    std::string key = material.mProperties[i]->mKey.C_Str();
+    if (!key.starts_with("$raw.")) continue;
+    std::transform(key.begin(), key.end(), key.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (key.ends_with("|useglossiness")) material.Get(material.mProperties[i]->mKey.C_Str(), 0, 0, useGlossiness);
+    else if (key.ends_with("|glossiness")) rawGlossiness = true;
+    else if (key.ends_with("|roughness") || key.ends_with("|metalness") || key.ends_with("|metallic")) rawMetalRough = true;
+  }
+  if (useGlossiness == 1 || (rawGlossiness && !rawMetalRough)) return MaterialWorkflow::kSpecularGlossiness;
+  if (useGlossiness == 0 || rawMetalRough) return MaterialWorkflow::kMetallicRoughness;
+  int shading = 0;
+  if ((material.Get(AI_MATKEY_SHADING_MODEL, shading) == AI_SUCCESS && shading == aiShadingMode_PBR_BRDF) ||
+      material.Get(AI_MATKEY_METALLIC_FACTOR, value) == AI_SUCCESS ||
+      material.GetTextureCount(aiTextureType_METALNESS) > 0 || material.GetTextureCount(aiTextureType_DIFFUSE_ROUGHNESS) > 0 ||
+      material.GetTextureCount(aiTextureType_BASE_COLOR) > 0)
     return MaterialWorkflow::kMetallicRoughness;
-  if (pbrShading) return MaterialWorkflow::kMetallicRoughness;
   return MaterialWorkflow::kPhongOrOther;
 }
 
@@ -240,7 +250,7 @@ class AssimpConverter {
       return;
     }
     Node child;
-    child.name = name + ".frame";
+    child.name = name;  // the frame node carries the name users know the camera or light by
     child.matrix = *frame;
     child.*slot = value;
     addNode(std::move(child), node);

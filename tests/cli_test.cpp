@@ -1,0 +1,181 @@
+// The dynbench executable end to end: outputs checked by reading them back, errors by exit status
+// and message, and no output file left behind by a failed run.
+#include <sys/wait.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fmt/format.h>
+
+#include "dynbench/version.h"
+#include "gltf_builder.h"
+
+namespace dynbench {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Run {
+  int status = -1;
+  std::string out, err;
+};
+
+Run dynbench(const std::string& args, const fs::path& dir) {
+  const fs::path errFile = dir / "stderr.txt";
+  const std::string cmd = std::string(DYNBENCH_EXE) + " " + args + " 2>" + errFile.string();
+  Run r;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf{};
+  for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0;) r.out.append(buf.data(), n);
+  const int status = ::pclose(pipe);
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream e(errFile);
+  std::stringstream ss;
+  ss << e.rdbuf();
+  r.err = ss.str();
+  return r;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+fs::path yawScene(const fs::path& dir) {
+  test::GltfBuilder b;
+  const int n = b.node({{"name", "eye"}, {"camera", b.perspectiveCamera()}});
+  std::vector<float> times, values, positions;
+  for (int k = 0; k <= 48; ++k) {
+    times.push_back(static_cast<float>(k / 24.0));
+    for (float v : test::yawQuat(7.5 * k)) values.push_back(v);
+  }
+  b.channel(n, "rotation", times, values);
+  b.channel(n, "translation", {0, 2}, {0, 0, 0, 0, 0, -96});  // 2 units per frame
+  return b.write(dir, "yaw");
+}
+
+TEST(Cli, VersionAndHelp) {
+  const auto dir = test::freshDir("cli_help");
+  auto r = dynbench("--version", dir);
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find(kVersion), std::string::npos);
+  r = dynbench("help stats", dir);
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find("--fps"), std::string::npos);
+  EXPECT_NE(r.out.find("default: 24"), std::string::npos);
+  r = dynbench("--help", dir);
+  EXPECT_NE(r.out.find("stats"), std::string::npos);
+  r = dynbench("help frobnicate", dir);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("frobnicate"), std::string::npos);
+  r = dynbench("stats", dir);  // FILE is required
+  EXPECT_NE(r.status, 0);
+}
+
+TEST(Cli, StatsWritesTablesJsonCsvSeriesAndPlots) {
+  const auto dir = test::freshDir("cli_stats");
+  const auto scene = yawScene(dir);
+  const auto r = dynbench(fmt::format("stats {} --json {} --csv {} --series {} --plots {}", scene.string(),
+                                      (dir / "s.json").string(), (dir / "s.csv").string(), (dir / "series").string(),
+                                      (dir / "plots").string()),
+                          dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  // Markdown tables on stdout with the known answers.
+  for (const char* title : {"Table 6.1", "Table 6.2", "Table 6.3", "Table 6.4", "Table 6.5", "Table 6.6"})
+    EXPECT_NE(r.out.find(title), std::string::npos) << title;
+  EXPECT_NE(r.out.find("| yaw.gltf |"), std::string::npos);
+  EXPECT_NE(r.out.find("7.500"), std::string::npos);
+  EXPECT_NE(r.out.find("2.000"), std::string::npos);
+
+  const auto json = nlohmann::json::parse(slurp(dir / "s.json"));
+  const auto& d = json["datasets"][0];
+  EXPECT_EQ(d["properties"]["animation_frames"], 49);
+  EXPECT_TRUE(d["properties"]["animated_camera"].get<bool>());
+  EXPECT_NEAR(d["camera_motion"]["yaw_degrees"]["mean"].get<double>(), 7.5, 1e-4);
+  EXPECT_NEAR(d["camera_motion"]["rotation_degrees"]["max"].get<double>(), 7.5, 1e-4);
+  EXPECT_NEAR(d["camera_motion"]["position"]["mean"].get<double>(), 2.0, 1e-4);
+  EXPECT_EQ(d["camera_motion"]["camera"], "eye");
+
+  std::istringstream csv(slurp(dir / "s.csv"));
+  std::string header, row, extra;
+  std::getline(csv, header);
+  std::getline(csv, row);
+  EXPECT_FALSE(std::getline(csv, extra));
+  auto column = [&](const std::string& name) {
+    std::vector<std::string> h, v;
+    for (std::istringstream hs(header), vs(row); ;) {
+      std::string a, b;
+      if (!std::getline(hs, a, ',') || !std::getline(vs, b, ',')) break;
+      h.push_back(a);
+      v.push_back(b);
+    }
+    for (std::size_t i = 0; i < h.size(); ++i)
+      if (h[i] == name) return v[i];
+    return std::string("missing");
+  };
+  EXPECT_NEAR(std::stod(column("yaw_mean_deg")), 7.5, 1e-4);
+  EXPECT_EQ(column("animation_frames"), "49");
+
+  const std::string series = slurp(dir / "series/yaw.gltf_camera.csv");
+  EXPECT_EQ(std::count(series.begin(), series.end(), '\n'), 50);  // header + 49 frames
+
+  for (const char* figure : {"rotation_per_axis", "rotation_geodesic"}) {
+    const std::string png = slurp(dir / "plots" / fmt::format("yaw.gltf_{}.png", figure));
+    ASSERT_GT(png.size(), 1000u) << figure;
+    EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+    const std::string svg = slurp(dir / "plots" / fmt::format("yaw.gltf_{}.svg", figure));
+    EXPECT_NE(svg.find("<svg"), std::string::npos);
+    EXPECT_NE(svg.find("</svg>"), std::string::npos);
+  }
+  for (const auto& entry : fs::directory_iterator(dir / "plots"))  // no temporaries left over
+    EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos) << entry.path();
+}
+
+TEST(Cli, BadInputFailsClearlyAndWritesNothing) {
+  const auto dir = test::freshDir("cli_bad");
+  test::GltfBuilder b;
+  const int n = b.node({{"name", "cam"}});
+  b.channel(n, "translation", {0, 1}, {0, 0, 0, std::nanf(""), 0, 0});
+  const auto scene = b.write(dir, "nan");
+  auto r = dynbench(fmt::format("stats {} --json {}", scene.string(), (dir / "out.json").string()), dir);
+  EXPECT_EQ(r.status, 5);  // ErrorCode::kInvalidData
+  EXPECT_NE(r.err.find("nan.gltf: /animations/0/samplers/0/output"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out.json"));
+  EXPECT_TRUE(r.out.empty());
+
+  r = dynbench(fmt::format("stats {} --camera nobody", yawScene(dir).string()), dir);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("nobody"), std::string::npos);
+
+  r = dynbench(fmt::format("stats {}", (dir / "does-not-exist.glb").string()), dir);
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("does-not-exist.glb"), std::string::npos);
+
+  r = dynbench(fmt::format("stats {} --fps -3", yawScene(dir).string()), dir);
+  EXPECT_NE(r.status, 0);
+}
+
+TEST(Cli, SeveralDatasetsOneRowEach) {
+  const auto dir = test::freshDir("cli_many");
+  const fs::path testdata = DYNBENCH_TESTDATA_DIR;
+  const auto r = dynbench(fmt::format("stats {} {} --json {}", (testdata / "SimpleSkin/SimpleSkin.gltf").string(),
+                                      yawScene(dir).string(), (dir / "m.json").string()),
+                          dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto json = nlohmann::json::parse(slurp(dir / "m.json"));
+  ASSERT_EQ(json["datasets"].size(), 2u);
+  EXPECT_EQ(json["datasets"][0]["properties"]["armatures"], 1);
+  EXPECT_TRUE(json["datasets"][0]["camera_motion"]["camera"].is_null());
+  EXPECT_NE(r.out.find("| SimpleSkin.gltf |"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace dynbench

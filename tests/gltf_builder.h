@@ -1,0 +1,38 @@
+#pragma once
+// Writes small analytic glTF files for tests: accessors from float vectors, nodes, animation
+// channels. Independent of dynbench's reader (it only uses nlohmann::json to write).
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace dynbench::test {
+
+// A fresh empty folder under the system temp dir, unique per test.
+std::filesystem::path freshDir(const std::string& name);
+
+std::string base64(const std::string& bytes);
+
+struct GltfBuilder {
+  nlohmann::json doc;
+  std::string bin;
+
+  GltfBuilder();
+  // Appends floats to the buffer (4-byte aligned) and returns the accessor index.
+  int accessor(const std::vector<float>& data, const std::string& type);
+  int node(nlohmann::json node);  // appends to nodes and to the scene's roots when it has no parent
+  int perspectiveCamera(double yfov = 1.0);
+  // Adds a channel (and its sampler) to animation 0.
+  void channel(int node, const std::string& path, const std::vector<float>& times, const std::vector<float>& values,
+               const std::string& interpolation = "LINEAR");
+  // Writes DIR/NAME.gltf and, when external, DIR/NAME.bin. Returns the .gltf path.
+  std::filesystem::path write(const std::filesystem::path& dir, const std::string& name, bool external = true);
+  // Writes a .glb container.
+  std::filesystem::path writeGlb(const std::filesystem::path& dir, const std::string& name);
+};
+
+// A quaternion (x, y, z, w) for a rotation of `degrees` about world +Y.
+std::vector<float> yawQuat(double degrees);
+
+}  // namespace dynbench::test
