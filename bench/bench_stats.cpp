@@ -70,7 +70,10 @@ void BM_Load(benchmark::State& state, fs::path file) {
     if (!scene) state.SkipWithError(scene.error().message.c_str());
     benchmark::DoNotOptimize(scene);
   }
-  state.counters["MiB"] = static_cast<double>(fs::file_size(file)) / (1024.0 * 1024.0);
+  auto bin = file;
+  bin.replace_extension(".bin");
+  const auto bytes = fs::file_size(file) + (fs::exists(bin) ? fs::file_size(bin) : 0);
+  state.counters["MiB"] = static_cast<double>(bytes) / (1024.0 * 1024.0);
 }
 
 void BM_LoadAndStats(benchmark::State& state, fs::path file) {

@@ -147,8 +147,8 @@ TEST(BadGltf, MissingBin) {
 TEST(BadGltf, AccessorOutOfRange) {
   const auto dir = test::freshDir("bad_accessor");
   auto b = animatedCamera();
-  b.doc["accessors"][1]["count"] = 50;  // translation output: 50 VEC3 in a 36-byte view
-  expectError(loadScene(b.write(dir, "scene")), ErrorCode::kInvalidData, {"/accessors/1", "bufferView 1", "36 bytes"});
+  b.doc["accessors"][1]["count"] = 5;  // translation output: 5 VEC3 (60 bytes) in a 36-byte view
+  expectError(loadScene(b.write(dir, "scene")), ErrorCode::kInvalidData, {"/accessors/1", "needs 60 bytes", "bufferView 1", "36 bytes"});
 }
 
 TEST(BadGltf, NanKeyframe) {
@@ -235,6 +235,33 @@ TEST(BadGltf, IndexOutOfRangeAndWrongTypes) {
   b = animatedCamera();
   b.doc["accessors"][0]["componentType"] = 5124;
   expectError(loadScene(b.write(dir, "scene")), ErrorCode::kInvalidData, {"/accessors/0/componentType"});
+}
+
+// Every truncation and a few thousand single-byte corruptions of a valid GLB: each load either
+// succeeds or returns an error; none crashes (run under ASan/UBSan with the debug preset).
+TEST(BadGltf, CorruptedGlbNeverCrashes) {
+  const auto dir = test::freshDir("corrupt");
+  auto b = animatedCamera();
+  const auto glb = b.writeGlb(dir, "ok");
+  std::string bytes;
+  {
+    std::ifstream in(glb, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const fs::path target = dir / "corrupt.glb";
+  auto attempt = [&](const std::string& data) {
+    std::ofstream(target, std::ios::binary | std::ios::trunc) << data;
+    auto scene = loadScene(target);
+    if (!scene) EXPECT_NE(scene.error().message.find("corrupt.glb"), std::string::npos) << scene.error().message;
+  };
+  for (std::size_t n = 0; n < bytes.size(); n += 3) attempt(bytes.substr(0, n));
+  std::uint32_t state = 12345;  // fixed-seed LCG: the same corruptions every run
+  for (int i = 0; i < 3000; ++i) {
+    state = state * 1664525u + 1013904223u;
+    std::string data = bytes;
+    data[(state >> 8) % data.size()] = static_cast<char>(state >> 24);
+    attempt(data);
+  }
 }
 
 TEST(Gltf, EmbeddedExternalAndGlbAgree) {

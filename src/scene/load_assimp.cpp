@@ -491,7 +491,7 @@ std::string formatName(const fs::path& path) {
 
 Expected<Scene> loadWithAssimp(const std::filesystem::path& path) {
   Assimp::Importer importer;
-  auto* io = new RecordingIOSystem;  // owned by the importer
+  auto* io = new RecordingIOSystem;  // owned and deleted by the importer
   importer.SetIOHandler(io);
   // No vertex welding: an OBJ sequence relies on every frame keeping assimp's vertex order.
   const aiScene* ai = importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_SortByPType |
@@ -509,7 +509,6 @@ Expected<Scene> loadWithAssimp(const std::filesystem::path& path) {
     if (auto size = fileSize(opened)) scene.source.files.push_back({opened, *size});
   }
   AssimpConverter(*ai, path, scene).convert();
-  importer.SetIOHandler(nullptr);
   return scene;
 }
 

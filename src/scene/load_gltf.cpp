@@ -479,6 +479,9 @@ class GltfReader {
         invalid(child(p, "type"), fmt::format("'{}' is not SCALAR, VEC2, VEC3, VEC4, MAT2, MAT3 or MAT4", info.type));
       if (info.bufferView >= 0) {
         const auto& view = bufferViews_[static_cast<std::size_t>(info.bufferView)];
+        if (info.count > view.length)  // also keeps the byte arithmetic below from overflowing
+          invalid(p, fmt::format("count {} is more elements than bufferView {} has bytes ({})", info.count,
+                                 info.bufferView, view.length));
         const std::size_t element = elementBytes(info);
         const std::size_t stride = view.stride ? view.stride : element;
         const std::size_t needed = info.byteOffset + stride * (info.count - 1) + element;
@@ -558,6 +561,7 @@ class GltfReader {
     const auto& iv = bufferViews_[static_cast<std::size_t>(iView)];
     const auto& vv = bufferViews_[static_cast<std::size_t>(vView)];
     const int ib = componentBytes(iType), cb = componentBytes(a.componentType);
+    if (count > a.count) invalid(child(p, "count"), fmt::format("{} sparse values for an accessor of {} elements", count, a.count));
     if (iOffset + count * static_cast<std::size_t>(ib) > iv.length)
       invalid(ip, fmt::format("{} indices do not fit in bufferView {} ({} bytes)", count, iView, iv.length));
     if (vOffset + count * static_cast<std::size_t>(cb * a.components) > vv.length)
@@ -1141,6 +1145,8 @@ Expected<Scene> loadGltf(const std::filesystem::path& path) {
   } catch (const std::bad_alloc&) {
     return fail(ErrorCode::kInvalidData, "{}: out of memory while reading (a count or length is implausibly large)",
                 path.string());
+  } catch (const std::length_error&) {
+    return fail(ErrorCode::kInvalidData, "{}: a count or length is implausibly large", path.string());
   }
   return scene;
 }
