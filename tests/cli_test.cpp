@@ -131,6 +131,14 @@ TEST(Cli, StatsWritesTablesJsonCsvSeriesAndPlots) {
     const std::string png = slurp(dir / "plots" / fmt::format("yaw.gltf_{}.png", figure));
     ASSERT_GT(png.size(), 1000u) << figure;
     EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+    // IHDR: big-endian width and height at bytes 16-23; the plots are 1200 x 450.
+    auto be32 = [&](std::size_t at) {
+      return (static_cast<unsigned char>(png[at]) << 24) | (static_cast<unsigned char>(png[at + 1]) << 16) |
+             (static_cast<unsigned char>(png[at + 2]) << 8) | static_cast<unsigned char>(png[at + 3]);
+    };
+    EXPECT_EQ(png.substr(12, 4), "IHDR");
+    EXPECT_EQ(be32(16), 1200);
+    EXPECT_EQ(be32(20), 450);
     const std::string svg = slurp(dir / "plots" / fmt::format("yaw.gltf_{}.svg", figure));
     EXPECT_NE(svg.find("<svg"), std::string::npos);
     EXPECT_NE(svg.find("</svg>"), std::string::npos);

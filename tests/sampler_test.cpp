@@ -1,4 +1,6 @@
 // glTF 2.0 Appendix C interpolation, checked against values worked out by hand.
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "core/math.h"
@@ -107,6 +109,32 @@ TEST(Evaluator, ChildFollowsAnimatedParentAndScaleZeroHides) {
   e.evaluate(0.5, pose);
   EXPECT_TRUE(pose.visible[1]);
   EXPECT_DOUBLE_EQ(pose.world[1][3].x, 5.0);
+}
+
+TEST(Evaluator, LightAndCameraWorldPoses) {
+  // A rig turning 90 degrees about +Y over 1 s carries a light 2 units in front of it (-Z) and a
+  // camera looking forward; at t = 1 the light sits at (-2, 0, 0) and the camera looks down -X.
+  const auto dir = test::freshDir("light_pose");
+  test::GltfBuilder b;
+  b.doc["extensions"] = {{"KHR_lights_punctual", {{"lights", {{{"type", "spot"}}}}}}};
+  const int rig = b.node({{"name", "rig"}, {"children", {1, 2}}});
+  b.doc["nodes"].push_back({{"name", "light"}, {"translation", {0, 0, -2}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  b.doc["nodes"].push_back({{"name", "eye"}, {"camera", b.perspectiveCamera()}});
+  const auto q = test::yawQuat(90);
+  b.channel(rig, "rotation", {0, 1}, {0, 0, 0, 1, q[0], q[1], q[2], q[3]});
+  auto scene = loadScene(b.write(dir, "light_pose"));
+  ASSERT_TRUE(scene) << scene.error().message;
+  EXPECT_EQ(scene->nodes[1].light, 0);
+  EXPECT_EQ(scene->lights[0].type, Light::Type::kSpot);
+  const Evaluator e(*scene);
+  const glm::dvec3 light(e.worldMatrix(1, 1.0)[3]);
+  EXPECT_NEAR(light.x, -2.0, 1e-6);
+  EXPECT_NEAR(light.z, 0.0, 1e-6);
+  const glm::dvec3 lightAtHalf(e.worldMatrix(1, 0.5)[3]);
+  EXPECT_NEAR(glm::length(lightAtHalf), 2.0, 1e-6);  // on the circle, halfway: 45 degrees
+  EXPECT_NEAR(lightAtHalf.x, -std::sqrt(2.0), 1e-5);
+  const glm::dvec3 view = glm::dmat3(e.worldMatrix(2, 1.0)) * glm::dvec3(0, 0, -1);
+  EXPECT_NEAR(view.x, -1.0, 1e-6);
 }
 
 TEST(Evaluator, NodeVisibilityExtensionAndAnimationPointer) {

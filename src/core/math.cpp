@@ -36,7 +36,7 @@ EulerYawPitchRoll eulerYawPitchRoll(const glm::dquat& rotation) {
   auto at = [&](int row, int col) { return m[col][row]; };
   EulerYawPitchRoll e;
   const double sinPitch = std::clamp(-at(1, 2), -1.0, 1.0);
-  e.pitch = std::asin(sinPitch);
+  e.pitch = std::asin(sinPitch) + 0.0;  // + 0.0 turns -0 into 0 for tidy output
   const double cosPitch = std::sqrt(at(0, 2) * at(0, 2) + at(2, 2) * at(2, 2));
   if (cosPitch > 1e-9) {
     e.yaw = std::atan2(at(0, 2), at(2, 2));
