@@ -294,6 +294,33 @@ class GltfReader {
     return static_cast<int>(i);
   }
 
+  // An array of indices into a top-level array of `limit` elements.
+  std::vector<int> indexList(const json& object, std::string_view key, std::string_view pointer, std::size_t limit,
+                             std::string_view what) const {
+    const json& list = array(object, key, pointer);
+    std::vector<int> out;
+    out.reserve(list.size());
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const json& v = list[k];
+      if (!v.is_number_integer() || v.get<long long>() < 0 || static_cast<std::size_t>(v.get<long long>()) >= limit)
+        invalid(child(child(pointer, key), k), fmt::format("expected a {} index below {}, got {}", what, limit, v.dump()));
+      out.push_back(v.get<int>());
+    }
+    return out;
+  }
+
+  std::vector<double> numberList(const json& object, std::string_view key, std::string_view pointer) const {
+    const json& list = array(object, key, pointer);
+    std::vector<double> out;
+    out.reserve(list.size());
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      if (!list[k].is_number() || !std::isfinite(list[k].get<double>()))
+        invalid(child(child(pointer, key), k), fmt::format("expected a finite number, got {}", list[k].dump()));
+      out.push_back(list[k].get<double>());
+    }
+    return out;
+  }
+
   double number(const json& object, std::string_view key, std::string_view pointer, double fallback,
                 bool required = false) const {
     const json* v = member(object, key);
@@ -720,13 +747,7 @@ class GltfReader {
       if (primitives.empty()) invalid(child(p, "primitives"), "a mesh needs at least one primitive");
       for (std::size_t k = 0; k < primitives.size(); ++k)
         mesh.primitives.push_back(readPrimitive(objectAt(primitives, k, child(p, "primitives")), child(child(p, "primitives"), k)));
-      if (const json* w = member(m, "weights")) {
-        if (!w->is_array()) invalid(child(p, "weights"), "expected an array of numbers");
-        for (std::size_t k = 0; k < w->size(); ++k) {
-          if (!(*w)[k].is_number()) invalid(child(child(p, "weights"), k), "expected a number");
-          mesh.defaultWeights.push_back((*w)[k].get<float>());
-        }
-      }
+      for (double w : numberList(m, "weights", p)) mesh.defaultWeights.push_back(static_cast<float>(w));
       mesh.defaultWeights.resize(mesh.morphTargetCount(), 0.0f);
       scene_.meshes.push_back(std::move(mesh));
     }
@@ -903,25 +924,12 @@ class GltfReader {
       const glm::dvec4 r = vector<4>(n, "rotation", p, glm::dvec4(0, 0, 0, 1));
       node.local.rotation = glm::dquat(r.w, r.x, r.y, r.z);
       node.local.scale = vector<3>(n, "scale", p, glm::dvec3(1.0));
-      if (const json* w = member(n, "weights")) {
-        if (!w->is_array()) invalid(child(p, "weights"), "expected an array of numbers");
-        for (std::size_t k = 0; k < w->size(); ++k) {
-          if (!(*w)[k].is_number()) invalid(child(child(p, "weights"), k), "expected a number");
-          node.weights.push_back((*w)[k].get<double>());
-        }
-      }
+      node.weights = numberList(n, "weights", p);
       if (const json* lp = extension(n, "KHR_lights_punctual"))
         node.light = index(*lp, "light", child(child(p, "extensions"), "KHR_lights_punctual"), scene_.lights.size(), "light", true);
       if (const json* vis = extension(n, "KHR_node_visibility"))
         node.visible = boolean(*vis, "visible", child(child(p, "extensions"), "KHR_node_visibility"), true);
-      const json& children = array(n, "children", p);
-      for (std::size_t k = 0; k < children.size(); ++k) {
-        const auto cp = child(child(p, "children"), k);
-        if (!children[k].is_number_integer() || children[k].get<long long>() < 0 ||
-            static_cast<std::size_t>(children[k].get<long long>()) >= nodes.size())
-          invalid(cp, fmt::format("expected a node index below {}", nodes.size()));
-        node.children.push_back(children[k].get<int>());
-      }
+      node.children = indexList(n, "children", p, nodes.size(), "node");
     }
     for (std::size_t i = 0; i < scene_.nodes.size(); ++i) {
       for (std::size_t k = 0; k < scene_.nodes[i].children.size(); ++k) {
@@ -951,14 +959,8 @@ class GltfReader {
       Skin skin;
       skin.name = string(s, "name", p);
       skin.skeleton = index(s, "skeleton", p, scene_.nodes.size(), "node");
-      const json& joints = array(s, "joints", p);
-      if (joints.empty()) invalid(child(p, "joints"), "a skin needs at least one joint");
-      for (std::size_t k = 0; k < joints.size(); ++k) {
-        if (!joints[k].is_number_integer() || joints[k].get<long long>() < 0 ||
-            static_cast<std::size_t>(joints[k].get<long long>()) >= scene_.nodes.size())
-          invalid(child(child(p, "joints"), k), fmt::format("expected a node index below {}", scene_.nodes.size()));
-        skin.joints.push_back(joints[k].get<int>());
-      }
+      skin.joints = indexList(s, "joints", p, scene_.nodes.size(), "node");
+      if (skin.joints.empty()) invalid(child(p, "joints"), "a skin needs at least one joint");
       skin.inverseBindMatrices.assign(skin.joints.size(), glm::dmat4(1.0));
       if (int a = index(s, "inverseBindMatrices", p, accessors_.size(), "accessor"); a >= 0) {
         const auto ap = child(p, "inverseBindMatrices");
@@ -992,16 +994,10 @@ class GltfReader {
     }
     const std::size_t s = active >= 0 ? static_cast<std::size_t>(active) : 0;
     const auto p = child("/scenes", s);
-    const json& sceneNodes = array(objectAt(scenes, s, "/scenes"), "nodes", p);
-    for (std::size_t k = 0; k < sceneNodes.size(); ++k) {
-      const auto np = child(child(p, "nodes"), k);
-      if (!sceneNodes[k].is_number_integer() || sceneNodes[k].get<long long>() < 0 ||
-          static_cast<std::size_t>(sceneNodes[k].get<long long>()) >= scene_.nodes.size())
-        invalid(np, fmt::format("expected a node index below {}", scene_.nodes.size()));
-      const int n = sceneNodes[k].get<int>();
-      if (scene_.nodes[static_cast<std::size_t>(n)].parent >= 0) invalid(np, fmt::format("node {} is not a root node", n));
-      scene_.roots.push_back(n);
-    }
+    scene_.roots = indexList(objectAt(scenes, s, "/scenes"), "nodes", p, scene_.nodes.size(), "node");
+    for (std::size_t k = 0; k < scene_.roots.size(); ++k)
+      if (scene_.nodes[static_cast<std::size_t>(scene_.roots[k])].parent >= 0)
+        invalid(child(child(p, "nodes"), k), fmt::format("node {} is not a root node", scene_.roots[k]));
   }
 
   // Parses "/nodes/N/extensions/KHR_node_visibility/visible"; -1 for any other pointer.
