@@ -163,6 +163,10 @@ TEST(Cli, BadInputFailsClearlyAndWritesNothing) {
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("nobody"), std::string::npos);
 
+  r = dynbench(fmt::format("stats {} --animation nope", yawScene(dir).string()), dir);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("animations in the file: 0 ''"), std::string::npos) << r.err;
+
   r = dynbench(fmt::format("stats {}", (dir / "does-not-exist.glb").string()), dir);
   EXPECT_EQ(r.status, 3);
   EXPECT_NE(r.err.find("does-not-exist.glb"), std::string::npos);

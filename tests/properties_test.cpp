@@ -57,6 +57,33 @@ TEST(Properties, CountsStaticDynamicLightsAndTextures) {
   EXPECT_EQ(p.totalBytes, expectedBytes);
 }
 
+TEST(Properties, SeparateClipsOnOneNodeAreFlaggedAndSelectable) {
+  const auto dir = test::freshDir("clips");
+  test::GltfBuilder b;
+  const int n = b.node({{"name", "cam"}, {"camera", b.perspectiveCamera()}});
+  b.channel(n, "translation", {0, 1}, {0, 0, 0, 24, 0, 0});  // "walk": 1 unit per frame at 24 fps
+  b.doc["animations"][0]["name"] = "walk";
+  // A second clip, "run", on the same property: 3 units per frame over 2 s.
+  const int in = b.accessor({0, 2}, "SCALAR"), out = b.accessor({0, 0, 0, 144, 0, 0}, "VEC3");
+  b.doc["animations"].push_back({{"name", "run"},
+                                 {"samplers", {{{"input", in}, {"output", out}}}},
+                                 {"channels", {{{"sampler", 0}, {"target", {{"node", n}, {"path", "translation"}}}}}}});
+  auto scene = scene::loadScene(b.write(dir, "clips"));
+  ASSERT_TRUE(scene) << scene.error().message;
+  const auto both = measureProperties(*scene, 24.0);
+  ASSERT_EQ(both.warnings.size(), 1u);
+  EXPECT_NE(both.warnings[0].find("more than one animation"), std::string::npos);
+  EXPECT_EQ(both.animationFrames, 49u);  // the clock spans both clips
+  auto walk = *scene;
+  ASSERT_TRUE(scene::keepOnlyAnimation(walk, "walk"));
+  EXPECT_EQ(measureProperties(walk, 24.0).animationFrames, 25u);
+  EXPECT_TRUE(measureProperties(walk, 24.0).warnings.empty());
+  auto run = *scene;
+  ASSERT_TRUE(scene::keepOnlyAnimation(run, "1"));
+  EXPECT_EQ(run.animations[0].name, "run");
+  EXPECT_FALSE(scene::keepOnlyAnimation(run, "jump"));
+}
+
 TEST(Properties, FrameCount) {
   EXPECT_EQ(frameCount({0.0, 2.0}, true, 24.0), 49u);
   EXPECT_EQ(frameCount({1.25, 2.5}, true, 24.0), 31u);

@@ -24,6 +24,7 @@ struct StatsOptions {
   double fps = 24.0;
   double sequenceRate = 24.0;
   std::optional<std::string> camera;
+  std::optional<std::string> animation;
   std::string json, csv, seriesDir, plotsDir;
 };
 
@@ -54,15 +55,22 @@ Expected<void> runStats(const StatsOptions& options) {
   for (std::size_t i = 0; i < options.inputs.size(); ++i) {
     const auto& input = options.inputs[i];
     if (interactive) fmt::print(stderr, "\rstats: [{}/{}] {}\033[K", i + 1, options.inputs.size(), input);
+    report::StatsRow row;
     scene::LoadOptions loadOptions;
     loadOptions.sequenceRate = options.sequenceRate;
     auto scene = scene::loadScene(input, loadOptions);
     if (!scene) return std::unexpected(scene.error());
-    for (const auto& warning : scene->warnings) spdlog::warn("{}", warning);
-    report::StatsRow row;
+    if (options.animation && !scene::keepOnlyAnimation(*scene, *options.animation)) {
+      std::string names;
+      for (std::size_t a = 0; a < scene->animations.size(); ++a)
+        names += fmt::format("{}{} '{}'", a ? ", " : "", a, scene->animations[a].name);
+      return fail(ErrorCode::kUsage, "{}: --animation '{}' names no animation (animations in the file: {})", input,
+                  *options.animation, names.empty() ? "none" : names);
+    }
+    row.properties = metrics::measureProperties(*scene, options.fps);
+    for (const auto& warning : row.properties.warnings) spdlog::warn("{}", warning);
     row.name = names[i];
     row.path = input;
-    row.properties = metrics::measureProperties(*scene, options.fps);
     auto motion = metrics::measureCameraMotion(*scene, options.fps, options.camera);
     if (!motion) return std::unexpected(motion.error());
     row.motion = std::move(*motion);
@@ -107,6 +115,8 @@ void addStatsCommand(CLI::App& app, CommandRun& run) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--camera", options->camera,
                   "Camera to measure: a camera index or a camera/node name (default: the first animated camera)");
+  cmd->add_option("--animation", options->animation,
+                  "Play only this animation: an index or a name (default: all animations together on one clock)");
   cmd->add_option("--json", options->json, "Also write the numbers as JSON to PATH");
   cmd->add_option("--csv", options->csv, "Also write one CSV row per dataset to PATH");
   cmd->add_option("--series", options->seriesDir, "Write per-frame camera series, DIR/<dataset>_camera.csv");

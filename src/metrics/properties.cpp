@@ -4,6 +4,8 @@
 #include <cmath>
 #include <set>
 
+#include <fmt/format.h>
+
 namespace dynbench::metrics {
 
 using namespace dynbench::scene;
@@ -51,6 +53,19 @@ DatasetProperties measureProperties(const Scene& scene, double fps) {
   p.lights = scene.lights.size();
   p.animations = scene.animations.size();
   p.warnings = scene.warnings;
+  // Several animations driving the same node property usually means separate clips (walk, run)
+  // that were never meant to play at once; all play together here and the later one wins.
+  std::set<std::pair<int, AnimationPath>> driven, conflicting;
+  for (const auto& a : scene.animations) {
+    std::set<std::pair<int, AnimationPath>> own;
+    for (const auto& c : a.channels) own.insert({c.node, c.path});
+    for (const auto& key : own)
+      if (!driven.insert(key).second) conflicting.insert(key);
+  }
+  if (!conflicting.empty())
+    p.warnings.push_back(fmt::format("{}: {} node properties are driven by more than one animation; all {} animations play "
+                                     "together and the later one wins (pick one with --animation)",
+                                     scene.source.path.string(), conflicting.size(), scene.animations.size()));
   for (const auto& s : scene.skins) p.joints += s.joints.size();
   for (const auto& a : scene.animations) p.channels += a.channels.size();
   for (const auto& m : scene.meshes) {

@@ -86,4 +86,16 @@ Scene::TimeRange Scene::timeRange() const {
   return {start, end};
 }
 
+bool keepOnlyAnimation(Scene& scene, const std::string& selector) {
+  for (std::size_t i = 0; i < scene.animations.size(); ++i) {
+    if (scene.animations[i].name == selector || std::to_string(i) == selector) {
+      Animation kept = std::move(scene.animations[i]);
+      scene.animations.clear();
+      scene.animations.push_back(std::move(kept));
+      return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace dynbench::scene

@@ -195,4 +195,8 @@ struct Scene {
   TimeRange timeRange() const;
 };
 
+// Keeps only the animation `selector` names (an index, or an animation's name) so that it plays
+// alone; returns false when nothing matches.
+bool keepOnlyAnimation(Scene& scene, const std::string& selector);
+
 }  // namespace dynbench::scene
