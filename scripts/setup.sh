@@ -11,7 +11,7 @@ packages=(
   nlohmann-json3-dev libassimp-dev libglm-dev
   libcli11-dev libfmt-dev libspdlog-dev
   # tests and benchmarks
-  libgtest-dev libgmock-dev googletest libbenchmark-dev
+  libgtest-dev libgmock-dev googletest libbenchmark-dev zlib1g-dev
   # plots
   gnuplot-nox
   # test data: FBX / DAE models with skeletons, cameras and lights

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include "core/files.h"
 #include "metrics/camera_motion.h"
@@ -22,6 +23,7 @@ const fs::path kModels = DYNBENCH_ASSIMP_MODELS_DIR;
 struct FbxRecord {
   std::string name;
   std::vector<std::string> strings;
+  std::vector<std::int32_t> ints;  // the first int32 array property, inflated
   std::vector<FbxRecord> children;
 };
 
@@ -75,7 +77,19 @@ class FbxWalker {
           off += 4 + n;
           break;
         }
-        default: off += 12 + get<std::uint32_t>(off + 8); break;  // arrays: length, encoding, bytes
+        case 'i': {  // int32 array: length, encoding (0 raw, 1 zlib), byte count, bytes
+          const auto length = get<std::uint32_t>(off), encoding = get<std::uint32_t>(off + 4), bytes = get<std::uint32_t>(off + 8);
+          if (out.ints.empty()) {
+            out.ints.resize(length);
+            uLongf size = length * 4;
+            if (encoding == 0) std::memcpy(out.ints.data(), d_.data() + off + 12, size);
+            else EXPECT_EQ(uncompress(reinterpret_cast<Bytef*>(out.ints.data()), &size,
+                                      reinterpret_cast<const Bytef*>(d_.data() + off + 12), bytes), Z_OK);
+          }
+          off += 12 + bytes;
+          break;
+        }
+        default: off += 12 + get<std::uint32_t>(off + 8); break;  // other arrays: length, encoding, bytes
       }
     }
     off = propStart + propBytes;
@@ -89,7 +103,9 @@ class FbxWalker {
 };
 
 struct FbxCounts {
-  int meshModels = 0, cameras = 0, lights = 0, clusters = 0, stacks = 0;
+  int meshModels = 0, cameras = 0, lights = 0, clusters = 0, skins = 0, stacks = 0;
+  std::size_t triangles = 0;           // polygons of n corners count n - 2
+  std::vector<std::string> modelNames;  // every Model, "Name\0\1Model" cut at the separator
 };
 
 FbxCounts countFbx(const fs::path& file) {
@@ -104,6 +120,20 @@ FbxCounts countFbx(const fs::path& file) {
       if (o.name == "Model" && kind == "Camera") ++c.cameras;
       if (o.name == "Model" && kind == "Light") ++c.lights;
       if (o.name == "Deformer" && kind == "Cluster") ++c.clusters;
+      if (o.name == "Deformer" && kind == "Skin") ++c.skins;
+      if (o.name == "Model" && !o.strings.empty()) c.modelNames.push_back(o.strings[0].substr(0, o.strings[0].find('\0')));
+      if (o.name == "Geometry" && kind == "Mesh")
+        for (const auto& field : o.children)
+          if (field.name == "PolygonVertexIndex") {
+            int corners = 0;
+            for (std::int32_t index : field.ints) {
+              ++corners;
+              if (index < 0) {  // a negative index (bitwise not) closes the polygon
+                c.triangles += static_cast<std::size_t>(corners - 2);
+                corners = 0;
+              }
+            }
+          }
       if (o.name == "AnimationStack") ++c.stacks;
     }
   }
@@ -131,6 +161,14 @@ TEST_P(FbxModel, CountsMatchTheFbxRecords) {
   EXPECT_EQ(scene->lights.size(), static_cast<std::size_t>(expected.lights));
   EXPECT_EQ(lightNodes, static_cast<std::size_t>(expected.lights));
   EXPECT_EQ(joints, static_cast<std::size_t>(expected.clusters));
+  EXPECT_EQ(scene->skins.size(), static_cast<std::size_t>(expected.skins));
+  std::size_t triangles = 0;
+  for (const auto& n : scene->nodes)
+    if (n.mesh >= 0) triangles += scene->meshes[static_cast<std::size_t>(n.mesh)].triangleCount();
+  EXPECT_EQ(triangles, expected.triangles);
+  for (const auto& name : expected.modelNames)
+    EXPECT_TRUE(std::any_of(scene->nodes.begin(), scene->nodes.end(), [&](const Node& n) { return n.name == name; }))
+        << "FBX Model '" << name << "' has no node";
   EXPECT_EQ(scene->animations.size(), static_cast<std::size_t>(expected.stacks));
 }
 
@@ -178,6 +216,16 @@ TEST(Collada, LightsAndCamerasMatchTheXml) {
   std::size_t lightNodes = 0;
   for (const auto& n : lightScene->nodes) lightNodes += n.light >= 0;
   EXPECT_EQ(lightNodes, countMatches(lights, "<instance_light"));
+
+  // Every named <node> of the XML is a node of the scene.
+  const std::regex nodeName("<node [^>]*name=\"([^\"]+)\"");
+  std::size_t named = 0;
+  for (auto it = std::sregex_iterator(lights.begin(), lights.end(), nodeName); it != std::sregex_iterator(); ++it, ++named) {
+    const std::string name = (*it)[1].str();
+    EXPECT_TRUE(std::any_of(lightScene->nodes.begin(), lightScene->nodes.end(), [&](const Node& n) { return n.name == name; }))
+        << name;
+  }
+  EXPECT_GE(named, countMatches(lights, "<instance_light"));  // at least the light nodes were checked
 
   const std::string cameras = text(kModels / "Collada/cameras.dae");
   auto cameraScene = loadScene(kModels / "Collada/cameras.dae");
