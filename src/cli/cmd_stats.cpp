@@ -2,12 +2,11 @@
 #include <map>
 #include <optional>
 
-#include <unistd.h>
-
 #include <spdlog/spdlog.h>
 
 #include "cli/commands.h"
 #include "core/files.h"
+#include "core/progress.h"
 #include "metrics/camera_motion.h"
 #include "metrics/properties.h"
 #include "report/plots.h"
@@ -49,12 +48,12 @@ std::string fileStem(const std::string& name) {
 }
 
 Expected<void> runStats(const StatsOptions& options) {
-  const bool interactive = ::isatty(STDERR_FILENO);
   const auto names = uniqueNames(options.inputs);
   std::vector<report::StatsRow> rows;
+  std::optional<Progress> progress(std::in_place, "stats", options.inputs.size(), "files");
   for (std::size_t i = 0; i < options.inputs.size(); ++i) {
     const auto& input = options.inputs[i];
-    if (interactive) fmt::print(stderr, "\rstats: [{}/{}] {}\033[K", i + 1, options.inputs.size(), input);
+    progress->update(i, input);
     report::StatsRow row;
     scene::LoadOptions loadOptions;
     loadOptions.sequenceRate = options.sequenceRate;
@@ -76,7 +75,7 @@ Expected<void> runStats(const StatsOptions& options) {
     row.motion = std::move(*motion);
     rows.push_back(std::move(row));
   }
-  if (interactive) fmt::print(stderr, "\r\033[K");
+  progress.reset();  // clears its line before the tables
 
   fmt::print("{}", report::statsMarkdown(rows));
   if (!options.json.empty())
