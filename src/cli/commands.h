@@ -13,6 +13,9 @@ using CommandRun = std::function<Expected<void>()>;
 // Registers `stats`; sets `run` when the user picked it.
 void addStatsCommand(CLI::App& app, CommandRun& run);
 
+// Registers `capture-check`.
+void addCaptureCheckCommand(CLI::App& app, CommandRun& run);
+
 // Exit status for an error (docs/cli.md lists them).
 int exitCode(const Error& error);
 

@@ -55,6 +55,25 @@ glm::dquat quatFromYawPitchRoll(double yaw, double pitch, double roll) {
          glm::angleAxis(roll, glm::dvec3(0, 0, 1));
 }
 
+DualQuaternion dualQuaternionFromRigid(const glm::dquat& rotation, const glm::dvec3& translation) {
+  const glm::dquat r = glm::normalize(rotation);
+  return {r, 0.5 * (glm::dquat(0.0, translation.x, translation.y, translation.z) * r)};
+}
+
+glm::dquat rotationOf(const DualQuaternion& q) { return glm::normalize(q.real); }
+
+glm::dvec3 translationOf(const DualQuaternion& q) {
+  const double n = glm::length(q.real);
+  const glm::dquat t = 2.0 * (q.dual / n) * glm::conjugate(q.real / n);
+  return {t.x, t.y, t.z};
+}
+
+glm::dmat4 matrixOf(const DualQuaternion& q) {
+  glm::dmat4 m = glm::mat4_cast(rotationOf(q));
+  m[3] = glm::dvec4(translationOf(q), 1.0);
+  return m;
+}
+
 double wrapDegrees(double d) {
   double w = std::fmod(d, 360.0);
   if (w <= -180.0) w += 360.0;

@@ -42,6 +42,17 @@ struct EulerYawPitchRoll {
 EulerYawPitchRoll eulerYawPitchRoll(const glm::dquat& rotation);
 glm::dquat quatFromYawPitchRoll(double yaw, double pitch, double roll);
 
+// A rigid transform as a unit dual quaternion (thesis §2.2): real = rotation r, dual = ½ (t, 0) r.
+struct DualQuaternion {
+  glm::dquat real{1.0, 0.0, 0.0, 0.0};
+  glm::dquat dual{0.0, 0.0, 0.0, 0.0};
+};
+DualQuaternion dualQuaternionFromRigid(const glm::dquat& rotation, const glm::dvec3& translation);
+// Rotation (normalised real part) and translation t = 2 d r* (r normalised first, d scaled alike).
+glm::dquat rotationOf(const DualQuaternion& q);
+glm::dvec3 translationOf(const DualQuaternion& q);
+glm::dmat4 matrixOf(const DualQuaternion& q);
+
 // Wraps an angle difference in degrees into (-180, 180], so a yaw going from 179° to -179° changes
 // by 2°, not 358°.
 double wrapDegrees(double degreesValue);

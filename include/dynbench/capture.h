@@ -1,0 +1,110 @@
+/* dynbench capture SDK: record what an interactive program shows, frame by frame, into a capture
+ * directory that `dynbench convert` turns into a glTF 2.0 benchmark dataset.
+ * The format is specified in docs/capture-format.md (thesis Tables 5.1 and 5.2).
+ *
+ * A plain C API so that any engine can call it. Link with dynbench_capture.
+ *
+ *   dbc_session* s;
+ *   if (dbc_open("capture/", "my engine 1.0", &s) != DBC_OK) puts(dbc_last_error());
+ *   dbc_set_camera_settings(s, 16.0f / 9, 60.0f, 0.1f, 1000.0f);
+ *   dbc_model_begin(s, "models/crate"); dbc_model_mesh(s, &mesh); dbc_model_end(s);
+ *   uint64_t crate = dbc_new_id(s);
+ *   for each frame:
+ *     dbc_frame_begin(s, frame, seconds);
+ *     dbc_camera(s, camera_id, position, pitch, yaw, roll);
+ *     dbc_model(s, crate, "models/crate", pose);
+ *     dbc_frame_end(s);          // the frame is on disk now: a crash later cannot lose it
+ *   dbc_close(s);
+ *
+ * Every function returns DBC_OK (0) or an error code; dbc_last_error() then says what went wrong
+ * (per thread). Nothing is written for a call that fails. Not thread-safe: one thread per session.
+ */
+#ifndef DYNBENCH_CAPTURE_H
+#define DYNBENCH_CAPTURE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct dbc_session dbc_session;
+
+enum dbc_status {
+  DBC_OK = 0,
+  DBC_ERROR_IO = 1,       /* a file could not be created or written */
+  DBC_ERROR_ARGUMENT = 2, /* NaN, a null pointer, a count out of range, an unknown model path */
+  DBC_ERROR_ORDER = 3     /* a call out of sequence (a record outside a frame, a model inside one) */
+};
+
+/* A rigid transform as a unit dual quaternion: real part r = rotation (x, y, z, w), dual part
+ * d = 1/2 (t, 0) r for the translation t (docs/capture-format.md). */
+typedef struct dbc_dual_quat {
+  float rx, ry, rz, rw;
+  float dx, dy, dz, dw;
+} dbc_dual_quat;
+
+typedef enum dbc_light_type { DBC_LIGHT_POINT = 0, DBC_LIGHT_SPOT = 1, DBC_LIGHT_DIRECTIONAL = 2 } dbc_light_type;
+
+/* One mesh of a model. Arrays hold vertex_count elements of the given width; normals, uvs,
+ * joints and weights may be NULL. joints/weights: 4 per vertex, unused influences have weight 0
+ * (at least one per vertex must be non-zero when given). */
+typedef struct dbc_mesh {
+  int mesh_id;              /* 0, 1, 2, ... in the order meshes are given */
+  const char* name;         /* may be NULL */
+  const char* texture;      /* base colour map, relative to the data root; may be NULL */
+  const char* mask_texture; /* mask map; may be NULL */
+  size_t vertex_count;
+  const float* positions;   /* 3 per vertex */
+  const float* normals;     /* 3 per vertex */
+  const float* uvs;         /* 2 per vertex */
+  const uint16_t* joints;   /* 4 per vertex */
+  const float* weights;     /* 4 per vertex */
+  size_t triangle_count;
+  const uint32_t* indices;  /* 3 per triangle */
+} dbc_mesh;
+
+/* Session. dbc_open creates the directory (and models/) and writes the version line. */
+int dbc_open(const char* directory, const char* source_name, dbc_session** session);
+/* Writes the closing record and frees the session (also on error). */
+int dbc_close(dbc_session* session);
+/* What the last failing call on this thread said. */
+const char* dbc_last_error(void);
+
+/* Capture-wide settings (before or between frames; camera settings also inside a frame). */
+int dbc_set_data_root(dbc_session* session, const char* path);
+int dbc_set_metres_per_unit(dbc_session* session, float metres);
+int dbc_set_map(dbc_session* session, const char* map_name, const float offset[3]);
+int dbc_set_camera_settings(dbc_session* session, float aspect, float yfov_degrees, float znear, float zfar);
+
+/* Models (outside frames). A model is recorded once; dbc_has_model tells whether it already is. */
+int dbc_has_model(const dbc_session* session, const char* model_path);
+int dbc_model_begin(dbc_session* session, const char* model_path);
+int dbc_model_mesh(dbc_session* session, const dbc_mesh* mesh);
+/* Joints in order 0..J-1, parents first (parent -1 for a root). */
+int dbc_model_joint(dbc_session* session, int joint_id, const char* name, int parent, dbc_dual_quat bind_pose,
+                    dbc_dual_quat inverse_bind_pose);
+int dbc_model_end(dbc_session* session);
+
+/* A fresh capturable id (running, never reused). */
+uint64_t dbc_new_id(dbc_session* session);
+
+/* Frames. */
+int dbc_frame_begin(dbc_session* session, uint64_t frame_number, double time_seconds);
+int dbc_camera(dbc_session* session, uint64_t id, const float position[3], float pitch_degrees, float yaw_degrees,
+               float roll_degrees);
+int dbc_static_model(dbc_session* session, uint64_t id, const char* model_path, dbc_dual_quat pose);
+int dbc_model(dbc_session* session, uint64_t id, const char* model_path, dbc_dual_quat pose);
+int dbc_joints(dbc_session* session, uint64_t id, const char* model_path, size_t joint_count,
+               const dbc_dual_quat* joints);
+int dbc_light(dbc_session* session, uint64_t id, const float position[3], const float rgb[3], dbc_light_type type,
+              int dynamic, const char* model_type);
+/* Writes the end-of-frame record and flushes: the frame is complete on disk. */
+int dbc_frame_end(dbc_session* session);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* DYNBENCH_CAPTURE_H */

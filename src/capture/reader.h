@@ -1,0 +1,128 @@
+#pragma once
+// Reader and validator of the capture format (docs/capture-format.md). ModelMesh files are read
+// whole (they are small); Capture.txt is streamed one frame at a time, so memory stays bounded
+// however long the capture. Every error names file:line and what was expected.
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/error.h"
+#include "core/math.h"
+
+namespace dynbench::capture {
+
+struct CapturedMesh {
+  int id = 0;
+  std::string name, texture, maskTexture;  // textures relative to the data root; empty when none
+  std::vector<glm::vec3> positions, normals;
+  std::vector<glm::vec2> uvs;
+  std::vector<glm::u16vec4> joints;  // up to 4 influences; unused ones have weight 0
+  std::vector<glm::vec4> weights;
+  std::vector<std::uint32_t> indices;  // 3 per triangle
+};
+
+struct CapturedJoint {
+  int id = 0;
+  int parent = -1;
+  std::string name;
+  DualQuaternion bindPose;         // local to the parent joint
+  DualQuaternion inverseBindPose;  // model space to joint space
+};
+
+struct CapturedModel {
+  std::string path;            // the model path Capture.txt refers to
+  std::filesystem::path file;  // its ModelMesh file
+  std::vector<CapturedMesh> meshes;
+  std::vector<CapturedJoint> joints;  // empty for a rigid model
+};
+
+Expected<CapturedModel> readModelMesh(const std::filesystem::path& file);
+
+struct CameraSettings {
+  double aspect = 0, yfovDegrees = 0, znear = 0, zfar = 0;
+};
+
+struct CaptureSettings {
+  std::string source, dataRoot, mapName;
+  glm::dvec3 mapOffset{0.0};
+  double metresPerUnit = 1.0;
+  std::optional<CameraSettings> camera;  // as set before the first frame
+};
+
+enum class LightType { kPoint, kSpot, kDirectional };
+
+struct CameraRecord {
+  std::uint64_t id = 0;
+  glm::dvec3 position{0.0};
+  double pitch = 0, yaw = 0, roll = 0;  // degrees
+};
+
+struct ModelRecord {  // `p` (static map model) and `m` (model transform)
+  std::uint64_t id = 0;
+  int model = -1;  // index into CaptureReader::models()
+  DualQuaternion pose;
+};
+
+struct JointsRecord {
+  std::uint64_t id = 0;
+  int model = -1;
+  std::vector<DualQuaternion> joints;  // model space, after blending, before the inverse bind pose
+};
+
+struct LightRecord {
+  std::uint64_t id = 0;
+  glm::dvec3 position{0.0};
+  glm::dvec3 color{0.0};
+  LightType type = LightType::kPoint;
+  bool dynamic = false;
+  std::string modelType;  // "none", "flash", "bouncer", "rocket", ...
+};
+
+struct CaptureFrame {
+  std::uint64_t number = 0;
+  double time = 0.0;
+  std::size_t line = 0;  // line of its `f` record
+  std::optional<CameraSettings> cameraSettings;  // a `C` record inside this frame
+  std::vector<CameraRecord> cameras;
+  std::vector<ModelRecord> staticModels, models;
+  std::vector<JointsRecord> joints;
+  std::vector<LightRecord> lights;
+  void clear();
+};
+
+class CaptureReader {
+ public:
+  // Reads every ModelMesh file and Capture.txt's records up to the first frame.
+  static Expected<std::unique_ptr<CaptureReader>> open(const std::filesystem::path& directory);
+
+  // The next complete frame: true, false at the end, or an error. A last frame cut short by a
+  // crash is dropped with a warning.
+  Expected<bool> next(CaptureFrame& frame);
+
+  const CaptureSettings& settings() const { return settings_; }
+  const std::vector<CapturedModel>& models() const { return models_; }
+  int modelIndex(const std::string& path) const;
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  bool closed() const { return closed_; }  // the `z` record was read
+
+  struct Impl;
+  ~CaptureReader();
+
+ private:
+  CaptureReader();
+  CaptureSettings settings_;
+  std::vector<CapturedModel> models_;
+  std::map<std::string, int> modelByPath_;
+  std::vector<std::string> warnings_;
+  bool closed_ = false;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dynbench::capture

@@ -1,0 +1,375 @@
+// The capture SDK (C API) writes, the reader reads back, capture-check summarises; broken
+// captures fail with file:line. Everything here is written by the test itself.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "capture/check.h"
+#include "capture/reader.h"
+#include "core/math.h"
+#include "dynbench/capture.h"
+#include "gltf_builder.h"
+#include "run_cli.h"
+
+namespace dynbench::capture {
+namespace {
+
+namespace fs = std::filesystem;
+
+dbc_dual_quat toC(const DualQuaternion& q) {
+  return {static_cast<float>(q.real.x), static_cast<float>(q.real.y), static_cast<float>(q.real.z), static_cast<float>(q.real.w),
+          static_cast<float>(q.dual.x), static_cast<float>(q.dual.y), static_cast<float>(q.dual.z), static_cast<float>(q.dual.w)};
+}
+
+dbc_dual_quat rigid(double yawDegrees, glm::dvec3 t) {
+  return toC(dualQuaternionFromRigid(glm::angleAxis(radians(yawDegrees), glm::dvec3(0, 1, 0)), t));
+}
+
+#define DBC_OK_OR_FAIL(call) ASSERT_EQ((call), DBC_OK) << dbc_last_error()
+
+// A two-joint "arm" (a quad skinned to both joints) and a one-triangle rigid "crate".
+void recordModels(dbc_session* s) {
+  const float positions[] = {0, 0, 0, 1, 0, 0, 1, 2, 0, 0, 2, 0};
+  const float normals[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+  const float uvs[] = {0, 0, 1, 0, 1, 1, 0, 1};
+  const uint16_t joints[] = {0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0};
+  const float weights[] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 0.25f, 0.75f, 0, 0};
+  const uint32_t quad[] = {0, 1, 2, 0, 2, 3};
+  DBC_OK_OR_FAIL(dbc_model_begin(s, "chars/arm"));
+  dbc_mesh arm{0, "skin", "chars/arm.png", "chars/arm_mask.png", 4, positions, normals, uvs, joints, weights, 2, quad};
+  DBC_OK_OR_FAIL(dbc_model_mesh(s, &arm));
+  DBC_OK_OR_FAIL(dbc_model_joint(s, 0, "shoulder", -1, rigid(0, {0, 0, 0}), rigid(0, {0, 0, 0})));
+  DBC_OK_OR_FAIL(dbc_model_joint(s, 1, "elbow", 0, rigid(0, {0, 1, 0}), rigid(0, {0, -1, 0})));
+  DBC_OK_OR_FAIL(dbc_model_end(s));
+  const uint32_t tri[] = {0, 1, 2};
+  DBC_OK_OR_FAIL(dbc_model_begin(s, "mapmodel/crate:1"));  // a ':' in a path must survive
+  dbc_mesh crate{0, nullptr, "crate.jpg", nullptr, 3, positions, nullptr, nullptr, nullptr, nullptr, 1, tri};
+  DBC_OK_OR_FAIL(dbc_model_mesh(s, &crate));
+  DBC_OK_OR_FAIL(dbc_model_end(s));
+}
+
+struct Ids {
+  uint64_t camera, arm, crate, tree, lamp, flash;
+};
+
+// Frames 0..9 at 60 fps: the camera yaws 3 degrees a frame, the crate spins and is absent in
+// frames 4-6, the arm walks along +X, a flash light exists in frames 2-3.
+Ids recordFrames(dbc_session* s, int frames = 10) {
+  Ids ids{dbc_new_id(s), dbc_new_id(s), dbc_new_id(s), dbc_new_id(s), dbc_new_id(s), dbc_new_id(s)};
+  for (int f = 0; f < frames; ++f) {
+    EXPECT_EQ(dbc_frame_begin(s, static_cast<uint64_t>(100 + f), f / 60.0), DBC_OK) << dbc_last_error();
+    const float eye[] = {0, 1.7f, static_cast<float>(f)};
+    EXPECT_EQ(dbc_camera(s, ids.camera, eye, -5.0f, 3.0f * f, 0.0f), DBC_OK);
+    EXPECT_EQ(dbc_static_model(s, ids.tree, "mapmodel/crate:1", rigid(0, {5, 0, 5})), DBC_OK);
+    EXPECT_EQ(dbc_model(s, ids.arm, "chars/arm", rigid(90, {0.1 * f, 0, 0})), DBC_OK);
+    const dbc_dual_quat pose[] = {rigid(0, {0, 0, 0}), rigid(10.0 * f, {0, 1, 0})};
+    EXPECT_EQ(dbc_joints(s, ids.arm, "chars/arm", 2, pose), DBC_OK) << dbc_last_error();
+    if (f < 4 || f > 6) EXPECT_EQ(dbc_model(s, ids.crate, "mapmodel/crate:1", rigid(20.0 * f, {2, 0, 0})), DBC_OK);
+    const float lampAt[] = {0, 5, 0}, white[] = {1, 1, 1}, orange[] = {1, 0.5f, 0};
+    EXPECT_EQ(dbc_light(s, ids.lamp, lampAt, white, DBC_LIGHT_POINT, 0, nullptr), DBC_OK);
+    if (f == 2 || f == 3) {
+      const float at[] = {0.5f, 1.5f, static_cast<float>(f)};
+      EXPECT_EQ(dbc_light(s, ids.flash, at, orange, DBC_LIGHT_POINT, 1, "flash"), DBC_OK);
+    }
+    EXPECT_EQ(dbc_frame_end(s), DBC_OK) << dbc_last_error();
+  }
+  return ids;
+}
+
+fs::path writeCapture(const std::string& name) {
+  const auto dir = test::freshDir(name);
+  dbc_session* s = nullptr;
+  EXPECT_EQ(dbc_open(dir.c_str(), "dynbench tests", &s), DBC_OK) << dbc_last_error();
+  const float offset[] = {1, 2, 3};
+  EXPECT_EQ(dbc_set_map(s, "testmap", offset), DBC_OK);
+  EXPECT_EQ(dbc_set_data_root(s, "/data/game"), DBC_OK);
+  EXPECT_EQ(dbc_set_camera_settings(s, 16.0f / 9, 75.0f, 0.1f, 500.0f), DBC_OK);
+  recordModels(s);
+  recordFrames(s);
+  EXPECT_EQ(dbc_close(s), DBC_OK) << dbc_last_error();
+  return dir;
+}
+
+TEST(DualQuaternion, RoundTripsRotationAndTranslation) {
+  const glm::dquat r = glm::angleAxis(radians(70.0), glm::normalize(glm::dvec3(1, 2, -1)));
+  const glm::dvec3 t(3, -4, 5);
+  const DualQuaternion q = dualQuaternionFromRigid(r, t);
+  EXPECT_NEAR(glm::length(translationOf(q) - t), 0.0, 1e-12);
+  EXPECT_NEAR(geodesicAngle(rotationOf(q), r), 0.0, 1e-12);
+  // Pure translation: d = (0, t/2).
+  const DualQuaternion p = dualQuaternionFromRigid(glm::dquat(1, 0, 0, 0), {2, 4, 6});
+  EXPECT_DOUBLE_EQ(p.dual.x, 1.0);
+  EXPECT_DOUBLE_EQ(p.dual.y, 2.0);
+  EXPECT_DOUBLE_EQ(p.dual.z, 3.0);
+  EXPECT_DOUBLE_EQ(p.dual.w, 0.0);
+  // The matrix applies the rotation, then the translation.
+  const glm::dvec3 x = glm::dvec3(matrixOf(q) * glm::dvec4(1, 0, 0, 1));
+  EXPECT_NEAR(glm::length(x - (r * glm::dvec3(1, 0, 0) + t)), 0.0, 1e-12);
+}
+
+TEST(Capture, WriteThenReadBack) {
+  const auto dir = writeCapture("capture_roundtrip");
+  auto reader = CaptureReader::open(dir);
+  ASSERT_TRUE(reader) << reader.error().message;
+  const auto& r = **reader;
+  EXPECT_EQ(r.settings().source, "dynbench tests");
+  EXPECT_EQ(r.settings().mapName, "testmap");
+  EXPECT_EQ(r.settings().mapOffset, glm::dvec3(1, 2, 3));
+  EXPECT_EQ(r.settings().dataRoot, "/data/game");
+  ASSERT_TRUE(r.settings().camera);
+  EXPECT_NEAR(r.settings().camera->yfovDegrees, 75.0, 1e-6);
+  ASSERT_EQ(r.models().size(), 2u);
+  const int arm = r.modelIndex("chars/arm");
+  ASSERT_GE(arm, 0);
+  const auto& model = r.models()[static_cast<std::size_t>(arm)];
+  ASSERT_EQ(model.meshes.size(), 1u);
+  EXPECT_EQ(model.meshes[0].texture, "chars/arm.png");
+  EXPECT_EQ(model.meshes[0].maskTexture, "chars/arm_mask.png");
+  EXPECT_EQ(model.meshes[0].positions[2], glm::vec3(1, 2, 0));
+  EXPECT_EQ(model.meshes[0].uvs[3], glm::vec2(0, 1));
+  EXPECT_EQ(model.meshes[0].joints[3], glm::u16vec4(0, 1, 0, 0));
+  EXPECT_EQ(model.meshes[0].weights[3], glm::vec4(0.25f, 0.75f, 0, 0));
+  EXPECT_EQ(model.meshes[0].indices, (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3}));
+  ASSERT_EQ(model.joints.size(), 2u);
+  EXPECT_EQ(model.joints[1].name, "elbow");
+  EXPECT_EQ(model.joints[1].parent, 0);
+  EXPECT_NEAR(translationOf(model.joints[1].inverseBindPose).y, -1.0, 1e-6);
+  EXPECT_GE(r.modelIndex("mapmodel/crate:1"), 0);
+
+  CaptureFrame frame;
+  std::size_t frames = 0, crateFrames = 0, flashFrames = 0;
+  while (true) {
+    auto more = (*reader)->next(frame);
+    ASSERT_TRUE(more) << more.error().message;
+    if (!*more) break;
+    const int f = static_cast<int>(frames);
+    EXPECT_EQ(frame.number, 100u + frames);
+    EXPECT_DOUBLE_EQ(frame.time, f / 60.0);  // times round-trip exactly (17 digits)
+    ASSERT_EQ(frame.cameras.size(), 1u);
+    EXPECT_FLOAT_EQ(static_cast<float>(frame.cameras[0].yaw), 3.0f * f);
+    EXPECT_FLOAT_EQ(static_cast<float>(frame.cameras[0].position.z), static_cast<float>(f));
+    EXPECT_EQ(frame.staticModels.size(), f == 0 ? 1u : 0u);  // static: recorded once
+    EXPECT_EQ(frame.lights.size(), (f == 0 ? 1u : 0u) + (f == 2 || f == 3 ? 1u : 0u));
+    for (const auto& l : frame.lights)
+      if (l.dynamic) {
+        ++flashFrames;
+        EXPECT_EQ(l.modelType, "flash");
+      }
+    ASSERT_EQ(frame.joints.size(), 1u);
+    ASSERT_EQ(frame.joints[0].joints.size(), 2u);
+    EXPECT_NEAR(degrees(geodesicAngle(glm::dquat(1, 0, 0, 0), rotationOf(frame.joints[0].joints[1]))), 10.0 * f, 1e-4);
+    for (const auto& m : frame.models)
+      if (m.model == r.modelIndex("mapmodel/crate:1")) {
+        ++crateFrames;
+        EXPECT_NEAR(translationOf(m.pose).x, 2.0, 1e-6);
+      } else {
+        EXPECT_NEAR(translationOf(m.pose).x, 0.1 * f, 1e-6);
+      }
+    ++frames;
+  }
+  EXPECT_EQ(frames, 10u);
+  EXPECT_EQ(crateFrames, 7u);  // absent in frames 4, 5 and 6
+  EXPECT_EQ(flashFrames, 2u);
+  EXPECT_TRUE(r.closed());
+  EXPECT_TRUE(r.warnings().empty());
+}
+
+TEST(Capture, CheckSummarises) {
+  const auto dir = writeCapture("capture_check");
+  auto s = checkCapture(dir);
+  ASSERT_TRUE(s) << s.error().message;
+  EXPECT_EQ(s->frames, 10u);
+  EXPECT_EQ(s->firstFrame, 100u);
+  EXPECT_EQ(s->lastFrame, 109u);
+  EXPECT_DOUBLE_EQ(s->endTime - s->startTime, 9 / 60.0);
+  EXPECT_EQ(s->cameras, 1u);
+  EXPECT_EQ(s->staticModels, 1u);
+  EXPECT_EQ(s->rigidModels, 1u);
+  EXPECT_EQ(s->skinnedModels, 1u);
+  EXPECT_EQ(s->staticLights, 1u);
+  EXPECT_EQ(s->dynamicLights, 1u);
+  EXPECT_EQ(s->lightsByModelType.at("flash"), 1u);
+  EXPECT_EQ(s->capturables, 6u);
+  EXPECT_EQ(s->models, 2u);
+  EXPECT_EQ(s->triangles, 3u);
+  EXPECT_EQ(s->joints, 2u);
+  EXPECT_TRUE(s->closed);
+  const std::string text = summaryText(dir, *s);
+  EXPECT_NE(text.find("frames:      10 (numbers 100..109)"), std::string::npos) << text;
+  EXPECT_NE(text.find("60.00 frames/s"), std::string::npos) << text;
+}
+
+TEST(CaptureSdk, RejectsBadCallsAndWritesNothingForThem) {
+  const auto dir = test::freshDir("capture_sdk_errors");
+  dbc_session* s = nullptr;
+  ASSERT_EQ(dbc_open(dir.c_str(), nullptr, &s), DBC_OK);
+  recordModels(s);
+  const float p[] = {0, 0, 0};
+  EXPECT_EQ(dbc_camera(s, 1, p, 0, 0, 0), DBC_ERROR_ORDER);  // outside a frame
+  EXPECT_NE(std::string(dbc_last_error()).find("outside a frame"), std::string::npos);
+  ASSERT_EQ(dbc_frame_begin(s, 1, 0.0), DBC_OK);
+  EXPECT_EQ(dbc_camera(s, 1, p, std::nanf(""), 0, 0), DBC_ERROR_ARGUMENT);
+  EXPECT_EQ(dbc_model(s, 2, "no/such/model", rigid(0, {})), DBC_ERROR_ARGUMENT);
+  EXPECT_NE(std::string(dbc_last_error()).find("no/such/model"), std::string::npos);
+  const dbc_dual_quat one[] = {rigid(0, {})};
+  EXPECT_EQ(dbc_joints(s, 3, "chars/arm", 1, one), DBC_ERROR_ARGUMENT);  // the arm has 2 joints
+  EXPECT_NE(std::string(dbc_last_error()).find("has 2 joints"), std::string::npos);
+  const dbc_dual_quat two[] = {rigid(0, {}), rigid(0, {})};
+  EXPECT_EQ(dbc_joints(s, 3, "chars/arm", 2, two), DBC_ERROR_ORDER);  // no dbc_model for id 3 yet
+  ASSERT_EQ(dbc_camera(s, 1, p, 0, 0, 0), DBC_OK);
+  EXPECT_EQ(dbc_model(s, 1, "chars/arm", rigid(0, {})), DBC_ERROR_ARGUMENT);  // id 1 is a camera
+  EXPECT_EQ(dbc_model_begin(s, "late"), DBC_ERROR_ORDER);
+  EXPECT_EQ(dbc_frame_begin(s, 2, 0.1), DBC_ERROR_ORDER);  // frame 1 has not ended
+  ASSERT_EQ(dbc_frame_end(s), DBC_OK);
+  EXPECT_EQ(dbc_frame_begin(s, 1, 0.2), DBC_ERROR_ARGUMENT);  // frame numbers must increase
+  ASSERT_EQ(dbc_close(s), DBC_OK);
+  auto summary = checkCapture(dir);
+  ASSERT_TRUE(summary) << summary.error().message;  // only the valid records were written
+  EXPECT_EQ(summary->frames, 1u);
+  EXPECT_EQ(summary->cameraRecords, 1u);
+  EXPECT_EQ(summary->modelRecords, 0u);
+}
+
+TEST(CaptureSdk, CrashKeepsEveryCompleteFrame) {
+  const auto dir = test::freshDir("capture_crash");
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    dbc_session* s = nullptr;
+    if (dbc_open(dir.c_str(), "crashing host", &s) != DBC_OK) ::_exit(3);
+    recordModels(s);
+    recordFrames(s, 5);
+    dbc_frame_begin(s, 999, 1.0);  // a frame in progress when the host dies
+    const float p[] = {0, 0, 0};
+    dbc_camera(s, 1, p, 0, 0, 0);
+    ::_exit(0);  // no dbc_close, no stdio flush: as abrupt as a crash for our buffers
+  }
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  auto summary = checkCapture(dir);
+  ASSERT_TRUE(summary) << summary.error().message;
+  EXPECT_EQ(summary->frames, 5u);
+  EXPECT_FALSE(summary->closed);
+  ASSERT_FALSE(summary->warnings.empty());
+  EXPECT_NE(summary->warnings.back().find("not closed"), std::string::npos);
+}
+
+TEST(CaptureCheckCli, PrintsSummaryWritesJsonAndFailsWithFileLine) {
+  const auto dir = writeCapture("capture_cli");
+  auto r = dynbench(fmt::format("capture-check {} --json {}", dir.string(), (dir / "summary.json").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("frames:      10 (numbers 100..109)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1 skinned models"), std::string::npos) << r.out;
+  std::ifstream in(dir / "summary.json");
+  const auto json = nlohmann::json::parse(in);
+  EXPECT_EQ(json["frames"], 10);
+  EXPECT_EQ(json["capturables"]["skinned_models"], 1);
+  EXPECT_EQ(json["map"], "testmap");
+
+  std::ofstream(dir / "Capture.txt", std::ios::app) << "f:200:1\nt:1:0:0:0:0:0\n";
+  r = dynbench(fmt::format("capture-check {}", dir.string()), dir);
+  EXPECT_EQ(r.status, 5) << r.err;  // "z" closed the session: a record after it is invalid
+  EXPECT_NE(r.err.find("Capture.txt:"), std::string::npos) << r.err;
+  r = dynbench(fmt::format("capture-check {}", (dir / "nowhere").string()), dir);
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("not a capture directory"), std::string::npos) << r.err;
+}
+
+// ---- broken captures written by hand ---------------------------------------------------------
+
+fs::path handCapture(const std::string& name, const std::string& capture) {
+  const auto dir = writeCapture(name);
+  std::ofstream(dir / "Capture.txt", std::ios::trunc) << capture;
+  return dir;
+}
+
+const std::string kHeader = "dynbench-capture:1\ns:hand\n";
+const std::string kGoodFrame = "f:1:0\nt:1:0:0:0:0:0:0\nm:2:0:0:0:1:0:0:0:0:chars/arm\n"
+                               "j:2:2:0:0:0:1:0:0:0:0:0:0:0:1:0:0:0:0:chars/arm\ne:1\n";
+
+void expectCaptureError(const fs::path& dir, ErrorCode code, std::vector<std::string> fragments) {
+  auto s = checkCapture(dir);
+  ASSERT_FALSE(s) << "expected an error";
+  EXPECT_EQ(s.error().code, code) << s.error().message;
+  for (const auto& f : fragments) EXPECT_NE(s.error().message.find(f), std::string::npos) << "missing '" << f << "' in " << s.error().message;
+}
+
+TEST(BadCapture, HandWrittenGoodFrameReads) {
+  auto s = checkCapture(handCapture("bad_none", kHeader + kGoodFrame + "z:1\n"));
+  ASSERT_TRUE(s) << s.error().message;
+  EXPECT_EQ(s->frames, 1u);
+  EXPECT_EQ(s->skinnedModels, 1u);
+}
+
+TEST(BadCapture, MalformedNumber) {
+  expectCaptureError(handCapture("bad_number", kHeader + "f:1:0\nt:1:0:zero:0:0:0:0\ne:1\n"), ErrorCode::kParse,
+                     {"Capture.txt:4:", "'zero', not a number"});
+}
+
+TEST(BadCapture, UnknownToken) {
+  expectCaptureError(handCapture("bad_token", kHeader + "f:1:0\nq:1:2\ne:1\n"), ErrorCode::kParse, {"Capture.txt:4:", "unknown record 'q'"});
+}
+
+TEST(BadCapture, WrongFieldCount) {
+  expectCaptureError(handCapture("bad_fields", kHeader + "f:1:0\nt:1:0:0:0:0:0\ne:1\n"), ErrorCode::kParse,
+                     {"Capture.txt:4:", "needs 7 fields", "got 6"});
+}
+
+TEST(BadCapture, NaN) {
+  expectCaptureError(handCapture("bad_nan", kHeader + "f:1:0\nt:1:0:nan:0:0:0:0\ne:1\n"), ErrorCode::kInvalidData,
+                     {"Capture.txt:4:", "must be finite"});
+}
+
+TEST(BadCapture, JointCountDisagreesWithModel) {
+  expectCaptureError(handCapture("bad_joints", kHeader + "f:1:0\nm:2:0:0:0:1:0:0:0:0:chars/arm\nj:2:1:0:0:0:1:0:0:0:0:chars/arm\ne:1\n"),
+                     ErrorCode::kInvalidData, {"Capture.txt:5:", "1 joints for model 'chars/arm', which has 2"});
+}
+
+TEST(BadCapture, UnknownModelAndUnknownCapturable) {
+  expectCaptureError(handCapture("bad_model", kHeader + "f:1:0\nm:2:0:0:0:1:0:0:0:0:chars/leg\ne:1\n"), ErrorCode::kInvalidData,
+                     {"Capture.txt:4:", "unknown model 'chars/leg'"});
+  // Joints for capturable 7, which has no model transform in this frame.
+  expectCaptureError(handCapture("bad_capturable", kHeader + "f:1:0\nj:7:2:0:0:0:1:0:0:0:0:0:0:0:1:0:0:0:0:chars/arm\ne:1\n"),
+                     ErrorCode::kInvalidData, {"Capture.txt:4:", "capturable 7", "no model transform"});
+  expectCaptureError(handCapture("bad_kind", kHeader + kGoodFrame + "f:2:1\nt:2:0:0:0:0:0:0\ne:2\n"), ErrorCode::kInvalidData,
+                     {"Capture.txt:9:", "capturable 2 was a model"});
+}
+
+TEST(BadCapture, TruncatedLastFrameIsAWarning) {
+  const std::string cut = kHeader + kGoodFrame + "f:2:0.5\nt:1:0:0:1:0:0:0\nm:2:0:0:0:1:0:0";  // no newline, no e:2
+  auto s = checkCapture(handCapture("bad_truncated", cut));
+  ASSERT_TRUE(s) << s.error().message;
+  EXPECT_EQ(s->frames, 1u);
+  ASSERT_EQ(s->warnings.size(), 1u);
+  EXPECT_NE(s->warnings[0].find("Capture.txt:10:"), std::string::npos) << s->warnings[0];
+  EXPECT_NE(s->warnings[0].find("frame 2 is dropped"), std::string::npos) << s->warnings[0];
+  // Cut between records: the frame has no end record.
+  auto t = checkCapture(handCapture("bad_truncated2", kHeader + kGoodFrame + "f:2:0.5\nt:1:0:0:1:0:0:0\n"));
+  ASSERT_TRUE(t);
+  EXPECT_EQ(t->frames, 1u);
+  EXPECT_NE(t->warnings.at(0).find("frame 2 has no end record"), std::string::npos) << t->warnings[0];
+}
+
+TEST(BadCapture, OrderAndVersion) {
+  expectCaptureError(handCapture("bad_version", "dynbench-capture:9\n"), ErrorCode::kParse, {"Capture.txt:1:", "version line"});
+  expectCaptureError(handCapture("bad_order", kHeader + "f:2:0\ne:2\nf:1:1\ne:1\n"), ErrorCode::kInvalidData,
+                     {"Capture.txt:5:", "frame numbers must increase"});
+  expectCaptureError(handCapture("bad_nested", kHeader + "f:1:0\nf:2:0\n"), ErrorCode::kInvalidData, {"Capture.txt:4:", "before frame 1"});
+}
+
+TEST(BadCapture, BrokenModelMeshFile) {
+  const auto dir = writeCapture("bad_modelmesh");
+  fs::path file;
+  for (const auto& e : fs::directory_iterator(dir / "models")) file = e.path();
+  std::ofstream(file, std::ios::app) << "i:0:0:1:7\n";
+  expectCaptureError(dir, ErrorCode::kInvalidData, {file.filename().string(), "triangles"});
+}
+
+}  // namespace
+}  // namespace dynbench::capture

@@ -1,0 +1,35 @@
+#pragma once
+// Runs the dynbench executable (DYNBENCH_EXE) for CLI tests: exit status, stdout, stderr.
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace dynbench {
+
+struct Run {
+  int status = -1;
+  std::string out, err;
+};
+
+inline Run dynbench(const std::string& args, const std::filesystem::path& dir) {
+  const std::filesystem::path errFile = dir / "stderr.txt";
+  const std::string cmd = std::string(DYNBENCH_EXE) + " " + args + " 2>" + errFile.string();
+  Run r;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf{};
+  for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0;) r.out.append(buf.data(), n);
+  const int status = ::pclose(pipe);
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream e(errFile);
+  std::stringstream ss;
+  ss << e.rdbuf();
+  r.err = ss.str();
+  return r;
+}
+
+}  // namespace dynbench
