@@ -34,3 +34,22 @@ if ((${#missing[@]})); then
 else
   echo "setup: all ${#packages[@]} Debian packages present"
 fi
+
+# The Khronos glTF validator (npm), which the tests run on every dataset dynbench writes.
+# Node.js comes from Debian when the machine has none.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  echo "setup: installing nodejs and npm"
+  SUDO=""
+  [[ $(id -u) -eq 0 ]] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends nodejs npm
+fi
+here=$(cd "$(dirname "$0")/.." && pwd)
+validator="$here/tools/gltf-validator"
+if [[ ! -f "$validator/node_modules/gltf-validator/package.json" ]] ||
+   ! grep -q '"version": "2.0.0-dev.3.10"' "$validator/node_modules/gltf-validator/package.json"; then
+  echo "setup: installing the Khronos glTF validator (npm ci)"
+  (cd "$validator" && npm ci --no-audit --no-fund --loglevel=error)
+else
+  echo "setup: glTF validator present"
+fi
