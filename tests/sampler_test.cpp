@@ -137,6 +137,33 @@ TEST(Evaluator, LightAndCameraWorldPoses) {
   EXPECT_NEAR(view.x, -1.0, 1e-6);
 }
 
+TEST(Evaluator, SimpleSkinVerticesFollowTheirJoints) {
+  // SimpleSkin: vertices 0-1 (y = 0) are bound to joint node 1 only; joint node 2 sits at y = 1
+  // and rotates about Z. A vertex weighted fully to joint 2 turns with it about (0, 1, 0).
+  auto scene = loadScene(std::filesystem::path(DYNBENCH_TESTDATA_DIR) / "SimpleSkin/SimpleSkin.gltf");
+  ASSERT_TRUE(scene) << scene.error().message;
+  const Evaluator e(*scene);
+  const auto& prim = scene->meshes[0].primitives[0];
+  for (double t : {0.0, 1.5, 3.0}) {
+    const auto world = e.worldPositions(0, 0, t);
+    const glm::dmat4 joint2 = e.worldMatrix(2, t) * scene->skins[0].inverseBindMatrices[1];
+    for (std::size_t v = 0; v < world.size(); ++v) {
+      // Independent expectation: blend the two joint matrices by the vertex weights.
+      const glm::dmat4 joint1 = e.worldMatrix(1, t) * scene->skins[0].inverseBindMatrices[0];
+      const glm::dvec4 p(glm::dvec3(prim.positions[v]), 1.0);
+      const glm::dvec3 expected =
+          glm::dvec3(static_cast<double>(prim.weights[v][0]) * ((prim.joints[v][0] == 0 ? joint1 : joint2) * p) +
+                     static_cast<double>(prim.weights[v][1]) * ((prim.joints[v][1] == 0 ? joint1 : joint2) * p));
+      EXPECT_NEAR(glm::length(world[v] - expected), 0.0, 1e-6) << v;
+    }
+    // The bottom vertices (fully on the unmoving root joint) never move.
+    EXPECT_NEAR(glm::length(world[0] - glm::dvec3(prim.positions[0])), 0.0, 1e-6);
+  }
+  // At t = 0 the joint is unrotated: vertex 9 (top right) is at its bind position.
+  const auto rest = e.worldPositions(0, 0, 0.0);
+  EXPECT_NEAR(glm::length(rest[9] - glm::dvec3(prim.positions[9])), 0.0, 1e-6);
+}
+
 TEST(Evaluator, NodeVisibilityExtensionAndAnimationPointer) {
   const auto dir = test::freshDir("visibility");
   test::GltfBuilder b;

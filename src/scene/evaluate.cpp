@@ -199,6 +199,36 @@ std::vector<double> Evaluator::morphWeights(int node, double t) const {
   return weights;
 }
 
+std::vector<glm::dvec3> Evaluator::worldPositions(int node, std::size_t primitive, double t) const {
+  const Node& n = scene_.nodes[static_cast<std::size_t>(node)];
+  const Primitive& p = scene_.meshes[static_cast<std::size_t>(n.mesh)].primitives[primitive];
+  std::vector<glm::dvec3> out(p.positions.begin(), p.positions.end());
+  const auto weights = morphWeights(node, t);
+  for (std::size_t k = 0; k < std::min(weights.size(), p.targets.size()); ++k) {
+    if (weights[k] == 0.0 || p.targets[k].positionDeltas.empty()) continue;
+    for (std::size_t v = 0; v < out.size(); ++v) out[v] += weights[k] * glm::dvec3(p.targets[k].positionDeltas[v]);
+  }
+  if (n.skin >= 0 && !p.joints.empty() && !p.weights.empty()) {
+    const Skin& skin = scene_.skins[static_cast<std::size_t>(n.skin)];
+    std::vector<glm::dmat4> jointMatrices(skin.joints.size());
+    for (std::size_t j = 0; j < skin.joints.size(); ++j)
+      jointMatrices[j] = worldMatrix(skin.joints[j], t) * skin.inverseBindMatrices[j];
+    for (std::size_t v = 0; v < out.size(); ++v) {
+      glm::dvec3 skinned(0.0);
+      for (int k = 0; k < 4; ++k) {
+        const double w = p.weights[v][k];
+        if (w == 0.0) continue;
+        skinned += w * glm::dvec3(jointMatrices[p.joints[v][k]] * glm::dvec4(out[v], 1.0));
+      }
+      out[v] = skinned;
+    }
+    return out;
+  }
+  const glm::dmat4 world = worldMatrix(node, t);
+  for (auto& v : out) v = glm::dvec3(world * glm::dvec4(v, 1.0));
+  return out;
+}
+
 void Evaluator::evaluate(double t, ScenePose& pose) const {
   const std::size_t count = scene_.nodes.size();
   pose.world.resize(count);

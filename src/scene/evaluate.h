@@ -40,6 +40,12 @@ class Evaluator {
   // Every node at once, parents before children.
   void evaluate(double t, ScenePose& pose) const;
 
+  // World-space vertex positions of one primitive of a mesh node at t: morph targets, then either
+  // linear blend skinning (thesis §2.2: p' = sum_i w_i B_i M_i^-1 p, with B_i the joint's world
+  // matrix and M_i^-1 its inverse bind matrix; the node's own transform is ignored, as glTF says)
+  // or the node's world matrix.
+  std::vector<glm::dvec3> worldPositions(int node, std::size_t primitive, double t) const;
+
   const Scene& scene() const { return scene_; }
 
  private:
