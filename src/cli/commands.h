@@ -16,6 +16,9 @@ void addStatsCommand(CLI::App& app, CommandRun& run);
 // Registers `capture-check`.
 void addCaptureCheckCommand(CLI::App& app, CommandRun& run);
 
+// Registers `convert`.
+void addConvertCommand(CLI::App& app, CommandRun& run);
+
 // Exit status for an error (docs/cli.md lists them).
 int exitCode(const Error& error);
 

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   cli::CommandRun run;
   cli::addStatsCommand(app, run);
   cli::addCaptureCheckCommand(app, run);
+  cli::addConvertCommand(app, run);
 
   // `dynbench help [COMMAND]`
   std::string helpTopic;

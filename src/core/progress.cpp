@@ -17,11 +17,12 @@ Progress::~Progress() {
 
 std::string Progress::format(const std::string& label, std::size_t done, std::size_t total, const std::string& unit,
                              double elapsedSeconds, const std::string& current) {
-  std::string line = fmt::format("{}: {}/{} {}", label, done, total, unit);
+  // total == 0: the amount of work is not known in advance; no fraction, no time left.
+  std::string line = total ? fmt::format("{}: {}/{} {}", label, done, total, unit) : fmt::format("{}: {} {}", label, done, unit);
   if (done > 0 && elapsedSeconds > 0) {
     const double rate = static_cast<double>(done) / elapsedSeconds;
-    const double left = static_cast<double>(total - done) / rate;
-    line += fmt::format(", {:.3g} {}/s, {:.0f} s left", rate, unit, left);
+    line += fmt::format(", {:.3g} {}/s", rate, unit);
+    if (total >= done && total) line += fmt::format(", {:.0f} s left", static_cast<double>(total - done) / rate);
   }
   if (!current.empty()) line += ": " + current;
   return line;
@@ -31,7 +32,7 @@ void Progress::update(std::size_t done, const std::string& current) {
   if (!enabled_) return;
   const auto now = std::chrono::steady_clock::now();
   // Redraw at most 5 times a second, but always the first time.
-  if (drawn_ && now - lastDraw_ < std::chrono::milliseconds(200) && done < total_) return;
+  if (drawn_ && now - lastDraw_ < std::chrono::milliseconds(200) && (total_ == 0 || done < total_)) return;
   lastDraw_ = now;
   drawn_ = true;
   const double elapsed = std::chrono::duration<double>(now - start_).count();

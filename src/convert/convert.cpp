@@ -1,0 +1,870 @@
+#include "convert/convert.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <set>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "capture/reader.h"
+#include "core/files.h"
+#include "core/math.h"
+#include "dynbench/version.h"
+
+namespace dynbench::convert {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using namespace dynbench::capture;
+
+struct ConvertError {
+  ErrorCode code;
+  std::string message;
+};
+
+constexpr int kFloat = 5126, kUnsignedByte = 5121, kUnsignedShort = 5123, kUnsignedInt = 5125;
+constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
+
+// The binary buffer: regions are allocated first, then filled in any order with pwrite.
+class BinaryBuffer {
+ public:
+  explicit BinaryBuffer(const fs::path& path) : path_(path) {
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644);
+    if (fd_ < 0) throw ConvertError{ErrorCode::kIo, fmt::format("{}: cannot create: {}", path.string(), std::strerror(errno))};
+  }
+  ~BinaryBuffer() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  BinaryBuffer(const BinaryBuffer&) = delete;
+  BinaryBuffer& operator=(const BinaryBuffer&) = delete;
+
+  std::uint64_t allocate(std::uint64_t bytes) {
+    size_ = (size_ + 3) & ~std::uint64_t{3};  // every region 4-byte aligned (glTF §3.6.2.4)
+    const std::uint64_t offset = size_;
+    size_ += bytes;
+    return offset;
+  }
+  void write(std::uint64_t offset, const void* data, std::size_t bytes) {
+    const char* p = static_cast<const char*>(data);
+    while (bytes > 0) {
+      const ssize_t n = ::pwrite(fd_, p, bytes, static_cast<off_t>(offset));
+      if (n < 0) {
+        if (errno == EINTR) continue;
+        throw ConvertError{ErrorCode::kIo, fmt::format("{}: write failed: {}", path_.string(), std::strerror(errno))};
+      }
+      p += n;
+      offset += static_cast<std::uint64_t>(n);
+      bytes -= static_cast<std::size_t>(n);
+    }
+  }
+  // Pads the file to its allocated (4-byte aligned) size.
+  void finish() {
+    size_ = (size_ + 3) & ~std::uint64_t{3};
+    if (::ftruncate(fd_, static_cast<off_t>(size_)) != 0)
+      throw ConvertError{ErrorCode::kIo, fmt::format("{}: cannot size: {}", path_.string(), std::strerror(errno))};
+  }
+  std::uint64_t size() const { return size_; }
+
+ private:
+  fs::path path_;
+  int fd_ = -1;
+  std::uint64_t size_ = 0;
+};
+
+// Fills one region front to back through a small buffer, so that a long capture costs a few
+// kilobytes per animated value, not its whole history.
+class RegionWriter {
+ public:
+  RegionWriter() = default;
+  RegionWriter(BinaryBuffer* bin, std::uint64_t offset) : bin_(bin), offset_(offset) {}
+  template <typename T>
+  void put(const T& value) {
+    const char* p = reinterpret_cast<const char*>(&value);
+    pending_.insert(pending_.end(), p, p + sizeof(T));
+    if (pending_.size() >= 4096) flush();
+  }
+  void flush() {
+    if (pending_.empty() || !bin_) return;
+    bin_->write(offset_ + written_, pending_.data(), pending_.size());
+    written_ += pending_.size();
+    pending_.clear();
+  }
+
+ private:
+  BinaryBuffer* bin_ = nullptr;
+  std::uint64_t offset_ = 0, written_ = 0;
+  std::vector<char> pending_;
+};
+
+enum class Kind { kCamera, kStaticModel, kModel, kLight };
+
+// One capturable: what pass 1 learns, the buffer layout, and pass 2's running state.
+struct Track {
+  std::uint64_t id = 0;
+  Kind kind = Kind::kModel;
+  int model = -1;
+  bool skinned = false;
+  int extraFrames = 0;  // lights kept on after their last record (flash rule)
+  // Life span and visibility (pass 1 counts, pass 2 writes).
+  bool appeared = false, visible = false;
+  std::size_t first = 0, lastPresent = 0, lastSpan = 0;
+  std::size_t visibilityKeys = 0;
+  std::size_t lastKeyFrame = 0;  // frame of the last visibility key
+  // Static records and light properties (from the first record).
+  DualQuaternion staticPose;
+  LightRecord light;
+  // Layout.
+  int node = -1;
+  std::uint64_t translationOffset = 0, rotationOffset = 0, visTimeOffset = 0, visValueOffset = 0, scaleOffset = 0;
+  std::vector<std::uint64_t> jointTranslationOffsets, jointRotationOffsets;
+  // Pass 2.
+  RegionWriter translation, rotation, visTime, visValue, scale;
+  std::vector<RegionWriter> jointTranslation, jointRotation;
+  glm::dvec3 heldTranslation{0.0};
+  glm::dquat heldRotation{1, 0, 0, 0};
+  std::vector<glm::dvec3> heldJointTranslation;
+  std::vector<glm::dquat> heldJointRotation;
+  glm::dquat lastRotation{1, 0, 0, 0};  // the last rotation key written, for the shortest arc
+  std::vector<glm::dquat> lastJointRotation;
+  bool hasVisibilityChannel() const { return visibilityKeys > 1; }
+  std::size_t span() const { return lastSpan - first + 1; }
+  bool animated() const { return kind == Kind::kCamera || kind == Kind::kModel || (kind == Kind::kLight && light.dynamic); }
+};
+
+const char* kindName(Kind kind) {
+  switch (kind) {
+    case Kind::kCamera: return "camera";
+    case Kind::kStaticModel: return "static";
+    case Kind::kModel: return "model";
+    case Kind::kLight: return "light";
+  }
+  return "?";
+}
+
+std::vector<float> quat(const glm::dquat& q) {
+  return {static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z), static_cast<float>(q.w)};
+}
+std::vector<float> vec(const glm::dvec3& v) { return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)}; }
+
+// Keeps consecutive rotation keys on the shortest arc (q and -q are the same rotation; LINEAR
+// interpolation between keys of opposite sign would spin the long way round).
+glm::dquat nearest(const glm::dquat& previous, glm::dquat q) {
+  if (glm::dot(previous, q) < 0.0) q = -q;
+  return q;
+}
+
+// Percent-encodes what may not stand in a URI path (RFC 3986 unreserved characters and '/' stay).
+std::string uriPath(const std::string& path) {
+  std::string out;
+  for (unsigned char c : path) {
+    if (std::isalnum(c) || c == '-' || c == '.' || c == '_' || c == '~' || c == '/') out += static_cast<char>(c);
+    else out += fmt::format("%{:02X}", c);
+  }
+  return out;
+}
+
+class Converter {
+ public:
+  explicit Converter(const ConvertOptions& options) : options_(options) {}
+
+  ConvertReport run() {
+    auto opened = CaptureReader::open(options_.capture);
+    if (!opened) throw ConvertError{opened.error().code, opened.error().message};
+    reader_ = std::move(*opened);
+    const fs::path out = options_.output;
+    stem_ = out.stem().string();
+    outDir_ = out.has_parent_path() ? out.parent_path() : fs::path(".");
+    std::error_code ec;
+    fs::create_directories(outDir_, ec);
+    if (ec) throw ConvertError{ErrorCode::kIo, fmt::format("{}: cannot create folder: {}", outDir_.string(), ec.message())};
+
+    passOne();
+    if (times_.empty()) throw ConvertError{ErrorCode::kInvalidData, fmt::format("{}: the capture has no complete frame", options_.capture.string())};
+    binPath_ = temporarySibling(outDir_ / (stem_ + ".bin"));
+    {
+      BinaryBuffer bin(binPath_);
+      bin_ = &bin;
+      buildDocument();
+      passTwo();
+      bin.finish();
+      report_.binBytes = bin.size();
+      bin_ = nullptr;
+    }
+    writeOutputs();
+    report_.warnings.insert(report_.warnings.begin(), reader_->warnings().begin(), reader_->warnings().end());
+    return report_;
+  }
+
+ private:
+  // ---- pass 1: spans and visibility key counts ------------------------------------------------
+
+  Track& track(std::uint64_t id, Kind kind, int model) {
+    auto [it, inserted] = tracks_.try_emplace(id);
+    Track& t = it->second;
+    if (inserted) {
+      t.id = id;
+      t.kind = kind;
+      t.model = model;
+      t.skinned = model >= 0 && !reader_->models()[static_cast<std::size_t>(model)].joints.empty();
+    }
+    return t;
+  }
+
+  // Called for every record of a dynamic capturable in frame i (once per frame and capturable).
+  // Emits visibility keys through `key(track, frame, value)`.
+  template <typename Key>
+  void present(Track& t, std::size_t i, Key&& key) {
+    if (t.lastPresent == i && t.appeared) return;  // a second record of the same capturable this frame
+    if (!t.visible) {
+      if (!t.appeared) {
+        t.appeared = true;
+        t.first = i;
+        if (i > 0) key(t, 0, false);  // hidden from the start until it appears
+      }
+      key(t, i, true);
+      t.visible = true;
+      visibleNow_.push_back(&t);
+    }
+    t.lastPresent = i;
+  }
+
+  template <typename Key>
+  void endFrame(std::size_t i, Key&& key) {
+    std::erase_if(visibleNow_, [&](Track* t) {
+      if (i - t->lastPresent <= static_cast<std::size_t>(t->extraFrames)) return false;
+      key(*t, i, false);
+      t->visible = false;
+      return true;
+    });
+  }
+
+  template <typename Key>
+  void scanFrame(const CaptureFrame& frame, std::size_t i, Key&& key) {
+    for (const auto& c : frame.cameras) present(track(c.id, Kind::kCamera, -1), i, key);
+    for (const auto& m : frame.models) present(track(m.id, Kind::kModel, m.model), i, key);
+    for (const auto& l : frame.lights) {
+      Track& t = track(l.id, Kind::kLight, -1);
+      if (!t.appeared && !l.dynamic) {
+        t.light = l;
+        t.appeared = true;
+        continue;
+      }
+      if (!t.appeared) {
+        t.light = l;
+        t.extraFrames = options_.lightRules.rule(l.modelType).extraFrames;
+      }
+      if (l.dynamic) present(t, i, key);
+    }
+    for (const auto& p : frame.staticModels) {
+      Track& t = track(p.id, Kind::kStaticModel, p.model);
+      t.staticPose = p.pose;
+      t.appeared = true;
+    }
+    endFrame(i, key);
+  }
+
+  void passOne() {
+    CaptureFrame frame;
+    std::size_t i = 0;
+    auto count = [](Track& t, std::size_t frame, bool) {
+      ++t.visibilityKeys;
+      t.lastKeyFrame = frame;
+    };
+    while (true) {
+      auto more = reader_->next(frame);
+      if (!more) throw ConvertError{more.error().code, more.error().message};
+      if (!*more) break;
+      if (frame.cameraSettings && !cameraChanged_) {
+        cameraChanged_ = true;
+        report_.warnings.push_back(fmt::format("{}: camera settings change at frame {}; the dataset keeps the first ones",
+                                               options_.capture.string(), frame.number));
+      }
+      times_.push_back(static_cast<float>(frame.time));
+      scanFrame(frame, i, count);
+      if (options_.onProgress) options_.onProgress(1, i + 1);
+      ++i;
+    }
+    const std::size_t n = times_.size();
+    for (auto& [id, t] : tracks_) t.lastSpan = std::min(n - 1, t.lastPresent + static_cast<std::size_t>(t.extraFrames));
+    // Times must strictly increase for glTF samplers; equal capture times (a paused game) cannot be keyed.
+    for (std::size_t k = 1; k < n; ++k)
+      if (!(times_[k] > times_[k - 1]))
+        throw ConvertError{ErrorCode::kInvalidData,
+                           fmt::format("{}: frames {} and {} have the same time {} s (as float); glTF key times must increase",
+                                       options_.capture.string(), k - 1, k, times_[k])};
+  }
+
+  // ---- the document --------------------------------------------------------------------------
+
+  int bufferView(std::uint64_t offset, std::uint64_t length, int target = 0) {
+    json v = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", length}};
+    if (target) v["target"] = target;
+    doc_["bufferViews"].push_back(v);
+    return static_cast<int>(doc_["bufferViews"].size()) - 1;
+  }
+
+  int accessor(int view, std::uint64_t byteOffset, int componentType, std::size_t count, const char* type, json min = nullptr,
+               json max = nullptr) {
+    json a = {{"bufferView", view}, {"componentType", componentType}, {"count", count}, {"type", type}};
+    if (byteOffset) a["byteOffset"] = byteOffset;
+    if (!min.is_null()) a["min"] = min;
+    if (!max.is_null()) a["max"] = max;
+    doc_["accessors"].push_back(a);
+    return static_cast<int>(doc_["accessors"].size()) - 1;
+  }
+
+  // Writes a whole array now (mesh data); returns the accessor.
+  template <typename T>
+  int dataAccessor(const std::vector<T>& data, int componentType, const char* type, int target, json min = nullptr, json max = nullptr,
+                   std::size_t count = 0) {
+    const std::uint64_t bytes = data.size() * sizeof(T);
+    const std::uint64_t offset = bin_->allocate(bytes);
+    bin_->write(offset, data.data(), bytes);
+    const std::string_view kind(type);
+    const std::size_t components = kind == "SCALAR" ? 1 : kind == "VEC2" ? 2 : kind == "VEC3" ? 3 : kind == "VEC4" ? 4 : 16;
+    return accessor(bufferView(offset, bytes, target), 0, componentType, count ? count : data.size() / components, type, min, max);
+  }
+
+  int addNode(json node, int parent) {
+    doc_["nodes"].push_back(std::move(node));
+    const int index = static_cast<int>(doc_["nodes"].size()) - 1;
+    if (parent >= 0) doc_["nodes"][static_cast<std::size_t>(parent)]["children"].push_back(index);
+    return index;
+  }
+
+  static json trs(const glm::dvec3& t, const glm::dquat& r) {
+    json n = json::object();
+    if (t != glm::dvec3(0.0)) n["translation"] = vec(t);
+    if (r != glm::dquat(1, 0, 0, 0)) n["rotation"] = quat(glm::normalize(r));
+    return n;
+  }
+
+  int image(const std::string& texture) {
+    if (texture.empty()) return -1;
+    if (auto it = imageByTexture_.find(texture); it != imageByTexture_.end()) return it->second;
+    int index = -1;
+    const fs::path relative = fs::path(texture).lexically_normal();
+    std::string ext = relative.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    fs::path root = options_.dataRoot ? *options_.dataRoot : fs::path(reader_->settings().dataRoot);
+    if (root.is_relative()) root = options_.capture / root;
+    const fs::path source = root / relative;
+    std::error_code ec;
+    if (relative.is_absolute() || relative.empty() || *relative.begin() == "..") {
+      report_.warnings.push_back(fmt::format("texture '{}' is not a path inside the data root; left out", texture));
+    } else if (ext != ".png" && ext != ".jpg" && ext != ".jpeg") {
+      report_.warnings.push_back(fmt::format("texture '{}' is neither PNG nor JPEG (glTF's image formats); left out", texture));
+    } else if (!fs::is_regular_file(source, ec)) {
+      report_.warnings.push_back(fmt::format("texture '{}' not found at {}; left out", texture, source.string()));
+    } else {
+      const fs::path target = outDir_ / (stem_ + "_textures") / relative;
+      fs::create_directories(target.parent_path(), ec);
+      fs::copy_file(source, target, fs::copy_options::overwrite_existing, ec);
+      if (ec) throw ConvertError{ErrorCode::kIo, fmt::format("{}: cannot copy texture: {}", target.string(), ec.message())};
+      report_.written.push_back(target);
+      doc_["images"].push_back({{"uri", uriPath(stem_ + "_textures/" + relative.generic_string())},
+                                {"mimeType", ext == ".png" ? "image/png" : "image/jpeg"}});
+      doc_["textures"].push_back({{"source", doc_["images"].size() - 1}, {"sampler", 0}});
+      index = static_cast<int>(doc_["textures"].size()) - 1;
+      ++report_.textures;
+    }
+    imageByTexture_[texture] = index;
+    return index;
+  }
+
+  // Material per (texture, mask) pair. docs/dataset.md: base colour from the texture map;
+  // dielectric (metallic 0), roughness 0.8. The mask map is copied and named in extras until its
+  // channels are remapped into a metallic-roughness texture.
+  int material(const CapturedMesh& mesh) {
+    const auto key = std::make_pair(mesh.texture, mesh.maskTexture);
+    if (auto it = materialByMaps_.find(key); it != materialByMaps_.end()) return it->second;
+    json m = {{"name", mesh.texture.empty() ? "untextured" : fs::path(mesh.texture).stem().string()},
+              {"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.8}}}};
+    if (int t = image(mesh.texture); t >= 0) m["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", t}};
+    if (int t = image(mesh.maskTexture); t >= 0) m["extras"] = {{"dynbench_mask_texture", t}};
+    doc_["materials"].push_back(m);
+    const int index = static_cast<int>(doc_["materials"].size()) - 1;
+    materialByMaps_[key] = index;
+    return index;
+  }
+
+  void buildMeshes() {
+    for (const auto& model : reader_->models()) {
+      json primitives = json::array();
+      for (const auto& mesh : model.meshes) {
+        if (mesh.indices.empty()) continue;
+        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+        std::vector<float> positions;
+        for (const auto& p : mesh.positions) {
+          lo = glm::min(lo, p);
+          hi = glm::max(hi, p);
+          positions.insert(positions.end(), {p.x, p.y, p.z});
+        }
+        json attributes = {{"POSITION", dataAccessor(positions, kFloat, "VEC3", kArrayBuffer, std::vector<float>{lo.x, lo.y, lo.z},
+                                                     std::vector<float>{hi.x, hi.y, hi.z})}};
+        if (!mesh.normals.empty()) {
+          std::vector<float> normals;
+          for (auto n : mesh.normals) {
+            const float len = glm::length(n);
+            n = len > 0 ? n / len : glm::vec3(0, 1, 0);  // glTF requires unit normals
+            normals.insert(normals.end(), {n.x, n.y, n.z});
+          }
+          attributes["NORMAL"] = dataAccessor(normals, kFloat, "VEC3", kArrayBuffer);
+        }
+        if (!mesh.uvs.empty()) {
+          std::vector<float> uvs;
+          for (const auto& t : mesh.uvs) uvs.insert(uvs.end(), {t.x, t.y});
+          attributes["TEXCOORD_0"] = dataAccessor(uvs, kFloat, "VEC2", kArrayBuffer);
+        }
+        if (!model.joints.empty() && !mesh.joints.empty()) {
+          std::vector<std::uint16_t> joints;
+          std::vector<float> weights;
+          for (std::size_t v = 0; v < mesh.joints.size(); ++v) {
+            const glm::vec4 w = mesh.weights[v];
+            const float sum = w.x + w.y + w.z + w.w;
+            for (int k = 0; k < 4; ++k) {
+              joints.push_back(w[k] > 0 ? mesh.joints[v][k] : 0);
+              weights.push_back(sum > 0 ? w[k] / sum : (k == 0 ? 1.0f : 0.0f));  // glTF: weights sum to 1
+            }
+          }
+          attributes["JOINTS_0"] = dataAccessor(joints, kUnsignedShort, "VEC4", kArrayBuffer);
+          attributes["WEIGHTS_0"] = dataAccessor(weights, kFloat, "VEC4", kArrayBuffer);
+        }
+        primitives.push_back({{"attributes", attributes},
+                              {"indices", dataAccessor(mesh.indices, kUnsignedInt, "SCALAR", kElementArrayBuffer)},
+                              {"material", material(mesh)}});
+      }
+      if (primitives.empty()) {
+        meshOfModel_.push_back(-1);
+        continue;
+      }
+      doc_["meshes"].push_back({{"name", model.path}, {"primitives", primitives}});
+      meshOfModel_.push_back(static_cast<int>(doc_["meshes"].size()) - 1);
+      ++report_.meshes;
+      // Inverse bind matrices, shared by every instance of the model.
+      if (!model.joints.empty()) {
+        std::vector<float> matrices;
+        for (const auto& j : model.joints) {
+          const glm::dmat4 m = matrixOf(j.inverseBindPose);
+          for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) matrices.push_back(static_cast<float>(m[c][r]));
+        }
+        ibmOfModel_[static_cast<int>(meshOfModel_.size()) - 1] = dataAccessor(matrices, kFloat, "MAT4", 0);
+      }
+    }
+  }
+
+  int lightDefinition(const LightRecord& l, double share) {
+    const double peak = std::max({l.color.r, l.color.g, l.color.b});
+    const LightRule& rule = options_.lightRules.rule(l.modelType);
+    const glm::dvec3 color = peak > 0 ? l.color / peak : glm::dvec3(1.0);
+    json light = {{"type", l.type == LightType::kSpot ? "spot" : l.type == LightType::kDirectional ? "directional" : "point"},
+                  {"color", vec(color)},
+                  {"intensity", options_.lightRules.candelaPerUnit * peak * rule.intensityScale * share},
+                  {"name", l.modelType}};
+    if (l.type == LightType::kSpot) light["spot"] = {{"outerConeAngle", 0.7853981633974483}};
+    lights_.push_back(light);
+    ++report_.lights;
+    return static_cast<int>(lights_.size()) - 1;
+  }
+
+  // A light capturable: one light, or (ring rule) six around its node.
+  void lightNodes(Track& t, int node) {
+    const LightRule& rule = options_.lightRules.rule(t.light.modelType);
+    if (rule.ringLights == 6) {
+      const int def = lightDefinition(t.light, 1.0 / 6);
+      const double r = rule.ringRadiusMetres / reader_->settings().metresPerUnit;
+      for (const glm::dvec3 axis : {glm::dvec3(1, 0, 0), glm::dvec3(-1, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, -1, 0),
+                                    glm::dvec3(0, 0, 1), glm::dvec3(0, 0, -1)})
+        addNode({{"name", fmt::format("light_{}_ring", t.id)}, {"translation", vec(axis * r)},
+                 {"extensions", {{"KHR_lights_punctual", {{"light", def}}}}}},
+                node);
+    } else {
+      doc_["nodes"][static_cast<std::size_t>(node)]["extensions"]["KHR_lights_punctual"] = {{"light", lightDefinition(t.light, 1.0)}};
+    }
+  }
+
+  void buildDocument() {
+    doc_ = {{"asset", {{"version", "2.0"}, {"generator", fmt::format("dynbench {} convert", kVersion)}}},
+            {"scene", 0},
+            {"scenes", {{{"name", "capture"}, {"nodes", {0}}}}},
+            {"nodes", json::array()},
+            {"buffers", json::array()},
+            {"bufferViews", json::array()},
+            {"accessors", json::array()},
+            {"samplers", {{{"magFilter", 9729}, {"minFilter", 9987}, {"wrapS", 10497}, {"wrapT", 10497}}}}};
+    const int world = addNode({{"name", "WorldOrigo"}}, -1);
+    const int staticObjects = addNode({{"name", "StaticObjects"}}, world);
+    const int dynamicObjects = addNode({{"name", "DynamicObjects"}}, world);
+    buildMeshes();
+
+    // The map geometry: a model whose path is the map's name, placed at the map offset.
+    const auto& settings = reader_->settings();
+    if (int model = reader_->modelIndex(settings.mapName); !settings.mapName.empty() && model >= 0 && meshOfModel_[static_cast<std::size_t>(model)] >= 0) {
+      json node = trs(settings.mapOffset, glm::dquat(1, 0, 0, 0));
+      node["name"] = "map " + settings.mapName;
+      node["mesh"] = meshOfModel_[static_cast<std::size_t>(model)];
+      addNode(node, staticObjects);
+    }
+    // The camera definition.
+    CameraSettings cam = settings.camera.value_or(CameraSettings{16.0 / 9.0, 60.0, 0.1, 1000.0});
+    if (!settings.camera) report_.warnings.push_back("the capture has no camera settings (C record); using 16:9, 60 degrees, 0.1-1000");
+    doc_["cameras"] = {{{"type", "perspective"},
+                        {"perspective", {{"aspectRatio", cam.aspect}, {"yfov", radians(cam.yfovDegrees)}, {"znear", cam.znear}, {"zfar", cam.zfar}}}}};
+
+    // Times: one array for the whole capture; every track's input is a slice of it.
+    const std::uint64_t timesBytes = times_.size() * sizeof(float);
+    const std::uint64_t timesOffset = bin_->allocate(timesBytes);
+    bin_->write(timesOffset, times_.data(), timesBytes);
+    timesView_ = bufferView(timesOffset, timesBytes);
+
+    std::vector<json> channels, samplers;
+    auto channel = [&](int input, int output, const char* interpolation, int node, const char* path) {
+      samplers.push_back({{"input", input}, {"output", output}, {"interpolation", interpolation}});
+      json target = {{"node", node}, {"path", path}};
+      channels.push_back({{"sampler", samplers.size() - 1}, {"target", target}});
+    };
+    auto pointerChannel = [&](int input, int output, int node) {
+      samplers.push_back({{"input", input}, {"output", output}, {"interpolation", "STEP"}});
+      channels.push_back({{"sampler", samplers.size() - 1},
+                          {"target", {{"path", "pointer"},
+                                      {"extensions", {{"KHR_animation_pointer",
+                                                       {{"pointer", fmt::format("/nodes/{}/extensions/KHR_node_visibility/visible", node)}}}}}}}});
+      usesVisibility_ = true;
+    };
+    auto spanInput = [&](const Track& t) {
+      return accessor(timesView_, 4 * t.first, kFloat, t.span(), "SCALAR", std::vector<float>{times_[t.first]},
+                      std::vector<float>{times_[t.lastSpan]});
+    };
+    auto region = [&](std::size_t count, std::size_t elementBytes, std::uint64_t& offset, int& view) {
+      offset = bin_->allocate(count * elementBytes);
+      view = bufferView(offset, count * elementBytes);
+    };
+
+    for (auto& [id, t] : tracks_) {
+      ++report_.capturables;
+      if (t.kind == Kind::kStaticModel) {
+        const int mesh = meshOfModel_[static_cast<std::size_t>(t.model)];
+        json node = trs(translationOf(t.staticPose), rotationOf(t.staticPose));
+        node["name"] = fmt::format("static_{}_{}", t.id, reader_->models()[static_cast<std::size_t>(t.model)].path);
+        if (mesh >= 0) node["mesh"] = mesh;
+        t.node = addNode(node, staticObjects);
+        continue;
+      }
+      if (t.kind == Kind::kLight && !t.light.dynamic) {
+        json node = trs(t.light.position, glm::dquat(1, 0, 0, 0));
+        node["name"] = fmt::format("light_{}_{}", t.id, t.light.modelType);
+        t.node = addNode(node, staticObjects);
+        lightNodes(t, t.node);
+        continue;
+      }
+      if (!t.appeared) continue;
+      // Dynamic capturables: node, key frames over their span, visibility keys.
+      json node = {{"name", fmt::format("{}_{}", kindName(t.kind), t.id)}};
+      if (t.kind == Kind::kModel) node["name"] = fmt::format("model_{}_{}", t.id, reader_->models()[static_cast<std::size_t>(t.model)].path);
+      if (t.kind == Kind::kCamera) node["camera"] = 0;
+      const int mesh = t.kind == Kind::kModel ? meshOfModel_[static_cast<std::size_t>(t.model)] : -1;
+      if (mesh >= 0 && !t.skinned) node["mesh"] = mesh;
+      const bool nodeVisibility = t.hasVisibilityChannel() && options_.visibility != VisibilityMode::kScale;
+      const bool scaleVisibility = t.hasVisibilityChannel() && options_.visibility != VisibilityMode::kNode && t.kind == Kind::kModel;
+      if (nodeVisibility && t.kind != Kind::kCamera) node["extensions"]["KHR_node_visibility"] = {{"visible", true}};
+      t.node = addNode(node, dynamicObjects);
+      if (t.kind == Kind::kLight) lightNodes(t, t.node);
+
+      const int input = spanInput(t);
+      int view = -1;
+      region(t.span(), 12, t.translationOffset, view);
+      channel(input, accessor(view, 0, kFloat, t.span(), "VEC3"), "LINEAR", t.node, "translation");
+      if (t.kind != Kind::kLight) {
+        region(t.span(), 16, t.rotationOffset, view);
+        channel(input, accessor(view, 0, kFloat, t.span(), "VEC4"), "LINEAR", t.node, "rotation");
+      }
+      if (t.hasVisibilityChannel() && (nodeVisibility && t.kind != Kind::kCamera || scaleVisibility)) {
+        region(t.visibilityKeys, 4, t.visTimeOffset, view);
+        const int visInput = accessor(view, 0, kFloat, t.visibilityKeys, "SCALAR", std::vector<float>{times_.front()},
+                                      std::vector<float>{times_[t.lastKeyFrame]});
+        visInputs_[t.id] = visInput;
+        if (nodeVisibility && t.kind != Kind::kCamera) {
+          region(t.visibilityKeys, 1, t.visValueOffset, view);
+          pointerChannel(visInput, accessor(view, 0, kUnsignedByte, t.visibilityKeys, "SCALAR"), t.node);
+        }
+        if (scaleVisibility) {
+          region(t.visibilityKeys, 12, t.scaleOffset, view);
+          channel(visInput, accessor(view, 0, kFloat, t.visibilityKeys, "VEC3"), "STEP", t.node, "scale");
+        }
+      }
+      if (t.skinned) buildSkin(t, mesh, input, channel, region);
+    }
+    report_.channels = channels.size();
+    if (!channels.empty()) doc_["animations"] = {{{"name", "capture"}, {"samplers", samplers}, {"channels", channels}}};
+  }
+
+  template <typename Channel, typename Region>
+  void buildSkin(Track& t, int mesh, int input, Channel& channel, Region& region) {
+    const auto& model = reader_->models()[static_cast<std::size_t>(t.model)];
+    std::vector<int> jointNodes;
+    for (const auto& j : model.joints) {
+      json node = trs(translationOf(j.bindPose), rotationOf(j.bindPose));
+      node["name"] = fmt::format("{}_{}", j.name.empty() ? "joint" : j.name, t.id);
+      jointNodes.push_back(addNode(node, j.parent < 0 ? t.node : jointNodes[static_cast<std::size_t>(j.parent)]));
+      std::uint64_t offset = 0;
+      int view = -1;
+      region(t.span(), 12, offset, view);
+      t.jointTranslationOffsets.push_back(offset);
+      channel(input, accessor(view, 0, kFloat, t.span(), "VEC3"), "LINEAR", jointNodes.back(), "translation");
+      region(t.span(), 16, offset, view);
+      t.jointRotationOffsets.push_back(offset);
+      channel(input, accessor(view, 0, kFloat, t.span(), "VEC4"), "LINEAR", jointNodes.back(), "rotation");
+    }
+    json skin = {{"joints", jointNodes}, {"skeleton", jointNodes.front()}, {"name", fmt::format("skin_{}", t.id)}};
+    if (auto it = ibmOfModel_.find(t.model); it != ibmOfModel_.end()) skin["inverseBindMatrices"] = it->second;
+    doc_["skins"].push_back(skin);
+    ++report_.skins;
+    if (mesh >= 0)
+      addNode({{"name", fmt::format("skinned_{}", t.id)}, {"mesh", mesh}, {"skin", doc_["skins"].size() - 1}}, t.node);
+    // Until the first joint record, joints hold the bind pose.
+    for (const auto& j : model.joints) {
+      t.heldJointTranslation.push_back(translationOf(j.bindPose));
+      t.heldJointRotation.push_back(rotationOf(j.bindPose));
+      t.lastJointRotation.push_back(rotationOf(j.bindPose));
+    }
+  }
+
+  // ---- pass 2: key frames ----------------------------------------------------------------------
+
+  void passTwo() {
+    auto opened = CaptureReader::open(options_.capture);
+    if (!opened) throw ConvertError{opened.error().code, opened.error().message};
+    auto reader = std::move(*opened);
+    for (auto& [id, t] : tracks_) {
+      t.appeared = t.visible = false;
+      t.lastPresent = 0;
+      if (t.translationOffset) t.translation = RegionWriter(bin_, t.translationOffset);
+      if (t.rotationOffset) t.rotation = RegionWriter(bin_, t.rotationOffset);
+      if (t.visTimeOffset) t.visTime = RegionWriter(bin_, t.visTimeOffset);
+      if (t.visValueOffset) t.visValue = RegionWriter(bin_, t.visValueOffset);
+      if (t.scaleOffset) t.scale = RegionWriter(bin_, t.scaleOffset);
+      for (auto o : t.jointTranslationOffsets) t.jointTranslation.emplace_back(bin_, o);
+      for (auto o : t.jointRotationOffsets) t.jointRotation.emplace_back(bin_, o);
+    }
+    visibleNow_.clear();
+    auto key = [&](Track& t, std::size_t frame, bool value) {
+      if (!visInputs_.contains(t.id)) return;
+      t.visTime.put(times_[frame]);
+      if (t.visValueOffset) t.visValue.put(static_cast<std::uint8_t>(value ? 1 : 0));
+      if (t.scaleOffset) {
+        const float s = value ? 1.0f : 0.0f;
+        for (int k = 0; k < 3; ++k) t.scale.put(s);
+      }
+    };
+    std::vector<Track*> active;
+    CaptureFrame frame;
+    for (std::size_t i = 0; i < times_.size(); ++i) {
+      auto more = reader->next(frame);
+      if (!more) throw ConvertError{more.error().code, more.error().message};
+      if (!*more) throw ConvertError{ErrorCode::kIo, fmt::format("{}: the capture changed while it was converted", options_.capture.string())};
+      // Held values follow this frame's records.
+      for (const auto& c : frame.cameras) {
+        Track& t = tracks_.at(c.id);
+        t.heldTranslation = c.position;
+        t.heldRotation = quatFromYawPitchRoll(radians(c.yaw), radians(c.pitch), radians(c.roll));
+        if (!t.appeared) active.push_back(&t);
+      }
+      for (const auto& m : frame.models) {
+        Track& t = tracks_.at(m.id);
+        t.heldTranslation = translationOf(m.pose);
+        t.heldRotation = rotationOf(m.pose);
+        if (!t.appeared) active.push_back(&t);
+      }
+      for (const auto& l : frame.lights) {
+        Track& t = tracks_.at(l.id);
+        if (!l.dynamic) continue;
+        t.heldTranslation = l.position;
+        if (!t.appeared) active.push_back(&t);
+      }
+      for (const auto& j : frame.joints) {
+        Track& t = tracks_.at(j.id);
+        // Model-space joints to parent-local: L_j = M_parent^-1 M_j (rigid, so exact).
+        const auto& model = reader_->models()[static_cast<std::size_t>(t.model)];
+        for (std::size_t k = 0; k < j.joints.size(); ++k) {
+          const glm::dquat r = rotationOf(j.joints[k]);
+          const glm::dvec3 p = translationOf(j.joints[k]);
+          const int parent = model.joints[k].parent;
+          if (parent < 0) {
+            t.heldJointTranslation[k] = p;
+            t.heldJointRotation[k] = r;
+          } else {
+            const glm::dquat rp = rotationOf(j.joints[static_cast<std::size_t>(parent)]);
+            const glm::dvec3 pp = translationOf(j.joints[static_cast<std::size_t>(parent)]);
+            t.heldJointTranslation[k] = glm::conjugate(rp) * (p - pp);
+            t.heldJointRotation[k] = glm::normalize(glm::conjugate(rp) * r);
+          }
+        }
+      }
+      scanFrame(frame, i, key);
+      // Every active track writes one key per frame of its span.
+      std::erase_if(active, [&](Track* t) {
+        if (i > t->lastSpan) return true;
+        if (t->translationOffset) t->translation.put(std::array<float, 3>{static_cast<float>(t->heldTranslation.x),
+                                                                           static_cast<float>(t->heldTranslation.y),
+                                                                           static_cast<float>(t->heldTranslation.z)});
+        if (t->rotationOffset) {
+          t->heldRotation = nearest(t->lastRotation, t->heldRotation);
+          t->lastRotation = t->heldRotation;
+          t->rotation.put(std::array<float, 4>{static_cast<float>(t->heldRotation.x), static_cast<float>(t->heldRotation.y),
+                                               static_cast<float>(t->heldRotation.z), static_cast<float>(t->heldRotation.w)});
+        }
+        for (std::size_t k = 0; k < t->jointTranslation.size(); ++k) {
+          const glm::dvec3 p = t->heldJointTranslation[k];
+          t->jointTranslation[k].put(std::array<float, 3>{static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
+          glm::dquat r = t->heldJointRotation[k];
+          r = nearest(t->lastJointRotation[k], r);
+          t->heldJointRotation[k] = r;
+          t->lastJointRotation[k] = r;
+          t->jointRotation[k].put(std::array<float, 4>{static_cast<float>(r.x), static_cast<float>(r.y), static_cast<float>(r.z),
+                                                       static_cast<float>(r.w)});
+        }
+        return i == t->lastSpan;
+      });
+      if (options_.onProgress) options_.onProgress(2, i + 1);
+    }
+    for (auto& [id, t] : tracks_) {
+      for (RegionWriter* w : {&t.translation, &t.rotation, &t.visTime, &t.visValue, &t.scale}) w->flush();
+      for (auto& w : t.jointTranslation) w.flush();
+      for (auto& w : t.jointRotation) w.flush();
+    }
+  }
+
+  // ---- files -----------------------------------------------------------------------------------
+
+  std::string datasetReadme() const {
+    const auto& s = reader_->settings();
+    std::string licences;
+    std::ifstream in(options_.capture / "LICENSES.txt");
+    if (in) licences.assign(std::istreambuf_iterator<char>(in), {});
+    std::string out = fmt::format("# {}\n\nA dynamic benchmark dataset for temporal rendering, made by dynbench {} (`dynbench convert`) "
+                                  "from a capture.\n\n", stem_, kVersion);
+    out += fmt::format("- source: {}\n- capture: {}\n- map: {}\n", s.source.empty() ? "not stated" : s.source,
+                       options_.capture.filename().string().empty() ? options_.capture.string() : options_.capture.filename().string(),
+                       s.mapName.empty() ? "-" : s.mapName);
+    out += fmt::format("- frames: {}, {:.3f} s to {:.3f} s\n", times_.size(), times_.front(), times_.back());
+    out += fmt::format("- capturables: {}; nodes {}, meshes {}, skins {}, lights {}, animation channels {}\n", report_.capturables,
+                       doc_["nodes"].size(), report_.meshes, report_.skins, report_.lights, report_.channels);
+    out += fmt::format("- length unit: {} m\n", s.metresPerUnit);
+    out += "\nLayout (thesis §5.1): WorldOrigo > StaticObjects (map, static map models, static lights) and DynamicObjects "
+           "(cameras, rigid and skinned models, dynamic lights). Objects that appear and disappear are switched with "
+           "KHR_node_visibility (STEP keys through KHR_animation_pointer) and, for meshes, a scale-0 STEP channel. "
+           "See dynbench's docs/dataset.md.\n";
+    out += "\n## Licences of the assets\n\n";
+    out += licences.empty() ? "The capture states none (no LICENSES.txt in the capture directory). Check the licences of the "
+                              "models and textures before publishing this dataset.\n"
+                            : licences;
+    return out;
+  }
+
+  void writeOutputs() {
+    json document = doc_;
+    if (!lights_.empty()) document["extensions"]["KHR_lights_punctual"] = {{"lights", lights_}};
+    std::vector<std::string> used;
+    if (!lights_.empty()) used.push_back("KHR_lights_punctual");
+    if (usesVisibility_) {
+      used.push_back("KHR_node_visibility");
+      used.push_back("KHR_animation_pointer");
+    }
+    if (!used.empty()) document["extensionsUsed"] = used;
+    for (const char* key : {"images", "textures", "materials", "meshes", "skins"})
+      if (document.contains(key) && document[key].empty()) document.erase(key);
+    if (!document.contains("images")) document.erase("samplers");
+    document["buffers"] = {{{"byteLength", report_.binBytes}}};
+    report_.nodes = document["nodes"].size();
+    report_.materials = document.contains("materials") ? document["materials"].size() : 0;
+    report_.frames = times_.size();
+
+    const fs::path readme = outDir_ / (stem_ + ".README.md");
+    if (auto ok = writeFileAtomic(readme, datasetReadme()); !ok) throw ConvertError{ok.error().code, ok.error().message};
+    report_.written.push_back(readme);
+    if (!options_.glb) {
+      const fs::path bin = outDir_ / (stem_ + ".bin");
+      document["buffers"][0]["uri"] = uriPath(stem_ + ".bin");
+      if (auto ok = commitTemporary(binPath_, bin); !ok) throw ConvertError{ok.error().code, ok.error().message};
+      report_.written.push_back(bin);
+      if (auto ok = writeFileAtomic(options_.output, document.dump()); !ok) throw ConvertError{ok.error().code, ok.error().message};
+    } else {
+      writeGlb(document);
+    }
+    report_.written.push_back(options_.output);
+  }
+
+  // GLB: header, JSON chunk, BIN chunk copied from the temporary buffer file (glTF §4.4).
+  void writeGlb(const json& document) {
+    std::string text = document.dump();
+    while (text.size() % 4) text.push_back(' ');
+    const std::uint64_t binPadded = (report_.binBytes + 3) & ~std::uint64_t{3};
+    const std::uint64_t total = 12 + 8 + text.size() + 8 + binPadded;
+    if (total > 0xFFFFFFFFull) throw ConvertError{ErrorCode::kUnsupported, "the dataset is larger than GLB's 4 GiB limit; write .gltf instead"};
+    const fs::path tmp = temporarySibling(options_.output);
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    auto u32 = [&](std::uint64_t v) {
+      const auto x = static_cast<std::uint32_t>(v);
+      out.write(reinterpret_cast<const char*>(&x), 4);
+    };
+    out.write("glTF", 4);
+    u32(2);
+    u32(total);
+    u32(text.size());
+    out.write("JSON", 4);
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    u32(binPadded);
+    out.write("BIN\0", 4);
+    {
+      std::ifstream in(binPath_, std::ios::binary);
+      out << in.rdbuf();
+    }
+    for (std::uint64_t k = report_.binBytes; k < binPadded; ++k) out.put('\0');
+    out.close();
+    std::error_code ec;
+    fs::remove(binPath_, ec);
+    if (!out) throw ConvertError{ErrorCode::kIo, fmt::format("{}: write failed", tmp.string())};
+    if (auto ok = commitTemporary(tmp, options_.output); !ok) throw ConvertError{ok.error().code, ok.error().message};
+  }
+
+  const ConvertOptions& options_;
+  std::unique_ptr<CaptureReader> reader_;
+  std::string stem_;
+  fs::path outDir_, binPath_;
+  BinaryBuffer* bin_ = nullptr;
+  std::vector<float> times_;
+  std::map<std::uint64_t, Track> tracks_;
+  std::vector<Track*> visibleNow_;
+  json doc_;
+  std::vector<json> lights_;
+  std::vector<int> meshOfModel_;
+  std::map<int, int> ibmOfModel_;
+  std::map<std::string, int> imageByTexture_;
+  std::map<std::pair<std::string, std::string>, int> materialByMaps_;
+  std::map<std::uint64_t, int> visInputs_;
+  int timesView_ = -1;
+  bool cameraChanged_ = false, usesVisibility_ = false;
+  ConvertReport report_;
+};
+
+}  // namespace
+
+Expected<ConvertReport> convertCapture(const ConvertOptions& options) {
+  try {
+    return Converter(options).run();
+  } catch (const ConvertError& e) {
+    return std::unexpected(Error{e.code, e.message});
+  }
+}
+
+}  // namespace dynbench::convert

@@ -1,0 +1,43 @@
+#pragma once
+// `dynbench convert`: a capture directory (docs/capture-format.md) to a glTF 2.0 dataset laid out
+// as thesis §5.1 (docs/dataset.md). Two streaming passes over Capture.txt: the first finds every
+// capturable's life span and visibility changes, the second writes key frames straight to their
+// place in the binary buffer. Memory grows with the number of capturables, not with the frames
+// (plus 4 bytes of time per frame).
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "convert/light_rules.h"
+#include "core/error.h"
+
+namespace dynbench::convert {
+
+enum class VisibilityMode { kNode, kScale, kBoth };
+
+struct ConvertOptions {
+  std::filesystem::path capture;
+  std::filesystem::path output;  // DATASET.gltf (or .glb with `glb`)
+  bool glb = false;
+  VisibilityMode visibility = VisibilityMode::kBoth;
+  LightRules lightRules = defaultLightRules();
+  std::optional<std::filesystem::path> dataRoot;  // overrides the capture's `d` record
+  // Progress: pass (1 or 2), frames done in it.
+  std::function<void(int, std::size_t)> onProgress;
+};
+
+struct ConvertReport {
+  std::size_t frames = 0;
+  std::size_t capturables = 0;
+  std::size_t nodes = 0, meshes = 0, materials = 0, textures = 0, skins = 0, lights = 0, channels = 0;
+  std::uint64_t binBytes = 0;
+  std::vector<std::filesystem::path> written;  // the dataset's files
+  std::vector<std::string> warnings;
+};
+
+Expected<ConvertReport> convertCapture(const ConvertOptions& options);
+
+}  // namespace dynbench::convert
