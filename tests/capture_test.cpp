@@ -13,6 +13,7 @@
 #include "capture/reader.h"
 #include "core/math.h"
 #include "dynbench/capture.h"
+#include "capture_fixture.h"
 #include "gltf_builder.h"
 #include "run_cli.h"
 
@@ -20,80 +21,7 @@ namespace dynbench::capture {
 namespace {
 
 namespace fs = std::filesystem;
-
-dbc_dual_quat toC(const DualQuaternion& q) {
-  return {static_cast<float>(q.real.x), static_cast<float>(q.real.y), static_cast<float>(q.real.z), static_cast<float>(q.real.w),
-          static_cast<float>(q.dual.x), static_cast<float>(q.dual.y), static_cast<float>(q.dual.z), static_cast<float>(q.dual.w)};
-}
-
-dbc_dual_quat rigid(double yawDegrees, glm::dvec3 t) {
-  return toC(dualQuaternionFromRigid(glm::angleAxis(radians(yawDegrees), glm::dvec3(0, 1, 0)), t));
-}
-
-#define DBC_OK_OR_FAIL(call) ASSERT_EQ((call), DBC_OK) << dbc_last_error()
-
-// A two-joint "arm" (a quad skinned to both joints) and a one-triangle rigid "crate".
-void recordModels(dbc_session* s) {
-  const float positions[] = {0, 0, 0, 1, 0, 0, 1, 2, 0, 0, 2, 0};
-  const float normals[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
-  const float uvs[] = {0, 0, 1, 0, 1, 1, 0, 1};
-  const uint16_t joints[] = {0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0};
-  const float weights[] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 0.25f, 0.75f, 0, 0};
-  const uint32_t quad[] = {0, 1, 2, 0, 2, 3};
-  DBC_OK_OR_FAIL(dbc_model_begin(s, "chars/arm"));
-  dbc_mesh arm{0, "skin", "chars/arm.png", "chars/arm_mask.png", 4, positions, normals, uvs, joints, weights, 2, quad};
-  DBC_OK_OR_FAIL(dbc_model_mesh(s, &arm));
-  DBC_OK_OR_FAIL(dbc_model_joint(s, 0, "shoulder", -1, rigid(0, {0, 0, 0}), rigid(0, {0, 0, 0})));
-  DBC_OK_OR_FAIL(dbc_model_joint(s, 1, "elbow", 0, rigid(0, {0, 1, 0}), rigid(0, {0, -1, 0})));
-  DBC_OK_OR_FAIL(dbc_model_end(s));
-  const uint32_t tri[] = {0, 1, 2};
-  DBC_OK_OR_FAIL(dbc_model_begin(s, "mapmodel/crate:1"));  // a ':' in a path must survive
-  dbc_mesh crate{0, nullptr, "crate.jpg", nullptr, 3, positions, nullptr, nullptr, nullptr, nullptr, 1, tri};
-  DBC_OK_OR_FAIL(dbc_model_mesh(s, &crate));
-  DBC_OK_OR_FAIL(dbc_model_end(s));
-}
-
-struct Ids {
-  uint64_t camera, arm, crate, tree, lamp, flash;
-};
-
-// Frames 0..9 at 60 fps: the camera yaws 3 degrees a frame, the crate spins and is absent in
-// frames 4-6, the arm walks along +X, a flash light exists in frames 2-3.
-Ids recordFrames(dbc_session* s, int frames = 10) {
-  Ids ids{dbc_new_id(s), dbc_new_id(s), dbc_new_id(s), dbc_new_id(s), dbc_new_id(s), dbc_new_id(s)};
-  for (int f = 0; f < frames; ++f) {
-    EXPECT_EQ(dbc_frame_begin(s, static_cast<uint64_t>(100 + f), f / 60.0), DBC_OK) << dbc_last_error();
-    const float eye[] = {0, 1.7f, static_cast<float>(f)};
-    EXPECT_EQ(dbc_camera(s, ids.camera, eye, -5.0f, 3.0f * f, 0.0f), DBC_OK);
-    EXPECT_EQ(dbc_static_model(s, ids.tree, "mapmodel/crate:1", rigid(0, {5, 0, 5})), DBC_OK);
-    EXPECT_EQ(dbc_model(s, ids.arm, "chars/arm", rigid(90, {0.1 * f, 0, 0})), DBC_OK);
-    const dbc_dual_quat pose[] = {rigid(0, {0, 0, 0}), rigid(10.0 * f, {0, 1, 0})};
-    EXPECT_EQ(dbc_joints(s, ids.arm, "chars/arm", 2, pose), DBC_OK) << dbc_last_error();
-    if (f < 4 || f > 6) EXPECT_EQ(dbc_model(s, ids.crate, "mapmodel/crate:1", rigid(20.0 * f, {2, 0, 0})), DBC_OK);
-    const float lampAt[] = {0, 5, 0}, white[] = {1, 1, 1}, orange[] = {1, 0.5f, 0};
-    EXPECT_EQ(dbc_light(s, ids.lamp, lampAt, white, DBC_LIGHT_POINT, 0, nullptr), DBC_OK);
-    if (f == 2 || f == 3) {
-      const float at[] = {0.5f, 1.5f, static_cast<float>(f)};
-      EXPECT_EQ(dbc_light(s, ids.flash, at, orange, DBC_LIGHT_POINT, 1, "flash"), DBC_OK);
-    }
-    EXPECT_EQ(dbc_frame_end(s), DBC_OK) << dbc_last_error();
-  }
-  return ids;
-}
-
-fs::path writeCapture(const std::string& name) {
-  const auto dir = test::freshDir(name);
-  dbc_session* s = nullptr;
-  EXPECT_EQ(dbc_open(dir.c_str(), "dynbench tests", &s), DBC_OK) << dbc_last_error();
-  const float offset[] = {1, 2, 3};
-  EXPECT_EQ(dbc_set_map(s, "testmap", offset), DBC_OK);
-  EXPECT_EQ(dbc_set_data_root(s, "/data/game"), DBC_OK);
-  EXPECT_EQ(dbc_set_camera_settings(s, 16.0f / 9, 75.0f, 0.1f, 500.0f), DBC_OK);
-  recordModels(s);
-  recordFrames(s);
-  EXPECT_EQ(dbc_close(s), DBC_OK) << dbc_last_error();
-  return dir;
-}
+using namespace dynbench::test;
 
 TEST(DualQuaternion, RoundTripsRotationAndTranslation) {
   const glm::dquat r = glm::angleAxis(radians(70.0), glm::normalize(glm::dvec3(1, 2, -1)));

@@ -190,16 +190,22 @@ class Converter {
     passOne();
     if (times_.empty()) throw ConvertError{ErrorCode::kInvalidData, fmt::format("{}: the capture has no complete frame", options_.capture.string())};
     binPath_ = temporarySibling(outDir_ / (stem_ + ".bin"));
-    {
-      BinaryBuffer bin(binPath_);
-      bin_ = &bin;
-      buildDocument();
-      passTwo();
-      bin.finish();
-      report_.binBytes = bin.size();
-      bin_ = nullptr;
+    try {
+      {
+        BinaryBuffer bin(binPath_);
+        bin_ = &bin;
+        buildDocument();
+        passTwo();
+        bin.finish();
+        report_.binBytes = bin.size();
+        bin_ = nullptr;
+      }
+      writeOutputs();
+    } catch (...) {
+      std::error_code ec;
+      fs::remove(binPath_, ec);  // no half-written buffer left behind
+      throw;
     }
-    writeOutputs();
     report_.warnings.insert(report_.warnings.begin(), reader_->warnings().begin(), reader_->warnings().end());
     return report_;
   }

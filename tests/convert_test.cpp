@@ -1,0 +1,262 @@
+// `dynbench convert` round trip: a capture written through the SDK, converted, checked by the
+// Khronos validator, reloaded with dynbench's own loader and evaluated at the captured times.
+#include <cmath>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "capture_fixture.h"
+#include "convert/convert.h"
+#include "gltf_builder.h"
+#include "run_cli.h"
+#include "scene/evaluate.h"
+#include "scene/load.h"
+
+namespace dynbench::convert {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace dynbench::test;
+
+// A 1x1 PNG (written by hand: IHDR, one zlib-compressed scanline, IEND).
+const unsigned char kPng[] = {137, 80, 78, 71, 13, 10, 26, 10, 0, 0, 0, 13, 73, 72, 68, 82, 0, 0, 0, 1, 0, 0, 0, 1, 8, 2, 0, 0, 0,
+                              144, 119, 83, 222, 0, 0, 0, 12, 73, 68, 65, 84, 120, 156, 99, 248, 223, 192, 0, 0, 4, 1, 1, 128,
+                              197, 42, 24, 93, 0, 0, 0, 0, 73, 69, 78, 68, 174, 66, 96, 130};
+
+// Runs the Khronos validator (node + npm gltf-validator, installed by scripts/setup.sh).
+std::string validate(const fs::path& file, int& status) {
+  const std::string cmd = fmt::format("node {}/tools/gltf-validator/validate.mjs '{}' 2>&1", DYNBENCH_SOURCE_DIR, file.string());
+  std::string out;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf{};
+  for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0;) out.append(buf.data(), n);
+  const int raw = ::pclose(pipe);
+  status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  return out;
+}
+
+struct Converted {
+  fs::path capture, dataset;
+  ConvertReport report;
+};
+
+Converted convertFixture(const std::string& name, ConvertOptions options = {}) {
+  Converted c;
+  c.capture = writeCapture(name + "_capture");
+  const fs::path dataRoot = freshDir(name + "_data");
+  fs::create_directories(dataRoot / "chars");
+  for (const char* texture : {"chars/arm.png", "chars/arm_mask.png"})
+    std::ofstream(dataRoot / texture, std::ios::binary).write(reinterpret_cast<const char*>(kPng), sizeof kPng);
+  options.capture = c.capture;
+  options.dataRoot = dataRoot;
+  if (options.output.empty()) options.output = freshDir(name + "_out") / (options.glb ? "dataset.glb" : "dataset.gltf");
+  c.dataset = options.output;
+  auto report = convertCapture(options);
+  EXPECT_TRUE(report) << report.error().message;
+  if (report) c.report = *report;
+  return c;
+}
+
+int nodeNamed(const scene::Scene& s, const std::string& name) {
+  for (std::size_t i = 0; i < s.nodes.size(); ++i)
+    if (s.nodes[i].name == name) return static_cast<int>(i);
+  ADD_FAILURE() << "no node named " << name;
+  return -1;
+}
+
+// |a - b| <= 1e-5 relative (absolute below 1).
+void expectClose(const glm::dvec3& a, const glm::dvec3& b, const std::string& what) {
+  EXPECT_LE(glm::length(a - b), 1e-5 * std::max(1.0, glm::length(b))) << what << ": (" << a.x << ", " << a.y << ", " << a.z
+                                                                        << ") vs (" << b.x << ", " << b.y << ", " << b.z << ")";
+}
+
+glm::dmat4 matrix(const dbc_dual_quat& q) {
+  return matrixOf(DualQuaternion{glm::dquat(q.rw, q.rx, q.ry, q.rz), glm::dquat(q.dw, q.dx, q.dy, q.dz)});
+}
+
+TEST(Convert, RoundTripMatchesTheCapture) {
+  const Converted c = convertFixture("convert_roundtrip");
+  int status = -1;
+  const std::string validation = validate(c.dataset, status);
+  EXPECT_EQ(status, 0) << validation;
+  EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
+
+  auto loaded = scene::loadScene(c.dataset);
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  const scene::Scene& s = *loaded;
+  const scene::Evaluator e(s);
+  // Thesis §5.1 layout.
+  EXPECT_EQ(s.nodes[0].name, "WorldOrigo");
+  EXPECT_EQ(s.nodes[static_cast<std::size_t>(s.nodes[0].children.at(0))].name, "StaticObjects");
+  EXPECT_EQ(s.nodes[static_cast<std::size_t>(s.nodes[0].children.at(1))].name, "DynamicObjects");
+  EXPECT_EQ(s.images.size(), 2u);  // arm.png and its mask, copied beside the dataset
+  EXPECT_TRUE(fs::exists(c.dataset.parent_path() / "dataset_textures/chars/arm.png"));
+  EXPECT_EQ(c.report.textures, 2u);
+
+  const int camera = nodeNamed(s, "camera_1");
+  const int arm = nodeNamed(s, "model_2_chars/arm");
+  const int crate = nodeNamed(s, "model_3_mapmodel/crate:1");
+  const int skinned = nodeNamed(s, "skinned_2");
+  const int flash = nodeNamed(s, "light_6");
+  ASSERT_TRUE(camera >= 0 && arm >= 0 && crate >= 0 && skinned >= 0 && flash >= 0);
+  EXPECT_EQ(s.meshes.size(), 2u);  // defined once, shared by the static tree and the crate
+  EXPECT_EQ(s.nodes[static_cast<std::size_t>(crate)].mesh, s.nodes[static_cast<std::size_t>(nodeNamed(s, "static_4_mapmodel/crate:1"))].mesh);
+
+  for (int f = 0; f < 10; ++f) {
+    const double t = static_cast<float>(f / 60.0);
+    const std::string at = fmt::format("frame {}", f);
+    // Camera: position and game-camera angles as captured.
+    const RigidPose pose = decomposeRigid(e.worldMatrix(camera, t));
+    expectClose(pose.position, {0, 1.7f, f}, at + " camera position");
+    const auto euler = eulerYawPitchRoll(pose.rotation);
+    EXPECT_NEAR(degrees(euler.yaw), 3.0 * f, 1e-4) << at;
+    EXPECT_NEAR(degrees(euler.pitch), -5.0, 1e-4) << at;
+    // The crate: absent in frames 4-6, otherwise where it was captured.
+    const bool crateThere = f < 4 || f > 6;
+    EXPECT_EQ(e.visible(crate, t), crateThere) << at;
+    if (crateThere) {
+      const glm::dmat4 expected = matrix(crateModelPose(f));
+      const glm::dmat4 got = e.worldMatrix(crate, t);
+      for (int col = 0; col < 4; ++col) expectClose(glm::dvec3(got[col]), glm::dvec3(expected[col]), at + " crate column");
+    }
+    // The flash: recorded in frames 2-3, kept 3 frames longer by the default light rules.
+    EXPECT_EQ(e.ownVisibility(flash, t), f >= 2 && f <= 6) << at;
+    // Skinned vertices: world = model transform x sum_k w_k J_k IBM_k v, from the capture's values.
+    const auto world = e.worldPositions(skinned, 0, t);
+    ASSERT_EQ(world.size(), 4u);
+    const glm::dmat4 model = matrix(armModelPose(f));
+    const glm::dmat4 ibm[2] = {matrix(rigid(0, {0, 0, 0})), matrix(rigid(0, {0, -1, 0}))};
+    for (int v = 0; v < 4; ++v) {
+      glm::dvec3 expected(0.0);
+      const glm::dvec4 p(kArmPositions[3 * v], kArmPositions[3 * v + 1], kArmPositions[3 * v + 2], 1.0);
+      for (int k = 0; k < 4; ++k) {
+        const double w = kArmWeights[4 * v + k];
+        if (w == 0) continue;
+        const int joint = kArmJoints[4 * v + k];
+        expected += w * glm::dvec3(model * matrix(armJointPose(f, joint)) * ibm[joint] * p);
+      }
+      expectClose(world[static_cast<std::size_t>(v)], expected, fmt::format("{} arm vertex {}", at, v));
+    }
+  }
+  // Between frames 4 and 7 the crate's scale-0 fallback hides it too.
+  EXPECT_TRUE(scene::hasZeroScale(e.worldMatrix(crate, static_cast<float>(5 / 60.0))));
+}
+
+TEST(Convert, GlbHoldsTheSameDataset) {
+  ConvertOptions options;
+  options.glb = true;
+  const Converted c = convertFixture("convert_glb", options);
+  int status = -1;
+  const std::string validation = validate(c.dataset, status);
+  EXPECT_EQ(status, 0) << validation;
+  auto loaded = scene::loadScene(c.dataset);
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  EXPECT_EQ(loaded->source.format, "GLB");
+  EXPECT_FALSE(fs::exists(c.dataset.parent_path() / "dataset.bin"));
+  const scene::Evaluator e(*loaded);
+  const RigidPose pose = decomposeRigid(e.worldMatrix(nodeNamed(*loaded, "camera_1"), static_cast<float>(7 / 60.0)));
+  expectClose(pose.position, {0, 1.7f, 7}, "camera at frame 7");
+}
+
+nlohmann::json readJson(const fs::path& p) {
+  std::ifstream in(p);
+  return nlohmann::json::parse(in);
+}
+
+TEST(Convert, VisibilityModes) {
+  ConvertOptions node;
+  node.visibility = VisibilityMode::kNode;
+  const auto j = readJson(convertFixture("convert_vis_node", node).dataset);
+  for (const auto& ch : j["animations"][0]["channels"]) EXPECT_NE(ch["target"]["path"], "scale");
+  ConvertOptions scale;
+  scale.visibility = VisibilityMode::kScale;
+  const auto k = readJson(convertFixture("convert_vis_scale", scale).dataset);
+  EXPECT_EQ(k["extensionsUsed"], nlohmann::json({"KHR_lights_punctual"}));
+  int scales = 0;
+  for (const auto& ch : k["animations"][0]["channels"]) scales += ch["target"]["path"] == "scale";
+  EXPECT_EQ(scales, 1);  // only the crate appears and disappears; lights never get a scale channel
+}
+
+TEST(Convert, LightRules) {
+  const Converted c = convertFixture("convert_lights");
+  const auto j = readJson(c.dataset);
+  const auto& lights = j["extensions"]["KHR_lights_punctual"]["lights"];
+  ASSERT_EQ(lights.size(), 2u);
+  // Lamp: white (1, 1, 1) at 100 cd per unit; flash: orange (1, 0.5, 0) amplified x4.
+  EXPECT_DOUBLE_EQ(lights[0]["intensity"].get<double>(), 100.0);
+  EXPECT_DOUBLE_EQ(lights[1]["intensity"].get<double>(), 400.0);
+  EXPECT_EQ(lights[1]["color"], nlohmann::json({1.0, 0.5, 0.0}));
+
+  const fs::path rules = freshDir("convert_rules") / "rules.json";
+  std::ofstream(rules) << R"({"candela_per_unit": 10, "types": {"flash": {"ring_lights": 6, "ring_radius_m": 2}}})";
+  auto parsed = readLightRules(rules);
+  ASSERT_TRUE(parsed) << parsed.error().message;
+  ConvertOptions options;
+  options.lightRules = *parsed;
+  const auto k = readJson(convertFixture("convert_lights_ring", options).dataset);
+  const auto& ring = k["extensions"]["KHR_lights_punctual"]["lights"];
+  ASSERT_EQ(ring.size(), 2u);
+  EXPECT_NEAR(ring[1]["intensity"].get<double>(), 10.0 / 6, 1e-12);  // six lights share the flash
+  int ringNodes = 0;
+  for (const auto& n : k["nodes"])
+    if (n.value("name", "") == "light_6_ring") {
+      ++ringNodes;
+      EXPECT_NEAR(glm::length(glm::dvec3(n["translation"][0], n["translation"][1], n["translation"][2])), 2.0, 1e-6);
+    }
+  EXPECT_EQ(ringNodes, 6);
+
+  std::ofstream(rules) << R"({"types": {"flash": {"extra_frames": -1}}})";
+  auto bad = readLightRules(rules);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("/types/flash/extra_frames"), std::string::npos) << bad.error().message;
+  std::ofstream(rules) << R"({"typo": 1})";
+  bad = readLightRules(rules);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("/typo"), std::string::npos) << bad.error().message;
+}
+
+TEST(Convert, TruncatedCaptureKeepsCompleteFrames) {
+  const fs::path capture = writeCapture("convert_truncated");
+  // Cut Capture.txt inside frame 109 (the last): keep everything before its end record.
+  std::ifstream in(capture / "Capture.txt");
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  text = text.substr(0, text.rfind("e:109")) ;
+  std::ofstream(capture / "Capture.txt", std::ios::trunc) << text;
+  ConvertOptions options;
+  options.capture = capture;
+  options.output = freshDir("convert_truncated_out") / "cut.gltf";
+  auto report = convertCapture(options);
+  ASSERT_TRUE(report) << report.error().message;
+  EXPECT_EQ(report->frames, 9u);
+  bool warned = false;
+  for (const auto& w : report->warnings) warned |= w.find("frame 109 has no end record") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+TEST(ConvertCli, WritesDatasetAndRejectsBadArguments) {
+  const fs::path capture = writeCapture("convert_cli");
+  const fs::path out = freshDir("convert_cli_out");
+  auto r = dynbench(fmt::format("convert {} -o {}", capture.string(), (out / "d.gltf").string()), out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("10 frames"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(out / "d.gltf") && fs::exists(out / "d.bin") && fs::exists(out / "d.README.md"));
+  std::ifstream readme(out / "d.README.md");
+  const std::string text((std::istreambuf_iterator<char>(readme)), {});
+  EXPECT_NE(text.find("dynbench tests"), std::string::npos);  // the capture's source
+  EXPECT_NE(text.find("Licences"), std::string::npos);
+  r = dynbench(fmt::format("convert {} -o {}", capture.string(), (out / "d.obj").string()), out);
+  EXPECT_EQ(r.status, 2);
+  r = dynbench(fmt::format("convert {} -o {} --visibility sometimes", capture.string(), (out / "e.gltf").string()), out);
+  EXPECT_NE(r.status, 0);
+  EXPECT_FALSE(fs::exists(out / "e.gltf"));
+  std::ofstream(capture / "Capture.txt", std::ios::app) << "garbage\n";
+  r = dynbench(fmt::format("convert {} -o {}", capture.string(), (out / "f.gltf").string()), out);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("Capture.txt:"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out / "f.gltf"));
+  EXPECT_FALSE(fs::exists(out / "f.bin"));
+}
+
+}  // namespace
+}  // namespace dynbench::convert
