@@ -8,6 +8,7 @@
 
 #include "capture_fixture.h"
 #include "convert/convert.h"
+#include "convert/merge_camera.h"
 #include "gltf_builder.h"
 #include "run_cli.h"
 #include "scene/evaluate.h"
@@ -256,6 +257,106 @@ TEST(ConvertCli, WritesDatasetAndRejectsBadArguments) {
   EXPECT_NE(r.err.find("Capture.txt:"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out / "f.gltf"));
   EXPECT_FALSE(fs::exists(out / "f.bin"));
+}
+
+TEST(MergeCamera, CsvPoseLogReplacesTheCameraKeepingRoll) {
+  const Converted c = convertFixture("merge_csv");
+  const fs::path csv = c.dataset.parent_path() / "headset.csv";
+  {
+    std::ofstream out(csv);
+    out << "time,x,y,z,qx,qy,qz,qw\n";
+    for (int k = 0; k < 20; ++k) {
+      const glm::dquat q = quatFromYawPitchRoll(radians(5.0 * k), radians(-2.0 * k), radians(10.0 * k));
+      out << fmt::format("{},{},{},{},{},{},{},{}\n", 100.0 + 0.05 * k, k, 2, 0, q.x, q.y, q.z, q.w);
+    }
+  }
+  MergeCameraOptions options;
+  options.dataset = c.dataset;
+  options.run = csv;
+  options.output = c.dataset.parent_path() / "vr.gltf";
+  options.offsetSeconds = 0.02;
+  auto report = mergeCamera(options);
+  ASSERT_TRUE(report) << report.error().message;
+  EXPECT_EQ(report->keys, 20u);
+  EXPECT_NEAR(report->startTime, 0.02, 1e-6);
+  int status = -1;
+  const std::string validation = validate(options.output, status);
+  EXPECT_EQ(status, 0) << validation;
+  auto merged = scene::loadScene(options.output);
+  ASSERT_TRUE(merged) << merged.error().message;
+  const scene::Evaluator e(*merged);
+  const int camera = nodeNamed(*merged, "camera_1");
+  for (int k = 0; k < 20; ++k) {
+    const double t = static_cast<float>(0.02 + 0.05 * k);
+    const RigidPose pose = decomposeRigid(e.worldMatrix(camera, t));
+    expectClose(pose.position, {k, 2, 0}, fmt::format("key {}", k));
+    const auto euler = eulerYawPitchRoll(pose.rotation);
+    EXPECT_NEAR(wrapDegrees(degrees(euler.yaw) - 5.0 * k), 0.0, 1e-3) << k;
+    EXPECT_NEAR(wrapDegrees(degrees(euler.pitch) + 2.0 * k), 0.0, 1e-3) << k;
+    EXPECT_NEAR(wrapDegrees(degrees(euler.roll) - 10.0 * k), 0.0, 1e-3) << k;  // roll is kept (190 reads as -170)
+  }
+  // Everything else is untouched: the crate still disappears in frames 4-6.
+  EXPECT_FALSE(e.visible(nodeNamed(*merged, "model_3_mapmodel/crate:1"), static_cast<float>(5 / 60.0)));
+  // The input dataset still has its own camera.
+  auto original = scene::loadScene(c.dataset);
+  ASSERT_TRUE(original);
+  const scene::Evaluator o(*original);
+  expectClose(decomposeRigid(o.worldMatrix(camera, static_cast<float>(3 / 60.0))).position, {0, 1.7f, 3}, "original camera");
+}
+
+TEST(MergeCamera, CameraOnlyCaptureRun) {
+  const Converted c = convertFixture("merge_capture");
+  const fs::path runDir = freshDir("merge_capture_run");
+  dbc_session* s = nullptr;
+  ASSERT_EQ(dbc_open(runDir.c_str(), "headset", &s), DBC_OK);
+  const uint64_t id = dbc_new_id(s);
+  for (int f = 0; f < 5; ++f) {
+    ASSERT_EQ(dbc_frame_begin(s, static_cast<uint64_t>(f), 5.0 + f / 30.0), DBC_OK);
+    const float p[] = {1, 1, static_cast<float>(-f)};
+    ASSERT_EQ(dbc_camera(s, id, p, 0, 0, 15.0f * f), DBC_OK);
+    ASSERT_EQ(dbc_frame_end(s), DBC_OK);
+  }
+  ASSERT_EQ(dbc_close(s), DBC_OK);
+  MergeCameraOptions options;
+  options.dataset = c.dataset;
+  options.run = runDir;
+  options.output = c.dataset.parent_path() / "run2.gltf";
+  auto report = mergeCamera(options);
+  ASSERT_TRUE(report) << report.error().message;
+  auto merged = scene::loadScene(options.output);
+  ASSERT_TRUE(merged);
+  const scene::Evaluator e(*merged);
+  const RigidPose pose = decomposeRigid(e.worldMatrix(nodeNamed(*merged, "camera_1"), static_cast<float>(4 / 30.0)));
+  expectClose(pose.position, {1, 1, -4}, "camera at run frame 4");
+  EXPECT_NEAR(degrees(eulerYawPitchRoll(pose.rotation).roll), 60.0, 1e-3);
+}
+
+TEST(MergeCamera, BadRunsAndPaths) {
+  const Converted c = convertFixture("merge_bad");
+  const fs::path csv = c.dataset.parent_path() / "bad.csv";
+  std::ofstream(csv) << "0,0,0,0,0,0,0,1\n0.1,1,2,3,0,0,0,1\n0.2,1,two,3,0,0,0,1\n";
+  MergeCameraOptions options;
+  options.dataset = c.dataset;
+  options.run = csv;
+  options.output = c.dataset.parent_path() / "never.gltf";
+  auto r = mergeCamera(options);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("bad.csv:3:"), std::string::npos) << r.error().message;
+  EXPECT_FALSE(fs::exists(options.output));
+  std::ofstream(csv, std::ios::trunc) << "0,0,0,0,0,0,0,1\n0,1,2,3,0,0,0,1\n";
+  r = mergeCamera(options);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("bad.csv:2:"), std::string::npos) << r.error().message;
+  std::ofstream(csv, std::ios::trunc) << "0,0,0,0,0,0,0,1\n";
+  options.output = freshDir("merge_elsewhere") / "x.gltf";
+  r = mergeCamera(options);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::kUsage);
+  options.output = c.dataset.parent_path() / "y.gltf";
+  options.camera = "nobody";
+  r = mergeCamera(options);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("nobody"), std::string::npos);
 }
 
 }  // namespace

@@ -19,6 +19,9 @@ void addCaptureCheckCommand(CLI::App& app, CommandRun& run);
 // Registers `convert`.
 void addConvertCommand(CLI::App& app, CommandRun& run);
 
+// Registers `merge-camera`.
+void addMergeCameraCommand(CLI::App& app, CommandRun& run);
+
 // Exit status for an error (docs/cli.md lists them).
 int exitCode(const Error& error);
 

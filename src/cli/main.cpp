@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   cli::addStatsCommand(app, run);
   cli::addCaptureCheckCommand(app, run);
   cli::addConvertCommand(app, run);
+  cli::addMergeCameraCommand(app, run);
 
   // `dynbench help [COMMAND]`
   std::string helpTopic;

@@ -1,0 +1,206 @@
+#include "convert/merge_camera.h"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "capture/reader.h"
+#include "core/files.h"
+#include "core/math.h"
+#include "metrics/camera_motion.h"
+#include "scene/load.h"
+
+namespace dynbench::convert {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+Expected<std::vector<CameraPoseKey>> readCaptureRun(const fs::path& dir) {
+  auto reader = capture::CaptureReader::open(dir);
+  if (!reader) return std::unexpected(reader.error());
+  std::vector<CameraPoseKey> keys;
+  std::optional<std::uint64_t> camera;
+  capture::CaptureFrame frame;
+  while (true) {
+    auto more = (*reader)->next(frame);
+    if (!more) return std::unexpected(more.error());
+    if (!*more) break;
+    for (const auto& c : frame.cameras) {
+      if (!camera) camera = c.id;
+      if (c.id != *camera) continue;
+      keys.push_back({frame.time, c.position, quatFromYawPitchRoll(radians(c.yaw), radians(c.pitch), radians(c.roll))});
+    }
+  }
+  if (keys.empty()) return fail(ErrorCode::kInvalidData, "{}: the capture has no camera records", dir.string());
+  return keys;
+}
+
+Expected<std::vector<CameraPoseKey>> readCsvRun(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) return fail(ErrorCode::kIo, "{}: cannot open", file.string());
+  std::vector<CameraPoseKey> keys;
+  std::string line;
+  for (std::size_t number = 1; std::getline(in, line); ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<double> values;
+    std::stringstream fields(line);
+    std::string field;
+    bool numeric = true;
+    while (std::getline(fields, field, ',')) {
+      const auto start = field.find_first_not_of(" \t"), end = field.find_last_not_of(" \t");
+      field = start == std::string::npos ? "" : field.substr(start, end - start + 1);
+      double v = 0;
+      const auto [ptr, ec] = std::from_chars(field.data(), field.data() + field.size(), v);
+      if (ec != std::errc() || ptr != field.data() + field.size() || field.empty()) {
+        numeric = false;
+        break;
+      }
+      values.push_back(v);
+    }
+    if (!numeric) {
+      if (keys.empty() && number == 1) continue;  // a header line
+      return fail(ErrorCode::kParse, "{}:{}: '{}' is not a number; expected time,x,y,z,qx,qy,qz,qw", file.string(), number, field);
+    }
+    if (values.size() != 8)
+      return fail(ErrorCode::kParse, "{}:{}: {} fields; expected 8 (time,x,y,z,qx,qy,qz,qw)", file.string(), number, values.size());
+    for (double v : values)
+      if (!std::isfinite(v)) return fail(ErrorCode::kInvalidData, "{}:{}: values must be finite", file.string(), number);
+    const glm::dquat q(values[7], values[4], values[5], values[6]);
+    if (glm::length(q) < 1e-6) return fail(ErrorCode::kInvalidData, "{}:{}: the quaternion has zero length", file.string(), number);
+    if (!keys.empty() && !(values[0] > keys.back().time))
+      return fail(ErrorCode::kInvalidData, "{}:{}: time {} is not after {}; times must increase", file.string(), number, values[0],
+                  keys.back().time);
+    keys.push_back({values[0], {values[1], values[2], values[3]}, glm::normalize(q)});
+  }
+  if (keys.empty()) return fail(ErrorCode::kInvalidData, "{}: no pose lines", file.string());
+  return keys;
+}
+
+}  // namespace
+
+Expected<std::vector<CameraPoseKey>> readCameraRun(const fs::path& run) {
+  std::error_code ec;
+  if (fs::is_directory(run, ec)) return readCaptureRun(run);
+  return readCsvRun(run);
+}
+
+Expected<MergeCameraReport> mergeCamera(const MergeCameraOptions& options) {
+  const fs::path datasetDir = fs::absolute(options.dataset).parent_path().lexically_normal();
+  const fs::path outputDir = fs::absolute(options.output).parent_path().lexically_normal();
+  if (options.dataset.extension() != ".gltf" || options.output.extension() != ".gltf")
+    return fail(ErrorCode::kUsage, "merge-camera reads and writes .gltf files (with an external .bin)");
+  if (datasetDir != outputDir)
+    return fail(ErrorCode::kUsage, "-o {}: write the output beside {} (same folder) so that its textures stay reachable",
+                options.output.string(), options.dataset.string());
+  // Validates the dataset and finds its camera with the same rules as `stats`.
+  auto scene = scene::loadScene(options.dataset);
+  if (!scene) return std::unexpected(scene.error());
+  auto node = metrics::selectCameraNode(*scene, options.camera);
+  if (!node) return std::unexpected(node.error());
+  if (*node < 0) return fail(ErrorCode::kInvalidData, "{}: the dataset has no camera", options.dataset.string());
+  auto run = readCameraRun(options.run);
+  if (!run) return std::unexpected(run.error());
+
+  auto text = readWholeFile(options.dataset);
+  if (!text) return std::unexpected(text.error());
+  json doc = json::parse(*text);  // valid: loadScene read it
+  if (doc["buffers"].size() != 1 || !doc["buffers"][0].contains("uri") ||
+      doc["buffers"][0]["uri"].get<std::string>().rfind("data:", 0) == 0)
+    return fail(ErrorCode::kUnsupported, "{}: merge-camera needs a dataset with one external .bin buffer (as convert writes)",
+                options.dataset.string());
+  const fs::path bin = datasetDir / doc["buffers"][0]["uri"].get<std::string>();
+
+  // New keys in dataset time: the run's first key lands on the dataset's start, plus the offset.
+  const double start = scene->timeRange().start + options.offsetSeconds - run->front().time;
+  std::vector<float> times, translations, rotations;
+  glm::dquat previous(1, 0, 0, 0);
+  for (const auto& key : *run) {
+    const double t = key.time + start;
+    if (t < 0) return fail(ErrorCode::kUsage, "--offset {}: the run would start before time 0", options.offsetSeconds);
+    if (!times.empty() && !(static_cast<float>(t) > times.back()))
+      return fail(ErrorCode::kInvalidData, "{}: two poses {} s apart collapse into one float key time", options.run.string(),
+                  key.time - (times.back() - start));
+    glm::dquat q = key.rotation;
+    if (glm::dot(previous, q) < 0) q = -q;  // shortest arc between keys
+    previous = q;
+    times.push_back(static_cast<float>(t));
+    translations.insert(translations.end(), {float(key.position.x), float(key.position.y), float(key.position.z)});
+    rotations.insert(rotations.end(), {float(q.x), float(q.y), float(q.z), float(q.w)});
+  }
+
+  // The new buffer: the old one, then the camera keys (4-byte aligned).
+  const fs::path outBin = outputDir / (options.output.stem().string() + ".bin");
+  const fs::path tmpBin = temporarySibling(outBin);
+  std::error_code ec;
+  fs::copy_file(bin, tmpBin, fs::copy_options::overwrite_existing, ec);
+  if (ec) return fail(ErrorCode::kIo, "{}: cannot copy to {}: {}", bin.string(), tmpBin.string(), ec.message());
+  std::uint64_t size = fs::file_size(tmpBin);
+  {
+    std::ofstream out(tmpBin, std::ios::binary | std::ios::app);
+    auto append = [&](const std::vector<float>& data) {
+      while (size % 4) {
+        out.put('\0');
+        ++size;
+      }
+      const std::uint64_t offset = size;
+      out.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size() * sizeof(float)));
+      size += data.size() * sizeof(float);
+      doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", data.size() * sizeof(float)}});
+      return doc["bufferViews"].size() - 1;
+    };
+    const auto tv = append(times), pv = append(translations), rv = append(rotations);
+    while (size % 4) {
+      out.put('\0');
+      ++size;
+    }
+    if (!out) {
+      fs::remove(tmpBin, ec);
+      return fail(ErrorCode::kIo, "{}: write failed", tmpBin.string());
+    }
+    auto accessor = [&](std::size_t view, const char* type, json a = json::object()) {
+      a["bufferView"] = view;
+      a["componentType"] = 5126;
+      a["count"] = times.size();
+      a["type"] = type;
+      doc["accessors"].push_back(a);
+      return doc["accessors"].size() - 1;
+    };
+    const auto input = accessor(tv, "SCALAR", {{"min", {times.front()}}, {"max", {times.back()}}});
+    const auto outputs = std::map<std::string, std::size_t>{{"translation", accessor(pv, "VEC3")}, {"rotation", accessor(rv, "VEC4")}};
+    // Repoint the camera's translation and rotation samplers; add channels where there were none.
+    if (!doc.contains("animations") || doc["animations"].empty())
+      doc["animations"] = {{{"name", "camera"}, {"samplers", json::array()}, {"channels", json::array()}}};
+    std::set<std::string> done;
+    for (auto& animation : doc["animations"])
+      for (auto& channel : animation["channels"]) {
+        const auto& target = channel["target"];
+        if (!target.contains("node") || target["node"] != *node) continue;
+        const std::string path = target.value("path", "");
+        if (!outputs.contains(path)) continue;
+        // A sampler may be shared with another node; it must not change under it: give this channel its own.
+        animation["samplers"].push_back({{"input", input}, {"output", outputs.at(path)}, {"interpolation", "LINEAR"}});
+        channel["sampler"] = animation["samplers"].size() - 1;
+        done.insert(path);
+      }
+    for (const auto& [path, output] : outputs) {
+      if (done.contains(path)) continue;
+      auto& animation = doc["animations"][0];
+      animation["samplers"].push_back({{"input", input}, {"output", output}, {"interpolation", "LINEAR"}});
+      animation["channels"].push_back({{"sampler", animation["samplers"].size() - 1}, {"target", {{"node", *node}, {"path", path}}}});
+    }
+  }
+  doc["buffers"][0]["byteLength"] = size;
+  doc["buffers"][0]["uri"] = outBin.filename().string();
+  if (auto ok = commitTemporary(tmpBin, outBin); !ok) return std::unexpected(ok.error());
+  if (auto ok = writeFileAtomic(options.output, doc.dump()); !ok) return std::unexpected(ok.error());
+  return MergeCameraReport{*node, times.size(), times.front(), times.back()};
+}
+
+}  // namespace dynbench::convert

@@ -1,0 +1,43 @@
+#pragma once
+// `dynbench merge-camera` (thesis §5.5, the VR workflow): replace a dataset's camera animation
+// with another camera run, keeping everything else byte for byte.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "core/error.h"
+
+namespace dynbench::convert {
+
+struct CameraPoseKey {
+  double time = 0.0;  // seconds
+  glm::dvec3 position{0.0};
+  glm::dquat rotation{1, 0, 0, 0};  // world orientation; roll included
+};
+
+// A camera run: a capture directory (its first camera capturable's `t` records), or a CSV pose log
+// with lines `time,x,y,z,qx,qy,qz,qw` (a header line is allowed) such as a head-mounted display
+// records. Errors name file:line.
+Expected<std::vector<CameraPoseKey>> readCameraRun(const std::filesystem::path& run);
+
+struct MergeCameraOptions {
+  std::filesystem::path dataset;  // .gltf with its .bin (as `convert` writes)
+  std::filesystem::path run;
+  std::filesystem::path output;   // .gltf, in the dataset's folder (textures stay reachable)
+  std::optional<std::string> camera;  // camera node: index or name (default: the first animated camera)
+  double offsetSeconds = 0.0;     // added after aligning the run's first key to the dataset's start
+};
+
+struct MergeCameraReport {
+  int cameraNode = -1;
+  std::size_t keys = 0;
+  double startTime = 0.0, endTime = 0.0;  // of the new camera keys, dataset time
+};
+
+Expected<MergeCameraReport> mergeCamera(const MergeCameraOptions& options);
+
+}  // namespace dynbench::convert
