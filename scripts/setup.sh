@@ -8,7 +8,7 @@ packages=(
   # build
   build-essential cmake ninja-build pkg-config git
   # libraries
-  nlohmann-json3-dev libassimp-dev libglm-dev
+  nlohmann-json3-dev libassimp-dev libglm-dev libopenimageio-dev
   libcli11-dev libfmt-dev libspdlog-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev googletest libbenchmark-dev zlib1g-dev

@@ -11,7 +11,8 @@ namespace dynbench::cli {
 namespace {
 
 struct ConvertCliOptions {
-  std::string capture, output, visibility = "both", lightRules, dataRoot;
+  std::string capture, output, visibility = "both", lightRules, dataRoot, environment;
+  convert::SkyParameters sky;
   bool glb = false;
 };
 
@@ -33,6 +34,8 @@ Expected<void> runConvert(const ConvertCliOptions& cli) {
     options.lightRules = *rules;
   }
   if (!cli.dataRoot.empty()) options.dataRoot = cli.dataRoot;
+  if (!cli.environment.empty()) options.environment = cli.environment;
+  options.sky = cli.sky;
   std::optional<Progress> progress;
   int shownPass = 0;
   options.onProgress = [&](int pass, std::size_t frames) {
@@ -69,6 +72,13 @@ void addConvertCommand(CLI::App& app, CommandRun& run) {
                   "or both (default: both; lights never use scale)")
       ->check(CLI::IsMember({"node", "scale", "both"}));
   cmd->add_option("--light-rules", options->lightRules, "JSON file overriding the light rules (docs/dataset.md)");
+  cmd->add_option("--env", options->environment,
+                  "Equirectangular .hdr/.exr environment copied beside the dataset (default: a generated daylight sky)");
+  cmd->add_option("--sun-elevation", options->sky.sunElevationDegrees, "Generated sky: sun elevation, degrees (default: 45)")
+      ->check(CLI::Range(0.0, 90.0));
+  cmd->add_option("--sun-azimuth", options->sky.sunAzimuthDegrees, "Generated sky: sun azimuth from -Z towards +X, degrees (default: 135)");
+  cmd->add_option("--turbidity", options->sky.turbidity, "Generated sky: turbidity, 2 (clear) to 10 (hazy) (default: 3)")
+      ->check(CLI::Range(1.7, 10.0));
   cmd->add_option("--data-root", options->dataRoot, "Where texture names are resolved (default: the capture's data root)");
   cmd->callback([options, &run] { run = [options] { return runConvert(*options); }; });
 }

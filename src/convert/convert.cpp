@@ -16,6 +16,7 @@
 
 #include "capture/reader.h"
 #include "core/files.h"
+#include "core/image_io.h"
 #include "core/math.h"
 #include "dynbench/version.h"
 
@@ -777,10 +778,45 @@ class Converter {
     return out;
   }
 
+  // The environment image beside the dataset and the root extension that names it (docs/dataset.md).
+  json environment() {
+    json ext = {{"projection", "equirectangular"}, {"units", "cd/m2"}, {"intensity", 1.0}};
+    fs::path target;
+    if (options_.environment) {
+      std::string ext2 = options_.environment->extension().string();
+      std::transform(ext2.begin(), ext2.end(), ext2.begin(), [](unsigned char c) { return std::tolower(c); });
+      if (ext2 != ".hdr" && ext2 != ".exr")
+        throw ConvertError{ErrorCode::kUsage, fmt::format("--env {}: expected an .hdr or .exr image", options_.environment->string())};
+      auto header = readImageHeader(*options_.environment);
+      if (!header) throw ConvertError{header.error().code, header.error().message};
+      if (header->width != 2 * header->height)
+        report_.warnings.push_back(fmt::format("--env {}: {}x{} is not 2:1; is it equirectangular?", options_.environment->string(),
+                                               header->width, header->height));
+      target = outDir_ / (stem_ + "_environment" + ext2);
+      std::error_code ec;
+      fs::copy_file(*options_.environment, target, fs::copy_options::overwrite_existing, ec);
+      if (ec) throw ConvertError{ErrorCode::kIo, fmt::format("{}: cannot copy the environment: {}", target.string(), ec.message())};
+      ext["source"] = options_.environment->filename().string();
+    } else {
+      const SkyImage sky = preethamSky(options_.sky);
+      target = outDir_ / (stem_ + "_sky.hdr");
+      if (auto ok = writeImage(target, FloatImage{sky.width, sky.height, 3, sky.rgb}); !ok) throw ConvertError{ok.error().code, ok.error().message};
+      ext["source"] = "dynbench Preetham sky";
+      ext["sky"] = {{"model", "Preetham 1999 + ESRA sun"}, {"turbidity", options_.sky.turbidity},
+                    {"sun_elevation_degrees", options_.sky.sunElevationDegrees}, {"sun_azimuth_degrees", options_.sky.sunAzimuthDegrees},
+                    {"sun_direction", vec(sky.sunDirection)}, {"sun_illuminance_lux", sky.sunIlluminanceLux},
+                    {"zenith_luminance_cd_m2", sky.zenithLuminance}};
+    }
+    report_.written.push_back(target);
+    ext["uri"] = uriPath(target.filename().string());
+    return ext;
+  }
+
   void writeOutputs() {
     json document = doc_;
+    document["extensions"]["DYNBENCH_environment"] = environment();
     if (!lights_.empty()) document["extensions"]["KHR_lights_punctual"] = {{"lights", lights_}};
-    std::vector<std::string> used;
+    std::vector<std::string> used{"DYNBENCH_environment"};
     if (!lights_.empty()) used.push_back("KHR_lights_punctual");
     if (usesVisibility_) {
       used.push_back("KHR_node_visibility");

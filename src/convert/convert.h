@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "convert/light_rules.h"
+#include "convert/sky.h"
 #include "core/error.h"
 
 namespace dynbench::convert {
@@ -25,6 +26,9 @@ struct ConvertOptions {
   VisibilityMode visibility = VisibilityMode::kBoth;
   LightRules lightRules = defaultLightRules();
   std::optional<std::filesystem::path> dataRoot;  // overrides the capture's `d` record
+  // Environment lighting: the user's equirectangular .hdr/.exr, or else the generated sky.
+  std::optional<std::filesystem::path> environment;
+  SkyParameters sky;
   // Progress: pass (1 or 2), frames done in it.
   std::function<void(int, std::size_t)> onProgress;
 };

@@ -1,0 +1,40 @@
+#pragma once
+// The default environment of a dataset: an analytic clear daylight sky with a sun, as an
+// equirectangular HDR image (docs/dataset.md, "Environment").
+//
+// Sky: Preetham, Shirley and Smits, "A Practical Analytic Model for Daylight", SIGGRAPH 1999:
+// luminance and chromaticity from the Perez distribution F(θ, γ) = (1 + A e^{B / cos θ})
+// (1 + C e^{D γ} + E cos² γ), scaled to the zenith values, as functions of turbidity T.
+// Sun: direct normal illuminance from the ESRA clear-sky model (Rigollier, Bauer and Wald 2000),
+// B_n = I_0 exp(-0.8662 T m δ_R(m)), with Kasten-Young air mass m, turned to lux with a luminous
+// efficacy of 93 lm/W, spread evenly over the pixels of the sun's disc.
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace dynbench::convert {
+
+struct SkyParameters {
+  double turbidity = 3.0;             // 2 (very clear) to 10 (hazy)
+  double sunElevationDegrees = 45.0;  // above the horizon
+  double sunAzimuthDegrees = 135.0;   // from -Z (the image centre) towards +X
+  int width = 1024;                   // equirectangular: height = width / 2
+};
+
+struct SkyImage {
+  int width = 0, height = 0;
+  std::vector<float> rgb;            // linear Rec.709 RGB, luminance in cd/m², top row = up (+Y)
+  glm::dvec3 sunDirection{0.0};      // towards the sun
+  double sunIlluminanceLux = 0.0;    // direct normal illuminance of the sun disc
+  double zenithLuminance = 0.0;      // cd/m², Preetham's Y_z
+};
+
+SkyImage preethamSky(const SkyParameters& parameters);
+
+// The equirectangular mapping used by the sky and documented for datasets: pixel centre (u, v) in
+// [0, 1]² to a direction; u = 0.5 looks down -Z, u grows towards +X; v = 0 is straight up.
+glm::dvec3 equirectDirection(double u, double v);
+// Solid angle of pixel row `row` of an equirectangular image of the given size, steradians.
+double equirectPixelSolidAngle(int row, int width, int height);
+
+}  // namespace dynbench::convert
