@@ -124,6 +124,8 @@ TEST(Convert, RoundTripMatchesTheCapture) {
     }
     // The flash: recorded in frames 2-3, kept 3 frames longer by the default light rules.
     EXPECT_EQ(e.ownVisibility(flash, t), f >= 2 && f <= 6) << at;
+    // ... at its captured position (0.5, 1.5, f) while recorded, then held.
+    if (f >= 2) expectClose(glm::dvec3(e.worldMatrix(flash, t)[3]), {0.5, 1.5, std::min(f, 3)}, at + " flash position");
     // Skinned vertices: world = model transform x sum_k w_k J_k IBM_k v, from the capture's values.
     const auto world = e.worldPositions(skinned, 0, t);
     ASSERT_EQ(world.size(), 4u);
