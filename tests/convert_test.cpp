@@ -183,6 +183,38 @@ TEST(Convert, EnvironmentSkyOrUserImage) {
   EXPECT_FALSE(fs::exists(options.output));
 }
 
+TEST(Convert, MaskMapBecomesMetallicRoughness) {
+  const fs::path capture = writeCapture("convert_mask");
+  const fs::path root = freshDir("convert_mask_data");
+  fs::create_directories(root / "chars");
+  std::ofstream(root / "chars/arm.png", std::ios::binary).write(reinterpret_cast<const char*>(kPng), sizeof kPng);
+  // Two mask texels: full specular, half chrome; no specular, full chrome.
+  ASSERT_TRUE(writeImage(root / "chars/arm_mask.png", FloatImage{2, 1, 3, {1.0f, 0.0f, 0.5f, 0.0f, 0.0f, 1.0f}}));
+  ConvertOptions options;
+  options.capture = capture;
+  options.dataRoot = root;
+  options.output = freshDir("convert_mask_out") / "masked.gltf";
+  auto report = convertCapture(options);
+  ASSERT_TRUE(report) << report.error().message;
+  const auto j = readJson(options.output);
+  const auto& pbr = j["materials"][0]["pbrMetallicRoughness"];
+  ASSERT_TRUE(pbr.contains("metallicRoughnessTexture"));
+  EXPECT_EQ(pbr["roughnessFactor"], 1.0);
+  const int texture = pbr["metallicRoughnessTexture"]["index"];
+  const std::string uri = j["images"][j["textures"][texture]["source"].get<int>()]["uri"];
+  auto mr = readImage(options.output.parent_path() / uri);
+  ASSERT_TRUE(mr) << mr.error().message;
+  ASSERT_EQ(mr->width, 2);
+  // roughness (G) = 1 - 0.8 x specular; metallic (B) = chrome; 8-bit, so within 1/255.
+  EXPECT_NEAR(mr->pixels[1], 0.2f, 1.0f / 255);
+  EXPECT_NEAR(mr->pixels[2], 0.5f, 1.0f / 255);
+  EXPECT_NEAR(mr->pixels[4], 1.0f, 1.0f / 255);
+  EXPECT_NEAR(mr->pixels[5], 1.0f, 1.0f / 255);
+  int status = -1;
+  const std::string validation = validate(options.output, status);
+  EXPECT_EQ(status, 0) << validation;
+}
+
 TEST(Convert, GlbHoldsTheSameDataset) {
   ConvertOptions options;
   options.glb = true;

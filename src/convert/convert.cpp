@@ -359,45 +359,99 @@ class Converter {
     if (texture.empty()) return -1;
     if (auto it = imageByTexture_.find(texture); it != imageByTexture_.end()) return it->second;
     int index = -1;
-    const fs::path relative = fs::path(texture).lexically_normal();
-    std::string ext = relative.extension().string();
+    std::string ext = fs::path(texture).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    fs::path root = options_.dataRoot ? *options_.dataRoot : fs::path(reader_->settings().dataRoot);
-    if (root.is_relative()) root = options_.capture / root;
-    const fs::path source = root / relative;
-    std::error_code ec;
-    if (relative.is_absolute() || relative.empty() || *relative.begin() == "..") {
-      report_.warnings.push_back(fmt::format("texture '{}' is not a path inside the data root; left out", texture));
-    } else if (ext != ".png" && ext != ".jpg" && ext != ".jpeg") {
+    if (ext != ".png" && ext != ".jpg" && ext != ".jpeg") {
       report_.warnings.push_back(fmt::format("texture '{}' is neither PNG nor JPEG (glTF's image formats); left out", texture));
-    } else if (!fs::is_regular_file(source, ec)) {
-      report_.warnings.push_back(fmt::format("texture '{}' not found at {}; left out", texture, source.string()));
-    } else {
+    } else if (const fs::path source = textureSource(texture); !source.empty()) {
+      const fs::path relative = fs::path(texture).lexically_normal();
       const fs::path target = outDir_ / (stem_ + "_textures") / relative;
+      std::error_code ec;
       fs::create_directories(target.parent_path(), ec);
       fs::copy_file(source, target, fs::copy_options::overwrite_existing, ec);
       if (ec) throw ConvertError{ErrorCode::kIo, fmt::format("{}: cannot copy texture: {}", target.string(), ec.message())};
       report_.written.push_back(target);
-      doc_["images"].push_back({{"uri", uriPath(stem_ + "_textures/" + relative.generic_string())},
-                                {"mimeType", ext == ".png" ? "image/png" : "image/jpeg"}});
-      doc_["textures"].push_back({{"source", doc_["images"].size() - 1}, {"sampler", 0}});
-      index = static_cast<int>(doc_["textures"].size()) - 1;
-      ++report_.textures;
+      index = addTexture(relative.generic_string(), ext == ".png" ? "image/png" : "image/jpeg");
     }
     imageByTexture_[texture] = index;
     return index;
   }
 
-  // Material per (texture, mask) pair. docs/dataset.md: base colour from the texture map;
-  // dielectric (metallic 0), roughness 0.8. The mask map is copied and named in extras until its
-  // channels are remapped into a metallic-roughness texture.
+  // A texture's file under the data root, or empty (with a warning) when it cannot be used.
+  fs::path textureSource(const std::string& texture) {
+    const fs::path relative = fs::path(texture).lexically_normal();
+    std::string ext = relative.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    fs::path root = options_.dataRoot ? *options_.dataRoot : fs::path(reader_->settings().dataRoot);
+    if (root.is_relative()) root = options_.capture / root;
+    std::error_code ec;
+    if (relative.is_absolute() || relative.empty() || *relative.begin() == "..") {
+      report_.warnings.push_back(fmt::format("texture '{}' is not a path inside the data root; left out", texture));
+      return {};
+    }
+    if (!fs::is_regular_file(root / relative, ec)) {
+      report_.warnings.push_back(fmt::format("texture '{}' not found at {}; left out", texture, (root / relative).string()));
+      return {};
+    }
+    return root / relative;
+  }
+
+  int addTexture(const std::string& relativeUri, const std::string& mime) {
+    doc_["images"].push_back({{"uri", uriPath(stem_ + "_textures/" + relativeUri)}, {"mimeType", mime}});
+    doc_["textures"].push_back({{"source", doc_["images"].size() - 1}, {"sampler", 0}});
+    ++report_.textures;
+    return static_cast<int>(doc_["textures"].size()) - 1;
+  }
+
+  // The mask map turned into a glTF metallic-roughness texture (docs/dataset.md): Cube 2 masks hold
+  // specular intensity in R and the environment-map (chrome) mask in B, so roughness (G) = 1 - 0.8 R
+  // and metallic (B) = B. Returns -1 when the mask cannot be read.
+  int metallicRoughnessFromMask(const std::string& mask) {
+    if (mask.empty()) return -1;
+    if (auto it = maskTextures_.find(mask); it != maskTextures_.end()) return it->second;
+    int index = -1;
+    if (const fs::path source = textureSource(mask); !source.empty()) {
+      auto image = readImage(source);
+      if (!image) {
+        report_.warnings.push_back(fmt::format("mask map '{}': {}; left out", mask, image.error().message));
+      } else {
+        FloatImage mr{image->width, image->height, 3, {}};
+        mr.pixels.resize(static_cast<std::size_t>(image->width) * image->height * 3);
+        for (std::size_t p = 0; p < mr.pixels.size() / 3; ++p) {
+          const float* in = &image->pixels[p * static_cast<std::size_t>(image->channels)];
+          const float specular = in[0];
+          const float chrome = image->channels >= 3 ? in[2] : 0.0f;
+          mr.pixels[p * 3 + 0] = 1.0f;                    // R: occlusion, unused
+          mr.pixels[p * 3 + 1] = 1.0f - 0.8f * specular;  // G: roughness
+          mr.pixels[p * 3 + 2] = chrome;                  // B: metallic
+        }
+        const std::string relative = (fs::path(mask).parent_path() / (fs::path(mask).stem().string() + "_metallic_roughness.png")).generic_string();
+        const fs::path target = outDir_ / (stem_ + "_textures") / relative;
+        std::error_code ec;
+        fs::create_directories(target.parent_path(), ec);
+        if (auto ok = writeImage(target, mr); !ok) throw ConvertError{ok.error().code, ok.error().message};
+        report_.written.push_back(target);
+        index = addTexture(relative, "image/png");
+      }
+    }
+    maskTextures_[mask] = index;
+    return index;
+  }
+
+  // Material per (texture, mask) pair (docs/dataset.md): base colour from the texture map;
+  // metallic and roughness from the mask map, or dielectric with roughness 0.8 without one.
   int material(const CapturedMesh& mesh) {
     const auto key = std::make_pair(mesh.texture, mesh.maskTexture);
     if (auto it = materialByMaps_.find(key); it != materialByMaps_.end()) return it->second;
     json m = {{"name", mesh.texture.empty() ? "untextured" : fs::path(mesh.texture).stem().string()},
               {"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.8}}}};
     if (int t = image(mesh.texture); t >= 0) m["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", t}};
-    if (int t = image(mesh.maskTexture); t >= 0) m["extras"] = {{"dynbench_mask_texture", t}};
+    if (int t = metallicRoughnessFromMask(mesh.maskTexture); t >= 0) {
+      m["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", t}};
+      m["pbrMetallicRoughness"]["metallicFactor"] = 1.0;
+      m["pbrMetallicRoughness"]["roughnessFactor"] = 1.0;
+      m["extras"] = {{"dynbench_mask_map", mesh.maskTexture}};
+    }
     doc_["materials"].push_back(m);
     const int index = static_cast<int>(doc_["materials"].size()) - 1;
     materialByMaps_[key] = index;
@@ -891,7 +945,7 @@ class Converter {
   std::vector<json> lights_;
   std::vector<int> meshOfModel_;
   std::map<int, int> ibmOfModel_;
-  std::map<std::string, int> imageByTexture_;
+  std::map<std::string, int> imageByTexture_, maskTextures_;
   std::map<std::pair<std::string, std::string>, int> materialByMaps_;
   std::map<std::uint64_t, int> visInputs_;
   int timesView_ = -1;

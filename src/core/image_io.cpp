@@ -1,5 +1,8 @@
 #include "core/image_io.h"
 
+#include <algorithm>
+#include <cctype>
+
 #include <OpenImageIO/imageio.h>
 
 #include "core/files.h"
@@ -11,7 +14,11 @@ Expected<void> writeImage(const std::filesystem::path& path, const FloatImage& i
   const auto tmp = temporarySibling(path);
   auto out = OIIO::ImageOutput::create(path.string());
   if (!out) return fail(ErrorCode::kIo, "{}: no image writer for this extension: {}", path.string(), OIIO::geterror());
-  const OIIO::ImageSpec spec(image.width, image.height, image.channels, OIIO::TypeDesc::FLOAT);
+  // 8-bit formats get 8-bit pixels (OpenImageIO quantises the floats); the rest keep floats.
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const bool eightBit = ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+  const OIIO::ImageSpec spec(image.width, image.height, image.channels, eightBit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
   if (!out->open(tmp.string(), spec)) return fail(ErrorCode::kIo, "{}: cannot write: {}", path.string(), out->geterror());
   if (!out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data()) || !out->close()) {
     std::error_code ec;
