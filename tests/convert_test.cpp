@@ -215,6 +215,30 @@ TEST(Convert, MaskMapBecomesMetallicRoughness) {
   EXPECT_EQ(status, 0) << validation;
 }
 
+// Blender's own glTF importer reads the dataset (the thesis rendered its datasets with Blender).
+TEST(Convert, BlenderImportsTheDataset) {
+  if (std::system("command -v blender >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "Blender is not installed (Debian package blender, with python3-numpy); the import check needs it";
+  const Converted c = convertFixture("convert_blender");
+  const std::string cmd = fmt::format("blender --background --factory-startup --python {}/tools/blender/import_gltf.py -- '{}' 2>&1",
+                                      DYNBENCH_SOURCE_DIR, c.dataset.string());
+  std::string out;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf{};
+  for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0;) out.append(buf.data(), n);
+  const int status = ::pclose(pipe);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << out;
+  const auto at = out.find("DYNBENCH_IMPORT ");
+  ASSERT_NE(at, std::string::npos) << out;
+  const auto summary = nlohmann::json::parse(out.substr(at + 16, out.find('\n', at) - at - 16));
+  EXPECT_EQ(summary["result"], "FINISHED");
+  EXPECT_EQ(summary["armatures"], 1);  // the arm
+  EXPECT_EQ(summary["cameras"], 1);
+  EXPECT_EQ(summary["lights"], 2);     // the lamp and the flash
+  EXPECT_EQ(summary["meshes"], 3);     // static tree, crate, skinned arm
+  EXPECT_GE(summary["actions"], 1);
+}
+
 TEST(Convert, GlbHoldsTheSameDataset) {
   ConvertOptions options;
   options.glb = true;
