@@ -38,10 +38,10 @@ Expected<void> runConvert(const ConvertCliOptions& cli) {
   options.sky = cli.sky;
   std::optional<Progress> progress;
   int shownPass = 0;
-  options.onProgress = [&](int pass, std::size_t frames) {
+  options.onProgress = [&](int pass, std::size_t frames, std::size_t total) {
     if (pass != shownPass) {
       progress.reset();
-      progress.emplace(fmt::format("convert pass {}/2", pass), 0, "frames");
+      progress.emplace(fmt::format("convert pass {}/2", pass), total, "frames");
       shownPass = pass;
     }
     if (frames % 64 == 0) progress->update(frames);

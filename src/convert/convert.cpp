@@ -297,7 +297,7 @@ class Converter {
       }
       times_.push_back(static_cast<float>(frame.time));
       scanFrame(frame, i, count);
-      if (options_.onProgress) options_.onProgress(1, i + 1);
+      if (options_.onProgress) options_.onProgress(1, i + 1, 0);
       ++i;
     }
     const std::size_t n = times_.size();
@@ -796,7 +796,7 @@ class Converter {
         }
         return i == t->lastSpan;
       });
-      if (options_.onProgress) options_.onProgress(2, i + 1);
+      if (options_.onProgress) options_.onProgress(2, i + 1, times_.size());
     }
     for (auto& [id, t] : tracks_) {
       for (RegionWriter* w : {&t.translation, &t.rotation, &t.visTime, &t.visValue, &t.scale}) w->flush();

@@ -29,8 +29,8 @@ struct ConvertOptions {
   // Environment lighting: the user's equirectangular .hdr/.exr, or else the generated sky.
   std::optional<std::filesystem::path> environment;
   SkyParameters sky;
-  // Progress: pass (1 or 2), frames done in it.
-  std::function<void(int, std::size_t)> onProgress;
+  // Progress: pass (1 or 2), frames done in it, frames in all (0 in pass 1: not known yet).
+  std::function<void(int, std::size_t, std::size_t)> onProgress;
 };
 
 struct ConvertReport {

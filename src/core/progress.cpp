@@ -21,7 +21,7 @@ std::string Progress::format(const std::string& label, std::size_t done, std::si
   std::string line = total ? fmt::format("{}: {}/{} {}", label, done, total, unit) : fmt::format("{}: {} {}", label, done, unit);
   if (done > 0 && elapsedSeconds > 0) {
     const double rate = static_cast<double>(done) / elapsedSeconds;
-    line += fmt::format(", {:.3g} {}/s", rate, unit);
+    line += rate >= 100 ? fmt::format(", {:.0f} {}/s", rate, unit) : fmt::format(", {:.3g} {}/s", rate, unit);
     if (total >= done && total) line += fmt::format(", {:.0f} s left", static_cast<double>(total - done) / rate);
   }
   if (!current.empty()) line += ": " + current;
