@@ -1,52 +1,98 @@
 #include "core/image_io.h"
 
-#include <algorithm>
-#include <cctype>
+#include <dlfcn.h>
+#include <unistd.h>
 
-#include <OpenImageIO/imageio.h>
+#include <cstdlib>
+#include <mutex>
 
 #include "core/files.h"
 
 namespace dynbench {
+namespace {
 
-Expected<void> writeImage(const std::filesystem::path& path, const FloatImage& image) {
-  // The writer is chosen by the final name's extension, then opened on the temporary name.
-  const auto tmp = temporarySibling(path);
-  auto out = OIIO::ImageOutput::create(path.string());
-  if (!out) return fail(ErrorCode::kIo, "{}: no image writer for this extension: {}", path.string(), OIIO::geterror());
-  // 8-bit formats get 8-bit pixels (OpenImageIO quantises the floats); the rest keep floats.
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  const bool eightBit = ext == ".png" || ext == ".jpg" || ext == ".jpeg";
-  const OIIO::ImageSpec spec(image.width, image.height, image.channels, eightBit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
-  if (!out->open(tmp.string(), spec)) return fail(ErrorCode::kIo, "{}: cannot write: {}", path.string(), out->geterror());
-  if (!out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data()) || !out->close()) {
+namespace fs = std::filesystem;
+
+using WriteFn = int (*)(const char*, const char*, int, int, int, const float*, char*, std::size_t);
+using ReadFn = int (*)(const char*, int*, int*, int*, float**, char*, std::size_t);
+using FreeFn = void (*)(float*);
+
+struct Module {
+  WriteFn write = nullptr;
+  ReadFn read = nullptr;
+  FreeFn free = nullptr;
+  std::string error;
+};
+
+// Finds the image module: $DYNBENCH_IMAGE_MODULE, beside the executable (or in ../lib/dynbench),
+// then where the build put it.
+const Module& module() {
+  static Module m;
+  static std::once_flag once;
+  std::call_once(once, [] {
+    std::vector<fs::path> candidates;
+    if (const char* env = std::getenv("DYNBENCH_IMAGE_MODULE")) candidates.emplace_back(env);
     std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    return fail(ErrorCode::kIo, "{}: write failed: {}", path.string(), out->geterror());
+    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    if (!ec) {
+      candidates.push_back(exe.parent_path() / "libdynbench_image.so");
+      candidates.push_back(exe.parent_path() / "../lib/dynbench/libdynbench_image.so");
+    }
+    candidates.emplace_back(DYNBENCH_IMAGE_MODULE_BUILD_PATH);
+    std::string tried;
+    for (const auto& c : candidates) {
+      void* handle = ::dlopen(c.c_str(), RTLD_NOW | RTLD_LOCAL);
+      if (!handle) {
+        tried += fmt::format("\n  {}: {}", c.string(), ::dlerror());
+        continue;
+      }
+      m.write = reinterpret_cast<WriteFn>(::dlsym(handle, "dynbench_image_write"));
+      m.read = reinterpret_cast<ReadFn>(::dlsym(handle, "dynbench_image_read"));
+      m.free = reinterpret_cast<FreeFn>(::dlsym(handle, "dynbench_image_free"));
+      if (m.write && m.read && m.free) return;
+      tried += fmt::format("\n  {}: not a dynbench image module", c.string());
+    }
+    m.error = "cannot load the image module (libdynbench_image.so, OpenImageIO); tried:" + tried;
+  });
+  return m;
+}
+
+}  // namespace
+
+Expected<void> writeImage(const fs::path& path, const FloatImage& image) {
+  const Module& m = module();
+  if (!m.write) return fail(ErrorCode::kExternalTool, "{}: {}", path.string(), m.error);
+  std::error_code ec;
+  if (path.has_parent_path()) fs::create_directories(path.parent_path(), ec);
+  const fs::path tmp = temporarySibling(path);
+  char error[1024] = "";
+  if (m.write(path.c_str(), tmp.c_str(), image.width, image.height, image.channels, image.pixels.data(), error, sizeof error) != 0) {
+    fs::remove(tmp, ec);
+    return fail(ErrorCode::kIo, "{}: cannot write: {}", path.string(), error);
   }
   return commitTemporary(tmp, path);
 }
 
-Expected<FloatImage> readImageHeader(const std::filesystem::path& path) {
-  auto in = OIIO::ImageInput::open(path.string());
-  if (!in) return fail(ErrorCode::kParse, "{}: not a readable image: {}", path.string(), OIIO::geterror());
-  const auto& spec = in->spec();
+Expected<FloatImage> readImageHeader(const fs::path& path) {
+  const Module& m = module();
+  if (!m.read) return fail(ErrorCode::kExternalTool, "{}: {}", path.string(), m.error);
   FloatImage image;
-  image.width = spec.width;
-  image.height = spec.height;
-  image.channels = spec.nchannels;
+  char error[1024] = "";
+  if (m.read(path.c_str(), &image.width, &image.height, &image.channels, nullptr, error, sizeof error) != 0)
+    return fail(ErrorCode::kParse, "{}: {}", path.string(), error);
   return image;
 }
 
-Expected<FloatImage> readImage(const std::filesystem::path& path) {
-  auto in = OIIO::ImageInput::open(path.string());
-  if (!in) return fail(ErrorCode::kParse, "{}: not a readable image: {}", path.string(), OIIO::geterror());
-  const auto& spec = in->spec();
-  FloatImage image{spec.width, spec.height, spec.nchannels, {}};
-  image.pixels.resize(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
-    return fail(ErrorCode::kParse, "{}: cannot read pixels: {}", path.string(), in->geterror());
+Expected<FloatImage> readImage(const fs::path& path) {
+  const Module& m = module();
+  if (!m.read) return fail(ErrorCode::kExternalTool, "{}: {}", path.string(), m.error);
+  FloatImage image;
+  float* pixels = nullptr;
+  char error[1024] = "";
+  if (m.read(path.c_str(), &image.width, &image.height, &image.channels, &pixels, error, sizeof error) != 0)
+    return fail(ErrorCode::kParse, "{}: {}", path.string(), error);
+  image.pixels.assign(pixels, pixels + static_cast<std::size_t>(image.width) * image.height * image.channels);
+  m.free(pixels);
   return image;
 }
 

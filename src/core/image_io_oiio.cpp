@@ -1,0 +1,72 @@
+// The image module: OpenImageIO behind a small C interface, built as a separate shared object
+// (dynbench_image) that dynbench loads on first use (src/core/image_io.cpp). OpenImageIO pulls in
+// some 250 shared libraries; linking it into dynbench made every command, even `--version`, spend
+// 0.7 s loading them.
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <string>
+
+#include <OpenImageIO/imageio.h>
+
+namespace {
+
+void setError(char* error, std::size_t size, const std::string& message) {
+  if (!error || size == 0) return;
+  std::strncpy(error, message.c_str(), size - 1);
+  error[size - 1] = '\0';
+}
+
+}  // namespace
+
+extern "C" {
+
+// Writes `temporary` with the writer chosen by `path`'s extension; 8-bit formats get 8-bit pixels.
+int dynbench_image_write(const char* path, const char* temporary, int width, int height, int channels, const float* pixels,
+                         char* error, std::size_t errorSize) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const bool eightBit = ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out) {
+    setError(error, errorSize, "no image writer for this extension: " + OIIO::geterror());
+    return 1;
+  }
+  const OIIO::ImageSpec spec(width, height, channels, eightBit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+  if (!out->open(temporary, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, pixels) || !out->close()) {
+    setError(error, errorSize, out->geterror());
+    return 1;
+  }
+  return 0;
+}
+
+// Reads the header (pixels == NULL) or the whole image as floats (*pixels malloc'd; free with
+// dynbench_image_free).
+int dynbench_image_read(const char* path, int* width, int* height, int* channels, float** pixels, char* error,
+                        std::size_t errorSize) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    setError(error, errorSize, "not a readable image: " + OIIO::geterror());
+    return 1;
+  }
+  const auto& spec = in->spec();
+  *width = spec.width;
+  *height = spec.height;
+  *channels = spec.nchannels;
+  if (!pixels) return 0;
+  const std::size_t count = static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels;
+  *pixels = static_cast<float*>(std::malloc(count * sizeof(float)));
+  if (!*pixels || !in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, *pixels)) {
+    setError(error, errorSize, "cannot read pixels: " + in->geterror());
+    std::free(*pixels);
+    *pixels = nullptr;
+    return 1;
+  }
+  return 0;
+}
+
+void dynbench_image_free(float* pixels) { std::free(pixels); }
+
+}  // extern "C"
