@@ -13,6 +13,19 @@ inline constexpr std::string_view kModelMeshVersionLine = "dynbench-modelmesh:1"
 inline constexpr std::string_view kCaptureFile = "Capture.txt";
 inline constexpr std::string_view kModelsFolder = "models";
 
+// What a capturable is; one id keeps one kind for its whole life.
+enum class CapturableKind { kCamera, kStaticModel, kModel, kLight };
+
+inline const char* capturableKindName(CapturableKind kind) {
+  switch (kind) {
+    case CapturableKind::kCamera: return "camera";
+    case CapturableKind::kStaticModel: return "static map model";
+    case CapturableKind::kModel: return "model";
+    case CapturableKind::kLight: return "light";
+  }
+  return "?";
+}
+
 // '%', ':', CR and LF percent-encoded so that a string never splits a record.
 inline std::string escapeField(std::string_view text) {
   std::string out;

@@ -242,16 +242,7 @@ CapturedModel parseModelMesh(const fs::path& path) {
   return model;
 }
 
-enum class Kind { kCamera, kStaticModel, kModel, kLight };
-const char* kindName(Kind k) {
-  switch (k) {
-    case Kind::kCamera: return "camera";
-    case Kind::kStaticModel: return "static map model";
-    case Kind::kModel: return "model";
-    case Kind::kLight: return "light";
-  }
-  return "?";
-}
+using Kind = CapturableKind;
 
 }  // namespace
 
@@ -417,9 +408,9 @@ Expected<bool> CaptureReader::next(CaptureFrame& frame) {
       auto claim = [&](std::uint64_t id, Kind kind, int model) {
         auto [it, inserted] = impl.capturables.emplace(id, std::make_pair(kind, model));
         if (!inserted && it->second != std::make_pair(kind, model))
-          l.fail(fmt::format("capturable {} was a {}{}; it cannot become a {}{}", id, kindName(it->second.first),
+          l.fail(fmt::format("capturable {} was a {}{}; it cannot become a {}{}", id, capturableKindName(it->second.first),
                              it->second.second >= 0 ? " of '" + models_[static_cast<std::size_t>(it->second.second)].path + "'" : "",
-                             kindName(kind), model >= 0 ? " of '" + models_[static_cast<std::size_t>(model)].path + "'" : ""));
+                             capturableKindName(kind), model >= 0 ? " of '" + models_[static_cast<std::size_t>(model)].path + "'" : ""));
       };
       auto modelAt = [&](std::size_t field) {
         const std::string path = l.text(field);

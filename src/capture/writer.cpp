@@ -28,16 +28,7 @@ int error(int code, std::string message) {
   return code;
 }
 
-enum class Kind { kCamera, kStaticModel, kModel, kLight };
-const char* kindName(Kind k) {
-  switch (k) {
-    case Kind::kCamera: return "camera";
-    case Kind::kStaticModel: return "static map model";
-    case Kind::kModel: return "model";
-    case Kind::kLight: return "light";
-  }
-  return "?";
-}
+using Kind = CapturableKind;
 
 bool finite(std::initializer_list<float> values) {
   for (float v : values)
@@ -88,7 +79,7 @@ struct dbc_session {
     auto [it, inserted] = capturables.emplace(id, std::make_pair(kind, path));
     if (!inserted && (it->second.first != kind || it->second.second != path))
       return error(DBC_ERROR_ARGUMENT, fmt::format("capturable {} was recorded as a {} '{}'; it cannot become a {} '{}'", id,
-                                                   kindName(it->second.first), it->second.second, kindName(kind), path));
+                                                   capturableKindName(it->second.first), it->second.second, capturableKindName(kind), path));
     return DBC_OK;
   }
 

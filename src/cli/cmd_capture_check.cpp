@@ -1,5 +1,5 @@
 // `dynbench capture-check DIR`: validate a capture and print its summary.
-#include <unistd.h>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 
@@ -16,15 +16,12 @@ struct CheckOptions {
 };
 
 Expected<void> runCheck(const CheckOptions& options) {
-  std::size_t shown = 0;
+  // The frame count is unknown until the end: frames read and their rate, no time left.
+  std::optional<Progress> progress(std::in_place, "capture-check", 0, "frames");
   auto summary = capture::checkCapture(options.directory, [&](std::size_t frames) {
-    // The frame count is unknown until the end: show frames read, not a fraction.
-    if (frames - shown >= 500 && ::isatty(STDERR_FILENO)) {
-      shown = frames;
-      fmt::print(stderr, "\rcapture-check: {} frames read\033[K", frames);
-    }
+    if (frames % 64 == 0) progress->update(frames);
   });
-  if (shown) fmt::print(stderr, "\r\033[K");
+  progress.reset();
   if (!summary) return std::unexpected(summary.error());
   for (const auto& warning : summary->warnings) spdlog::warn("{}", warning);
   fmt::print("{}", capture::summaryText(options.directory, *summary));
