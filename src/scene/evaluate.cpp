@@ -200,33 +200,49 @@ std::vector<double> Evaluator::morphWeights(int node, double t) const {
 }
 
 std::vector<glm::dvec3> Evaluator::worldPositions(int node, std::size_t primitive, double t) const {
+  std::vector<glm::dvec3> positions, normals;
+  worldGeometry(node, primitive, t, positions, normals);
+  return positions;
+}
+
+void Evaluator::worldGeometry(int node, std::size_t primitive, double t, std::vector<glm::dvec3>& positions,
+                              std::vector<glm::dvec3>& normals) const {
   const Node& n = scene_.nodes[static_cast<std::size_t>(node)];
   const Primitive& p = scene_.meshes[static_cast<std::size_t>(n.mesh)].primitives[primitive];
-  std::vector<glm::dvec3> out(p.positions.begin(), p.positions.end());
+  positions.assign(p.positions.begin(), p.positions.end());
+  normals.assign(p.normals.begin(), p.normals.end());
   const auto weights = morphWeights(node, t);
   for (std::size_t k = 0; k < std::min(weights.size(), p.targets.size()); ++k) {
-    if (weights[k] == 0.0 || p.targets[k].positionDeltas.empty()) continue;
-    for (std::size_t v = 0; v < out.size(); ++v) out[v] += weights[k] * glm::dvec3(p.targets[k].positionDeltas[v]);
+    if (weights[k] == 0.0) continue;
+    const auto& target = p.targets[k];
+    for (std::size_t v = 0; v < target.positionDeltas.size() && v < positions.size(); ++v)
+      positions[v] += weights[k] * glm::dvec3(target.positionDeltas[v]);
+    for (std::size_t v = 0; v < target.normalDeltas.size() && v < normals.size(); ++v)
+      normals[v] += weights[k] * glm::dvec3(target.normalDeltas[v]);
   }
+  auto normalMatrix = [](const glm::dmat4& m) { return glm::transpose(glm::inverse(glm::dmat3(m))); };
   if (n.skin >= 0 && !p.joints.empty() && !p.weights.empty()) {
     const Skin& skin = scene_.skins[static_cast<std::size_t>(n.skin)];
     std::vector<glm::dmat4> jointMatrices(skin.joints.size());
     for (std::size_t j = 0; j < skin.joints.size(); ++j)
       jointMatrices[j] = worldMatrix(skin.joints[j], t) * skin.inverseBindMatrices[j];
-    for (std::size_t v = 0; v < out.size(); ++v) {
-      glm::dvec3 skinned(0.0);
-      for (int k = 0; k < 4; ++k) {
-        const double w = p.weights[v][k];
-        if (w == 0.0) continue;
-        skinned += w * glm::dvec3(jointMatrices[p.joints[v][k]] * glm::dvec4(out[v], 1.0));
-      }
-      out[v] = skinned;
+    for (std::size_t v = 0; v < positions.size(); ++v) {
+      glm::dmat4 blended(0.0);
+      for (int k = 0; k < 4; ++k)
+        if (p.weights[v][k] != 0.0f) blended += static_cast<double>(p.weights[v][k]) * jointMatrices[p.joints[v][k]];
+      positions[v] = glm::dvec3(blended * glm::dvec4(positions[v], 1.0));
+      if (v < normals.size()) normals[v] = normalMatrix(blended) * normals[v];
     }
-    return out;
+  } else {
+    const glm::dmat4 world = worldMatrix(node, t);
+    const glm::dmat3 nm = normalMatrix(world);
+    for (auto& v : positions) v = glm::dvec3(world * glm::dvec4(v, 1.0));
+    for (auto& v : normals) v = nm * v;
   }
-  const glm::dmat4 world = worldMatrix(node, t);
-  for (auto& v : out) v = glm::dvec3(world * glm::dvec4(v, 1.0));
-  return out;
+  for (auto& v : normals) {
+    const double len = glm::length(v);
+    if (len > 0) v /= len;
+  }
 }
 
 void Evaluator::evaluate(double t, ScenePose& pose) const {

@@ -45,6 +45,10 @@ class Evaluator {
   // matrix and M_i^-1 its inverse bind matrix; the node's own transform is ignored, as glTF says)
   // or the node's world matrix.
   std::vector<glm::dvec3> worldPositions(int node, std::size_t primitive, double t) const;
+  // Positions and (unit) normals together; normals go through the same morph and skinning, with
+  // the inverse transpose of each blended matrix. `normals` is empty when the mesh has none.
+  void worldGeometry(int node, std::size_t primitive, double t, std::vector<glm::dvec3>& positions,
+                     std::vector<glm::dvec3>& normals) const;
 
   const Scene& scene() const { return scene_; }
 
