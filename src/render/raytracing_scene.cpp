@@ -1,0 +1,201 @@
+#include "render/raytracing_scene.h"
+
+#include <limits>
+
+#include <embree3/rtcore.h>
+
+#include "metrics/properties.h"
+
+namespace dynbench::render {
+namespace {
+
+// Embree reports errors through a callback; the last one is kept and turned into an Error.
+void onEmbreeError(void* user, RTCError, const char* message) { *static_cast<std::string*>(user) = message ? message : "unknown"; }
+
+struct Entry {  // what an Embree geometry is in the scene model
+  int node = -1;
+  int primitive = -1;
+  std::vector<glm::dvec3> positions, normals;  // world space (double copies for exact hit data)
+  std::vector<std::uint32_t> indices;
+};
+
+}  // namespace
+
+struct RayTracingScene::Impl {
+  const scene::Scene* scene = nullptr;
+  scene::Evaluator evaluator;
+  std::string error;
+  RTCDevice device = nullptr;
+  RTCScene top = nullptr, staticScene = nullptr, dynamicScene = nullptr;
+  std::vector<Entry> staticEntries, dynamicEntries;
+  std::vector<std::pair<int, int>> dynamicParts;  // (node, primitive) rebuilt per frame
+  RayTracingStats stats;
+
+  explicit Impl(const scene::Scene& s) : scene(&s), evaluator(s) {}
+  ~Impl() {
+    for (RTCScene* sc : {&top, &staticScene, &dynamicScene})
+      if (*sc) rtcReleaseScene(*sc);
+    if (device) rtcReleaseDevice(device);
+  }
+
+  // Adds a triangle geometry (float copy for Embree) and returns its entry.
+  void addTriangles(RTCScene target, std::vector<Entry>& entries, Entry entry) {
+    RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                                 3 * sizeof(float), entry.positions.size()));
+    for (std::size_t v = 0; v < entry.positions.size(); ++v)
+      for (int c = 0; c < 3; ++c) vertices[3 * v + static_cast<std::size_t>(c)] = static_cast<float>(entry.positions[v][c]);
+    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                   3 * sizeof(unsigned), entry.indices.size() / 3));
+    std::copy(entry.indices.begin(), entry.indices.end(), indices);
+    rtcCommitGeometry(geometry);
+    const unsigned id = rtcAttachGeometry(target, geometry);
+    rtcReleaseGeometry(geometry);
+    if (entries.size() <= id) entries.resize(id + 1);
+    entries[id] = std::move(entry);
+  }
+
+  Entry evaluate(int node, int primitive, double t) const {
+    Entry e;
+    e.node = node;
+    e.primitive = primitive;
+    evaluator.worldGeometry(node, static_cast<std::size_t>(primitive), t, e.positions, e.normals);
+    const auto& prim = scene->meshes[static_cast<std::size_t>(scene->nodes[static_cast<std::size_t>(node)].mesh)]
+                           .primitives[static_cast<std::size_t>(primitive)];
+    e.indices = prim.indices;
+    return e;
+  }
+};
+
+RayTracingScene::RayTracingScene(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+RayTracingScene::~RayTracingScene() = default;
+
+Expected<std::unique_ptr<RayTracingScene>> RayTracingScene::create(const scene::Scene& scene) {
+  auto impl = std::make_unique<Impl>(scene);
+  impl->device = rtcNewDevice(nullptr);
+  if (!impl->device) return fail(ErrorCode::kExternalTool, "Embree: cannot create a device (error {})", static_cast<int>(rtcGetDeviceError(nullptr)));
+  rtcSetDeviceErrorFunction(impl->device, onEmbreeError, &impl->error);
+  impl->staticScene = rtcNewScene(impl->device);
+  impl->dynamicScene = rtcNewScene(impl->device);
+  rtcSetSceneBuildQuality(impl->dynamicScene, RTC_BUILD_QUALITY_LOW);  // rebuilt every frame
+  rtcSetSceneFlags(impl->dynamicScene, RTC_SCENE_FLAG_DYNAMIC);
+
+  // Static: not dynamic (docs/metrics.md), not skinned, no morph animation, visible at rest.
+  const auto dynamic = metrics::dynamicNodes(scene);
+  const auto inScene = metrics::nodesInScene(scene);
+  std::vector<char> morphing(scene.nodes.size(), 0);
+  for (const auto& a : scene.animations)
+    for (const auto& c : a.channels)
+      if (c.path == scene::AnimationPath::kWeights) morphing[static_cast<std::size_t>(c.node)] = 1;
+  for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
+    const auto& node = scene.nodes[i];
+    if (!inScene[i] || node.mesh < 0) continue;
+    const auto& mesh = scene.meshes[static_cast<std::size_t>(node.mesh)];
+    for (std::size_t p = 0; p < mesh.primitives.size(); ++p) {
+      if (mesh.primitives[p].triangleCount() == 0) continue;
+      if (dynamic[i] || node.skin >= 0 || morphing[i]) {
+        impl->dynamicParts.push_back({static_cast<int>(i), static_cast<int>(p)});
+      } else if (impl->evaluator.visible(static_cast<int>(i), 0.0)) {
+        Entry e = impl->evaluate(static_cast<int>(i), static_cast<int>(p), 0.0);
+        impl->stats.staticTriangles += e.indices.size() / 3;
+        impl->addTriangles(impl->staticScene, impl->staticEntries, std::move(e));
+      }
+    }
+  }
+  rtcCommitScene(impl->staticScene);
+  impl->top = rtcNewScene(impl->device);
+  for (RTCScene child : {impl->staticScene, impl->dynamicScene}) {
+    RTCGeometry instance = rtcNewGeometry(impl->device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(instance, child);
+    const float identity[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    rtcSetGeometryTransform(instance, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, identity);
+    rtcCommitGeometry(instance);
+    rtcAttachGeometry(impl->top, instance);  // instance 0: static, 1: dynamic
+    rtcReleaseGeometry(instance);
+  }
+  rtcCommitScene(impl->dynamicScene);
+  rtcCommitScene(impl->top);
+  if (!impl->error.empty()) return fail(ErrorCode::kExternalTool, "Embree: {}", impl->error);
+  return std::unique_ptr<RayTracingScene>(new RayTracingScene(std::move(impl)));
+}
+
+void RayTracingScene::update(double t) {
+  Impl& m = *impl_;
+  // Rebuilding the small dynamic BVH from scratch each frame is simpler than refitting and, with
+  // LOW build quality, cheap next to shading (measured in the render benchmark).
+  rtcReleaseScene(m.dynamicScene);
+  m.dynamicScene = rtcNewScene(m.device);
+  rtcSetSceneBuildQuality(m.dynamicScene, RTC_BUILD_QUALITY_LOW);
+  m.dynamicEntries.clear();
+  m.stats.dynamicTriangles = 0;
+  for (const auto& [node, primitive] : m.dynamicParts) {
+    if (!m.evaluator.visible(node, t)) continue;
+    Entry e = m.evaluate(node, primitive, t);
+    m.stats.dynamicTriangles += e.indices.size() / 3;
+    m.addTriangles(m.dynamicScene, m.dynamicEntries, std::move(e));
+  }
+  rtcCommitScene(m.dynamicScene);
+  RTCGeometry instance = rtcGetGeometry(m.top, 1);
+  rtcSetGeometryInstancedScene(instance, m.dynamicScene);
+  rtcCommitGeometry(instance);
+  rtcCommitScene(m.top);
+}
+
+SurfaceHit RayTracingScene::intersect(const Ray& ray, double tMin, double tMax) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh{};
+  rh.ray.org_x = static_cast<float>(ray.origin.x);
+  rh.ray.org_y = static_cast<float>(ray.origin.y);
+  rh.ray.org_z = static_cast<float>(ray.origin.z);
+  rh.ray.dir_x = static_cast<float>(ray.direction.x);
+  rh.ray.dir_y = static_cast<float>(ray.direction.y);
+  rh.ray.dir_z = static_cast<float>(ray.direction.z);
+  rh.ray.tnear = static_cast<float>(tMin);
+  rh.ray.tfar = static_cast<float>(std::min(tMax, 1e30));
+  rh.ray.mask = 0xFFFFFFFF;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(impl_->top, &context, &rh);
+  SurfaceHit hit;
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
+  const auto& entries = rh.hit.instID[0] == 0 ? impl_->staticEntries : impl_->dynamicEntries;
+  const Entry& e = entries[rh.hit.geomID];
+  hit.hit = true;
+  hit.distance = rh.ray.tfar;
+  hit.node = e.node;
+  hit.primitive = e.primitive;
+  hit.triangle = rh.hit.primID;
+  hit.barycentric = {rh.hit.u, rh.hit.v};
+  const std::uint32_t i0 = e.indices[3 * rh.hit.primID], i1 = e.indices[3 * rh.hit.primID + 1], i2 = e.indices[3 * rh.hit.primID + 2];
+  const double u = rh.hit.u, v = rh.hit.v, w = 1.0 - u - v;
+  hit.position = w * e.positions[i0] + u * e.positions[i1] + v * e.positions[i2];
+  hit.geometricNormal = glm::normalize(glm::cross(e.positions[i1] - e.positions[i0], e.positions[i2] - e.positions[i0]));
+  hit.shadingNormal = hit.geometricNormal;
+  if (!e.normals.empty()) {
+    const glm::dvec3 n = w * e.normals[i0] + u * e.normals[i1] + v * e.normals[i2];
+    if (glm::length(n) > 0) hit.shadingNormal = glm::normalize(n);
+  }
+  return hit;
+}
+
+bool RayTracingScene::occluded(const glm::dvec3& origin, const glm::dvec3& direction, double tMax) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay ray{};
+  ray.org_x = static_cast<float>(origin.x);
+  ray.org_y = static_cast<float>(origin.y);
+  ray.org_z = static_cast<float>(origin.z);
+  ray.dir_x = static_cast<float>(direction.x);
+  ray.dir_y = static_cast<float>(direction.y);
+  ray.dir_z = static_cast<float>(direction.z);
+  ray.tnear = 0.0f;
+  ray.tfar = static_cast<float>(tMax);
+  ray.mask = 0xFFFFFFFF;
+  rtcOccluded1(impl_->top, &context, &ray);
+  return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
+}
+
+RayTracingStats RayTracingScene::stats() const { return impl_->stats; }
+
+}  // namespace dynbench::render
