@@ -118,5 +118,26 @@ TEST(Sky, HdrFileRoundTripsThroughOpenImageIO) {
   EXPECT_FALSE(header);
 }
 
+// Feature buffers are EXR files with named channels (P.X, N.Z, direct.R, ...); they must survive.
+TEST(ImageIo, ExrKeepsNamedFloatChannels) {
+  FloatImage image{3, 2, 4, {}, {"P.X", "P.Y", "P.Z", "hit"}};
+  for (int i = 0; i < 24; ++i) image.pixels.push_back(i * 1.5f - 7.0f + 1e-3f * i);
+  const auto file = test::freshDir("exr_names") / "frame_00000.exr";
+  ASSERT_TRUE(writeImage(file, image));
+  auto back = readImage(file);
+  ASSERT_TRUE(back) << back.error().message;
+  ASSERT_EQ(back->channels, 4);
+  EXPECT_EQ(back->channelNames.size(), 4u);
+  // OpenEXR stores channels sorted by name; find each by name and compare exactly (32-bit float).
+  for (int c = 0; c < 4; ++c) {
+    const auto it = std::find(back->channelNames.begin(), back->channelNames.end(), image.channelNames[static_cast<std::size_t>(c)]);
+    ASSERT_NE(it, back->channelNames.end()) << image.channelNames[static_cast<std::size_t>(c)];
+    const int b = static_cast<int>(it - back->channelNames.begin());
+    for (int p = 0; p < 6; ++p) EXPECT_EQ(back->pixels[static_cast<std::size_t>(p * 4 + b)], image.pixels[static_cast<std::size_t>(p * 4 + c)]);
+  }
+  FloatImage wrong{1, 1, 2, {0, 0}, {"only one"}};
+  EXPECT_FALSE(writeImage(file, wrong));
+}
+
 }  // namespace
 }  // namespace dynbench::convert

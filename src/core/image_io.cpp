@@ -13,8 +13,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-using WriteFn = int (*)(const char*, const char*, int, int, int, const float*, char*, std::size_t);
-using ReadFn = int (*)(const char*, int*, int*, int*, float**, char*, std::size_t);
+using WriteFn = int (*)(const char*, const char*, int, int, int, const float*, const char* const*, char*, std::size_t);
+using ReadFn = int (*)(const char*, int*, int*, int*, float**, char*, std::size_t, char*, std::size_t);
 using FreeFn = void (*)(float*);
 
 struct Module {
@@ -66,34 +66,42 @@ Expected<void> writeImage(const fs::path& path, const FloatImage& image) {
   if (path.has_parent_path()) fs::create_directories(path.parent_path(), ec);
   const fs::path tmp = temporarySibling(path);
   char error[1024] = "";
-  if (m.write(path.c_str(), tmp.c_str(), image.width, image.height, image.channels, image.pixels.data(), error, sizeof error) != 0) {
+  if (!image.channelNames.empty() && image.channelNames.size() != static_cast<std::size_t>(image.channels))
+    return fail(ErrorCode::kInvalidData, "{}: {} channel names for {} channels", path.string(), image.channelNames.size(), image.channels);
+  std::vector<const char*> names;
+  for (const auto& n : image.channelNames) names.push_back(n.c_str());
+  if (m.write(path.c_str(), tmp.c_str(), image.width, image.height, image.channels, image.pixels.data(),
+              names.empty() ? nullptr : names.data(), error, sizeof error) != 0) {
     fs::remove(tmp, ec);
     return fail(ErrorCode::kIo, "{}: cannot write: {}", path.string(), error);
   }
   return commitTemporary(tmp, path);
 }
 
-Expected<FloatImage> readImageHeader(const fs::path& path) {
-  const Module& m = module();
-  if (!m.read) return fail(ErrorCode::kExternalTool, "{}: {}", path.string(), m.error);
-  FloatImage image;
-  char error[1024] = "";
-  if (m.read(path.c_str(), &image.width, &image.height, &image.channels, nullptr, error, sizeof error) != 0)
-    return fail(ErrorCode::kParse, "{}: {}", path.string(), error);
-  return image;
-}
+namespace {
 
-Expected<FloatImage> readImage(const fs::path& path) {
+Expected<FloatImage> read(const fs::path& path, bool pixelsToo) {
   const Module& m = module();
   if (!m.read) return fail(ErrorCode::kExternalTool, "{}: {}", path.string(), m.error);
   FloatImage image;
   float* pixels = nullptr;
   char error[1024] = "";
-  if (m.read(path.c_str(), &image.width, &image.height, &image.channels, &pixels, error, sizeof error) != 0)
+  std::string names(4096, '\0');
+  if (m.read(path.c_str(), &image.width, &image.height, &image.channels, pixelsToo ? &pixels : nullptr, names.data(), names.size(),
+             error, sizeof error) != 0)
     return fail(ErrorCode::kParse, "{}: {}", path.string(), error);
-  image.pixels.assign(pixels, pixels + static_cast<std::size_t>(image.width) * image.height * image.channels);
-  m.free(pixels);
+  for (std::size_t start = 0, end; (end = names.find('\n', start)) != std::string::npos; start = end + 1)
+    image.channelNames.push_back(names.substr(start, end - start));
+  if (pixels) {
+    image.pixels.assign(pixels, pixels + static_cast<std::size_t>(image.width) * image.height * image.channels);
+    m.free(pixels);
+  }
   return image;
 }
+
+}  // namespace
+
+Expected<FloatImage> readImageHeader(const fs::path& path) { return read(path, false); }
+Expected<FloatImage> readImage(const fs::path& path) { return read(path, true); }
 
 }  // namespace dynbench

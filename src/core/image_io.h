@@ -2,6 +2,7 @@
 // Image files through OpenImageIO (Debian libopenimageio-dev). This is the only place that talks
 // to OpenImageIO; its errors come back as Error.
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "core/error.h"
@@ -11,6 +12,7 @@ namespace dynbench {
 struct FloatImage {
   int width = 0, height = 0, channels = 0;
   std::vector<float> pixels;  // row-major, top row first, channels interleaved
+  std::vector<std::string> channelNames;  // empty: the format's defaults (R, G, B, A)
 };
 
 // Writes to a temporary name and renames, as every output. The format follows the extension

@@ -25,7 +25,7 @@ extern "C" {
 
 // Writes `temporary` with the writer chosen by `path`'s extension; 8-bit formats get 8-bit pixels.
 int dynbench_image_write(const char* path, const char* temporary, int width, int height, int channels, const float* pixels,
-                         char* error, std::size_t errorSize) {
+                         const char* const* channelNames, char* error, std::size_t errorSize) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   const bool eightBit = ext == ".png" || ext == ".jpg" || ext == ".jpeg";
@@ -34,7 +34,11 @@ int dynbench_image_write(const char* path, const char* temporary, int width, int
     setError(error, errorSize, "no image writer for this extension: " + OIIO::geterror());
     return 1;
   }
-  const OIIO::ImageSpec spec(width, height, channels, eightBit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+  OIIO::ImageSpec spec(width, height, channels, eightBit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+  if (channelNames) {
+    spec.channelnames.assign(channelNames, channelNames + channels);
+    spec.alpha_channel = -1;  // feature buffers have no alpha; keep every channel as it is
+  }
   if (!out->open(temporary, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, pixels) || !out->close()) {
     setError(error, errorSize, out->geterror());
     return 1;
@@ -44,8 +48,8 @@ int dynbench_image_write(const char* path, const char* temporary, int width, int
 
 // Reads the header (pixels == NULL) or the whole image as floats (*pixels malloc'd; free with
 // dynbench_image_free).
-int dynbench_image_read(const char* path, int* width, int* height, int* channels, float** pixels, char* error,
-                        std::size_t errorSize) {
+int dynbench_image_read(const char* path, int* width, int* height, int* channels, float** pixels, char* names,
+                        std::size_t namesSize, char* error, std::size_t errorSize) {
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     setError(error, errorSize, "not a readable image: " + OIIO::geterror());
@@ -55,6 +59,11 @@ int dynbench_image_read(const char* path, int* width, int* height, int* channels
   *width = spec.width;
   *height = spec.height;
   *channels = spec.nchannels;
+  if (names && namesSize) {  // channel names joined by '\n'
+    std::string joined;
+    for (const auto& n : spec.channelnames) joined += n + "\n";
+    setError(names, namesSize, joined);
+  }
   if (!pixels) return 0;
   const std::size_t count = static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels;
   *pixels = static_cast<float*>(std::malloc(count * sizeof(float)));
