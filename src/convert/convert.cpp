@@ -415,7 +415,7 @@ class Converter {
       if (!image) {
         report_.warnings.push_back(fmt::format("mask map '{}': {}; left out", mask, image.error().message));
       } else {
-        FloatImage mr{image->width, image->height, 3, {}};
+        FloatImage mr{image->width, image->height, 3, {}, {}};
         mr.pixels.resize(static_cast<std::size_t>(image->width) * image->height * 3);
         for (std::size_t p = 0; p < mr.pixels.size() / 3; ++p) {
           const float* in = &image->pixels[p * static_cast<std::size_t>(image->channels)];
@@ -649,7 +649,7 @@ class Converter {
         region(t.span(), 16, t.rotationOffset, view);
         channel(input, accessor(view, 0, kFloat, t.span(), "VEC4"), "LINEAR", t.node, "rotation");
       }
-      if (t.hasVisibilityChannel() && (nodeVisibility && t.kind != Kind::kCamera || scaleVisibility)) {
+      if (t.hasVisibilityChannel() && ((nodeVisibility && t.kind != Kind::kCamera) || scaleVisibility)) {
         region(t.visibilityKeys, 4, t.visTimeOffset, view);
         const int visInput = accessor(view, 0, kFloat, t.visibilityKeys, "SCALAR", std::vector<float>{times_.front()},
                                       std::vector<float>{times_[t.lastKeyFrame]});
