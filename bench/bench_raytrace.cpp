@@ -1,0 +1,83 @@
+// Raw Embree ray throughput on a dataset, no shading (run by hand; the render benchmark's ceiling):
+//   build/release/bench/bench_raytrace DATASET [TIME_SECONDS]
+// Prints the BVH build times (static once, dynamic per frame) and single-thread rays per second for
+// primary rays (640x360) and random incoherent rays (random origins in the scene's bounds,
+// uniformly random directions).
+#include <chrono>
+#include <cstdio>
+#include <random>
+
+#include "render/camera.h"
+#include "render/raytracing_scene.h"
+#include "metrics/camera_motion.h"
+#include "scene/load.h"
+
+using namespace dynbench;
+using Clock = std::chrono::steady_clock;
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: bench_raytrace DATASET [TIME_SECONDS]\n");
+    return 2;
+  }
+  auto scene = scene::loadScene(argv[1]);
+  if (!scene) {
+    std::fprintf(stderr, "%s\n", scene.error().message.c_str());
+    return 1;
+  }
+  const double t = argc > 2 ? std::atof(argv[2]) : scene->timeRange().start;
+  auto start = Clock::now();
+  auto rt = render::RayTracingScene::create(*scene);
+  if (!rt) {
+    std::fprintf(stderr, "%s\n", rt.error().message.c_str());
+    return 1;
+  }
+  const double staticBuild = std::chrono::duration<double>(Clock::now() - start).count();
+  start = Clock::now();
+  constexpr int kUpdates = 10;
+  for (int i = 0; i < kUpdates; ++i) (*rt)->update(t + i / 60.0);
+  const double dynamicBuild = std::chrono::duration<double>(Clock::now() - start).count() / kUpdates;
+  const auto stats = (*rt)->stats();
+  std::printf("%s at t = %.3f s: %zu static triangles (BVH %.1f ms, once), %zu dynamic triangles (update %.2f ms per frame)\n", argv[1],
+              t, stats.staticTriangles, staticBuild * 1e3, stats.dynamicTriangles, dynamicBuild * 1e3);
+
+  // Primary rays through the dataset's camera (or a default view of the origin).
+  auto node = metrics::selectCameraNode(*scene, std::nullopt);
+  const scene::Evaluator evaluator(*scene);
+  scene::Camera lens;
+  lens.yfov = 1.0;
+  lens.znear = 0.1;
+  glm::dmat4 world(1.0);
+  world[3] = glm::dvec4(0, 2, 10, 1);
+  if (node && *node >= 0) {
+    lens = scene->cameras[static_cast<std::size_t>(scene->nodes[static_cast<std::size_t>(*node)].camera)];
+    world = evaluator.worldMatrix(*node, t);
+  }
+  const render::RenderCamera camera(world, lens, 640, 360);
+  std::size_t hits = 0;
+  start = Clock::now();
+  for (int repeat = 0; repeat < 4; ++repeat)
+    for (int y = 0; y < 360; ++y)
+      for (int x = 0; x < 640; ++x) hits += (*rt)->intersect(camera.ray(x + 0.5, y + 0.5)).hit;
+  const double primary = std::chrono::duration<double>(Clock::now() - start).count();
+  std::printf("primary rays:  %.2f Mrays/s (one thread, %.0f %% hit)\n", 4 * 640 * 360 / primary / 1e6, 100.0 * hits / (4 * 640 * 360));
+
+  // Incoherent rays: origins around the camera (within 20 units), random directions.
+  std::mt19937 random(1);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  constexpr int kRays = 1'000'000;
+  std::vector<render::Ray> rays(kRays);
+  for (auto& r : rays) {
+    r.origin = camera.position() + 20.0 * glm::dvec3(u(random), u(random), u(random));
+    glm::dvec3 d;
+    do d = {u(random), u(random), u(random)};
+    while (glm::length(d) > 1.0 || glm::length(d) < 1e-3);
+    r.direction = glm::normalize(d);
+  }
+  hits = 0;
+  start = Clock::now();
+  for (const auto& r : rays) hits += (*rt)->intersect(r).hit;
+  const double incoherent = std::chrono::duration<double>(Clock::now() - start).count();
+  std::printf("random rays:   %.2f Mrays/s (one thread, %.0f %% hit)\n", kRays / incoherent / 1e6, 100.0 * hits / kRays);
+  return 0;
+}
