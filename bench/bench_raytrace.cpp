@@ -38,6 +38,14 @@ int main(int argc, char** argv) {
   for (int i = 0; i < kUpdates; ++i) (*rt)->update(t + i / 60.0);
   const double dynamicBuild = std::chrono::duration<double>(Clock::now() - start).count() / kUpdates;
   const auto stats = (*rt)->stats();
+  {
+    const scene::Evaluator evaluator(*scene);
+    scene::ScenePose pose;
+    const auto s0 = Clock::now();
+    for (int i = 0; i < kUpdates; ++i) evaluator.evaluate(t + i / 60.0, pose);
+    std::printf("scene pose (%zu nodes): %.2f ms per frame\n", scene->nodes.size(),
+                std::chrono::duration<double>(Clock::now() - s0).count() * 1e3 / kUpdates);
+  }
   std::printf("%s at t = %.3f s: %zu static triangles (BVH %.1f ms, once), %zu dynamic triangles (update %.2f ms per frame)\n", argv[1],
               t, stats.staticTriangles, staticBuild * 1e3, stats.dynamicTriangles, dynamicBuild * 1e3);
 

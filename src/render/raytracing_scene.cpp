@@ -15,6 +15,8 @@ void onEmbreeError(void* user, RTCError, const char* message) { *static_cast<std
 struct Entry {  // what an Embree geometry is in the scene model
   int node = -1;
   int primitive = -1;
+  RTCGeometry geometry = nullptr;  // dynamic entries keep theirs to update it every frame
+  bool enabled = true;
   std::vector<glm::dvec3> positions, normals;  // world space (double copies for exact hit data)
   std::vector<std::uint32_t> indices;
 };
@@ -28,38 +30,48 @@ struct RayTracingScene::Impl {
   RTCDevice device = nullptr;
   RTCScene top = nullptr, staticScene = nullptr, dynamicScene = nullptr;
   std::vector<Entry> staticEntries, dynamicEntries;
-  std::vector<std::pair<int, int>> dynamicParts;  // (node, primitive) rebuilt per frame
+  scene::ScenePose pose;                          // every node at the last update's time
   RayTracingStats stats;
 
   explicit Impl(const scene::Scene& s) : scene(&s), evaluator(s) {}
   ~Impl() {
+    for (auto& e : dynamicEntries)
+      if (e.geometry) rtcReleaseGeometry(e.geometry);
     for (RTCScene* sc : {&top, &staticScene, &dynamicScene})
       if (*sc) rtcReleaseScene(*sc);
     if (device) rtcReleaseDevice(device);
   }
 
-  // Adds a triangle geometry (float copy for Embree) and returns its entry.
-  void addTriangles(RTCScene target, std::vector<Entry>& entries, Entry entry) {
+  static void copyVertices(RTCGeometry geometry, const std::vector<glm::dvec3>& positions) {
+    auto* vertices = static_cast<float*>(rtcGetGeometryBufferData(geometry, RTC_BUFFER_TYPE_VERTEX, 0));
+    for (std::size_t v = 0; v < positions.size(); ++v)
+      for (int c = 0; c < 3; ++c) vertices[3 * v + static_cast<std::size_t>(c)] = static_cast<float>(positions[v][c]);
+  }
+
+  // Adds a triangle geometry (a float copy for Embree). Dynamic geometries are refitted every
+  // frame: same topology, new vertices, so Embree updates bounds instead of rebuilding.
+  void addTriangles(RTCScene target, std::vector<Entry>& entries, Entry entry, bool dynamicGeometry) {
     RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                                 3 * sizeof(float), entry.positions.size()));
-    for (std::size_t v = 0; v < entry.positions.size(); ++v)
-      for (int c = 0; c < 3; ++c) vertices[3 * v + static_cast<std::size_t>(c)] = static_cast<float>(entry.positions[v][c]);
+    rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), entry.positions.size());
+    copyVertices(geometry, entry.positions);
     auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                                    3 * sizeof(unsigned), entry.indices.size() / 3));
     std::copy(entry.indices.begin(), entry.indices.end(), indices);
+    if (dynamicGeometry) rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_REFIT);
     rtcCommitGeometry(geometry);
     const unsigned id = rtcAttachGeometry(target, geometry);
-    rtcReleaseGeometry(geometry);
+    if (dynamicGeometry) entry.geometry = geometry;  // the scene holds a reference too
+    else rtcReleaseGeometry(geometry);
     if (entries.size() <= id) entries.resize(id + 1);
     entries[id] = std::move(entry);
   }
 
-  Entry evaluate(int node, int primitive, double t) const {
+  Entry evaluate(int node, int primitive, double t, const scene::ScenePose* pose = nullptr) const {
     Entry e;
     e.node = node;
     e.primitive = primitive;
-    evaluator.worldGeometry(node, static_cast<std::size_t>(primitive), t, e.positions, e.normals);
+    if (pose) evaluator.worldGeometry(node, static_cast<std::size_t>(primitive), t, *pose, e.positions, e.normals);
+    else evaluator.worldGeometry(node, static_cast<std::size_t>(primitive), t, e.positions, e.normals);
     const auto& prim = scene->meshes[static_cast<std::size_t>(scene->nodes[static_cast<std::size_t>(node)].mesh)]
                            .primitives[static_cast<std::size_t>(primitive)];
     e.indices = prim.indices;
@@ -94,11 +106,12 @@ Expected<std::unique_ptr<RayTracingScene>> RayTracingScene::create(const scene::
     for (std::size_t p = 0; p < mesh.primitives.size(); ++p) {
       if (mesh.primitives[p].triangleCount() == 0) continue;
       if (dynamic[i] || node.skin >= 0 || morphing[i]) {
-        impl->dynamicParts.push_back({static_cast<int>(i), static_cast<int>(p)});
+        // Created once with the rest pose; update() refits it to each frame.
+        impl->addTriangles(impl->dynamicScene, impl->dynamicEntries, impl->evaluate(static_cast<int>(i), static_cast<int>(p), 0.0), true);
       } else if (impl->evaluator.visible(static_cast<int>(i), 0.0)) {
         Entry e = impl->evaluate(static_cast<int>(i), static_cast<int>(p), 0.0);
         impl->stats.staticTriangles += e.indices.size() / 3;
-        impl->addTriangles(impl->staticScene, impl->staticEntries, std::move(e));
+        impl->addTriangles(impl->staticScene, impl->staticEntries, std::move(e), false);
       }
     }
   }
@@ -121,23 +134,26 @@ Expected<std::unique_ptr<RayTracingScene>> RayTracingScene::create(const scene::
 
 void RayTracingScene::update(double t) {
   Impl& m = *impl_;
-  // Rebuilding the small dynamic BVH from scratch each frame is simpler than refitting and, with
-  // LOW build quality, cheap next to shading (measured in the render benchmark).
-  rtcReleaseScene(m.dynamicScene);
-  m.dynamicScene = rtcNewScene(m.device);
-  rtcSetSceneBuildQuality(m.dynamicScene, RTC_BUILD_QUALITY_LOW);
-  m.dynamicEntries.clear();
   m.stats.dynamicTriangles = 0;
-  for (const auto& [node, primitive] : m.dynamicParts) {
-    if (!m.evaluator.visible(node, t)) continue;
-    Entry e = m.evaluate(node, primitive, t);
+  m.evaluator.evaluate(t, m.pose);  // all world matrices and visibility once, then look them up
+  for (auto& e : m.dynamicEntries) {
+    if (!e.geometry) continue;
+    const bool visible = m.pose.visible[static_cast<std::size_t>(e.node)] != 0;
+    if (!visible) {
+      if (e.enabled) rtcDisableGeometry(e.geometry);
+      e.enabled = false;
+      continue;
+    }
+    m.evaluator.worldGeometry(e.node, static_cast<std::size_t>(e.primitive), t, m.pose, e.positions, e.normals);
+    Impl::copyVertices(e.geometry, e.positions);
+    rtcUpdateGeometryBuffer(e.geometry, RTC_BUFFER_TYPE_VERTEX, 0);
+    if (!e.enabled) rtcEnableGeometry(e.geometry);
+    e.enabled = true;
+    rtcCommitGeometry(e.geometry);
     m.stats.dynamicTriangles += e.indices.size() / 3;
-    m.addTriangles(m.dynamicScene, m.dynamicEntries, std::move(e));
   }
   rtcCommitScene(m.dynamicScene);
-  RTCGeometry instance = rtcGetGeometry(m.top, 1);
-  rtcSetGeometryInstancedScene(instance, m.dynamicScene);
-  rtcCommitGeometry(instance);
+  rtcCommitGeometry(rtcGetGeometry(m.top, 1));
   rtcCommitScene(m.top);
 }
 

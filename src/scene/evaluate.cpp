@@ -207,6 +207,19 @@ std::vector<glm::dvec3> Evaluator::worldPositions(int node, std::size_t primitiv
 
 void Evaluator::worldGeometry(int node, std::size_t primitive, double t, std::vector<glm::dvec3>& positions,
                               std::vector<glm::dvec3>& normals) const {
+  ScenePose pose;
+  pose.world.resize(scene_.nodes.size());
+  // Only the matrices this primitive needs: its node's, or its skin's joints'.
+  const Node& owner = scene_.nodes[static_cast<std::size_t>(node)];
+  if (owner.skin >= 0)
+    for (int j : scene_.skins[static_cast<std::size_t>(owner.skin)].joints) pose.world[static_cast<std::size_t>(j)] = worldMatrix(j, t);
+  else
+    pose.world[static_cast<std::size_t>(node)] = worldMatrix(node, t);
+  worldGeometry(node, primitive, t, pose, positions, normals);
+}
+
+void Evaluator::worldGeometry(int node, std::size_t primitive, double t, const ScenePose& pose, std::vector<glm::dvec3>& positions,
+                              std::vector<glm::dvec3>& normals) const {
   const Node& n = scene_.nodes[static_cast<std::size_t>(node)];
   const Primitive& p = scene_.meshes[static_cast<std::size_t>(n.mesh)].primitives[primitive];
   positions.assign(p.positions.begin(), p.positions.end());
@@ -225,7 +238,7 @@ void Evaluator::worldGeometry(int node, std::size_t primitive, double t, std::ve
     const Skin& skin = scene_.skins[static_cast<std::size_t>(n.skin)];
     std::vector<glm::dmat4> jointMatrices(skin.joints.size());
     for (std::size_t j = 0; j < skin.joints.size(); ++j)
-      jointMatrices[j] = worldMatrix(skin.joints[j], t) * skin.inverseBindMatrices[j];
+      jointMatrices[j] = pose.world[static_cast<std::size_t>(skin.joints[j])] * skin.inverseBindMatrices[j];
     for (std::size_t v = 0; v < positions.size(); ++v) {
       glm::dmat4 blended(0.0);
       for (int k = 0; k < 4; ++k)
@@ -234,7 +247,7 @@ void Evaluator::worldGeometry(int node, std::size_t primitive, double t, std::ve
       if (v < normals.size()) normals[v] = normalMatrix(blended) * normals[v];
     }
   } else {
-    const glm::dmat4 world = worldMatrix(node, t);
+    const glm::dmat4& world = pose.world[static_cast<std::size_t>(node)];
     const glm::dmat3 nm = normalMatrix(world);
     for (auto& v : positions) v = glm::dvec3(world * glm::dvec4(v, 1.0));
     for (auto& v : normals) v = nm * v;

@@ -49,6 +49,10 @@ class Evaluator {
   // the inverse transpose of each blended matrix. `normals` is empty when the mesh has none.
   void worldGeometry(int node, std::size_t primitive, double t, std::vector<glm::dvec3>& positions,
                      std::vector<glm::dvec3>& normals) const;
+  // The same from a pose evaluate() computed for time t: every world matrix is looked up, not
+  // recomputed (a renderer evaluates the pose once per frame).
+  void worldGeometry(int node, std::size_t primitive, double t, const ScenePose& pose, std::vector<glm::dvec3>& positions,
+                     std::vector<glm::dvec3>& normals) const;
 
   const Scene& scene() const { return scene_; }
 
