@@ -30,11 +30,7 @@ const unsigned char kPng[] = {137, 80, 78, 71, 13, 10, 26, 10, 0, 0, 0, 13, 73, 
 std::string validate(const fs::path& file, int& status) {
   const std::string cmd = fmt::format("node {}/tools/gltf-validator/validate.mjs '{}' 2>&1", DYNBENCH_SOURCE_DIR, file.string());
   std::string out;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf{};
-  for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0;) out.append(buf.data(), n);
-  const int raw = ::pclose(pipe);
-  status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  status = runShell(cmd, out);
   return out;
 }
 
@@ -223,11 +219,7 @@ TEST(Convert, BlenderImportsTheDataset) {
   const std::string cmd = fmt::format("blender --background --factory-startup --python {}/tools/blender/import_gltf.py -- '{}' 2>&1",
                                       DYNBENCH_SOURCE_DIR, c.dataset.string());
   std::string out;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf{};
-  for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0;) out.append(buf.data(), n);
-  const int status = ::pclose(pipe);
-  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << out;
+  ASSERT_EQ(runShell(cmd, out), 0) << out;
   const auto at = out.find("DYNBENCH_IMPORT ");
   ASSERT_NE(at, std::string::npos) << out;
   const auto summary = nlohmann::json::parse(out.substr(at + 16, out.find('\n', at) - at - 16));

@@ -11,6 +11,16 @@
 
 namespace dynbench {
 
+// Runs a shell command; returns its exit status (-1 if it did not exit) and appends its stdout.
+inline int runShell(const std::string& command, std::string& out) {
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return -1;
+  std::array<char, 4096> buf{};
+  for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0;) out.append(buf.data(), n);
+  const int status = ::pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
 struct Run {
   int status = -1;
   std::string out, err;
@@ -20,11 +30,7 @@ inline Run dynbench(const std::string& args, const std::filesystem::path& dir) {
   const std::filesystem::path errFile = dir / "stderr.txt";
   const std::string cmd = std::string(DYNBENCH_EXE) + " " + args + " 2>" + errFile.string();
   Run r;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf{};
-  for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0;) r.out.append(buf.data(), n);
-  const int status = ::pclose(pipe);
-  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.status = runShell(cmd, r.out);
   std::ifstream e(errFile);
   std::stringstream ss;
   ss << e.rdbuf();

@@ -75,9 +75,7 @@ Expected<CameraMotion> measureCameraMotion(const Scene& scene, double fps, const
   motion.cameraName = !cameraNode.name.empty() ? cameraNode.name : scene.cameras[static_cast<std::size_t>(cameraNode.camera)].name;
 
   const auto range = scene.timeRange();
-  bool animated = false;
-  for (const auto& a : scene.animations) animated = animated || !a.channels.empty();
-  const std::size_t count = std::max<std::size_t>(1, frameCount(range, animated, fps));
+  const std::size_t count = std::max<std::size_t>(1, frameCount(scene, fps));
   const Evaluator evaluator(scene);
   motion.frames.resize(count);
   std::vector<double> dPosition, dRotation, dPitch, dYaw, dRoll;

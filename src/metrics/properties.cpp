@@ -16,6 +16,12 @@ std::size_t frameCount(const Scene::TimeRange& range, bool animated, double fps)
   return static_cast<std::size_t>(std::floor((range.end - range.start) * fps + 1e-6)) + 1;
 }
 
+std::size_t frameCount(const Scene& scene, double fps) {
+  bool animated = false;
+  for (const auto& a : scene.animations) animated = animated || !a.channels.empty();
+  return frameCount(scene.timeRange(), animated, fps);
+}
+
 std::vector<char> dynamicNodes(const Scene& scene) {
   std::vector<char> animated(scene.nodes.size(), 0);
   for (const auto& animation : scene.animations)
@@ -86,12 +92,10 @@ DatasetProperties measureProperties(const Scene& scene, double fps) {
   for (const auto& image : scene.images) p.textureBytes += image.bytes;
 
   const auto range = scene.timeRange();
-  bool animated = false;
-  for (const auto& a : scene.animations) animated = animated || !a.channels.empty();
   p.fps = fps;
   p.startTime = range.start;
   p.endTime = range.end;
-  p.animationFrames = frameCount(range, animated, fps);
+  p.animationFrames = frameCount(scene, fps);
 
   const auto dynamic = dynamicNodes(scene);
   const auto inScene = nodesInScene(scene);

@@ -102,10 +102,6 @@ std::string percentDecode(std::string_view uri) {
   return out;
 }
 
-struct ComponentInfo {
-  int bytes = 0;
-};
-
 int componentBytes(int componentType) {
   switch (componentType) {
     case 5120: case 5121: return 1;
@@ -544,7 +540,7 @@ class GltfReader {
   }
 
   // All elements of an accessor as doubles, components flattened, sparse substitution applied.
-  std::vector<double> readAccessor(int accessorIndex, std::string_view usePointer) const {
+  std::vector<double> readAccessor(int accessorIndex) const {
     const auto& a = accessors_[static_cast<std::size_t>(accessorIndex)];
     const auto p = child("/accessors", static_cast<std::size_t>(accessorIndex));
     std::vector<double> out(a.count * static_cast<std::size_t>(a.components), 0.0);
@@ -566,7 +562,6 @@ class GltfReader {
     }
     const json& accessorJson = root_["accessors"][static_cast<std::size_t>(accessorIndex)];
     if (const json* sparse = member(accessorJson, "sparse")) readSparse(*sparse, a, child(p, "sparse"), out);
-    (void)usePointer;
     return out;
   }
 
@@ -728,7 +723,7 @@ class GltfReader {
   template <typename Vec>
   std::vector<Vec> readVectors(int accessor, std::string_view pointer) const {
     constexpr int N = Vec::length();
-    const auto values = readAccessor(accessor, pointer);
+    const auto values = readAccessor(accessor);
     requireFinite(values, accessorAt(accessor).components, pointer, "element");
     std::vector<Vec> out(accessorAt(accessor).count);
     for (std::size_t i = 0; i < out.size(); ++i)
@@ -795,7 +790,7 @@ class GltfReader {
     std::vector<std::uint32_t> indices;
     if (int a = index(pr, "indices", p, accessors_.size(), "accessor"); a >= 0) {
       requireType(a, child(p, "indices"), {"SCALAR"});
-      const auto values = readAccessor(a, child(p, "indices"));
+      const auto values = readAccessor(a);
       indices.reserve(values.size());
       for (std::size_t k = 0; k < values.size(); ++k) {
         if (values[k] >= static_cast<double>(vertexCount))
@@ -967,7 +962,7 @@ class GltfReader {
         requireType(a, ap, {"MAT4"});
         if (accessorAt(a).count < skin.joints.size())
           invalid(ap, fmt::format("accessor {} has {} matrices for {} joints", a, accessorAt(a).count, skin.joints.size()));
-        const auto values = readAccessor(a, ap);
+        const auto values = readAccessor(a);
         requireFinite(values, 16, ap, "matrix");
         for (std::size_t k = 0; k < skin.joints.size(); ++k)
           for (int e = 0; e < 16; ++e) skin.inverseBindMatrices[k][e / 4][e % 4] = values[k * 16 + static_cast<std::size_t>(e)];
@@ -1091,7 +1086,7 @@ class GltfReader {
     const auto ip = child(p, "input"), op = child(p, "output");
     requireType(input, ip, {"SCALAR"});
     if (accessorAt(input).componentType != 5126) invalid(ip, fmt::format("accessor {}: key times must be floats", input));
-    const auto times = readAccessor(input, ip);
+    const auto times = readAccessor(input);
     requireFinite(times, 1, ip, "key time");
     for (std::size_t k = 0; k < times.size(); ++k) {
       if (times[k] < 0) invalid(ip, fmt::format("key time {} is {}; times must not be negative", k, times[k]));
@@ -1105,7 +1100,7 @@ class GltfReader {
       invalid(child(p, "interpolation"), "CUBICSPLINE needs at least two keys");
     const std::size_t perKey = static_cast<std::size_t>(components) * (sampler.interpolation == Interpolation::kCubicSpline ? 3 : 1);
     const auto& out = accessorAt(output);
-    const auto values = readAccessor(output, op);
+    const auto values = readAccessor(output);
     if (values.size() != keys * perKey)
       invalid(op, fmt::format("accessor {} has {} values ({} x {}) but {} keys of {} need {}", output, values.size(),
                               out.count, out.type, keys, use, keys * perKey));
