@@ -22,6 +22,9 @@ void addConvertCommand(CLI::App& app, CommandRun& run);
 // Registers `merge-camera`.
 void addMergeCameraCommand(CLI::App& app, CommandRun& run);
 
+// Registers `render`.
+void addRenderCommand(CLI::App& app, CommandRun& run);
+
 // Exit status for an error (docs/cli.md lists them).
 int exitCode(const Error& error);
 

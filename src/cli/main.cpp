@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   cli::addCaptureCheckCommand(app, run);
   cli::addConvertCommand(app, run);
   cli::addMergeCameraCommand(app, run);
+  cli::addRenderCommand(app, run);
 
   // `dynbench help [COMMAND]`
   std::string helpTopic;

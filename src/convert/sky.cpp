@@ -40,17 +40,6 @@ glm::dvec3 xyYToLinearRgb(double x, double y, double Y) {
 
 }  // namespace
 
-glm::dvec3 equirectDirection(double u, double v) {
-  const double phi = 2.0 * kPi * (u - 0.5);  // azimuth from -Z towards +X
-  const double theta = kPi * v;              // polar angle from +Y
-  return {std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi)};
-}
-
-double equirectPixelSolidAngle(int row, int width, int height) {
-  const double theta0 = kPi * row / height, theta1 = kPi * (row + 1) / height;
-  return (2.0 * kPi / width) * (std::cos(theta0) - std::cos(theta1));
-}
-
 SkyImage preethamSky(const SkyParameters& p) {
   SkyImage sky;
   sky.width = std::max(8, p.width);

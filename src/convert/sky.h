@@ -12,6 +12,8 @@
 
 #include <glm/glm.hpp>
 
+#include "core/math.h"
+
 namespace dynbench::convert {
 
 struct SkyParameters {
@@ -31,10 +33,9 @@ struct SkyImage {
 
 SkyImage preethamSky(const SkyParameters& parameters);
 
-// The equirectangular mapping used by the sky and documented for datasets: pixel centre (u, v) in
-// [0, 1]² to a direction; u = 0.5 looks down -Z, u grows towards +X; v = 0 is straight up.
-glm::dvec3 equirectDirection(double u, double v);
-// Solid angle of pixel row `row` of an equirectangular image of the given size, steradians.
-double equirectPixelSolidAngle(int row, int width, int height);
+// The equirectangular mapping (equirectDirection, equirectPixelSolidAngle) is in core/math.h:
+// the renderer reads the same images.
+using dynbench::equirectDirection;
+using dynbench::equirectPixelSolidAngle;
 
 }  // namespace dynbench::convert

@@ -81,4 +81,21 @@ double wrapDegrees(double d) {
   return w;
 }
 
+glm::dvec3 equirectDirection(double u, double v) {
+  const double phi = 2.0 * kPi * (u - 0.5);  // azimuth from -Z towards +X
+  const double theta = kPi * v;              // polar angle from +Y
+  return {std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi)};
+}
+
+glm::dvec2 equirectCoordinates(const glm::dvec3& d) {
+  const double phi = std::atan2(d.x, -d.z);
+  const double theta = std::acos(std::clamp(d.y, -1.0, 1.0));
+  return {phi / (2.0 * kPi) + 0.5, theta / kPi};
+}
+
+double equirectPixelSolidAngle(int row, int width, int height) {
+  const double theta0 = kPi * row / height, theta1 = kPi * (row + 1) / height;
+  return (2.0 * kPi / width) * (std::cos(theta0) - std::cos(theta1));
+}
+
 }  // namespace dynbench

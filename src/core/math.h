@@ -57,4 +57,12 @@ glm::dmat4 matrixOf(const DualQuaternion& q);
 // by 2°, not 358°.
 double wrapDegrees(double degreesValue);
 
+// The equirectangular mapping of dataset environments (docs/dataset.md): image point (u, v) in
+// [0, 1]² to a unit direction; u = 0.5 looks down -Z, u grows towards +X; v = 0 is straight up (+Y).
+glm::dvec3 equirectDirection(double u, double v);
+// Its inverse: the image point a unit direction maps to.
+glm::dvec2 equirectCoordinates(const glm::dvec3& direction);
+// Solid angle of pixel row `row` of an equirectangular image of the given size, steradians.
+double equirectPixelSolidAngle(int row, int width, int height);
+
 }  // namespace dynbench

@@ -17,20 +17,42 @@ struct Entry {  // what an Embree geometry is in the scene model
   int primitive = -1;
   RTCGeometry geometry = nullptr;  // dynamic entries keep theirs to update it every frame
   bool enabled = true;
+  bool previousValid = false;  // previousPositions hold the update before the last one
   std::vector<glm::dvec3> positions, normals;  // world space (double copies for exact hit data)
+  std::vector<glm::dvec3> previousPositions;
   std::vector<std::uint32_t> indices;
 };
+
+// Embree calls this for every candidate hit on a geometry with an alpha test; rejecting the hit
+// (valid = 0) lets the ray go on through the cut-out part of the surface.
+struct AlphaFilterData {
+  const AlphaTest* test = nullptr;
+  int node = -1, primitive = -1;
+};
+
+void alphaFilter(const RTCFilterFunctionNArguments* args) {
+  const auto* data = static_cast<const AlphaFilterData*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+    const glm::dvec2 uv(RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
+    if (!data->test->opaque(data->node, data->primitive, prim, uv)) args->valid[i] = 0;
+  }
+}
 
 }  // namespace
 
 struct RayTracingScene::Impl {
   const scene::Scene* scene = nullptr;
+  AlphaTest alphaTest;
+  std::vector<std::unique_ptr<AlphaFilterData>> filterData;
   scene::Evaluator evaluator;
   std::string error;
   RTCDevice device = nullptr;
   RTCScene top = nullptr, staticScene = nullptr, dynamicScene = nullptr;
   std::vector<Entry> staticEntries, dynamicEntries;
   scene::ScenePose pose;                          // every node at the last update's time
+  bool updated = false;                           // update() has run at least once
   RayTracingStats stats;
 
   explicit Impl(const scene::Scene& s) : scene(&s), evaluator(s) {}
@@ -58,6 +80,12 @@ struct RayTracingScene::Impl {
                                                                    3 * sizeof(unsigned), entry.indices.size() / 3));
     std::copy(entry.indices.begin(), entry.indices.end(), indices);
     if (dynamicGeometry) rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_REFIT);
+    if (alphaTest.needed && alphaTest.opaque && alphaTest.needed(entry.node, entry.primitive)) {
+      filterData.push_back(std::make_unique<AlphaFilterData>(AlphaFilterData{&alphaTest, entry.node, entry.primitive}));
+      rtcSetGeometryUserData(geometry, filterData.back().get());
+      rtcSetGeometryIntersectFilterFunction(geometry, alphaFilter);
+      rtcSetGeometryOccludedFilterFunction(geometry, alphaFilter);
+    }
     rtcCommitGeometry(geometry);
     const unsigned id = rtcAttachGeometry(target, geometry);
     if (dynamicGeometry) entry.geometry = geometry;  // the scene holds a reference too
@@ -82,8 +110,9 @@ struct RayTracingScene::Impl {
 RayTracingScene::RayTracingScene(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 RayTracingScene::~RayTracingScene() = default;
 
-Expected<std::unique_ptr<RayTracingScene>> RayTracingScene::create(const scene::Scene& scene) {
+Expected<std::unique_ptr<RayTracingScene>> RayTracingScene::create(const scene::Scene& scene, AlphaTest alphaTest) {
   auto impl = std::make_unique<Impl>(scene);
+  impl->alphaTest = std::move(alphaTest);
   impl->device = rtcNewDevice(nullptr);
   if (!impl->device) return fail(ErrorCode::kExternalTool, "Embree: cannot create a device (error {})", static_cast<int>(rtcGetDeviceError(nullptr)));
   rtcSetDeviceErrorFunction(impl->device, onEmbreeError, &impl->error);
@@ -142,8 +171,11 @@ void RayTracingScene::update(double t) {
     if (!visible) {
       if (e.enabled) rtcDisableGeometry(e.geometry);
       e.enabled = false;
+      e.previousValid = false;
       continue;
     }
+    e.previousValid = e.enabled && m.updated;
+    std::swap(e.previousPositions, e.positions);
     m.evaluator.worldGeometry(e.node, static_cast<std::size_t>(e.primitive), t, m.pose, e.positions, e.normals);
     Impl::copyVertices(e.geometry, e.positions);
     rtcUpdateGeometryBuffer(e.geometry, RTC_BUFFER_TYPE_VERTEX, 0);
@@ -155,7 +187,31 @@ void RayTracingScene::update(double t) {
   rtcCommitScene(m.dynamicScene);
   rtcCommitGeometry(rtcGetGeometry(m.top, 1));
   rtcCommitScene(m.top);
+  m.updated = true;
 }
+
+glm::dvec3 RayTracingScene::previousPosition(const SurfaceHit& hit) const {
+  if (!hit.hit || !hit.dynamicGeometry) return hit.position;
+  const Entry& e = impl_->dynamicEntries[hit.geometry];
+  if (!e.previousValid) return hit.position;
+  const std::uint32_t* idx = &e.indices[3 * hit.triangle];
+  const double u = hit.barycentric.x, v = hit.barycentric.y;
+  return (1.0 - u - v) * e.previousPositions[idx[0]] + u * e.previousPositions[idx[1]] + v * e.previousPositions[idx[2]];
+}
+
+void RayTracingScene::forEachPrimitive(const std::function<void(const PrimitiveView&)>& visit) const {
+  for (const auto* entries : {&impl_->staticEntries, &impl_->dynamicEntries})
+    for (const Entry& e : *entries)
+      if (e.node >= 0 && e.enabled) visit(PrimitiveView{e.node, e.primitive, &e.positions, &e.indices});
+}
+
+std::array<glm::dvec3, 3> RayTracingScene::trianglePositions(const SurfaceHit& hit) const {
+  const Entry& e = (hit.dynamicGeometry ? impl_->dynamicEntries : impl_->staticEntries)[hit.geometry];
+  const std::uint32_t* idx = &e.indices[3 * hit.triangle];
+  return {e.positions[idx[0]], e.positions[idx[1]], e.positions[idx[2]]};
+}
+
+const scene::ScenePose& RayTracingScene::pose() const { return impl_->pose; }
 
 SurfaceHit RayTracingScene::intersect(const Ray& ray, double tMin, double tMax) const {
   RTCIntersectContext context;
@@ -183,6 +239,8 @@ SurfaceHit RayTracingScene::intersect(const Ray& ray, double tMin, double tMax) 
   hit.primitive = e.primitive;
   hit.triangle = rh.hit.primID;
   hit.barycentric = {rh.hit.u, rh.hit.v};
+  hit.dynamicGeometry = rh.hit.instID[0] != 0;
+  hit.geometry = rh.hit.geomID;
   const std::uint32_t i0 = e.indices[3 * rh.hit.primID], i1 = e.indices[3 * rh.hit.primID + 1], i2 = e.indices[3 * rh.hit.primID + 2];
   const double u = rh.hit.u, v = rh.hit.v, w = 1.0 - u - v;
   hit.position = w * e.positions[i0] + u * e.positions[i1] + v * e.positions[i2];

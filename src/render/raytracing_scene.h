@@ -3,6 +3,8 @@
 // Embree). Two levels, as the thesis's StaticObjects / DynamicObjects split intends: geometry that
 // never moves is built into one BVH once; animated, skinned and morphing geometry is rebuilt into a
 // second BVH for each frame; a top-level scene instances both.
+#include <array>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -22,6 +24,22 @@ struct SurfaceHit {
   int node = -1;
   int primitive = -1;
   unsigned triangle = 0;
+  bool dynamicGeometry = false;  // which Embree geometry it was (for previousPosition)
+  unsigned geometry = 0;
+};
+
+// Decides whether a hit on an alpha-masked surface counts (glTF alphaMode MASK). Called by Embree's
+// filter functions, from any thread; installed only on primitives for which `needed` says so.
+struct AlphaTest {
+  std::function<bool(int node, int primitive)> needed;
+  std::function<bool(int node, int primitive, unsigned triangle, glm::dvec2 barycentric)> opaque;
+};
+
+// One triangle primitive of a mesh node as it is at the last update (world space).
+struct PrimitiveView {
+  int node = -1, primitive = -1;
+  const std::vector<glm::dvec3>* positions = nullptr;
+  const std::vector<std::uint32_t>* indices = nullptr;
 };
 
 struct RayTracingStats {
@@ -30,11 +48,21 @@ struct RayTracingStats {
 
 class RayTracingScene {
  public:
-  static Expected<std::unique_ptr<RayTracingScene>> create(const scene::Scene& scene);
+  static Expected<std::unique_ptr<RayTracingScene>> create(const scene::Scene& scene, AlphaTest alphaTest = {});
   ~RayTracingScene();
 
-  // Rebuilds the dynamic part for time t (node transforms, skinning, morph targets, visibility).
+  // Refits the dynamic part to time t (node transforms, skinning, morph targets, visibility). The
+  // positions of the update before are kept for previousPosition().
   void update(double t);
+  // Where the surface point of `hit` was at the previous update: the same barycentric point of the
+  // same triangle, moved with its node, skin and morph targets (the hit position itself for static
+  // geometry, and for geometry that was hidden then).
+  glm::dvec3 previousPosition(const SurfaceHit& hit) const;
+  // Every visible triangle primitive, static and dynamic, as of the last update.
+  void forEachPrimitive(const std::function<void(const PrimitiveView&)>& visit) const;
+  const scene::ScenePose& pose() const;
+  // The world positions of the hit's triangle at the last update (tangent frames for normal maps).
+  std::array<glm::dvec3, 3> trianglePositions(const SurfaceHit& hit) const;  // every node at the last update's time
   SurfaceHit intersect(const Ray& ray, double tMin = 0.0, double tMax = 1e30) const;
   bool occluded(const glm::dvec3& origin, const glm::dvec3& direction, double tMax) const;
   RayTracingStats stats() const;

@@ -164,6 +164,7 @@ class GltfReader {
     readMeshes();
     readCameras();
     readLights();
+    readEnvironment();
     readNodes();
     readSkins();
     readScenes();
@@ -706,6 +707,14 @@ class GltfReader {
       material.occlusionTexture = textureRef(m, "occlusionTexture", p);
       material.emissiveTexture = textureRef(m, "emissiveTexture", p);
       material.emissiveFactor = glm::vec3(vector<3>(m, "emissiveFactor", p, glm::dvec3(0.0)));
+      if (const json* es = extension(m, "KHR_materials_emissive_strength"))
+        material.emissiveFactor *= static_cast<float>(
+            number(*es, "emissiveStrength", child(child(p, "extensions"), "KHR_materials_emissive_strength"), 1.0));
+      if (const json* sp = extension(m, "KHR_materials_specular")) {
+        const auto spp = child(child(p, "extensions"), "KHR_materials_specular");
+        material.specularFactor = static_cast<float>(number(*sp, "specularFactor", spp, 1.0));
+        material.specularColorFactor = glm::vec3(vector<3>(*sp, "specularColorFactor", spp, glm::dvec3(1.0)));
+      }
       const std::string alphaMode = string(m, "alphaMode", p, "OPAQUE");
       if (alphaMode == "MASK") material.alphaMode = AlphaMode::kMask;
       else if (alphaMode == "BLEND") material.alphaMode = AlphaMode::kBlend;
@@ -894,6 +903,26 @@ class GltfReader {
       }
       scene_.lights.push_back(std::move(light));
     }
+  }
+
+  // DYNBENCH_environment (docs/dataset.md): the image is resolved like any URI and must exist.
+  void readEnvironment() {
+    const json* ext = extension(root_, "DYNBENCH_environment");
+    if (!ext) return;
+    const std::string p = "/extensions/DYNBENCH_environment";
+    Environment env;
+    if (!member(*ext, "uri")) invalid(p, "missing 'uri' (the environment image)");
+    env.uri = string(*ext, "uri", p);
+    env.file = resolveUri(env.uri, child(p, "uri"));
+    auto size = fileSize(env.file);
+    if (!size) fail(ErrorCode::kIo, child(p, "uri"), fmt::format("cannot find environment image '{}' ({})", env.uri, size.error().message));
+    const std::string projection = string(*ext, "projection", p, "equirectangular");
+    if (projection != "equirectangular")
+      fail(ErrorCode::kUnsupported, child(p, "projection"), fmt::format("'{}' is not supported (expected equirectangular)", projection));
+    env.intensity = static_cast<float>(number(*ext, "intensity", p, 1.0));
+    if (!(env.intensity >= 0.0f)) invalid(child(p, "intensity"), "expected a non-negative number");
+    addSourceFile(env.file, *size);
+    scene_.environment = std::move(env);
   }
 
   void readNodes() {

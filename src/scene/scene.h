@@ -74,7 +74,10 @@ struct Material {
   glm::vec4 baseColorFactor{1.0f};
   float metallicFactor = 1.0f;
   float roughnessFactor = 1.0f;
-  glm::vec3 emissiveFactor{0.0f};
+  glm::vec3 emissiveFactor{0.0f};  // times KHR_materials_emissive_strength's emissiveStrength
+  // KHR_materials_specular: scales the dielectric's 4% reflection (0 makes it purely diffuse).
+  float specularFactor = 1.0f;
+  glm::vec3 specularColorFactor{1.0f};
   AlphaMode alphaMode = AlphaMode::kOpaque;
   float alphaCutoff = 0.5f;
   bool doubleSided = false;
@@ -173,8 +176,17 @@ struct Animation {
   std::vector<Channel> channels;
 };
 
+// The dataset's image-based light (dynbench's DYNBENCH_environment extension, docs/dataset.md):
+// an equirectangular HDR image of radiance in cd/m2 (+Y up, the image centre looking down -Z).
+struct Environment {
+  std::string uri;
+  std::filesystem::path file;  // resolved; empty when the scene has no environment
+  float intensity = 1.0f;      // multiplies every pixel
+};
+
 struct Scene {
   SceneSource source;
+  std::optional<Environment> environment;
   std::vector<Node> nodes;
   std::vector<int> roots;  // root nodes of the displayed scene
   std::vector<Mesh> meshes;

@@ -1,0 +1,239 @@
+#include "render/lights.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "core/image_io.h"
+#include "core/math.h"
+
+namespace dynbench::render {
+
+Expected<EnvironmentLight> EnvironmentLight::load(const scene::Environment& environment) {
+  auto image = readImage(environment.file);
+  if (!image) return std::unexpected(image.error());
+  if (image->channels < 3 || image->width < 2 || image->height < 1)
+    return fail(ErrorCode::kInvalidData, "{}: the environment must be an RGB image (got {}x{} with {} channels)",
+                environment.file.string(), image->width, image->height, image->channels);
+  EnvironmentLight env;
+  env.width_ = image->width;
+  env.height_ = image->height;
+  env.pixels_.resize(static_cast<std::size_t>(env.width_) * env.height_);
+  std::vector<double> weights(env.pixels_.size());
+  double total = 0.0, solidAngle = 0.0;
+  for (int y = 0; y < env.height_; ++y) {
+    const double pixelSolidAngle = equirectPixelSolidAngle(y, env.width_, env.height_);
+    for (int x = 0; x < env.width_; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * env.width_ + x;
+      const float* p = &image->pixels[i * static_cast<std::size_t>(image->channels)];
+      glm::vec3 value(p[0], p[1], p[2]);
+      for (int c = 0; c < 3; ++c)
+        if (!std::isfinite(value[c]) || value[c] < 0) value[c] = 0;  // NaN/negative texels emit nothing
+      env.pixels_[i] = value * environment.intensity;
+      const double y709 = luminance(glm::dvec3(env.pixels_[i]));
+      weights[i] = y709 * pixelSolidAngle;
+      total += y709 * pixelSolidAngle;
+      solidAngle += pixelSolidAngle;
+    }
+  }
+  env.meanLuminance_ = solidAngle > 0 ? total / solidAngle : 0.0;
+  env.distribution_ = Distribution2D(weights, env.width_, env.height_);
+  return env;
+}
+
+EnvironmentLight EnvironmentLight::constant(const glm::dvec3& radiance) {
+  EnvironmentLight env;
+  env.width_ = 2;  // two columns so the mapping has a seam like any other image
+  env.height_ = 1;
+  env.pixels_.assign(2, glm::vec3(radiance));
+  // Weight by solid angle only: with one row this samples the sphere uniformly.
+  const std::vector<double> weights{1.0, 1.0};
+  env.distribution_ = Distribution2D(weights, 2, 1);
+  env.meanLuminance_ = luminance(radiance);
+  return env;
+}
+
+glm::dvec3 EnvironmentLight::radiance(const glm::dvec3& direction) const {
+  const glm::dvec2 uv = equirectCoordinates(direction);
+  const int x = std::clamp(static_cast<int>(uv.x * width_), 0, width_ - 1);
+  const int y = std::clamp(static_cast<int>(uv.y * height_), 0, height_ - 1);
+  return glm::dvec3(pixels_[static_cast<std::size_t>(y) * width_ + x]);
+}
+
+// A density over the image square becomes a solid-angle density through the equirectangular
+// Jacobian: dω = 2π² sin θ du dv.
+glm::dvec3 EnvironmentLight::sample(glm::dvec2 u, double* pdf) const {
+  double density = 0.0;
+  if (distribution_.empty()) {  // a black environment: nothing to sample
+    *pdf = 0.0;
+    return {0, 1, 0};
+  }
+  glm::dvec2 uv;
+  if (height_ == 1) {
+    // A single row (constant environment): sample the sphere uniformly instead of in (u, v), so
+    // the density stays bounded at the poles.
+    const double z = 1.0 - 2.0 * u.y, r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = 2.0 * kPi * u.x;
+    *pdf = 1.0 / (4.0 * kPi);
+    return {r * std::cos(phi), z, r * std::sin(phi)};
+  }
+  uv = distribution_.sample(u, &density);
+  const glm::dvec3 d = equirectDirection(uv.x, uv.y);
+  const double sinTheta = std::sin(kPi * uv.y);
+  *pdf = sinTheta > 0 ? density / (2.0 * kPi * kPi * sinTheta) : 0.0;
+  return d;
+}
+
+double EnvironmentLight::pdf(const glm::dvec3& direction) const {
+  if (distribution_.empty()) return 0.0;
+  if (height_ == 1) return 1.0 / (4.0 * kPi);
+  const glm::dvec2 uv = equirectCoordinates(direction);
+  const double sinTheta = std::sin(kPi * uv.y);
+  return sinTheta > 0 ? distribution_.density(uv) / (2.0 * kPi * kPi * sinTheta) : 0.0;
+}
+
+void LightSet::build(const scene::Scene& scene, const RayTracingScene& rayTracing, const EnvironmentLight* environment,
+                     double sceneRadius, EmissionFunction emission) {
+  punctual_.clear();
+  triangles_.clear();
+  environment_ = environment;
+  emission_ = std::move(emission);
+  std::vector<double> weights;
+  const auto& pose = rayTracing.pose();
+  const double disc = kPi * sceneRadius * sceneRadius;  // area a distant light's power crosses
+  for (std::size_t n = 0; n < scene.nodes.size() && n < pose.world.size(); ++n) {
+    const int li = scene.nodes[n].light;
+    if (li < 0 || !pose.visible[n]) continue;
+    const auto& l = scene.lights[static_cast<std::size_t>(li)];
+    Punctual p;
+    p.type = l.type;
+    const RigidPose rigid = decomposeRigid(pose.world[n]);
+    p.position = rigid.position;
+    p.direction = glm::normalize(rigid.rotation * glm::dvec3(0, 0, -1));
+    p.intensity = glm::dvec3(l.color) * static_cast<double>(l.intensity);
+    p.range = l.range;
+    if (l.type == scene::Light::Type::kSpot) {
+      p.cosOuter = std::cos(static_cast<double>(l.outerConeAngle));
+      p.cosInner = std::cos(static_cast<double>(l.innerConeAngle));
+    }
+    double power = luminance(p.intensity);
+    if (l.type == scene::Light::Type::kPoint) power *= 4.0 * kPi;
+    else if (l.type == scene::Light::Type::kSpot) power *= 2.0 * kPi * (1.0 - p.cosOuter);
+    else power *= disc;
+    if (power <= 0) continue;
+    punctual_.push_back(p);
+    weights.push_back(power);
+  }
+  double environmentPower = 0.0;
+  if (environment_) environmentPower = environment_->meanLuminance() * kPi * disc;
+  weights.push_back(environmentPower);
+
+  std::vector<double> triangleWeights;
+  if (emission_) {
+    rayTracing.forEachPrimitive([&](const PrimitiveView& v) {
+      const auto& node = scene.nodes[static_cast<std::size_t>(v.node)];
+      const int material = scene.meshes[static_cast<std::size_t>(node.mesh)].primitives[static_cast<std::size_t>(v.primitive)].material;
+      if (material < 0) return;
+      const double weight = emissiveWeight(glm::dvec3(scene.materials[static_cast<std::size_t>(material)].emissiveFactor));
+      if (weight <= 0) return;
+      const auto& idx = *v.indices;
+      for (std::size_t t = 0; t + 2 < idx.size(); t += 3) {
+        const Triangle tri{(*v.positions)[idx[t]], (*v.positions)[idx[t + 1]], (*v.positions)[idx[t + 2]], v.node, v.primitive,
+                           static_cast<unsigned>(t / 3)};
+        const double area = 0.5 * glm::length(glm::cross(tri.p1 - tri.p0, tri.p2 - tri.p0));
+        if (!(area > 0)) continue;
+        triangles_.push_back(tri);
+        triangleWeights.push_back(area * weight);
+      }
+    });
+  }
+  triangleChoice_ = Distribution1D(triangleWeights);
+  weights.push_back(kPi * triangleChoice_.total());  // power of one side of a Lambertian emitter: π L A
+  choice_ = Distribution1D(weights);
+  if (choice_.empty()) {
+    choice_ = Distribution1D();
+    environmentChoice_ = emissiveChoice_ = 0.0;
+    return;
+  }
+  environmentChoice_ = choice_.probability(punctual_.size());
+  emissiveChoice_ = choice_.probability(punctual_.size() + 1);
+}
+
+std::optional<LightSample> LightSet::sample(const glm::dvec3& point, double uChoice, glm::dvec2 u) const {
+  if (choice_.empty()) return std::nullopt;
+  double choiceProbability = 0.0;
+  const std::size_t pick = choice_.sampleDiscrete(uChoice, &choiceProbability);
+  LightSample s;
+  if (pick < punctual_.size()) {
+    const Punctual& l = punctual_[pick];
+    s.delta = true;
+    s.pdf = choiceProbability;
+    if (l.type == scene::Light::Type::kDirectional) {
+      s.direction = -l.direction;
+      s.distance = std::numeric_limits<double>::infinity();
+      s.radiance = l.intensity;
+      return s;
+    }
+    const glm::dvec3 toLight = l.position - point;
+    const double d2 = glm::dot(toLight, toLight);
+    if (!(d2 > 0)) return std::nullopt;
+    s.distance = std::sqrt(d2);
+    s.direction = toLight / s.distance;
+    double attenuation = 1.0 / d2;
+    if (l.range > 0) {  // KHR_lights_punctual's recommended window: max(min(1 - (d/range)^4, 1), 0) / d^2
+      const double r = s.distance / l.range;
+      attenuation *= std::clamp(1.0 - r * r * r * r, 0.0, 1.0);
+    }
+    if (l.type == scene::Light::Type::kSpot) {  // KHR_lights_punctual's spot falloff, squared smooth ramp
+      const double cd = glm::dot(l.direction, -s.direction);
+      const double scale = 1.0 / std::max(1e-3, l.cosInner - l.cosOuter);
+      const double a = std::clamp((cd - l.cosOuter) * scale, 0.0, 1.0);
+      attenuation *= a * a;
+    }
+    if (attenuation <= 0) return std::nullopt;
+    s.radiance = l.intensity * attenuation;
+    return s;
+  }
+  if (pick == punctual_.size()) {
+    double pdf = 0.0;
+    s.direction = environment_->sample(u, &pdf);
+    if (!(pdf > 0)) return std::nullopt;
+    s.distance = std::numeric_limits<double>::infinity();
+    s.radiance = environment_->radiance(s.direction);
+    s.pdf = choiceProbability * pdf;
+    return s;
+  }
+  // An emissive triangle by area x emissive luminance, then a uniform point on it.
+  double remapped = 0.0, triangleProbability = 0.0;
+  const std::size_t t = triangleChoice_.sampleDiscrete(u.x, &triangleProbability, &remapped);
+  const Triangle& tri = triangles_[t];
+  const glm::dvec2 b = sampleTriangle({remapped, u.y});
+  const glm::dvec3 p = (1.0 - b.x - b.y) * tri.p0 + b.x * tri.p1 + b.y * tri.p2;
+  const glm::dvec3 toLight = p - point;
+  const double d2 = glm::dot(toLight, toLight);
+  if (!(d2 > 0)) return std::nullopt;
+  s.distance = std::sqrt(d2);
+  s.direction = toLight / s.distance;
+  const glm::dvec3 cross = glm::cross(tri.p1 - tri.p0, tri.p2 - tri.p0);
+  const double area = 0.5 * glm::length(cross);
+  const double cosLight = std::abs(glm::dot(cross / (2.0 * area), s.direction));
+  if (cosLight <= 1e-12) return std::nullopt;
+  s.radiance = emission_(tri.node, tri.primitive, tri.index, b);
+  s.pdf = choiceProbability * triangleProbability * d2 / (area * cosLight);
+  return s;
+}
+
+double LightSet::pdfEnvironment(const glm::dvec3& direction) const {
+  if (!environment_ || environmentChoice_ <= 0) return 0.0;
+  return environmentChoice_ * environment_->pdf(direction);
+}
+
+// Choice of the triangle ∝ area x weight, then uniform on it: the area cancels, leaving
+// P(emissive) x weight / total x d^2 / cos.
+double LightSet::pdfEmissive(double emissiveLuminance, double distance, double cosAtLight) const {
+  if (emissiveChoice_ <= 0 || triangleChoice_.total() <= 0 || cosAtLight <= 1e-12) return 0.0;
+  return emissiveChoice_ * emissiveLuminance / triangleChoice_.total() * distance * distance / cosAtLight;
+}
+
+}  // namespace dynbench::render

@@ -1,0 +1,375 @@
+#include "render/path_tracer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "core/math.h"
+
+namespace dynbench::render {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// Rays leave a surface from a point pushed off it along the geometric normal, by an amount that
+// grows with the coordinates' magnitude (Embree intersects in single precision).
+glm::dvec3 offsetOrigin(const glm::dvec3& p, const glm::dvec3& normalTowardsRay) {
+  const double scale = std::max({1.0, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+  return p + normalTowardsRay * (3e-5 * scale);
+}
+
+bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+void put3(std::vector<float>& buffer, std::size_t pixel, const glm::dvec3& v) {
+  for (int c = 0; c < 3; ++c) buffer[3 * pixel + static_cast<std::size_t>(c)] = static_cast<float>(v[c]);
+}
+
+}  // namespace
+
+struct PathTracer::Shading {
+  SurfaceMaterial material;
+  glm::dvec3 shadingNormal{0.0};    // faces the viewer
+  glm::dvec3 geometricNormal{0.0};  // faces the viewer
+  double emissiveWeight = 0.0;      // luminance of the emissive factor (the light choice's weight)
+};
+
+void FrameBuffers::resize(int w, int h) {
+  width = w;
+  height = h;
+  const auto n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  for (auto* b : {&position, &normal, &direct, &indirect, &albedo}) b->assign(3 * n, 0.0f);
+  for (auto* b : {&depth, &directVariance, &indirectVariance, &hit}) b->assign(n, 0.0f);
+  id.assign(n, -1.0f);
+  motion.assign(2 * n, 0.0f);
+}
+
+const std::vector<std::string>& FrameBuffers::channelNames() {
+  static const std::vector<std::string> names{
+      "P.X",    "P.Y",    "P.Z",      "N.X",        "N.Y",        "N.Z",          "direct.R", "direct.G",
+      "direct.B", "indirect.R", "indirect.G", "indirect.B", "albedo.R", "albedo.G", "albedo.B", "Z",
+      "id",     "motion.X", "motion.Y", "direct.var", "indirect.var", "hit"};
+  return names;
+}
+
+FloatImage FrameBuffers::toImage() const {
+  FloatImage image;
+  image.width = width;
+  image.height = height;
+  image.channelNames = channelNames();
+  image.channels = static_cast<int>(image.channelNames.size());
+  const auto n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  image.pixels.resize(n * image.channelNames.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    float* out = &image.pixels[i * image.channelNames.size()];
+    for (const auto* b : {&position, &normal, &direct, &indirect, &albedo}) {
+      for (int c = 0; c < 3; ++c) *out++ = (*b)[3 * i + static_cast<std::size_t>(c)];
+    }
+    *out++ = depth[i];
+    *out++ = id[i];
+    *out++ = motion[2 * i];
+    *out++ = motion[2 * i + 1];
+    *out++ = directVariance[i];
+    *out++ = indirectVariance[i];
+    *out++ = hit[i];
+  }
+  return image;
+}
+
+PathTracer::PathTracer(const scene::Scene& scene, const RenderSettings& settings) : scene_(scene), settings_(settings) {}
+PathTracer::~PathTracer() = default;
+
+Expected<std::unique_ptr<PathTracer>> PathTracer::create(const scene::Scene& scene, const RenderSettings& settings,
+                                                         std::vector<std::string>& warnings) {
+  if (settings.width <= 0 || settings.height <= 0 || settings.samplesPerPixel <= 0 || settings.bounces < 0)
+    return fail(ErrorCode::kUsage, "render settings: resolution and samples must be positive, bounces non-negative");
+  std::unique_ptr<PathTracer> tracer(new PathTracer(scene, settings));
+  auto textures = TextureSet::load(scene, warnings);
+  if (!textures) return std::unexpected(textures.error());
+  tracer->textures_ = std::move(*textures);
+  if (settings.constantEnvironment) {
+    tracer->environment_ = EnvironmentLight::constant(*settings.constantEnvironment);
+  } else if (settings.useEnvironment && scene.environment) {
+    auto env = EnvironmentLight::load(*scene.environment);
+    if (!env) return std::unexpected(env.error());
+    tracer->environment_ = std::move(*env);
+  }
+  AlphaTest alpha;
+  const PathTracer* self = tracer.get();
+  alpha.needed = [self](int node, int primitive) {
+    const scene::Material* m = self->materialOf(node, primitive);
+    return m && m->alphaMode == scene::AlphaMode::kMask;
+  };
+  alpha.opaque = [self](int node, int primitive, unsigned triangle, glm::dvec2 b) {
+    return self->alphaOpaque(node, primitive, triangle, b);
+  };
+  auto rt = RayTracingScene::create(scene, std::move(alpha));
+  if (!rt) return std::unexpected(rt.error());
+  tracer->rayTracing_ = std::move(*rt);
+  return tracer;
+}
+
+const scene::Material* PathTracer::materialOf(int node, int primitive) const {
+  const auto& n = scene_.nodes[static_cast<std::size_t>(node)];
+  const int m = scene_.meshes[static_cast<std::size_t>(n.mesh)].primitives[static_cast<std::size_t>(primitive)].material;
+  return m >= 0 ? &scene_.materials[static_cast<std::size_t>(m)] : nullptr;
+}
+
+glm::dvec2 PathTracer::texCoord(int node, int primitive, unsigned triangle, glm::dvec2 b) const {
+  const auto& n = scene_.nodes[static_cast<std::size_t>(node)];
+  const auto& prim = scene_.meshes[static_cast<std::size_t>(n.mesh)].primitives[static_cast<std::size_t>(primitive)];
+  if (prim.uvs.empty()) return glm::dvec2(0.0);
+  const std::uint32_t* idx = &prim.indices[3 * static_cast<std::size_t>(triangle)];
+  return (1.0 - b.x - b.y) * glm::dvec2(prim.uvs[idx[0]]) + b.x * glm::dvec2(prim.uvs[idx[1]]) + b.y * glm::dvec2(prim.uvs[idx[2]]);
+}
+
+// glTF alphaMode MASK: the surface exists where base colour alpha (factor x texture) >= cutoff.
+bool PathTracer::alphaOpaque(int node, int primitive, unsigned triangle, glm::dvec2 b) const {
+  const scene::Material* m = materialOf(node, primitive);
+  if (!m || m->alphaMode != scene::AlphaMode::kMask) return true;
+  double alpha = m->baseColorFactor.a;
+  if (m->baseColorTexture.image >= 0)
+    alpha *= textures_.sample(m->baseColorTexture, true, texCoord(node, primitive, triangle, b)).a;
+  return alpha >= m->alphaCutoff;
+}
+
+glm::dvec3 PathTracer::emission(int node, int primitive, unsigned triangle, glm::dvec2 b) const {
+  const scene::Material* m = materialOf(node, primitive);
+  if (!m) return glm::dvec3(0.0);
+  glm::dvec3 e(m->emissiveFactor);
+  if (e == glm::dvec3(0.0)) return e;
+  if (m->emissiveTexture.image >= 0) e *= glm::dvec3(textures_.sample(m->emissiveTexture, true, texCoord(node, primitive, triangle, b)));
+  return e;
+}
+
+PathTracer::Shading PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo) const {
+  Shading s;
+  const scene::Material* m = materialOf(hit.node, hit.primitive);
+  const glm::dvec2 uv = texCoord(hit.node, hit.primitive, hit.triangle, hit.barycentric);
+  // glTF's default material when a primitive has none: white, metallic 1, roughness 1 (§3.9.6).
+  SurfaceMaterial& mat = s.material;
+  mat.metallic = 1.0;
+  if (m) {
+    glm::dvec4 base(m->baseColorFactor);
+    if (m->baseColorTexture.image >= 0) base *= textures_.sample(m->baseColorTexture, true, uv);
+    mat.baseColor = glm::dvec3(base);
+    if (m->workflow == scene::MaterialWorkflow::kMetallicRoughness) {
+      mat.metallic = m->metallicFactor;
+      mat.roughness = m->roughnessFactor;
+      if (m->metallicRoughnessTexture.image >= 0) {
+        const glm::dvec4 mr = textures_.sample(m->metallicRoughnessTexture, false, uv);
+        mat.roughness *= mr.g;  // glTF: green = roughness, blue = metallic
+        mat.metallic *= mr.b;
+      }
+    } else {
+      // Specular-glossiness and Phong-style materials render as their diffuse colour.
+      mat.metallic = 0.0;
+      mat.roughness = 1.0;
+    }
+    mat.specular = m->specularFactor;
+    mat.specularColor = glm::dvec3(m->specularColorFactor);
+    s.emissiveWeight = LightSet::emissiveWeight(glm::dvec3(m->emissiveFactor));
+    mat.emission = emission(hit.node, hit.primitive, hit.triangle, hit.barycentric);
+  }
+  // Both sides of a surface are shaded alike: the normals are turned towards the viewer.
+  const bool back = glm::dot(hit.geometricNormal, wo) < 0;
+  s.geometricNormal = back ? -hit.geometricNormal : hit.geometricNormal;
+  glm::dvec3 n = back ? -hit.shadingNormal : hit.shadingNormal;
+  if (m && m->normalTexture.image >= 0 && textures_.find(m->normalTexture.image, false)) {
+    // Tangent frame from the triangle's uv parameterisation (what glTF implies when a mesh has no
+    // TANGENT attribute), then n = T x + B y + N z with (x, y, z) = 2 texel - 1.
+    const auto p = rayTracing_->trianglePositions(hit);
+    const auto& node = scene_.nodes[static_cast<std::size_t>(hit.node)];
+    const auto& prim = scene_.meshes[static_cast<std::size_t>(node.mesh)].primitives[static_cast<std::size_t>(hit.primitive)];
+    if (!prim.uvs.empty()) {
+      const std::uint32_t* idx = &prim.indices[3 * static_cast<std::size_t>(hit.triangle)];
+      const glm::dvec2 d1 = glm::dvec2(prim.uvs[idx[1]]) - glm::dvec2(prim.uvs[idx[0]]);
+      const glm::dvec2 d2 = glm::dvec2(prim.uvs[idx[2]]) - glm::dvec2(prim.uvs[idx[0]]);
+      const double det = d1.x * d2.y - d2.x * d1.y;
+      if (std::abs(det) > 1e-20) {
+        glm::dvec3 t = ((p[1] - p[0]) * d2.y - (p[2] - p[0]) * d1.y) / det;
+        t -= n * glm::dot(n, t);
+        if (glm::length(t) > 1e-20) {
+          t = glm::normalize(t);
+          const glm::dvec3 b = glm::cross(n, t);
+          const glm::dvec3 texel = 2.0 * glm::dvec3(textures_.sample(m->normalTexture, false, uv)) - 1.0;
+          const glm::dvec3 mapped = texel.x * t + texel.y * b + texel.z * n;
+          if (glm::length(mapped) > 1e-12) n = glm::normalize(mapped);
+        }
+      }
+    }
+  }
+  // A shading normal facing away from the viewer would make the surface black: pull it back to
+  // just in front (a common fix; pbrt and Cycles do similar).
+  if (glm::dot(n, wo) < 1e-4) n = glm::normalize(n - wo * (glm::dot(n, wo) - 1e-4));
+  s.shadingNormal = n;
+  return s;
+}
+
+SurfaceHit PathTracer::trace(const Ray& ray) const { return rayTracing_->intersect(ray); }
+
+void PathTracer::setTime(double time, double previousTime) {
+  if (!time_ || *time_ != previousTime) rayTracing_->update(previousTime);
+  rayTracing_->update(time);
+  time_ = time;
+  // The scene's size for the light choice: from the first frame's geometry.
+  if (sceneRadius_ == 1.0) {
+    glm::dvec3 lo(kInfinity), hi(-kInfinity);
+    rayTracing_->forEachPrimitive([&](const PrimitiveView& v) {
+      for (const auto& p : *v.positions) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+      }
+    });
+    if (lo.x <= hi.x) sceneRadius_ = std::max(1e-3, 0.5 * glm::length(hi - lo));
+  }
+  lights_.build(scene_, *rayTracing_, environment_ ? &*environment_ : nullptr, sceneRadius_,
+                [this](int node, int primitive, unsigned triangle, glm::dvec2 b) { return emission(node, primitive, triangle, b); });
+}
+
+FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& camera, const RenderCamera& previousCamera,
+                                std::atomic<int>* rowsDone, RenderStatistics* statistics) const {
+  FrameBuffers out;
+  out.resize(camera.width(), camera.height());
+  const int width = camera.width(), height = camera.height(), spp = settings_.samplesPerPixel;
+  const glm::dvec3 forward = -glm::dvec3(camera.world()[2]);
+  std::atomic<std::uint64_t> rays{0};
+
+  tbb::parallel_for(tbb::blocked_range<int>(0, height, 1), [&](const tbb::blocked_range<int>& rows) {
+    std::uint64_t localRays = 0;
+    for (int py = rows.begin(); py < rows.end(); ++py) {
+      for (int px = 0; px < width; ++px) {
+        const std::size_t pixel = static_cast<std::size_t>(py) * static_cast<std::size_t>(width) + static_cast<std::size_t>(px);
+
+        // Geometry buffers: the ray through the pixel centre, so that P, N, Z, id and motion
+        // describe one surface point (a blend of two surfaces across an edge is on neither).
+        {
+          const Ray ray = camera.ray(px + 0.5, py + 0.5);
+          const SurfaceHit hit = trace(ray);
+          ++localRays;
+          if (hit.hit) {
+            const Shading s = shade(hit, -ray.direction);
+            put3(out.position, pixel, hit.position);
+            put3(out.normal, pixel, s.shadingNormal);
+            out.depth[pixel] = static_cast<float>(glm::dot(hit.position - camera.position(), forward));
+            out.id[pixel] = static_cast<float>(hit.node);
+            out.hit[pixel] = 1.0f;
+            const PixelProjection previous = previousCamera.project(rayTracing_->previousPosition(hit));
+            // Behind the previous camera there is no pixel to point to: a vector far off screen.
+            const glm::dvec2 target = previous.inFront ? previous.pixel : glm::dvec2(-1e9);
+            out.motion[2 * pixel] = static_cast<float>(target.x - (px + 0.5));
+            out.motion[2 * pixel + 1] = static_cast<float>(target.y - (py + 0.5));
+          }
+        }
+
+        glm::dvec3 directSum(0.0), indirectSum(0.0), albedoSum(0.0);
+        double directSq = 0.0, indirectSq = 0.0;
+        for (int sample = 0; sample < spp; ++sample) {
+          Random rng(settings_.seed, frameIndex, pixel, static_cast<std::uint64_t>(sample));
+          const glm::dvec2 jitter = rng.uniform2();
+          Ray ray = camera.ray(px + jitter.x, py + jitter.y);
+          glm::dvec3 throughput(1.0), direct(0.0), indirect(0.0);
+          double previousBsdfPdf = 0.0;  // solid-angle pdf of the BSDF sample that made `ray`
+          bool previousDelta = true;     // camera rays: nothing else could have found the emitter
+          for (int depth = 0;; ++depth) {
+            const SurfaceHit hit = trace(ray);
+            ++localRays;
+            // Radiance found by this ray is direct when it reaches the camera from the first
+            // surface (depth 1) or is seen by the camera itself (depth 0).
+            glm::dvec3& bucket = depth <= 1 ? direct : indirect;
+            if (!hit.hit) {
+              if (environment_) {
+                const glm::dvec3 le = environment_->radiance(ray.direction);
+                const double w = previousDelta || !settings_.nextEventEstimation
+                                     ? 1.0
+                                     : powerHeuristic(previousBsdfPdf, lights_.pdfEnvironment(ray.direction));
+                bucket += throughput * le * w;
+              }
+              break;
+            }
+            const glm::dvec3 wo = -ray.direction;
+            const Shading s = shade(hit, wo);
+            if (depth == 0) albedoSum += s.material.baseColor;
+            if (s.material.emission != glm::dvec3(0.0)) {
+              double w = 1.0;
+              if (!previousDelta && settings_.nextEventEstimation) {
+                const double cosLight = std::abs(glm::dot(hit.geometricNormal, ray.direction));
+                w = powerHeuristic(previousBsdfPdf, lights_.pdfEmissive(s.emissiveWeight, hit.distance, cosLight));
+              }
+              bucket += throughput * s.material.emission * w;
+            }
+            if (depth > settings_.bounces) break;
+            const Frame frame(s.shadingNormal);
+            const Bsdf bsdf(s.material, frame, s.geometricNormal);
+            const glm::dvec3 origin = offsetOrigin(hit.position, s.geometricNormal);
+            glm::dvec3& nextBucket = depth == 0 ? direct : indirect;  // light reaching this hit
+
+            if (settings_.nextEventEstimation && !lights_.empty()) {
+              const double uChoice = rng.uniform();
+              const glm::dvec2 uLight = rng.uniform2();
+              if (const auto ls = lights_.sample(hit.position, uChoice, uLight)) {
+                const glm::dvec3 f = bsdf.eval(wo, ls->direction);
+                const double cosine = std::abs(glm::dot(s.shadingNormal, ls->direction));
+                if (f != glm::dvec3(0.0) && ls->pdf > 0) {
+                  const double tMax = std::isinf(ls->distance) ? 1e30 : ls->distance * (1.0 - 1e-4) - 3e-5;
+                  ++localRays;
+                  if (!rayTracing_->occluded(origin, ls->direction, tMax)) {
+                    const double w = ls->delta ? 1.0 : powerHeuristic(ls->pdf, bsdf.pdf(wo, ls->direction));
+                    nextBucket += throughput * f * ls->radiance * (cosine * w / ls->pdf);
+                  }
+                }
+              }
+            } else if (settings_.nextEventEstimation) {
+              rng.uniform();  // keep the random stream aligned whether or not there are lights
+              rng.uniform2();
+            }
+
+            const double uLobe = rng.uniform();
+            const auto bs = bsdf.sample(wo, rng.uniform2(), uLobe);
+            if (!bs) break;
+            throughput *= bs->value * (std::abs(glm::dot(s.shadingNormal, bs->direction)) / bs->pdf);
+            if (depth >= 3) {  // Russian roulette keeps long paths cheap without bias
+              const double survive = std::min(0.95, std::max({throughput.x, throughput.y, throughput.z}));
+              if (rng.uniform() >= survive) break;
+              throughput /= survive;
+            }
+            if (!finite(throughput) || throughput == glm::dvec3(0.0)) break;
+            previousBsdfPdf = bs->pdf;
+            previousDelta = false;
+            ray.origin = origin;
+            ray.direction = bs->direction;
+          }
+          if (!finite(direct)) direct = glm::dvec3(0.0);
+          if (!finite(indirect)) indirect = glm::dvec3(0.0);
+          directSum += direct;
+          indirectSum += indirect;
+          directSq += luminance(direct) * luminance(direct);
+          indirectSq += luminance(indirect) * luminance(indirect);
+        }
+        const double n = spp;
+        put3(out.direct, pixel, directSum / n);
+        put3(out.indirect, pixel, indirectSum / n);
+        put3(out.albedo, pixel, albedoSum / n);
+        // Variance of the pixel's mean luminance: the sample variance (n - 1 denominator) over n.
+        auto varianceOfMean = [n](double sum, double sumSq) {
+          if (n < 2) return 0.0;
+          const double mean = sum / n;
+          return std::max(0.0, (sumSq - n * mean * mean) / (n - 1.0)) / n;
+        };
+        out.directVariance[pixel] = static_cast<float>(varianceOfMean(luminance(directSum), directSq));
+        out.indirectVariance[pixel] = static_cast<float>(varianceOfMean(luminance(indirectSum), indirectSq));
+      }
+      if (rowsDone) rowsDone->fetch_add(1, std::memory_order_relaxed);
+    }
+    rays.fetch_add(localRays, std::memory_order_relaxed);
+  });
+  if (statistics) {
+    statistics->cameraSamples += static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height) * static_cast<std::uint64_t>(spp);
+    statistics->rays += rays.load();
+  }
+  return out;
+}
+
+}  // namespace dynbench::render

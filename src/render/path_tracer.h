@@ -1,0 +1,93 @@
+#pragma once
+// The path tracer behind `dynbench render --engine embree`: unidirectional path tracing with next
+// event estimation and multiple importance sampling (Veach 1997, power heuristic), over the
+// two-level Embree scene, writing the feature buffers of docs/feature-buffers.md.
+//
+// Direct = emitted light seen from the camera (surfaces, environment) plus light that reaches the
+// first hit straight from a light source or the environment; indirect = light that arrives after
+// one or more further bounces. `bounces` counts those further bounces, as Cycles' "max bounces"
+// does: 0 renders direct light only.
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "core/image_io.h"
+#include "render/bsdf.h"
+#include "render/camera.h"
+#include "render/lights.h"
+#include "render/raytracing_scene.h"
+#include "render/textures.h"
+
+namespace dynbench::render {
+
+struct RenderSettings {
+  int width = 480, height = 270;
+  int samplesPerPixel = 16;
+  int bounces = 4;
+  std::uint64_t seed = 1;
+  // Light the scene with this radiance from every direction instead of the dataset's environment.
+  std::optional<glm::dvec3> constantEnvironment;
+  bool useEnvironment = true;  // false: no image-based light (black background)
+  // false: BSDF sampling alone, no light sampling (an independent estimator for tests; punctual
+  // lights are then invisible, as no BSDF sample can hit a point).
+  bool nextEventEstimation = true;
+};
+
+// One frame's buffers, channels interleaved per pixel, row 0 at the top.
+struct FrameBuffers {
+  int width = 0, height = 0;
+  std::vector<float> position, normal, direct, indirect, albedo;  // 3 per pixel
+  std::vector<float> depth, id, directVariance, indirectVariance, hit;  // 1 per pixel
+  std::vector<float> motion;  // 2 per pixel
+
+  void resize(int width, int height);
+  // All buffers as one image with the contract's channel names (P.X P.Y P.Z N.X ... hit).
+  FloatImage toImage() const;
+  static const std::vector<std::string>& channelNames();
+};
+
+struct RenderStatistics {
+  std::uint64_t cameraSamples = 0, rays = 0;
+};
+
+class PathTracer {
+ public:
+  static Expected<std::unique_ptr<PathTracer>> create(const scene::Scene& scene, const RenderSettings& settings,
+                                                      std::vector<std::string>& warnings);
+  ~PathTracer();
+
+  // Moves the scene to time t; `previousTime` is where motion vectors point back to.
+  void setTime(double time, double previousTime);
+  // Renders the frame at the current time. `frameIndex` seeds the random streams;
+  // `rowsDone` (optional) counts finished rows for progress reporting.
+  FrameBuffers render(std::uint64_t frameIndex, const RenderCamera& camera, const RenderCamera& previousCamera,
+                      std::atomic<int>* rowsDone = nullptr, RenderStatistics* statistics = nullptr) const;
+
+  const RayTracingScene& rayTracing() const { return *rayTracing_; }
+  const RenderSettings& settings() const { return settings_; }
+
+ private:
+  struct Shading;
+  PathTracer(const scene::Scene& scene, const RenderSettings& settings);
+  Shading shade(const SurfaceHit& hit, const glm::dvec3& wo) const;
+  glm::dvec3 emission(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
+  glm::dvec2 texCoord(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
+  bool alphaOpaque(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
+  const scene::Material* materialOf(int node, int primitive) const;
+  SurfaceHit trace(const Ray& ray) const;
+
+  const scene::Scene& scene_;
+  RenderSettings settings_;
+  TextureSet textures_;
+  std::optional<EnvironmentLight> environment_;
+  std::unique_ptr<RayTracingScene> rayTracing_;
+  LightSet lights_;
+  double sceneRadius_ = 1.0;
+  std::optional<double> time_;
+};
+
+}  // namespace dynbench::render

@@ -1,0 +1,158 @@
+#include "render/render_job.h"
+
+#include <charconv>
+#include <chrono>
+#include <thread>
+
+#include <tbb/global_control.h>
+
+#include "core/files.h"
+#include "metrics/camera_motion.h"
+#include "metrics/properties.h"
+#include "render/frame_output.h"
+#include "scene/evaluate.h"
+
+namespace dynbench::render {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::optional<long> parseLong(std::string_view s) {
+  long v = 0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
+const char* engineName(Engine e) { return e == Engine::kCycles ? "cycles" : "embree"; }
+
+}  // namespace
+
+Expected<FrameRange> parseFrameRange(const std::string& text) {
+  auto bad = [&] {
+    return fail(ErrorCode::kUsage, "--frames '{}': expected A:B[:STEP], A: or A with whole numbers A >= 0, B >= A, STEP >= 1", text);
+  };
+  FrameRange r;
+  const auto first = text.find(':');
+  if (first == std::string::npos) {
+    const auto v = parseLong(text);
+    if (!v || *v < 0) return bad();
+    r.first = r.last = *v;
+    return r;
+  }
+  const auto a = parseLong(std::string_view(text).substr(0, first));
+  if (!a || *a < 0) return bad();
+  r.first = *a;
+  std::string_view rest = std::string_view(text).substr(first + 1);
+  const auto second = rest.find(':');
+  const std::string_view last = rest.substr(0, second);
+  if (!last.empty()) {
+    const auto b = parseLong(last);
+    if (!b || *b < r.first) return bad();
+    r.last = *b;
+  }
+  if (second != std::string_view::npos) {
+    const auto step = parseLong(rest.substr(second + 1));
+    if (!step || *step < 1) return bad();
+    r.step = *step;
+  }
+  return r;
+}
+
+Expected<std::vector<long>> jobFrames(const scene::Scene& scene, const RenderJob& job) {
+  if (!(job.fps > 0)) return fail(ErrorCode::kUsage, "--fps must be positive (got {})", job.fps);
+  const long count = static_cast<long>(std::max<std::size_t>(1, metrics::frameCount(scene, job.fps)));
+  const long last = job.frames.last < 0 ? count - 1 : job.frames.last;
+  if (job.frames.first > last || job.frames.first >= count)
+    return fail(ErrorCode::kUsage, "--frames {}:{}: the animation has frames 0 to {} at {} fps", job.frames.first, last, count - 1,
+                job.fps);
+  std::vector<long> frames;
+  for (long f = job.frames.first; f <= std::min(last, count - 1); f += job.frames.step) frames.push_back(f);
+  return frames;
+}
+
+Expected<FrameCameras> frameCameras(const scene::Scene& scene, int cameraNode, const RenderJob& job, long frame) {
+  const scene::Evaluator evaluator(scene);
+  const auto& node = scene.nodes[static_cast<std::size_t>(cameraNode)];
+  const scene::Camera& lens = scene.cameras[static_cast<std::size_t>(node.camera)];
+  if (lens.type == scene::Camera::Type::kPerspective && !(lens.yfov > 0 && lens.yfov < 3.14159))
+    return fail(ErrorCode::kInvalidData, "{}: camera '{}' has yfov {} (expected 0 < yfov < pi)", job.dataset.string(), lens.name, lens.yfov);
+  const double start = scene.timeRange().start;
+  const double t = start + static_cast<double>(frame) / job.fps;
+  const double previous = t - 1.0 / job.fps;
+  return FrameCameras{t, previous,
+                      RenderCamera(evaluator.worldMatrix(cameraNode, t), lens, job.settings.width, job.settings.height),
+                      RenderCamera(evaluator.worldMatrix(cameraNode, previous), lens, job.settings.width, job.settings.height)};
+}
+
+nlohmann::json renderRecord(const RenderJob& job) {
+  const auto& s = job.settings;
+  nlohmann::json r = {{"engine", engineName(job.engine)},
+                      {"dataset", job.dataset.string()},
+                      {"fps", job.fps},
+                      {"samples_per_pixel", s.samplesPerPixel},
+                      {"bounces", s.bounces},
+                      {"seed", s.seed},
+                      {"width", s.width},
+                      {"height", s.height},
+                      {"environment", s.constantEnvironment ? "constant" : (s.useEnvironment ? "dataset" : "none")}};
+  if (job.camera) r["camera"] = *job.camera;
+  if (s.constantEnvironment) r["environment_radiance"] = {s.constantEnvironment->r, s.constantEnvironment->g, s.constantEnvironment->b};
+  return r;
+}
+
+Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob& job, const RenderProgress& progress) {
+  auto frames = jobFrames(scene, job);
+  if (!frames) return std::unexpected(frames.error());
+  auto cameraNode = metrics::selectCameraNode(scene, job.camera);
+  if (!cameraNode) return std::unexpected(cameraNode.error());
+  std::error_code ec;
+  fs::create_directories(job.output, ec);
+  if (ec) return fail(ErrorCode::kIo, "{}: cannot create the output folder: {}", job.output.string(), ec.message());
+
+  const nlohmann::json record = renderRecord(job);
+  RenderSummary summary;
+  std::vector<long> todo;
+  for (long f : *frames) (frameComplete(job.output, f, record) ? summary.skipped : todo).push_back(f);
+  if (todo.empty()) return summary;
+
+  const auto started = std::chrono::steady_clock::now();
+  if (job.engine == Engine::kCycles) return fail(ErrorCode::kUnsupported, "--engine cycles: not available in this build");
+
+  std::optional<tbb::global_control> limit;
+  if (job.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(job.threads));
+  auto tracer = PathTracer::create(scene, job.settings, summary.warnings);
+  if (!tracer) return std::unexpected(tracer.error());
+  const std::size_t rowsTotal = todo.size() * static_cast<std::size_t>(job.settings.height);
+  for (std::size_t i = 0; i < todo.size(); ++i) {
+    const long f = todo[i];
+    auto cameras = frameCameras(scene, *cameraNode, job, f);
+    if (!cameras) return std::unexpected(cameras.error());
+    (*tracer)->setTime(cameras->time, cameras->previousTime);
+    std::atomic<int> rows{0};
+    RenderStatistics stats;
+    FrameBuffers buffers;
+    if (progress) {
+      // The frame renders on a worker thread while this one reports progress.
+      std::thread worker([&] { buffers = (*tracer)->render(static_cast<std::uint64_t>(f), cameras->camera, cameras->previous, &rows, &stats); });
+      while (rows.load() < job.settings.height) {
+        progress(i * static_cast<std::size_t>(job.settings.height) + static_cast<std::size_t>(rows.load()), rowsTotal, i, todo.size());
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      }
+      worker.join();
+    } else {
+      buffers = (*tracer)->render(static_cast<std::uint64_t>(f), cameras->camera, cameras->previous, &rows, &stats);
+    }
+    summary.cameraSamples += stats.cameraSamples;
+    summary.rays += stats.rays;
+    if (auto w = writeImage(frameImagePath(job.output, f), buffers.toImage()); !w) return std::unexpected(w.error());
+    const auto sidecar = frameSidecar(f, cameras->time, cameras->camera, record);
+    if (auto w = writeFileAtomic(frameSidecarPath(job.output, f), sidecar.dump(2) + "\n"); !w) return std::unexpected(w.error());
+    summary.rendered.push_back(f);
+    if (progress) progress((i + 1) * static_cast<std::size_t>(job.settings.height), rowsTotal, i + 1, todo.size());
+  }
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return summary;
+}
+
+}  // namespace dynbench::render

@@ -1,0 +1,65 @@
+#pragma once
+// A render job: which frames of a dataset to render, with which engine, into which folder.
+// Frames already complete with the same settings are skipped (resumable); each file is written
+// to a temporary name and renamed.
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include <nlohmann/json.hpp>
+
+#include "render/path_tracer.h"
+#include "scene/scene.h"
+
+namespace dynbench::render {
+
+// Frames first..last (inclusive) every `step`; last < 0 means the animation's last frame.
+struct FrameRange {
+  long first = 0, last = -1, step = 1;
+};
+// "A:B[:STEP]", "A:" (to the end) or "A" (one frame).
+Expected<FrameRange> parseFrameRange(const std::string& text);
+
+enum class Engine { kEmbree, kCycles };
+
+struct RenderJob {
+  std::filesystem::path dataset;  // as given (recorded in sidecars)
+  std::filesystem::path output;
+  RenderSettings settings;
+  Engine engine = Engine::kEmbree;
+  double fps = 24.0;
+  FrameRange frames;
+  std::optional<std::string> camera;
+  int threads = 0;  // 0: all cores
+  std::string blender = "blender";  // the Blender executable for --engine cycles
+};
+
+struct RenderSummary {
+  std::vector<long> rendered, skipped;
+  double seconds = 0.0;
+  std::uint64_t cameraSamples = 0, rays = 0;
+  std::vector<std::string> warnings;
+};
+
+// Progress callback: (rows done, rows total, frames done, frames total).
+using RenderProgress = std::function<void(std::size_t, std::size_t, std::size_t, std::size_t)>;
+
+// The frame indices the job covers for `scene` (every frame of the animation by default).
+Expected<std::vector<long>> jobFrames(const scene::Scene& scene, const RenderJob& job);
+
+Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob& job, const RenderProgress& progress = {});
+
+// The cameras of a frame and the frame before it (t - 1/fps), as the job renders them.
+struct FrameCameras {
+  double time = 0.0, previousTime = 0.0;
+  RenderCamera camera, previous;
+};
+Expected<FrameCameras> frameCameras(const scene::Scene& scene, int cameraNode, const RenderJob& job, long frame);
+
+// The settings a frame's sidecar records (`render` object), compared when resuming.
+nlohmann::json renderRecord(const RenderJob& job);
+
+}  // namespace dynbench::render

@@ -1,0 +1,122 @@
+#pragma once
+// Random numbers and sampling routines of the path tracer. Written here rather than taken from a
+// library because each is a few lines and must be bit-for-bit deterministic per pixel and sample
+// whatever the thread schedule (pbrt-v4 keeps the same routines in its own util/sampling.h).
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace dynbench::render {
+
+// PCG32 (O'Neill 2014): small state, good statistics, reproducible streams.
+class Random {
+ public:
+  // One independent stream per (seed, frame, pixel, sample): the image does not depend on which
+  // thread renders which pixel.
+  Random(std::uint64_t seed, std::uint64_t frame, std::uint64_t pixel, std::uint64_t sample) {
+    state_ = 0;
+    increment_ = (mix(seed ^ mix(frame + 0x9E3779B97F4A7C15ull)) << 1u) | 1u;
+    next();
+    state_ += mix(pixel * 0x100000001B3ull + sample);
+    next();
+  }
+  std::uint32_t next() {
+    const std::uint64_t old = state_;
+    state_ = old * 6364136223846793005ull + increment_;
+    const auto xorshifted = static_cast<std::uint32_t>(((old >> 18u) ^ old) >> 27u);
+    const auto rot = static_cast<std::uint32_t>(old >> 59u);
+    return (xorshifted >> rot) | (xorshifted << ((32u - rot) & 31u));
+  }
+  // Uniform in [0, 1).
+  double uniform() { return next() * 0x1p-32; }
+  glm::dvec2 uniform2() {
+    const double a = uniform();
+    return {a, uniform()};
+  }
+
+ private:
+  static std::uint64_t mix(std::uint64_t z) {  // splitmix64's finaliser
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
+  std::uint64_t state_ = 0, increment_ = 1;
+};
+
+constexpr double kPi = std::numbers::pi;
+
+// An orthonormal basis around a unit normal (Duff et al. 2017, "Building an orthonormal basis,
+// revisited").
+struct Frame {
+  glm::dvec3 t, b, n;
+  explicit Frame(const glm::dvec3& normal) : n(normal) {
+    const double sign = std::copysign(1.0, n.z);
+    const double a = -1.0 / (sign + n.z);
+    const double c = n.x * n.y * a;
+    t = {1.0 + sign * n.x * n.x * a, sign * c, -sign * n.x};
+    b = {c, sign + n.y * n.y * a, -n.y};
+  }
+  glm::dvec3 toLocal(const glm::dvec3& v) const { return {glm::dot(v, t), glm::dot(v, b), glm::dot(v, n)}; }
+  glm::dvec3 toWorld(const glm::dvec3& v) const { return v.x * t + v.y * b + v.z * n; }
+};
+
+// Cosine-weighted direction about +Z (Malley's method); pdf = cos(theta) / pi.
+inline glm::dvec3 sampleCosineHemisphere(glm::dvec2 u) {
+  const double r = std::sqrt(u.x), phi = 2.0 * kPi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0, 1.0 - u.x))};
+}
+
+// Uniform point on a triangle, as barycentric weights of vertices 1 and 2 (Heitz 2019's
+// low-distortion map would also do; the square-root map is the textbook one).
+inline glm::dvec2 sampleTriangle(glm::dvec2 u) {
+  const double s = std::sqrt(u.x);
+  return {s * (1.0 - u.y), s * u.y};
+}
+
+// A piecewise-constant 1D distribution over n bins of [0, 1) (pbrt's PiecewiseConstant1D).
+class Distribution1D {
+ public:
+  Distribution1D() = default;
+  explicit Distribution1D(std::span<const double> weights);
+  bool empty() const { return cdf_.size() < 2 || total_ <= 0.0; }
+  double total() const { return total_; }  // sum of the weights
+  std::size_t size() const { return weights_.size(); }
+  // A bin picked with probability weight / total; `remapped` is u rescaled to [0, 1) inside it.
+  std::size_t sampleDiscrete(double u, double* probability = nullptr, double* remapped = nullptr) const;
+  double probability(std::size_t bin) const { return total_ > 0 ? weights_[bin] / total_ : 0.0; }
+
+ private:
+  std::vector<double> weights_, cdf_;
+  double total_ = 0.0;
+};
+
+// A piecewise-constant 2D distribution over a width x height grid of [0, 1)^2: rows by their
+// sums, then a column within the row. Samples a pixel of an environment map by its weight.
+class Distribution2D {
+ public:
+  Distribution2D() = default;
+  Distribution2D(std::span<const double> weights, int width, int height);
+  bool empty() const { return rows_.empty(); }
+  // A continuous point in [0, 1)^2 with its density with respect to area in [0, 1)^2.
+  glm::dvec2 sample(glm::dvec2 u, double* density) const;
+  double density(glm::dvec2 point) const;
+
+ private:
+  int width_ = 0, height_ = 0;
+  Distribution1D rows_;
+  std::vector<Distribution1D> columns_;
+};
+
+// The power heuristic with beta = 2 (Veach 1997, eq. 9.13): weight of a sample of strategy f.
+inline double powerHeuristic(double pdfF, double pdfG) {
+  const double f = pdfF * pdfF, g = pdfG * pdfG;
+  return f + g > 0.0 ? f / (f + g) : 0.0;
+}
+
+inline double luminance(const glm::dvec3& rgb) { return 0.2126 * rgb.r + 0.7152 * rgb.g + 0.0722 * rgb.b; }
+
+}  // namespace dynbench::render

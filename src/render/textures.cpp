@@ -1,0 +1,92 @@
+#include "render/textures.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/image_io.h"
+
+namespace dynbench::render {
+namespace {
+
+float srgbToLinear(float c) {  // IEC 61966-2-1
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+Texture toTexture(const FloatImage& image, bool srgb) {
+  Texture t;
+  t.width = image.width;
+  t.height = image.height;
+  t.texels.resize(static_cast<std::size_t>(image.width) * image.height);
+  const int c = image.channels;
+  for (std::size_t i = 0; i < t.texels.size(); ++i) {
+    const float* p = &image.pixels[i * static_cast<std::size_t>(c)];
+    glm::vec4 v;
+    if (c == 1) v = {p[0], p[0], p[0], 1.0f};
+    else if (c == 2) v = {p[0], p[0], p[0], p[1]};  // grey + alpha
+    else v = {p[0], p[1], p[2], c >= 4 ? p[3] : 1.0f};
+    if (srgb)
+      for (int k = 0; k < 3; ++k) v[k] = srgbToLinear(v[k]);
+    t.texels[i] = v;
+  }
+  return t;
+}
+
+}  // namespace
+
+glm::dvec4 Texture::sample(glm::dvec2 uv) const {
+  const double x = uv.x * width - 0.5, y = uv.y * height - 0.5;
+  const double fx = std::floor(x), fy = std::floor(y);
+  const double tx = x - fx, ty = y - fy;
+  auto wrap = [](long long i, int n) { return static_cast<std::size_t>(((i % n) + n) % n); };
+  const auto x0 = wrap(static_cast<long long>(fx), width), x1 = wrap(static_cast<long long>(fx) + 1, width);
+  const auto y0 = wrap(static_cast<long long>(fy), height), y1 = wrap(static_cast<long long>(fy) + 1, height);
+  const auto w = static_cast<std::size_t>(width);
+  const glm::dvec4 a(texels[y0 * w + x0]), b(texels[y0 * w + x1]), c(texels[y1 * w + x0]), d(texels[y1 * w + x1]);
+  return (1 - ty) * ((1 - tx) * a + tx * b) + ty * ((1 - tx) * c + tx * d);
+}
+
+Expected<TextureSet> TextureSet::load(const scene::Scene& scene, std::vector<std::string>& warnings) {
+  TextureSet set;
+  set.linear_.resize(scene.images.size());
+  set.raw_.resize(scene.images.size());
+  std::vector<char> wantLinear(scene.images.size(), 0), wantRaw(scene.images.size(), 0);
+  for (const auto& m : scene.materials) {
+    if (m.workflow != scene::MaterialWorkflow::kMetallicRoughness) continue;
+    for (const auto* ref : {&m.baseColorTexture, &m.emissiveTexture})
+      if (ref->image >= 0) wantLinear[static_cast<std::size_t>(ref->image)] = 1;
+    for (const auto* ref : {&m.metallicRoughnessTexture, &m.normalTexture})
+      if (ref->image >= 0) wantRaw[static_cast<std::size_t>(ref->image)] = 1;
+  }
+  for (std::size_t i = 0; i < scene.images.size(); ++i) {
+    if (!wantLinear[i] && !wantRaw[i]) continue;
+    const auto& image = scene.images[i];
+    if (image.embedded || image.file.empty()) {
+      warnings.push_back(fmt::format("image {} ('{}') is embedded in the file; render reads only external image files, "
+                                     "so its material slots use their factors alone", i, image.name));
+      continue;
+    }
+    auto decoded = readImage(image.file);
+    if (!decoded) {
+      warnings.push_back(fmt::format("image {}: {}; its material slots use their factors alone", i, decoded.error().message));
+      continue;
+    }
+    if (decoded->width <= 0 || decoded->height <= 0 || decoded->channels <= 0) continue;
+    if (wantLinear[i]) set.linear_[i] = toTexture(*decoded, true);
+    if (wantRaw[i]) set.raw_[i] = toTexture(*decoded, false);
+  }
+  return set;
+}
+
+const Texture* TextureSet::find(int image, bool srgb) const {
+  if (image < 0 || static_cast<std::size_t>(image) >= linear_.size()) return nullptr;
+  const Texture& t = (srgb ? linear_ : raw_)[static_cast<std::size_t>(image)];
+  return t.texels.empty() ? nullptr : &t;
+}
+
+glm::dvec4 TextureSet::sample(const scene::TextureRef& ref, bool srgb, glm::dvec2 uv, glm::dvec4 fallback) const {
+  const Texture* t = find(ref.image, srgb);
+  return t ? t->sample(uv) : fallback;
+}
+
+}  // namespace dynbench::render

@@ -1,0 +1,37 @@
+#pragma once
+// The textures a scene's materials use, decoded once (through core/image_io, i.e. OpenImageIO)
+// and shared by every frame and thread. Colour slots (base colour, emissive) are sRGB-decoded at
+// load; data slots (metallic-roughness, normal) keep their values (glTF 2.0 §3.9).
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/error.h"
+#include "scene/scene.h"
+
+namespace dynbench::render {
+
+struct Texture {
+  int width = 0, height = 0;
+  std::vector<glm::vec4> texels;  // row-major, top row first (glTF's uv (0, 0) is the top left)
+  // Bilinear filtering between the four nearest texel centres, repeating at the edges (glTF's
+  // default sampler; dynbench does not read sampler objects).
+  glm::dvec4 sample(glm::dvec2 uv) const;
+};
+
+class TextureSet {
+ public:
+  // Loads every image the scene's metallic-roughness materials use. Embedded images (GLB, data:
+  // URIs) and images that cannot be decoded are skipped with a warning: their slot falls back to
+  // white / the factor alone, so a dataset with one bad texture still renders.
+  static Expected<TextureSet> load(const scene::Scene& scene, std::vector<std::string>& warnings);
+
+  // The texture in `ref` sampled at uv; `fallback` when the slot is unused or was skipped.
+  glm::dvec4 sample(const scene::TextureRef& ref, bool srgb, glm::dvec2 uv, glm::dvec4 fallback = glm::dvec4(1.0)) const;
+  const Texture* find(int image, bool srgb) const;
+
+ private:
+  std::vector<Texture> linear_, raw_;  // per image: sRGB-decoded and as stored (empty when unused)
+};
+
+}  // namespace dynbench::render
