@@ -71,6 +71,15 @@ int GltfBuilder::accessor(const std::vector<float>& data, const std::string& typ
   return static_cast<int>(doc["accessors"].size()) - 1;
 }
 
+int GltfBuilder::indices(const std::vector<std::uint32_t>& data) {
+  while (bin.size() % 4) bin.push_back('\0');
+  const std::size_t offset = bin.size();
+  bin.append(reinterpret_cast<const char*>(data.data()), data.size() * sizeof(std::uint32_t));
+  doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", data.size() * sizeof(std::uint32_t)}});
+  doc["accessors"].push_back({{"bufferView", doc["bufferViews"].size() - 1}, {"componentType", 5125}, {"count", data.size()}, {"type", "SCALAR"}});
+  return static_cast<int>(doc["accessors"].size()) - 1;
+}
+
 int GltfBuilder::node(nlohmann::json n) {
   doc["nodes"].push_back(std::move(n));
   const int index = static_cast<int>(doc["nodes"].size()) - 1;

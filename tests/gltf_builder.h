@@ -2,6 +2,7 @@
 // Writes small analytic glTF files for tests: accessors from float vectors, nodes, animation
 // channels. Independent of dynbench's reader (it only uses nlohmann::json to write).
 #include <filesystem>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,8 @@ struct GltfBuilder {
   GltfBuilder();
   // Appends floats to the buffer (4-byte aligned) and returns the accessor index.
   int accessor(const std::vector<float>& data, const std::string& type);
+  // Appends 32-bit triangle indices and returns the accessor index.
+  int indices(const std::vector<std::uint32_t>& data);
   int node(nlohmann::json node);  // appends to nodes and to the scene's roots when it has no parent
   int perspectiveCamera(double yfov = 1.0);
   // Adds a channel (and its sampler) to animation 0.

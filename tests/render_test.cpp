@@ -1,0 +1,571 @@
+// The path tracer against known answers: a white furnace, a point light over a diffuse plane, the
+// geometry buffers of a plane, two independent estimators of the same image, moving geometry and
+// the motion vectors of a camera pan. Noise bounds come from the per-pixel variance buffers the
+// renderer writes, so a test fails on a bias, not on bad luck (5 standard errors: a false alarm
+// about once in 3.5 million).
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include "core/math.h"
+#include "gltf_builder.h"
+#include "render/bsdf.h"
+#include "render/lights.h"
+#include "render/path_tracer.h"
+#include "scene/evaluate.h"
+#include "scene/load.h"
+
+namespace dynbench::render {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// A material the builder can add: base colour, metallic, roughness; specular 0 makes it Lambertian.
+int addMaterial(test::GltfBuilder& b, glm::dvec3 base, double metallic, double roughness, bool lambert,
+                glm::dvec3 emissive = glm::dvec3(0.0)) {
+  json m = {{"pbrMetallicRoughness", {{"baseColorFactor", {base.r, base.g, base.b, 1.0}}, {"metallicFactor", metallic}, {"roughnessFactor", roughness}}},
+            {"emissiveFactor", {emissive.r, emissive.g, emissive.b}}};
+  if (lambert) m["extensions"] = {{"KHR_materials_specular", {{"specularFactor", 0.0}}}};
+  b.doc["materials"].push_back(m);
+  return static_cast<int>(b.doc["materials"].size()) - 1;
+}
+
+int addMesh(test::GltfBuilder& b, const std::vector<float>& positions, const std::vector<std::uint32_t>& indices, int material,
+            const std::vector<float>& normals = {}) {
+  json attributes = {{"POSITION", b.accessor(positions, "VEC3")}};
+  if (!normals.empty()) attributes["NORMAL"] = b.accessor(normals, "VEC3");
+  json primitive = {{"attributes", attributes}, {"indices", b.indices(indices)}, {"material", material}};
+  b.doc["meshes"].push_back({{"primitives", json::array({primitive})}});
+  return static_cast<int>(b.doc["meshes"].size()) - 1;
+}
+
+// A flat-shaded (no normals) UV sphere: convex, so a ray leaving it never comes back.
+int addSphere(test::GltfBuilder& b, glm::dvec3 centre, double radius, int material, int rings = 24, int segments = 48) {
+  std::vector<float> p;
+  std::vector<std::uint32_t> idx;
+  for (int r = 0; r <= rings; ++r)
+    for (int s = 0; s <= segments; ++s) {
+      const double theta = kPi * r / rings, phi = 2 * kPi * s / segments;
+      const glm::dvec3 v = centre + radius * glm::dvec3(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
+      p.insert(p.end(), {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)});
+    }
+  for (int r = 0; r < rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      const auto a = static_cast<std::uint32_t>(r * (segments + 1) + s), c = a + static_cast<std::uint32_t>(segments + 1);
+      if (r > 0) idx.insert(idx.end(), {a, a + 1, c});
+      if (r < rings - 1) idx.insert(idx.end(), {a + 1, c + 1, c});
+    }
+  return addMesh(b, p, idx, material);
+}
+
+// A y = height square of half size `half`, facing +Y.
+int addPlane(test::GltfBuilder& b, double half, double height, int material) {
+  const auto h = static_cast<float>(half), y = static_cast<float>(height);
+  return addMesh(b, {-h, y, -h, -h, y, h, h, y, h, h, y, -h}, {0, 1, 2, 0, 2, 3}, material, {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0});
+}
+
+scene::Scene load(test::GltfBuilder& b, const std::string& name) {
+  auto s = scene::loadScene(b.write(test::freshDir(name), name));
+  EXPECT_TRUE(s) << s.error().message;
+  return s ? std::move(*s) : scene::Scene{};
+}
+
+// A camera at `position` looking along `forward` (up +Y, or -Z when looking straight down).
+RenderCamera lookCamera(glm::dvec3 position, glm::dvec3 forward, double yfovDegrees, int w, int h) {
+  forward = glm::normalize(forward);
+  const glm::dvec3 up = std::abs(forward.y) > 0.99 ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);
+  const glm::dvec3 x = glm::normalize(glm::cross(forward, up)), y = glm::cross(x, forward);
+  glm::dmat4 world(1.0);
+  world[0] = glm::dvec4(x, 0);
+  world[1] = glm::dvec4(y, 0);
+  world[2] = glm::dvec4(-forward, 0);
+  world[3] = glm::dvec4(position, 1);
+  scene::Camera lens;
+  lens.yfov = radians(yfovDegrees);
+  lens.znear = 0.01;
+  return RenderCamera(world, lens, w, h);
+}
+
+std::unique_ptr<PathTracer> tracerFor(const scene::Scene& s, const RenderSettings& settings) {
+  std::vector<std::string> warnings;
+  auto t = PathTracer::create(s, settings, warnings);
+  EXPECT_TRUE(t) << t.error().message;
+  return t ? std::move(*t) : nullptr;
+}
+
+glm::dvec3 rgb(const std::vector<float>& buffer, std::size_t i) {
+  return {buffer[3 * i], buffer[3 * i + 1], buffer[3 * i + 2]};
+}
+
+TEST(Render, WhiteFurnace) {
+  // A white Lambertian sphere inside an environment of radiance 1: every path ends in the
+  // environment after one bounce, carrying albedo 1, so every pixel's expected radiance is 1
+  // and, the sphere being convex, indirect light is exactly 0.
+  test::GltfBuilder b;
+  const int white = addMaterial(b, glm::dvec3(1.0), 0.0, 1.0, true);
+  b.node({{"mesh", addSphere(b, glm::dvec3(0.0), 1.0, white)}});
+  const scene::Scene s = load(b, "furnace");
+  RenderSettings settings;
+  settings.samplesPerPixel = 16;
+  settings.constantEnvironment = glm::dvec3(1.0);
+  auto tracer = tracerFor(s, settings);
+  ASSERT_TRUE(tracer);
+  tracer->setTime(0.0, 0.0);
+  const RenderCamera cam = lookCamera({0, 0, 4}, {0, 0, -1}, 40.0, 64, 64);
+  const FrameBuffers f = tracer->render(0, cam, cam);
+  double sum = 0.0, variance = 0.0;
+  int hits = 0, outliers = 0;
+  for (std::size_t i = 0; i < 64 * 64; ++i) {
+    const glm::dvec3 d = rgb(f.direct, i);
+    EXPECT_EQ(rgb(f.indirect, i), glm::dvec3(0.0)) << "pixel " << i;
+    // Every pixel, on the sphere, off it or on its edge, has expectation 1.
+    if (std::abs(luminance(d) - 1.0) > 5.0 * std::sqrt(f.directVariance[i]) + 1e-6) ++outliers;
+    if (f.hit[i] == 0.0f) continue;
+    ++hits;
+    sum += luminance(d);
+    variance += f.directVariance[i];
+  }
+  ASSERT_GT(hits, 1000);
+  const double mean = sum / hits, standardError = std::sqrt(variance) / hits;
+  EXPECT_NEAR(mean, 1.0, 5.0 * standardError) << "standard error " << standardError;
+  EXPECT_LT(standardError, 0.01);  // the bound is tight enough to mean something
+  EXPECT_LE(outliers, hits / 1000 + 1);
+}
+
+struct PlaneScene {
+  scene::Scene scene;
+  glm::dvec3 light{0.7, 2.0, -0.4};
+  double intensity = 30.0, albedo = 0.5;
+};
+
+PlaneScene pointLightOverPlane() {
+  PlaneScene p;
+  test::GltfBuilder b;
+  const int grey = addMaterial(b, glm::dvec3(p.albedo), 0.0, 1.0, true);
+  b.node({{"name", "plane"}, {"mesh", addPlane(b, 3.0, 0.0, grey)}});
+  b.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"type", "point"}, {"intensity", p.intensity}}});
+  b.doc["extensionsUsed"] = {"KHR_lights_punctual", "KHR_materials_specular"};
+  b.node({{"name", "lamp"}, {"translation", {p.light.x, p.light.y, p.light.z}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  p.scene = load(b, "point_light");
+  return p;
+}
+
+TEST(Render, PointLightOverDiffusePlaneGivesTheAnalyticRadiance) {
+  // L = (albedo / pi) I cos(theta) / d^2 = (albedo / pi) I h / d^3 at a point of the plane y = 0.
+  const PlaneScene p = pointLightOverPlane();
+  RenderSettings settings;
+  settings.samplesPerPixel = 8;
+  settings.useEnvironment = false;
+  auto tracer = tracerFor(p.scene, settings);
+  ASSERT_TRUE(tracer);
+  tracer->setTime(0.0, 0.0);
+  const int w = 80, h = 60;
+  const RenderCamera cam = lookCamera({0, 4, 0}, {0, -1, 0}, 60.0, w, h);
+  const FrameBuffers f = tracer->render(0, cam, cam);
+  auto analytic = [&](double px, double py) {
+    const Ray r = cam.ray(px, py);
+    const glm::dvec3 x = r.origin + r.direction * (-r.origin.y / r.direction.y);
+    const double d = glm::length(p.light - x);
+    return p.albedo / kPi * p.intensity * p.light.y / (d * d * d);
+  };
+  int checked = 0;
+  for (int py = 2; py < h; py += 7)
+    for (int px = 3; px < w; px += 9) {
+      const std::size_t i = static_cast<std::size_t>(py * w + px);
+      if (f.hit[i] == 0.0f) continue;
+      // The pixel averages jittered samples over its footprint: the answer lies between the
+      // analytic values at the footprint's corners (the function is smooth at pixel scale).
+      const double c[4] = {analytic(px, py), analytic(px + 1, py), analytic(px, py + 1), analytic(px + 1, py + 1)};
+      const double lo = *std::min_element(c, c + 4), hi = *std::max_element(c, c + 4);
+      const double value = f.direct[3 * i];
+      EXPECT_GE(value, lo * (1 - 1e-4)) << px << "," << py;
+      EXPECT_LE(value, hi * (1 + 1e-4)) << px << "," << py;
+      EXPECT_EQ(rgb(f.indirect, i), glm::dvec3(0.0));  // a plane cannot light itself
+      EXPECT_FLOAT_EQ(f.directVariance[i] >= 0 ? 1.0f : 0.0f, 1.0f);
+      ++checked;
+    }
+  EXPECT_GT(checked, 40);
+}
+
+TEST(Render, SpotLightConeAndRangeWindow) {
+  // A spot light straight above the plane: full intensity inside the inner cone, nothing outside
+  // the outer cone; and a point light's range window switches light off beyond `range`.
+  test::GltfBuilder b;
+  const int grey = addMaterial(b, glm::dvec3(1.0), 0.0, 1.0, true);
+  b.node({{"mesh", addPlane(b, 10.0, 0.0, grey)}});
+  b.doc["extensions"]["KHR_lights_punctual"]["lights"] =
+      json::array({{{"type", "spot"}, {"intensity", 10.0}, {"spot", {{"innerConeAngle", 0.2}, {"outerConeAngle", 0.4}}}}});
+  b.doc["extensionsUsed"] = {"KHR_lights_punctual", "KHR_materials_specular"};
+  // Rotated so local -Z points down (-Y): 90 degrees about +X.
+  const double c = std::cos(kPi / 4), sn = std::sin(kPi / 4);
+  b.node({{"translation", {0, 2, 0}}, {"rotation", {-sn, 0, 0, c}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  const scene::Scene s = load(b, "spot");
+  RenderSettings settings;
+  settings.samplesPerPixel = 1;
+  settings.useEnvironment = false;
+  auto tracer = tracerFor(s, settings);
+  ASSERT_TRUE(tracer);
+  tracer->setTime(0.0, 0.0);
+  const RenderCamera cam = lookCamera({0, 6, 0}, {0, -1, 0}, 90.0, 101, 101);
+  const FrameBuffers f = tracer->render(0, cam, cam);
+  for (std::size_t i = 0; i < f.hit.size(); ++i) {
+    const glm::dvec3 x(f.position[3 * i], 0.0, f.position[3 * i + 2]);
+    const double angle = std::atan2(glm::length(glm::dvec2(x.x, x.z)), 2.0);
+    // One sample per pixel at a random point: only judge pixels well inside or outside the cones.
+    if (angle > 0.45) EXPECT_EQ(f.direct[3 * i], 0.0f) << "outside the outer cone";
+    if (angle < 0.15) {
+      const double d2 = 4.0 + glm::dot(x, x);
+      EXPECT_NEAR(f.direct[3 * i], 1.0 / kPi * 10.0 * 2.0 / std::pow(d2, 1.5), 0.03) << "inside the inner cone";
+    }
+  }
+}
+
+TEST(Render, GeometryBuffersOfAPlaneEqualTheAnalyticIntersection) {
+  const PlaneScene p = pointLightOverPlane();
+  RenderSettings settings;
+  settings.samplesPerPixel = 1;
+  auto tracer = tracerFor(p.scene, settings);
+  ASSERT_TRUE(tracer);
+  tracer->setTime(0.0, 0.0);
+  const int w = 64, h = 48;
+  // Looking down at 35 degrees from (0, 2, 5): the far rows see past the plane's edge.
+  const RenderCamera cam = lookCamera({0, 2, 5}, {0, -std::tan(radians(35.0)), -1}, 50.0, w, h);
+  const FrameBuffers f = tracer->render(0, cam, cam);
+  int hits = 0, misses = 0;
+  for (int py = 0; py < h; ++py)
+    for (int px = 0; px < w; ++px) {
+      const std::size_t i = static_cast<std::size_t>(py * w + px);
+      const Ray r = cam.ray(px + 0.5, py + 0.5);
+      const double t = -r.origin.y / r.direction.y;
+      const glm::dvec3 x = r.origin + t * r.direction;
+      const bool onPlane = t > 0 && std::abs(x.x) < 3 && std::abs(x.z) < 3;
+      if (std::abs(std::abs(x.x) - 3) < 0.05 || std::abs(std::abs(x.z) - 3) < 0.05) continue;  // the edge itself
+      if (!onPlane) {
+        ++misses;
+        EXPECT_EQ(f.hit[i], 0.0f);
+        EXPECT_EQ(rgb(f.position, i), glm::dvec3(0.0));
+        EXPECT_EQ(f.id[i], -1.0f);
+        continue;
+      }
+      ++hits;
+      ASSERT_EQ(f.hit[i], 1.0f) << px << "," << py;
+      EXPECT_LT(glm::length(rgb(f.position, i) - x), 1e-4 * (1 + glm::length(x)));
+      EXPECT_LT(glm::length(rgb(f.normal, i) - glm::dvec3(0, 1, 0)), 1e-6);
+      EXPECT_NEAR(f.depth[i], glm::dot(x - cam.position(), -glm::dvec3(cam.world()[2])), 1e-4);
+      EXPECT_EQ(f.id[i], 0.0f);  // node 0
+      // Albedo averages the jittered samples: the plane's albedo where the whole pixel is on it.
+      auto inside = [&](double qx, double qy) {
+        const Ray q = cam.ray(qx, qy);
+        const glm::dvec3 y = q.origin + q.direction * (-q.origin.y / q.direction.y);
+        return q.direction.y < 0 && std::abs(y.x) < 3 && std::abs(y.z) < 3;
+      };
+      if (inside(px, py) && inside(px + 1, py) && inside(px, py + 1) && inside(px + 1, py + 1))
+        EXPECT_NEAR(f.albedo[3 * i], p.albedo, 1e-6);
+      // Nothing moved; Embree's single-precision barycentrics put the hit ~1e-7 relative off the
+      // exact ray point, a few 1e-5 pixels at the far rows.
+      EXPECT_NEAR(f.motion[2 * i], 0.0f, 1e-4);
+      EXPECT_NEAR(f.motion[2 * i + 1], 0.0f, 1e-4);
+    }
+  EXPECT_GT(hits, 1000);
+  EXPECT_GT(misses, 100);
+}
+
+// Light sampling + MIS (direct + indirect) against BSDF sampling alone (the whole image as one
+// "full" render): two independent estimators of the same radiance, compared per 8 x 8 block.
+TEST(Render, DirectPlusIndirectEqualsAnIndependentFullRender) {
+  test::GltfBuilder b;
+  const int floorMaterial = addMaterial(b, {0.8, 0.7, 0.6}, 0.0, 1.0, false);
+  const int metal = addMaterial(b, {0.9, 0.6, 0.3}, 1.0, 0.35, false);
+  const int lamp = addMaterial(b, glm::dvec3(0.0), 0.0, 1.0, true, {4.0, 3.5, 3.0});
+  b.node({{"mesh", addPlane(b, 4.0, 0.0, floorMaterial)}});
+  b.node({{"mesh", addSphere(b, {0.3, 0.8, 0.0}, 0.8, metal, 16, 32)}});
+  // An emissive quad facing down at y = 2.5.
+  b.node({{"mesh", addMesh(b, {-0.8f, 2.5f, -0.8f, 0.8f, 2.5f, -0.8f, 0.8f, 2.5f, 0.8f, -0.8f, 2.5f, 0.8f}, {0, 1, 2, 0, 2, 3}, lamp)}});
+  b.doc["extensionsUsed"] = {"KHR_materials_specular"};
+  const scene::Scene s = load(b, "mis");
+  const RenderCamera cam = lookCamera({0, 2.2, 5}, {0, -0.35, -1}, 50.0, 48, 32);
+  RenderSettings settings;
+  settings.bounces = 3;
+  settings.constantEnvironment = glm::dvec3(0.3, 0.35, 0.5);
+  settings.samplesPerPixel = 64;
+  auto mis = tracerFor(s, settings);
+  settings.nextEventEstimation = false;
+  settings.seed = 2;
+  auto bsdfOnly = tracerFor(s, settings);
+  ASSERT_TRUE(mis && bsdfOnly);
+  mis->setTime(0, 0);
+  bsdfOnly->setTime(0, 0);
+  const FrameBuffers a = mis->render(0, cam, cam), c = bsdfOnly->render(0, cam, cam);
+  int blocks = 0;
+  double worst = 0.0;
+  for (int by = 0; by < 32; by += 8)
+    for (int bx = 0; bx < 48; bx += 8) {
+      double sumA = 0, sumC = 0, varA = 0, varC = 0;
+      for (int y = by; y < by + 8; ++y)
+        for (int x = bx; x < bx + 8; ++x) {
+          const std::size_t i = static_cast<std::size_t>(y * 48 + x);
+          sumA += luminance(rgb(a.direct, i) + rgb(a.indirect, i));
+          sumC += luminance(rgb(c.direct, i) + rgb(c.indirect, i));
+          // Variance of a sum of two estimates: at most (sqrt(v1) + sqrt(v2))^2.
+          varA += std::pow(std::sqrt(a.directVariance[i]) + std::sqrt(a.indirectVariance[i]), 2);
+          varC += std::pow(std::sqrt(c.directVariance[i]) + std::sqrt(c.indirectVariance[i]), 2);
+        }
+      // Blocks that see only the environment have no noise at all: then the sums must agree.
+      const double z = varA + varC > 0 ? std::abs(sumA - sumC) / std::sqrt(varA + varC) : std::abs(sumA - sumC) * 1e6;
+      worst = std::max(worst, z);
+      EXPECT_LT(z, 5.0) << "block " << bx << "," << by << ": " << sumA / 64 << " vs " << sumC / 64;
+      ++blocks;
+    }
+  EXPECT_EQ(blocks, 24);
+  // Light sampling must actually help: it is much less noisy on the lamp-lit floor.
+  double noiseA = 0, noiseC = 0;
+  for (std::size_t i = 0; i < a.directVariance.size(); ++i) {
+    noiseA += a.directVariance[i];
+    noiseC += c.directVariance[i];
+  }
+  EXPECT_LT(noiseA, noiseC);
+  std::printf("worst block z = %.2f; direct variance MIS / BSDF-only = %.3f\n", worst, noiseA / noiseC);
+}
+
+TEST(Render, SameSeedSameImageWhateverTheThreads) {
+  const PlaneScene p = pointLightOverPlane();
+  RenderSettings settings;
+  settings.samplesPerPixel = 4;
+  settings.constantEnvironment = glm::dvec3(0.5);
+  const RenderCamera cam = lookCamera({0, 2, 5}, {0, -0.5, -1}, 50.0, 40, 30);
+  auto render = [&](std::uint64_t seed, int threads) {
+    settings.seed = seed;
+    auto t = tracerFor(p.scene, settings);
+    t->setTime(0, 0);
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+    return t->render(3, cam, cam).toImage().pixels;
+  };
+  const auto one = render(7, 1), two = render(7, 2), other = render(8, 2);
+  EXPECT_EQ(one, two);
+  EXPECT_NE(one, other);
+}
+
+// Distance from a point to a triangle (Ericson, Real-Time Collision Detection §5.1.5).
+double pointTriangleDistance(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
+  const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return glm::length(p - a);
+  const glm::dvec3 bp = p - b;
+  const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return glm::length(p - b);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return glm::length(p - (a + ab * (d1 / (d1 - d3))));
+  const glm::dvec3 cp = p - c;
+  const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return glm::length(p - c);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return glm::length(p - (a + ac * (d2 / (d2 - d6))));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return glm::length(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
+  const double denom = 1.0 / (va + vb + vc);
+  return glm::length(p - (a + ab * (vb * denom) + ac * (vc * denom)));
+}
+
+TEST(Render, PositionBufferFollowsTheSkinnedMesh) {
+  auto s = scene::loadScene(fs::path(DYNBENCH_TESTDATA_DIR) / "SimpleSkin" / "SimpleSkin.gltf");
+  ASSERT_TRUE(s) << s.error().message;
+  RenderSettings settings;
+  settings.samplesPerPixel = 1;
+  settings.useEnvironment = false;
+  auto tracer = tracerFor(*s, settings);
+  ASSERT_TRUE(tracer);
+  const scene::Evaluator evaluator(*s);
+  const RenderCamera cam = lookCamera({0.5, 1.0, 4.0}, {0, 0, -1}, 45.0, 48, 64);
+  for (double t : {0.0, 1.5, 3.5}) {
+    tracer->setTime(t, t - 1.0 / 24);
+    const FrameBuffers f = tracer->render(0, cam, cam);
+    std::vector<glm::dvec3> world;
+    const int meshNode = 0;
+    world = evaluator.worldPositions(meshNode, 0, t);
+    const auto& indices = s->meshes[0].primitives[0].indices;
+    int hits = 0;
+    for (std::size_t i = 0; i < f.hit.size(); ++i) {
+      if (f.hit[i] == 0.0f) continue;
+      ++hits;
+      double best = 1e30;
+      for (std::size_t k = 0; k < indices.size(); k += 3)
+        best = std::min(best, pointTriangleDistance(rgb(f.position, i), world[indices[k]], world[indices[k + 1]], world[indices[k + 2]]));
+      EXPECT_LT(best, 1e-5) << "t = " << t;
+    }
+    EXPECT_GT(hits, 50) << "t = " << t;
+  }
+}
+
+TEST(Render, MotionOfACameraPanIsExact) {
+  // A pure yaw by angle a: a pixel centre's direction (x, y, -1) in camera space (x, y at the
+  // image plane z = -1) is, in the previous camera (turned by -a about +Y relative to this one),
+  // (x cos a - sin a, y, -x sin a - cos a)... written out below with the pinhole model.
+  const PlaneScene p = pointLightOverPlane();
+  RenderSettings settings;
+  settings.samplesPerPixel = 1;
+  settings.useEnvironment = false;
+  auto tracer = tracerFor(p.scene, settings);
+  ASSERT_TRUE(tracer);
+  tracer->setTime(0, 0);
+  const int w = 64, h = 36;
+  const double yfov = radians(50.0), a = radians(4.0), tanHalf = std::tan(yfov / 2), aspect = double(w) / h;
+  const glm::dvec3 eye(0, 2, 1);
+  auto camera = [&](double yaw) {
+    glm::dmat4 world = glm::mat4_cast(quatFromYawPitchRoll(yaw, radians(-40.0), 0.0));
+    world[3] = glm::dvec4(eye, 1);
+    scene::Camera lens;
+    lens.yfov = yfov;
+    lens.znear = 0.01;
+    return RenderCamera(world, lens, w, h);
+  };
+  const RenderCamera now = camera(0.0), before = camera(a);
+  const FrameBuffers f = tracer->render(0, now, before);
+  int checked = 0;
+  for (int py = 0; py < h; ++py)
+    for (int px = 0; px < w; ++px) {
+      const std::size_t i = static_cast<std::size_t>(py * w + px);
+      if (f.hit[i] == 0.0f) continue;
+      // The world direction of this pixel, rotated into the previous camera's frame: the previous
+      // camera's basis is this one's turned by +a about world +Y.
+      const glm::dvec3 local((2 * (px + 0.5) / w - 1) * tanHalf * aspect, (1 - 2 * (py + 0.5) / h) * tanHalf, -1);
+      const glm::dmat3 r = glm::dmat3(now.world());
+      const glm::dvec3 d = r * local;
+      const glm::dvec3 dPrev(d.x * std::cos(a) - d.z * std::sin(a), d.y, d.x * std::sin(a) + d.z * std::cos(a));  // R_y(-a) d
+      const glm::dvec3 q = glm::transpose(r) * dPrev;  // in the previous camera's own axes
+      const double xPrev = (q.x / -q.z / (tanHalf * aspect) + 1) * w / 2, yPrev = (1 - q.y / -q.z / tanHalf) * h / 2;
+      EXPECT_NEAR(f.motion[2 * i], xPrev - (px + 0.5), 2e-3) << px << "," << py;
+      EXPECT_NEAR(f.motion[2 * i + 1], yPrev - (py + 0.5), 2e-3) << px << "," << py;
+      ++checked;
+    }
+  EXPECT_GT(checked, 500);
+}
+
+TEST(Render, MotionOfATranslatingObject) {
+  // A quad at height 1 sliding +X at 1.2 units/s under a camera looking straight down from y = 5:
+  // at depth 4 a pixel spans 2 * 4 * tan(yfov/2) / h units, so the motion is -1.2/24 of that, in x.
+  test::GltfBuilder b;
+  const int grey = addMaterial(b, glm::dvec3(0.5), 0.0, 1.0, true);
+  const int quad = b.node({{"mesh", addPlane(b, 0.5, 1.0, grey)}});
+  b.channel(quad, "translation", {0, 10}, {0, 0, 0, 12, 0, 0});
+  const scene::Scene s = load(b, "slide");
+  RenderSettings settings;
+  settings.samplesPerPixel = 1;
+  settings.useEnvironment = false;
+  auto tracer = tracerFor(s, settings);
+  ASSERT_TRUE(tracer);
+  const int w = 64, h = 64;
+  const RenderCamera cam = lookCamera({0, 5, 0}, {0, -1, 0}, 40.0, w, h);
+  tracer->setTime(1.0, 1.0 - 1.0 / 24);
+  const FrameBuffers f = tracer->render(24, cam, cam);
+  const double unitsPerPixel = 2.0 * 4.0 * std::tan(radians(20.0)) / h;
+  int checked = 0;
+  for (std::size_t i = 0; i < f.hit.size(); ++i) {
+    if (f.hit[i] == 0.0f) continue;
+    // The camera's +X is world +X when looking down with up = -Z: moving +X moves right.
+    EXPECT_NEAR(f.motion[2 * i], -(1.2 / 24) / unitsPerPixel, 1e-3);
+    EXPECT_NEAR(f.motion[2 * i + 1], 0.0, 1e-3);
+    ++checked;
+  }
+  EXPECT_GT(checked, 100);
+}
+
+TEST(Sampling, Distribution2DDensityMatchesItsSamples) {
+  // Weights 1..6 on a 3 x 2 grid: the density of a cell is weight / mean weight.
+  const std::vector<double> weights{1, 2, 3, 4, 5, 6};
+  const Distribution2D d(weights, 3, 2);
+  for (int k = 0; k < 6; ++k)
+    EXPECT_NEAR(d.density({(k % 3 + 0.5) / 3, (k / 3 + 0.5) / 2}), weights[static_cast<std::size_t>(k)] / 3.5, 1e-12);
+  Random rng(1, 0, 0, 0);
+  std::vector<int> counts(6, 0);
+  for (int i = 0; i < 210000; ++i) {
+    double density = 0;
+    const glm::dvec2 p = d.sample(rng.uniform2(), &density);
+    const int cell = static_cast<int>(p.y * 2) * 3 + static_cast<int>(p.x * 3);
+    ++counts[static_cast<std::size_t>(cell)];
+    ASSERT_NEAR(density, d.density(p), 1e-12);
+  }
+  for (int k = 0; k < 6; ++k) {
+    const double expected = 210000.0 * (k + 1) / 21.0;  // binomial: sigma = sqrt(n p (1 - p))
+    EXPECT_NEAR(counts[static_cast<std::size_t>(k)], expected, 5 * std::sqrt(expected));
+  }
+}
+
+TEST(Sampling, GgxIsNormalisedAndItsSamplingPdfIntegratesToOne) {
+  for (double alpha : {0.05, 0.3, 1.0}) {
+    // Projected-area normalisation: integral of D(h) cos(theta_h) over the hemisphere = 1.
+    double integral = 0;
+    const int n = 4000;
+    for (int i = 0; i < n; ++i) {
+      const double theta = (i + 0.5) / n * kPi / 2;
+      integral += Bsdf::ggxD({std::sin(theta), 0, std::cos(theta)}, alpha) * std::cos(theta) * std::sin(theta) * (kPi / 2 / n) * 2 * kPi;
+    }
+    EXPECT_NEAR(integral, 1.0, 2e-3) << "alpha " << alpha;
+  }
+  // A rough metal BSDF: the estimate of integral of pdf over sampled directions, E[1/pdf * pdf]
+  // is trivial, so test the other way: E[f cos / pdf] equals the same integral by uniform sampling.
+  SurfaceMaterial m;
+  m.baseColor = glm::dvec3(0.9);
+  m.metallic = 0.5;
+  m.roughness = 0.4;
+  const Frame frame(glm::dvec3(0, 0, 1));
+  const Bsdf bsdf(m, frame, glm::dvec3(0, 0, 1));
+  const glm::dvec3 wo = glm::normalize(glm::dvec3(0.5, 0.2, 0.8));
+  Random rng(3, 0, 0, 0);
+  double importance = 0, uniform = 0, pdfIntegral = 0;
+  int accepted = 0;
+  const int n = 400000;
+  for (int i = 0; i < n; ++i) {
+    if (const auto s = bsdf.sample(wo, rng.uniform2(), rng.uniform())) {
+      ++accepted;
+      importance += luminance(s->value) * s->direction.z / s->pdf;
+      EXPECT_NEAR(s->pdf, bsdf.pdf(wo, s->direction), 1e-9 * s->pdf);
+    }
+    const glm::dvec2 u = rng.uniform2();  // uniform hemisphere, pdf 1 / (2 pi)
+    const double z = u.x, r = std::sqrt(1 - z * z);
+    const glm::dvec3 wi(r * std::cos(2 * kPi * u.y), r * std::sin(2 * kPi * u.y), z);
+    uniform += luminance(bsdf.eval(wo, wi)) * z * 2 * kPi;
+    pdfIntegral += bsdf.pdf(wo, wi) * 2 * kPi;
+  }
+  EXPECT_NEAR(importance / n, uniform / n, 0.01);
+  // Reflected microfacet samples that point below the surface are rejected, so the pdf over the
+  // hemisphere integrates to the fraction of samples that succeed (just under 1).
+  EXPECT_NEAR(pdfIntegral / n, double(accepted) / n, 0.01);
+  EXPECT_GT(double(accepted) / n, 0.9);
+  EXPECT_LT(importance / n, 1.0);           // no energy gain
+}
+
+TEST(Sampling, EnvironmentPdfMatchesItsSamples) {
+  // A 16 x 8 environment with one bright pixel: samples land there with the probability its
+  // weight says, and the solid-angle pdf integrates to 1 over the sphere.
+  const fs::path dir = test::freshDir("environment");
+  FloatImage image;
+  image.width = 16;
+  image.height = 8;
+  image.channels = 3;
+  image.pixels.assign(16 * 8 * 3, 0.1f);
+  for (int c = 0; c < 3; ++c) image.pixels[(3 * 16 + 5) * 3 + static_cast<std::size_t>(c)] = 50.0f;
+  ASSERT_TRUE(writeImage(dir / "env.hdr", image));
+  scene::Environment e;
+  e.file = dir / "env.hdr";
+  e.intensity = 2.0f;
+  auto env = EnvironmentLight::load(e);
+  ASSERT_TRUE(env) << env.error().message;
+  EXPECT_NEAR(env->radiance(equirectDirection((5 + 0.5) / 16, (3 + 0.5) / 8)).r, 100.0, 1e-4);
+  Random rng(5, 0, 0, 0);
+  double integral = 0;
+  const int n = 200000;
+  for (int i = 0; i < n; ++i) {
+    const glm::dvec2 u = rng.uniform2();
+    const double z = 1 - 2 * u.x, r = std::sqrt(1 - z * z);
+    integral += env->pdf({r * std::cos(2 * kPi * u.y), z, r * std::sin(2 * kPi * u.y)}) * 4 * kPi;
+    double pdf = 0;
+    const glm::dvec3 d = env->sample(rng.uniform2(), &pdf);
+    ASSERT_NEAR(pdf, env->pdf(d), 1e-6 * pdf);
+  }
+  EXPECT_NEAR(integral / n, 1.0, 0.02);
+}
+
+}  // namespace
+}  // namespace dynbench::render
