@@ -1,0 +1,157 @@
+// `dynbench render` end to end: the feature-buffer contract on disk (EXR channel names, sidecar),
+// resuming, the dataset's environment, and bad input.
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fmt/format.h>
+#include <glm/glm.hpp>
+
+#include "core/files.h"
+#include "core/image_io.h"
+#include "gltf_builder.h"
+#include "run_cli.h"
+
+namespace dynbench {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kOrbit = fs::path(DYNBENCH_SOURCE_DIR) / "examples" / "orbit" / "orbit.gltf";
+
+nlohmann::json readJson(const fs::path& p) {
+  auto text = readWholeFile(p);
+  EXPECT_TRUE(text) << p;
+  return nlohmann::json::parse(text ? *text : "{}");
+}
+
+glm::dmat4 matrix(const nlohmann::json& a) {
+  glm::dmat4 m;
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) m[c][r] = a[static_cast<std::size_t>(4 * c + r)].get<double>();
+  return m;
+}
+
+TEST(RenderCli, WritesTheContractAndResumes) {
+  const auto dir = test::freshDir("render_cli");
+  const fs::path out = dir / "frames";
+  auto r = dynbench(fmt::format("render {} -o {} --res 32x18 --spp 2 --frames 0:4:2", kOrbit.string(), out.string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("3 frame(s) rendered, 0 already complete"), std::string::npos) << r.out;
+  for (long f : {0L, 2L, 4L}) {
+    const fs::path exr = out / fmt::format("frame_{:05d}.exr", f);
+    auto image = readImage(exr);
+    ASSERT_TRUE(image) << image.error().message;
+    EXPECT_EQ(image->width, 32);
+    EXPECT_EQ(image->height, 18);
+    const std::vector<std::string> expected{"P.X",    "P.Y",    "P.Z",      "N.X",        "N.Y",          "N.Z",
+                                            "direct.R", "direct.G", "direct.B", "indirect.R", "indirect.G",   "indirect.B",
+                                            "albedo.R", "albedo.G", "albedo.B", "Z",          "id",           "motion.X",
+                                            "motion.Y", "direct.var", "indirect.var", "hit"};
+    // EXR stores channels sorted by name; compare as sets.
+    auto names = image->channelNames;
+    auto sorted = expected;
+    std::sort(names.begin(), names.end());
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(names, sorted);
+    const auto j = readJson(out / fmt::format("frame_{:05d}.json", f));
+    EXPECT_EQ(j["frame"], f);
+    EXPECT_NEAR(j["time"].get<double>(), f / 24.0, 1e-12);  // orbit's animation starts at 0
+    EXPECT_EQ(j["width"], 32);
+    EXPECT_EQ(j["render"]["samples_per_pixel"], 2);
+    const glm::dmat4 product = matrix(j["camera"]["view"]) * matrix(j["camera"]["world"]);
+    for (int c = 0; c < 4; ++c)
+      for (int k = 0; k < 4; ++k) EXPECT_NEAR(product[c][k], c == k ? 1.0 : 0.0, 1e-9);
+    EXPECT_NEAR(matrix(j["camera"]["projection"])[1][1], 1.0 / std::tan(j["camera"]["yfov"].get<double>() / 2), 1e-9);
+  }
+  EXPECT_FALSE(fs::exists(out / "frame_00001.exr"));  // step 2
+
+  r = dynbench(fmt::format("render {} -o {} --res 32x18 --spp 2 --frames 0:4:2", kOrbit.string(), out.string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("0 frame(s) rendered, 3 already complete"), std::string::npos) << r.out;
+
+  // A frame whose sidecar is missing (interrupted before it was written) is rendered again, and
+  // so is every frame when the settings change.
+  fs::remove(out / "frame_00002.json");
+  r = dynbench(fmt::format("render {} -o {} --res 32x18 --spp 2 --frames 0:4:2", kOrbit.string(), out.string()), dir);
+  EXPECT_NE(r.out.find("1 frame(s) rendered, 2 already complete"), std::string::npos) << r.out;
+  r = dynbench(fmt::format("render {} -o {} --res 32x18 --spp 3 --frames 0:4:2", kOrbit.string(), out.string()), dir);
+  EXPECT_NE(r.out.find("3 frame(s) rendered, 0 already complete"), std::string::npos) << r.out;
+  for (const auto& entry : fs::directory_iterator(out))
+    EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+}
+
+TEST(RenderCli, TheDatasetEnvironmentLightsTheBackground) {
+  const auto dir = test::freshDir("render_env");
+  FloatImage sky;
+  sky.width = 8;
+  sky.height = 4;
+  sky.channels = 3;
+  sky.pixels.assign(8 * 4 * 3, 0.0f);
+  for (std::size_t i = 0; i < sky.pixels.size(); i += 3) {
+    sky.pixels[i] = 0.25f;
+    sky.pixels[i + 1] = 0.5f;
+    sky.pixels[i + 2] = 1.0f;
+  }
+  ASSERT_TRUE(writeImage(dir / "sky.hdr", sky));
+  test::GltfBuilder b;
+  b.node({{"name", "eye"}, {"camera", b.perspectiveCamera()}});
+  b.doc["extensions"]["DYNBENCH_environment"] = {{"uri", "sky.hdr"}, {"intensity", 2.0}};
+  b.doc["extensionsUsed"] = {"DYNBENCH_environment"};
+  const fs::path scene = b.write(dir, "env");
+  auto r = dynbench(fmt::format("render {} -o {} --res 8x4 --spp 1", scene.string(), (dir / "out").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto image = readImage(dir / "out" / "frame_00000.exr");
+  ASSERT_TRUE(image);
+  auto channel = [&](const std::string& name) {
+    const auto it = std::find(image->channelNames.begin(), image->channelNames.end(), name);
+    return static_cast<std::size_t>(it - image->channelNames.begin());
+  };
+  for (std::size_t p = 0; p < 32; ++p) {
+    const float* px = &image->pixels[p * static_cast<std::size_t>(image->channels)];
+    EXPECT_FLOAT_EQ(px[channel("direct.R")], 0.5f);
+    EXPECT_FLOAT_EQ(px[channel("direct.G")], 1.0f);
+    EXPECT_FLOAT_EQ(px[channel("direct.B")], 2.0f);
+    EXPECT_EQ(px[channel("hit")], 0.0f);
+    EXPECT_EQ(px[channel("P.X")], 0.0f);
+  }
+  // --no-environment: black.
+  r = dynbench(fmt::format("render {} -o {} --res 8x4 --spp 1 --no-environment", scene.string(), (dir / "dark").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  image = readImage(dir / "dark" / "frame_00000.exr");
+  ASSERT_TRUE(image);
+  EXPECT_EQ(image->pixels[channel("direct.B")], 0.0f);
+
+  // The environment image missing: the error names the file and the JSON pointer.
+  fs::remove(dir / "sky.hdr");
+  r = dynbench(fmt::format("render {} -o {}", scene.string(), (dir / "out2").string()), dir);
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("env.gltf: /extensions/DYNBENCH_environment/uri"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out2"));
+}
+
+TEST(RenderCli, BadOptionsFailClearly) {
+  const auto dir = test::freshDir("render_bad");
+  const std::string base = fmt::format("render {} -o {} ", kOrbit.string(), (dir / "out").string());
+  struct Case {
+    std::string args, message;
+    int status;
+  };
+  for (const Case& c : {Case{"--frames 5:2", "--frames '5:2'", 2}, Case{"--frames 9999", "the animation has frames 0 to", 2},
+                        Case{"--frames a:b", "--frames 'a:b'", 2}, Case{"--res 0x5", "--res '0x5'", 2},
+                        Case{"--res 64", "--res '64'", 2}, Case{"--engine optix", "--engine 'optix'", 2},
+                        Case{"--spp 0", "--spp must be at least 1", 2}, Case{"--camera nobody", "nobody", 2},
+                        Case{"--env-constant x", "--env-constant 'x'", 2}}) {
+    const auto r = dynbench(base + c.args, dir);
+    EXPECT_EQ(r.status, c.status) << c.args << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << ": " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "out" / "frame_00000.exr"));
+  const auto r = dynbench(fmt::format("render {} -o {}", (dir / "missing.gltf").string(), (dir / "out").string()), dir);
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("missing.gltf"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace dynbench
