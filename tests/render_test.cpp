@@ -189,6 +189,39 @@ TEST(Render, PointLightOverDiffusePlaneGivesTheAnalyticRadiance) {
   EXPECT_GT(checked, 40);
 }
 
+TEST(Render, ManyPunctualLightsAreChosenWithoutBias) {
+  // Ten lights of a tenth of the intensity at the same place: more than LightSet samples one by
+  // one, so one is chosen at random per shading point. The image is the single light's, within noise.
+  const PlaneScene one = pointLightOverPlane();
+  test::GltfBuilder b;
+  const int grey = addMaterial(b, glm::dvec3(one.albedo), 0.0, 1.0, true);
+  b.node({{"name", "plane"}, {"mesh", addPlane(b, 3.0, 0.0, grey)}});
+  static_assert(LightSet::kEveryPunctualLimit < 10);
+  for (int k = 0; k < 10; ++k) {
+    b.doc["extensions"]["KHR_lights_punctual"]["lights"].push_back({{"type", "point"}, {"intensity", one.intensity / 10}});
+    b.node({{"translation", {one.light.x, one.light.y, one.light.z}}, {"extensions", {{"KHR_lights_punctual", {{"light", k}}}}}});
+  }
+  b.doc["extensionsUsed"] = {"KHR_lights_punctual", "KHR_materials_specular"};
+  const scene::Scene ten = load(b, "ten_lights");
+  RenderSettings settings;
+  settings.samplesPerPixel = 4;
+  settings.useEnvironment = false;
+  auto a = tracerFor(one.scene, settings), c = tracerFor(ten, settings);
+  ASSERT_TRUE(a && c);
+  a->setTime(0, 0);
+  c->setTime(0, 0);
+  const RenderCamera cam = lookCamera({0, 4, 0}, {0, -1, 0}, 60.0, 40, 30);
+  const FrameBuffers fa = a->render(0, cam, cam), fc = c->render(0, cam, cam);
+  double sumA = 0, sumC = 0, var = 0;
+  for (std::size_t i = 0; i < fa.hit.size(); ++i) {
+    sumA += luminance(rgb(fa.direct, i));
+    sumC += luminance(rgb(fc.direct, i));
+    var += fc.directVariance[i] + fa.directVariance[i];
+  }
+  EXPECT_NEAR(sumC, sumA, 5 * std::sqrt(var));
+  EXPECT_GT(var, 0.0);  // the choice is random: there is noise to bound
+}
+
 TEST(Render, SpotLightConeAndRangeWindow) {
   // A spot light straight above the plane: full intensity inside the inner cone, nothing outside
   // the outer cone; and a point light's range window switches light off beyond `range`.

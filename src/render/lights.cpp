@@ -125,6 +125,8 @@ void LightSet::build(const scene::Scene& scene, const RayTracingScene& rayTracin
     punctual_.push_back(p);
     weights.push_back(power);
   }
+  punctualInChoice_ = punctual_.size() > kEveryPunctualLimit;
+  if (!punctualInChoice_) weights.clear();
   double environmentPower = 0.0;
   if (environment_) environmentPower = environment_->meanLuminance() * kPi * disc;
   weights.push_back(environmentPower);
@@ -156,8 +158,41 @@ void LightSet::build(const scene::Scene& scene, const RayTracingScene& rayTracin
     environmentChoice_ = emissiveChoice_ = 0.0;
     return;
   }
-  environmentChoice_ = choice_.probability(punctual_.size());
-  emissiveChoice_ = choice_.probability(punctual_.size() + 1);
+  const std::size_t p = punctualInChoice_ ? punctual_.size() : 0;
+  environmentChoice_ = choice_.probability(p);
+  emissiveChoice_ = choice_.probability(p + 1);
+}
+
+std::optional<LightSample> LightSet::samplePunctual(std::size_t light, const glm::dvec3& point) const {
+  const Punctual& l = punctual_[light];
+  LightSample s;
+  s.delta = true;
+  s.pdf = 1.0;
+  if (l.type == scene::Light::Type::kDirectional) {
+    s.direction = -l.direction;
+    s.distance = std::numeric_limits<double>::infinity();
+    s.radiance = l.intensity;
+    return s;
+  }
+  const glm::dvec3 toLight = l.position - point;
+  const double d2 = glm::dot(toLight, toLight);
+  if (!(d2 > 0)) return std::nullopt;
+  s.distance = std::sqrt(d2);
+  s.direction = toLight / s.distance;
+  double attenuation = 1.0 / d2;
+  if (l.range > 0) {  // KHR_lights_punctual's recommended window: max(min(1 - (d/range)^4, 1), 0) / d^2
+    const double r = s.distance / l.range;
+    attenuation *= std::clamp(1.0 - r * r * r * r, 0.0, 1.0);
+  }
+  if (l.type == scene::Light::Type::kSpot) {  // KHR_lights_punctual's spot falloff, a squared linear ramp
+    const double cd = glm::dot(l.direction, -s.direction);
+    const double scale = 1.0 / std::max(1e-3, l.cosInner - l.cosOuter);
+    const double a = std::clamp((cd - l.cosOuter) * scale, 0.0, 1.0);
+    attenuation *= a * a;
+  }
+  if (attenuation <= 0) return std::nullopt;
+  s.radiance = l.intensity * attenuation;
+  return s;
 }
 
 std::optional<LightSample> LightSet::sample(const glm::dvec3& point, double uChoice, glm::dvec2 u) const {
@@ -165,37 +200,13 @@ std::optional<LightSample> LightSet::sample(const glm::dvec3& point, double uCho
   double choiceProbability = 0.0;
   const std::size_t pick = choice_.sampleDiscrete(uChoice, &choiceProbability);
   LightSample s;
-  if (pick < punctual_.size()) {
-    const Punctual& l = punctual_[pick];
-    s.delta = true;
-    s.pdf = choiceProbability;
-    if (l.type == scene::Light::Type::kDirectional) {
-      s.direction = -l.direction;
-      s.distance = std::numeric_limits<double>::infinity();
-      s.radiance = l.intensity;
-      return s;
-    }
-    const glm::dvec3 toLight = l.position - point;
-    const double d2 = glm::dot(toLight, toLight);
-    if (!(d2 > 0)) return std::nullopt;
-    s.distance = std::sqrt(d2);
-    s.direction = toLight / s.distance;
-    double attenuation = 1.0 / d2;
-    if (l.range > 0) {  // KHR_lights_punctual's recommended window: max(min(1 - (d/range)^4, 1), 0) / d^2
-      const double r = s.distance / l.range;
-      attenuation *= std::clamp(1.0 - r * r * r * r, 0.0, 1.0);
-    }
-    if (l.type == scene::Light::Type::kSpot) {  // KHR_lights_punctual's spot falloff, squared smooth ramp
-      const double cd = glm::dot(l.direction, -s.direction);
-      const double scale = 1.0 / std::max(1e-3, l.cosInner - l.cosOuter);
-      const double a = std::clamp((cd - l.cosOuter) * scale, 0.0, 1.0);
-      attenuation *= a * a;
-    }
-    if (attenuation <= 0) return std::nullopt;
-    s.radiance = l.intensity * attenuation;
-    return s;
+  const std::size_t punctualChoices = punctualInChoice_ ? punctual_.size() : 0;
+  if (pick < punctualChoices) {
+    auto light = samplePunctual(pick, point);
+    if (light) light->pdf = choiceProbability;
+    return light;
   }
-  if (pick == punctual_.size()) {
+  if (pick == punctualChoices) {
     double pdf = 0.0;
     s.direction = environment_->sample(u, &pdf);
     if (!(pdf > 0)) return std::nullopt;

@@ -62,8 +62,16 @@ class LightSet {
   void build(const scene::Scene& scene, const RayTracingScene& rayTracing, const EnvironmentLight* environment,
              double sceneRadius, EmissionFunction emission);
 
+  // With a few punctual lights (up to kEveryPunctualLimit) every one of them is sampled at each
+  // shading point (a shadow ray each, no noise from choosing); with more, they join the random
+  // choice below. Cube 2 maps have hundreds of lights; small test scenes have one or two.
+  static constexpr std::size_t kEveryPunctualLimit = 8;
+  std::size_t everyPunctualCount() const { return punctualInChoice_ ? 0 : punctual_.size(); }
+  std::optional<LightSample> samplePunctual(std::size_t light, const glm::dvec3& point) const;
+
   bool empty() const { return choice_.empty(); }
-  // One light picked by estimated power, then a point on it (next event estimation).
+  // One light picked by estimated power (the environment, the emissive triangles and, when there
+  // are many, the punctual lights), then a point on it (next event estimation).
   std::optional<LightSample> sample(const glm::dvec3& point, double uChoice, glm::dvec2 u) const;
   // Densities of the other strategy for MIS, when a BSDF-sampled ray reaches the environment or
   // an emissive triangle (whose emissive factor luminance is `emissiveLuminance`).
@@ -89,8 +97,10 @@ class LightSet {
   Distribution1D triangleChoice_;
   const EnvironmentLight* environment_ = nullptr;
   EmissionFunction emission_;
-  // Choice among: punctual lights [0, P), the environment (P), the emissive triangles (P + 1).
+  // Choice among: punctual lights [0, P) when punctualInChoice_ (else P = 0), the environment (P),
+  // the emissive triangles (P + 1).
   Distribution1D choice_;
+  bool punctualInChoice_ = false;
   double environmentChoice_ = 0.0, emissiveChoice_ = 0.0;
 };
 

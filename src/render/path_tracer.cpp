@@ -173,9 +173,11 @@ PathTracer::Shading PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& w
     s.emissiveWeight = LightSet::emissiveWeight(glm::dvec3(m->emissiveFactor));
     mat.emission = emission(hit.node, hit.primitive, hit.triangle, hit.barycentric);
   }
-  // Both sides of a surface are shaded alike: the normals are turned towards the viewer.
-  const bool back = glm::dot(hit.geometricNormal, wo) < 0;
-  s.geometricNormal = back ? -hit.geometricNormal : hit.geometricNormal;
+  // Both sides of a surface are shaded alike: the normals are turned towards the viewer. When a
+  // mesh's winding contradicts its vertex normals, the vertex normals say which side is which.
+  const glm::dvec3 ng = glm::dot(hit.geometricNormal, hit.shadingNormal) < 0 ? -hit.geometricNormal : hit.geometricNormal;
+  const bool back = glm::dot(ng, wo) < 0;
+  s.geometricNormal = back ? -ng : ng;
   glm::dvec3 n = back ? -hit.shadingNormal : hit.shadingNormal;
   if (m && m->normalTexture.image >= 0 && textures_.find(m->normalTexture.image, false)) {
     // Tangent frame from the triangle's uv parameterisation (what glTF implies when a mesh has no
@@ -306,24 +308,24 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
             const glm::dvec3 origin = offsetOrigin(hit.position, s.geometricNormal);
             glm::dvec3& nextBucket = depth == 0 ? direct : indirect;  // light reaching this hit
 
-            if (settings_.nextEventEstimation && !lights_.empty()) {
+            if (settings_.nextEventEstimation) {
+              // Adds one light sample's contribution, weighted against BSDF sampling (Veach's MIS).
+              auto addLight = [&](const std::optional<LightSample>& ls) {
+                if (!ls || !(ls->pdf > 0)) return;
+                const glm::dvec3 f = bsdf.eval(wo, ls->direction);
+                if (f == glm::dvec3(0.0)) return;
+                const double cosine = std::abs(glm::dot(s.shadingNormal, ls->direction));
+                const double tMax = std::isinf(ls->distance) ? 1e30 : ls->distance * (1.0 - 1e-4) - 3e-5;
+                ++localRays;
+                if (rayTracing_->occluded(origin, ls->direction, tMax)) return;
+                const double w = ls->delta ? 1.0 : powerHeuristic(ls->pdf, bsdf.pdf(wo, ls->direction));
+                nextBucket += throughput * f * ls->radiance * (cosine * w / ls->pdf);
+              };
+              for (std::size_t l = 0; l < lights_.everyPunctualCount(); ++l) addLight(lights_.samplePunctual(l, hit.position));
+              // Drawn whether or not there is anything to choose, so the random stream stays aligned.
               const double uChoice = rng.uniform();
               const glm::dvec2 uLight = rng.uniform2();
-              if (const auto ls = lights_.sample(hit.position, uChoice, uLight)) {
-                const glm::dvec3 f = bsdf.eval(wo, ls->direction);
-                const double cosine = std::abs(glm::dot(s.shadingNormal, ls->direction));
-                if (f != glm::dvec3(0.0) && ls->pdf > 0) {
-                  const double tMax = std::isinf(ls->distance) ? 1e30 : ls->distance * (1.0 - 1e-4) - 3e-5;
-                  ++localRays;
-                  if (!rayTracing_->occluded(origin, ls->direction, tMax)) {
-                    const double w = ls->delta ? 1.0 : powerHeuristic(ls->pdf, bsdf.pdf(wo, ls->direction));
-                    nextBucket += throughput * f * ls->radiance * (cosine * w / ls->pdf);
-                  }
-                }
-              }
-            } else if (settings_.nextEventEstimation) {
-              rng.uniform();  // keep the random stream aligned whether or not there are lights
-              rng.uniform2();
+              if (!lights_.empty()) addLight(lights_.sample(hit.position, uChoice, uLight));
             }
 
             const double uLobe = rng.uniform();

@@ -8,6 +8,7 @@
 
 #include "core/files.h"
 #include "metrics/camera_motion.h"
+#include "render/cycles_backend.h"
 #include "metrics/properties.h"
 #include "render/frame_output.h"
 #include "scene/evaluate.h"
@@ -117,7 +118,13 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
   if (todo.empty()) return summary;
 
   const auto started = std::chrono::steady_clock::now();
-  if (job.engine == Engine::kCycles) return fail(ErrorCode::kUnsupported, "--engine cycles: not available in this build");
+  if (job.engine == Engine::kCycles) {
+    auto done = renderWithCycles(scene, *cameraNode, job, todo, record, progress);
+    if (!done) return std::unexpected(done.error());
+    summary.rendered = todo;
+    summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    return summary;
+  }
 
   std::optional<tbb::global_control> limit;
   if (job.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(job.threads));

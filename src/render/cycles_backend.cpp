@@ -1,0 +1,245 @@
+#include "render/cycles_backend.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "core/files.h"
+#include "core/math.h"
+#include "render/frame_output.h"
+#include "scene/evaluate.h"
+
+namespace dynbench::render {
+namespace {
+
+namespace fs = std::filesystem;
+
+nlohmann::json matrixJson(const glm::dmat4& m) {
+  nlohmann::json a = nlohmann::json::array();
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) a.push_back(m[c][r]);
+  return a;
+}
+
+// The script beside the executable's share folder, or in the source tree the build came from.
+Expected<fs::path> renderScript() {
+  std::vector<fs::path> candidates;
+  if (const char* env = std::getenv("DYNBENCH_BLENDER_SCRIPT")) candidates.emplace_back(env);
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) candidates.push_back(exe.parent_path() / "../share/dynbench/blender/render_cycles.py");
+  candidates.emplace_back(fs::path(DYNBENCH_SOURCE_DIR) / "tools" / "blender" / "render_cycles.py");
+  for (const auto& c : candidates)
+    if (fs::is_regular_file(c, ec)) return c;
+  return fail(ErrorCode::kExternalTool, "cannot find tools/blender/render_cycles.py (set DYNBENCH_BLENDER_SCRIPT)");
+}
+
+std::string shellQuote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// Channel lookup by Blender's names ("ViewLayer.DiffDir.R" or "DiffDir.R").
+struct Passes {
+  const FloatImage& image;
+  std::map<std::string, int> index;
+  explicit Passes(const FloatImage& i) : image(i) {
+    for (std::size_t c = 0; c < i.channelNames.size(); ++c) {
+      std::string name = i.channelNames[c];
+      // Drop the view layer's name: everything before the second-to-last dot.
+      const auto last = name.rfind('.');
+      const auto before = last == std::string::npos || last == 0 ? std::string::npos : name.rfind('.', last - 1);
+      if (before != std::string::npos) name = name.substr(before + 1);
+      index[name] = static_cast<int>(c);
+    }
+  }
+  int find(const std::string& name) const {
+    const auto it = index.find(name);
+    return it == index.end() ? -1 : it->second;
+  }
+  float at(std::size_t pixel, int channel) const {
+    return channel < 0 ? 0.0f : image.pixels[pixel * static_cast<std::size_t>(image.channels) + static_cast<std::size_t>(channel)];
+  }
+};
+
+}  // namespace
+
+Expected<fs::path> findBlender(const std::string& blender) {
+  if (blender.find('/') != std::string::npos) {
+    if (::access(blender.c_str(), X_OK) == 0) return fs::path(blender);
+    return fail(ErrorCode::kExternalTool, "--blender {}: not an executable file", blender);
+  }
+  const char* path = std::getenv("PATH");
+  std::string dirs = path ? path : "/usr/bin:/bin";
+  for (std::size_t start = 0; start <= dirs.size();) {
+    const auto end = std::min(dirs.find(':', start), dirs.size());
+    const fs::path candidate = fs::path(dirs.substr(start, end - start)) / blender;
+    if (::access(candidate.c_str(), X_OK) == 0) return candidate;
+    start = end + 1;
+  }
+  return fail(ErrorCode::kExternalTool,
+              "--engine cycles needs Blender, and '{}' is not on PATH: install Debian's blender package "
+              "(apt-get install blender) or pass --blender PATH",
+              blender);
+}
+
+Expected<FloatImage> cyclesPassesToContract(const FloatImage& passes, const fs::path& source, const RenderCamera& camera) {
+  const Passes p(passes);
+  for (const char* required : {"Position.X", "Normal.X", "DiffDir.R", "DiffInd.R", "DiffCol.R", "Depth.Z"})
+    if (p.find(required) < 0)
+      return fail(ErrorCode::kParse, "{}: Cycles output lacks the {} pass", source.string(), required);
+  FloatImage out;
+  out.width = passes.width;
+  out.height = passes.height;
+  out.channelNames = {"P.X",      "P.Y",      "P.Z",        "N.X",        "N.Y",        "N.Z",      "direct.R", "direct.G",
+                      "direct.B", "indirect.R", "indirect.G", "indirect.B", "albedo.R", "albedo.G", "albedo.B", "Z",
+                      "hit"};
+  out.channels = static_cast<int>(out.channelNames.size());
+  const auto n = static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height);
+  out.pixels.assign(n * out.channelNames.size(), 0.0f);
+  const char* rgb = "RGB";
+  const glm::dvec3 forward = -glm::dvec3(camera.world()[2]);
+  for (std::size_t i = 0; i < n; ++i) {
+    float* o = &out.pixels[i * out.channelNames.size()];
+    const bool hit = p.at(i, p.find("Depth.Z")) < 1e9f;
+    // Blender world (x, y, z) is glTF (x, z, -y).
+    auto toGltf = [](glm::dvec3 b) { return glm::dvec3(b.x, b.z, -b.y); };
+    const glm::dvec3 position = toGltf({p.at(i, p.find("Position.X")), p.at(i, p.find("Position.Y")), p.at(i, p.find("Position.Z"))});
+    const glm::dvec3 normal = toGltf({p.at(i, p.find("Normal.X")), p.at(i, p.find("Normal.Y")), p.at(i, p.find("Normal.Z"))});
+    for (int c = 0; c < 3; ++c) {
+      o[c] = hit ? static_cast<float>(position[c]) : 0.0f;
+      o[3 + c] = hit ? static_cast<float>(normal[c]) : 0.0f;
+      const std::string ch(1, rgb[c]);
+      double direct = p.at(i, p.find("Emit." + ch)) + p.at(i, p.find("Env." + ch)), indirect = 0.0;
+      for (const char* kind : {"Diff", "Gloss", "Trans"}) {
+        const double colour = p.at(i, p.find(std::string(kind) + "Col." + ch));
+        direct += colour * p.at(i, p.find(std::string(kind) + "Dir." + ch));
+        indirect += colour * p.at(i, p.find(std::string(kind) + "Ind." + ch));
+      }
+      o[6 + c] = static_cast<float>(direct);
+      o[9 + c] = static_cast<float>(indirect);
+      o[12 + c] = p.at(i, p.find("DiffCol." + ch));
+    }
+    o[15] = hit ? static_cast<float>(glm::dot(position - camera.position(), forward)) : 0.0f;
+    o[16] = hit ? 1.0f : 0.0f;
+  }
+  return out;
+}
+
+Expected<void> renderWithCycles(const scene::Scene& scene, int cameraNode, const RenderJob& job, const std::vector<long>& frames,
+                                const nlohmann::json& record, const RenderProgress& progress) {
+  auto blender = findBlender(job.blender);
+  if (!blender) return std::unexpected(blender.error());
+  auto script = renderScript();
+  if (!script) return std::unexpected(script.error());
+  const fs::path work = job.output / fmt::format(".cycles-{}", ::getpid());
+  std::error_code ec;
+  fs::create_directories(work, ec);
+  if (ec) return fail(ErrorCode::kIo, "{}: {}", work.string(), ec.message());
+
+  nlohmann::json j;
+  j["dataset"] = fs::absolute(job.dataset).string();
+  j["fps"] = job.fps;
+  j["width"] = job.settings.width;
+  j["height"] = job.settings.height;
+  j["samples_per_pixel"] = job.settings.samplesPerPixel;
+  j["bounces"] = job.settings.bounces;
+  j["seed"] = job.settings.seed;
+  j["threads"] = job.threads;
+  if (job.settings.constantEnvironment)
+    j["environment"] = {{"kind", "constant"},
+                        {"radiance", {job.settings.constantEnvironment->r, job.settings.constantEnvironment->g, job.settings.constantEnvironment->b}}};
+  else if (job.settings.useEnvironment && scene.environment)
+    j["environment"] = {{"kind", "image"}, {"file", fs::absolute(scene.environment->file).string()}, {"intensity", scene.environment->intensity}};
+  else
+    j["environment"] = {{"kind", "none"}};
+  const scene::Evaluator evaluator(scene);
+  std::vector<FrameCameras> cameras;
+  scene::ScenePose pose;
+  for (long f : frames) {
+    auto c = frameCameras(scene, cameraNode, job, f);
+    if (!c) return std::unexpected(c.error());
+    nlohmann::json frame = {{"frame", f},
+                            {"time", c->time},
+                            {"output", fs::absolute(work / fmt::format("cycles_{:05d}.exr", f)).string()},
+                            {"camera", {{"world", matrixJson(c->camera.world())}, {"yfov", c->camera.yfov()}, {"znear", c->camera.znear()}, {"zfar", c->camera.zfar()}}}};
+    evaluator.evaluate(c->time, pose);
+    frame["lights"] = nlohmann::json::array();
+    for (std::size_t n = 0; n < scene.nodes.size(); ++n) {
+      if (scene.nodes[n].light < 0) continue;
+      const auto& l = scene.lights[static_cast<std::size_t>(scene.nodes[n].light)];
+      const RigidPose rigid = decomposeRigid(pose.world[n]);
+      glm::dmat4 world = glm::mat4_cast(rigid.rotation);
+      world[3] = glm::dvec4(rigid.position, 1.0);
+      frame["lights"].push_back({{"type", toString(l.type)},
+                                 {"world", matrixJson(world)},
+                                 {"color", {l.color.r, l.color.g, l.color.b}},
+                                 {"intensity", l.intensity},
+                                 {"inner_cone", l.innerConeAngle},
+                                 {"outer_cone", l.outerConeAngle},
+                                 {"visible", pose.visible[n] != 0}});
+    }
+    j["frames"].push_back(frame);
+    cameras.push_back(std::move(*c));
+  }
+  const fs::path jobFile = work / "job.json";
+  if (auto w = writeFileAtomic(jobFile, j.dump(1)); !w) return std::unexpected(w.error());
+
+  const std::string command = fmt::format("{} --background --factory-startup --python {} -- {} 2>&1", shellQuote(blender->string()),
+                                          shellQuote(script->string()), shellQuote(jobFile.string()));
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return fail(ErrorCode::kExternalTool, "cannot start Blender ({})", blender->string());
+  std::string tail, line;
+  std::size_t done = 0;
+  const std::size_t rowsPerFrame = static_cast<std::size_t>(job.settings.height);
+  char buffer[4096];
+  std::string error;
+  while (std::fgets(buffer, sizeof buffer, pipe)) {
+    line = buffer;
+    tail += line;
+    if (tail.size() > 4000) tail.erase(0, tail.size() - 4000);
+    if (line.rfind("DYNBENCH_ERROR ", 0) == 0) error = line.substr(15);
+    if (line.rfind("DYNBENCH_FRAME_DONE ", 0) == 0) {
+      // Convert the finished frame to the contract right away, so an interrupted run keeps it.
+      const std::size_t k = done++;
+      const fs::path raw = j["frames"][k]["output"].get<std::string>();
+      auto passes = readImage(raw);
+      if (!passes) {
+        ::pclose(pipe);
+        return std::unexpected(passes.error());
+      }
+      auto image = cyclesPassesToContract(*passes, raw, cameras[k].camera);
+      if (!image) {
+        ::pclose(pipe);
+        return std::unexpected(image.error());
+      }
+      const long f = frames[k];
+      if (auto w = writeImage(frameImagePath(job.output, f), *image); !w) {
+        ::pclose(pipe);
+        return std::unexpected(w.error());
+      }
+      const auto sidecar = frameSidecar(f, cameras[k].time, cameras[k].camera, record);
+      if (auto w = writeFileAtomic(frameSidecarPath(job.output, f), sidecar.dump(2) + "\n"); !w) {
+        ::pclose(pipe);
+        return std::unexpected(w.error());
+      }
+      fs::remove(raw, ec);
+      if (progress) progress(done * rowsPerFrame, frames.size() * rowsPerFrame, done, frames.size());
+    }
+  }
+  const int status = ::pclose(pipe);
+  if (status != 0 || done != frames.size()) {
+    while (!tail.empty() && tail.back() == '\n') tail.pop_back();
+    return fail(ErrorCode::kExternalTool, "Blender (Cycles) failed after {} of {} frames{}; its last output:\n{}", done, frames.size(),
+                error.empty() ? "" : ": " + error, tail);
+  }
+  fs::remove_all(work, ec);
+  return {};
+}
+
+}  // namespace dynbench::render

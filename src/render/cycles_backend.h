@@ -1,0 +1,30 @@
+#pragma once
+// `--engine cycles`: the thesis's own renderer (Blender Cycles, §6.3) as a second backend. dynbench
+// evaluates every frame's camera and punctual lights itself, hands them to Blender with
+// tools/blender/render_cycles.py, and turns Cycles' passes into the feature-buffer contract:
+//   P, N      Position and Normal passes (Blender's Z-up world turned back to glTF's Y-up)
+//   direct    DiffCol x DiffDir + GlossCol x GlossDir + TransCol x TransDir + Emit + Env
+//   indirect  DiffCol x DiffInd + GlossCol x GlossInd + TransCol x TransInd
+//   albedo    DiffCol;  Z from P and the camera;  hit where Cycles' depth is finite
+// Cycles frames carry no id, motion or variance channels (docs/feature-buffers.md).
+#include <filesystem>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "core/image_io.h"
+#include "render/render_job.h"
+
+namespace dynbench::render {
+
+// Finds the Blender executable: a path, or a name looked up on PATH.
+Expected<std::filesystem::path> findBlender(const std::string& blender);
+
+Expected<void> renderWithCycles(const scene::Scene& scene, int cameraNode, const RenderJob& job, const std::vector<long>& frames,
+                                const nlohmann::json& record, const RenderProgress& progress);
+
+// One Cycles multilayer EXR (Blender's pass names) to the contract's channels.
+Expected<FloatImage> cyclesPassesToContract(const FloatImage& passes, const std::filesystem::path& source, const RenderCamera& camera);
+
+}  // namespace dynbench::render
