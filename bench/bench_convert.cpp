@@ -1,9 +1,10 @@
 // Conversion benchmark (run by hand; not part of the test suite):
-//   build/release/bench/bench_convert [GIGABYTES=1.0]
+//   build/release/bench/bench_convert [GIGABYTES=1.0 [DIR]]
 // Writes a synthetic capture of at least GIGABYTES through the SDK (40 skinned characters with 25
 // joints, 200 rigid models that appear and disappear, a camera, flashing lights), converts it in a
-// child process, and prints capture MB/s and the child's peak memory. The capture is kept in
-// /tmp/dynbench_bench_convert and reused while it is large enough.
+// child process, and prints capture MB/s and the child's peak memory. The capture is kept in DIR
+// (default /tmp/dynbench_bench_convert) and reused while it is large enough; DIR/out/bench.gltf is
+// the dataset (a small one, e.g. 0.02 GB, is bench_render's test scene).
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -94,7 +95,7 @@ std::uintmax_t writeCapture(const fs::path& dir, double gigabytes) {
 
 int main(int argc, char** argv) {
   const double gigabytes = argc > 1 ? std::atof(argv[1]) : 1.0;
-  const fs::path dir = fs::temp_directory_path() / "dynbench_bench_convert";
+  const fs::path dir = argc > 2 ? fs::path(argv[2]) : fs::temp_directory_path() / "dynbench_bench_convert";
   const fs::path capture = dir / "capture";
   std::uintmax_t bytes = fs::exists(capture / "Capture.txt") ? fs::file_size(capture / "Capture.txt") : 0;
   if (bytes < gigabytes * 1e9) {
