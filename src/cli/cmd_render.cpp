@@ -72,23 +72,21 @@ Expected<void> runRender(const RenderCli& cli) {
   if (cli.animation && !scene::keepOnlyAnimation(*scene, *cli.animation))
     return fail(ErrorCode::kUsage, "{}: --animation '{}' names no animation", cli.dataset, *cli.animation);
 
-  std::optional<Progress> progress(std::in_place, "render", 0, "rows");
+  // Progress on a terminal only: rows (of all frames) done, frames done, samples per second.
+  std::optional<Progress> progress;
   render::RenderProgress report;
-  std::optional<Progress> rowsProgress;
-  const auto spp = static_cast<double>(cli.spp) * job.settings.width;
+  const double samplesPerRow = static_cast<double>(cli.spp) * job.settings.width;
   const auto started = std::chrono::steady_clock::now();
-  if (progress->enabled()) {
-    progress.reset();
+  if (Progress("render", 0, "rows").enabled()) {
     report = [&](std::size_t rows, std::size_t rowsTotal, std::size_t frames, std::size_t framesTotal) {
-      if (!rowsProgress) rowsProgress.emplace("render", rowsTotal, "rows");
+      if (!progress) progress.emplace("render", rowsTotal, "rows");
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-      const double samplesPerSecond = seconds > 0 ? rows * spp / seconds : 0.0;
-      rowsProgress->update(rows, fmt::format("{}/{} frames, {:.2f} M samples/s", frames, framesTotal, samplesPerSecond / 1e6));
+      const double samplesPerSecond = seconds > 0 ? rows * samplesPerRow / seconds : 0.0;
+      progress->update(rows, fmt::format("{}/{} frames, {:.2f} M samples/s", frames, framesTotal, samplesPerSecond / 1e6));
     };
   }
-  progress.reset();
   auto summary = render::renderDataset(*scene, job, report);
-  rowsProgress.reset();
+  progress.reset();
   if (!summary) return std::unexpected(summary.error());
   for (const auto& w : scene->warnings) spdlog::warn("{}", w);
   for (const auto& w : summary->warnings) spdlog::warn("{}", w);
