@@ -18,13 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-nlohmann::json matrixJson(const glm::dmat4& m) {
-  nlohmann::json a = nlohmann::json::array();
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r) a.push_back(m[c][r]);
-  return a;
-}
-
 // The script beside the executable's share folder, or in the source tree the build came from.
 Expected<fs::path> renderScript() {
   std::vector<fs::path> candidates;

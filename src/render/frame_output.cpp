@@ -5,16 +5,12 @@
 #include "core/files.h"
 
 namespace dynbench::render {
-namespace {
-
 nlohmann::json matrixJson(const glm::dmat4& m) {
   nlohmann::json a = nlohmann::json::array();
   for (int c = 0; c < 4; ++c)
     for (int r = 0; r < 4; ++r) a.push_back(m[c][r]);
   return a;
 }
-
-}  // namespace
 
 std::filesystem::path frameImagePath(const std::filesystem::path& dir, long frame) {
   return dir / fmt::format("frame_{:05d}.exr", frame);

@@ -14,6 +14,9 @@ namespace dynbench::render {
 std::filesystem::path frameImagePath(const std::filesystem::path& dir, long frame);
 std::filesystem::path frameSidecarPath(const std::filesystem::path& dir, long frame);
 
+// A matrix as 16 numbers, column-major (glTF's order).
+nlohmann::json matrixJson(const glm::dmat4& m);
+
 // The sidecar's JSON: frame, time, resolution, camera matrices (column-major, glTF's order),
 // lens and conventions; `render` records the engine and settings that made the frame.
 nlohmann::json frameSidecar(long frame, double time, const RenderCamera& camera, const nlohmann::json& render);
