@@ -17,6 +17,9 @@ packages=(
   gnuplot-nox
   # test data: FBX / DAE models with skeletons, cameras and lights
   assimp-testmodels
+  # Blender: `render --engine cycles` (the thesis's renderer) and the tests that check dynbench's
+  # datasets with Blender's glTF importer and its P/N buffers against Cycles
+  blender python3-numpy
 )
 
 missing=()
