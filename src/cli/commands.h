@@ -25,6 +25,9 @@ void addMergeCameraCommand(CLI::App& app, CommandRun& run);
 // Registers `render`.
 void addRenderCommand(CLI::App& app, CommandRun& run);
 
+// Registers `discard`.
+void addDiscardCommand(CLI::App& app, CommandRun& run);
+
 // Exit status for an error (docs/cli.md lists them).
 int exitCode(const Error& error);
 

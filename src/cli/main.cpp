@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   cli::addConvertCommand(app, run);
   cli::addMergeCameraCommand(app, run);
   cli::addRenderCommand(app, run);
+  cli::addDiscardCommand(app, run);
 
   // `dynbench help [COMMAND]`
   std::string helpTopic;

@@ -1,0 +1,113 @@
+// `dynbench discard FRAMES_DIR`: reprojection discard percentages (thesis §3.2.2, Table 6.7).
+#include <fstream>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
+
+#include "cli/commands.h"
+#include "core/files.h"
+#include "core/image_io.h"
+#include "core/progress.h"
+#include "discard/discard.h"
+
+namespace dynbench::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct DiscardCli {
+  std::string frames, json, csv, masks;
+  discard::Thresholds thresholds;
+};
+
+nlohmann::json percentagesJson(const discard::FramePercentages& p) {
+  return {{"frustum", p.frustum}, {"world_position", p.position}, {"shading_normal", p.normal}, {"direct_radiance", p.direct},
+          {"indirect_radiance", p.indirect}};
+}
+
+Expected<void> runDiscard(const DiscardCli& cli) {
+  const auto& t = cli.thresholds;
+  for (const auto& [name, value] : {std::pair{"--threshold-position", t.position}, {"--threshold-normal", t.normal},
+                                    {"--threshold-direct", t.direct}, {"--threshold-indirect", t.indirect}})
+    if (!(value >= 0)) return fail(ErrorCode::kUsage, "{} must be a non-negative number (got {})", name, value);
+  discard::MaskSink masks;
+  if (!cli.masks.empty()) {
+    masks = [&](const discard::FeatureFrame& frame, const discard::DiscardResult& r) -> Expected<void> {
+      FloatImage image{frame.width, frame.height, 3, discard::maskImage(frame, r.mask), {}};
+      return writeImage(fs::path(cli.masks) / fmt::format("discard_{:05d}.png", frame.frame), image);
+    };
+  }
+  std::optional<Progress> progress;
+  discard::DiscardProgress report = [&](std::size_t done, std::size_t total) {
+    if (!progress) progress.emplace("discard", total, "frames");
+    progress->update(done);
+  };
+  auto run = discard::discardFolder(cli.frames, t, masks, report);
+  progress.reset();
+  if (!run) return std::unexpected(run.error());
+  for (const auto& w : run->warnings) spdlog::warn("{}: {}", cli.frames, w);
+
+  fmt::print("Table 6.7. Discarded pixels (% of the image), mean over {} frame pairs ({}x{}).\n\n", run->frames.size(), run->width,
+             run->height);
+  fmt::print("| frames | frustum % | world position % | shading normal % | direct radiance % | indirect radiance % |\n");
+  fmt::print("| ------ | --------: | ---------------: | ---------------: | ----------------: | ------------------: |\n");
+  const auto& m = run->mean;
+  fmt::print("| {} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} |\n", fs::path(cli.frames).filename().string().empty() ? cli.frames : fs::path(cli.frames).filename().string(),
+             m.frustum, m.position, m.normal, m.direct, m.indirect);
+
+  if (!cli.json.empty()) {
+    nlohmann::json j;
+    j["frames_dir"] = cli.frames;
+    j["width"] = run->width;
+    j["height"] = run->height;
+    j["scene_size"] = run->sceneSize;
+    j["thresholds"] = {{"position", t.position},       {"relative_position", t.relativePosition}, {"normal", t.normal},
+                       {"direct", t.direct},           {"indirect", t.indirect},                 {"absolute_radiance", t.absoluteRadiance},
+                       {"noise_aware", t.noiseAware}, {"noise_sigmas", t.noiseSigmas}};
+    j["mean"] = percentagesJson(m);
+    j["frames"] = nlohmann::json::array();
+    for (const auto& f : run->frames) {
+      auto row = percentagesJson(f);
+      row["frame"] = f.frame;
+      row["time"] = f.time;
+      j["frames"].push_back(row);
+    }
+    j["warnings"] = run->warnings;
+    if (auto ok = writeFileAtomic(cli.json, j.dump(2) + "\n"); !ok) return ok;
+  }
+  if (!cli.csv.empty()) {
+    std::string csv = "frame,time,frustum,world_position,shading_normal,direct_radiance,indirect_radiance\n";
+    for (const auto& f : run->frames)
+      csv += fmt::format("{},{},{},{},{},{},{}\n", f.frame, f.time, f.frustum, f.position, f.normal, f.direct, f.indirect);
+    if (auto ok = writeFileAtomic(cli.csv, csv); !ok) return ok;
+  }
+  return {};
+}
+
+}  // namespace
+
+void addDiscardCommand(CLI::App& app, CommandRun& run) {
+  auto o = std::make_shared<DiscardCli>();
+  auto* cmd = app.add_subcommand("discard", "Reprojection discard percentages of a frames folder (thesis Table 6.7)");
+  cmd->footer("FRAMES_DIR holds frame_NNNNN.exr + frame_NNNNN.json per frame (docs/feature-buffers.md), e.g. from\n"
+              "`dynbench render`. Definitions and defaults: docs/metrics.md.\n"
+              "Example: dynbench discard frames/run1 --relative-position --noise-aware --json discard.json --masks masks/");
+  cmd->add_option("FRAMES_DIR", o->frames, "Folder of feature-buffer frames")->required();
+  cmd->add_option("--threshold-position", o->thresholds.position, "World-position distance (default: 0.05 scene units)");
+  cmd->add_flag("--relative-position", o->thresholds.relativePosition, "Position threshold as a fraction of the scene's size");
+  cmd->add_option("--threshold-normal", o->thresholds.normal, "Shading-normal vector distance (default: 0.1, about 5.7 degrees)");
+  cmd->add_option("--threshold-direct", o->thresholds.direct,
+                  "Direct radiance distance, a fraction of the frame's mean luminance (default: 0.1)");
+  cmd->add_option("--threshold-indirect", o->thresholds.indirect,
+                  "Indirect radiance distance, a fraction of the frame's mean luminance (default: 0.1)");
+  cmd->add_flag("--absolute-radiance", o->thresholds.absoluteRadiance, "Radiance thresholds in radiance units, not relative");
+  cmd->add_flag("--noise-aware", o->thresholds.noiseAware,
+                "Discard radiance only when the change exceeds 3 standard deviations of the pixels' noise (needs *.var channels)");
+  cmd->add_option("--json", o->json, "Per-frame and mean percentages as JSON");
+  cmd->add_option("--csv", o->csv, "Per-frame percentages as CSV");
+  cmd->add_option("--masks", o->masks, "Write discard_NNNNN.png per frame: discarded pixels coloured by reason over the dimmed image");
+  cmd->callback([o, &run] { run = [o] { return runDiscard(*o); }; });
+}
+
+}  // namespace dynbench::cli

@@ -1,0 +1,225 @@
+#include "discard/discard.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace dynbench::discard {
+namespace {
+
+double luminance(const glm::dvec3& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
+
+glm::dvec3 at3(const std::vector<float>& b, std::size_t i) { return {b[3 * i], b[3 * i + 1], b[3 * i + 2]}; }
+
+double meanLuminance(const std::vector<float>& rgb) {
+  const std::size_t n = rgb.size() / 3;
+  double sum = 0;
+  for (std::size_t i = 0; i < n; ++i) sum += luminance(at3(rgb, i));
+  return n ? sum / static_cast<double>(n) : 0.0;
+}
+
+}  // namespace
+
+BilinearTaps bilinearTaps(double x, double y, int width, int height) {
+  // Texel space: pixel (i, j)'s centre is at (i + 0.5, j + 0.5).
+  const double u = std::clamp(x - 0.5, 0.0, static_cast<double>(width - 1));
+  const double v = std::clamp(y - 0.5, 0.0, static_cast<double>(height - 1));
+  const int x0 = std::min(static_cast<int>(u), width - 1), y0 = std::min(static_cast<int>(v), height - 1);
+  const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
+  const double tx = u - x0, ty = v - y0;
+  auto index = [width](int px, int py) { return static_cast<std::size_t>(py) * static_cast<std::size_t>(width) + static_cast<std::size_t>(px); };
+  return BilinearTaps{{index(x0, y0), index(x1, y0), index(x0, y1), index(x1, y1)},
+                      {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty}};
+}
+
+glm::dvec3 sample3(const std::vector<float>& buffer, const BilinearTaps& taps) {
+  glm::dvec3 s(0.0);
+  for (int k = 0; k < 4; ++k) s += taps.weight[k] * at3(buffer, taps.index[k]);
+  return s;
+}
+
+double sample1(const std::vector<float>& buffer, const BilinearTaps& taps) {
+  double s = 0;
+  for (int k = 0; k < 4; ++k) s += taps.weight[k] * buffer[taps.index[k]];
+  return s;
+}
+
+std::optional<glm::dvec2> reproject(const FrameCamera& camera, const glm::dvec3& p) {
+  const glm::dvec4 clip = camera.projection * camera.view * glm::dvec4(p, 1.0);  // Eq. (2.2)
+  if (clip.w <= 0) return std::nullopt;
+  const glm::dvec2 ndc(clip.x / clip.w, clip.y / clip.w);  // perspective division
+  return glm::dvec2((ndc.x + 1.0) * 0.5 * camera.width, (1.0 - ndc.y) * 0.5 * camera.height);  // Eq. (2.3), row 0 at the top
+}
+
+std::optional<glm::dvec2> reprojectDirection(const FrameCamera& camera, const glm::dvec3& direction) {
+  const glm::dvec4 clip = camera.projection * camera.view * glm::dvec4(direction, 0.0);
+  if (clip.w <= 0) return std::nullopt;
+  const glm::dvec2 ndc(clip.x / clip.w, clip.y / clip.w);
+  return glm::dvec2((ndc.x + 1.0) * 0.5 * camera.width, (1.0 - ndc.y) * 0.5 * camera.height);
+}
+
+glm::dvec3 pixelDirection(const FrameCamera& camera, double x, double y) {
+  const glm::dvec2 ndc(2.0 * x / camera.width - 1.0, 1.0 - 2.0 * y / camera.height);
+  const glm::dmat4 inverse = glm::inverse(camera.projection * camera.view);
+  const glm::dvec4 near = inverse * glm::dvec4(ndc, -1.0, 1.0), far = inverse * glm::dvec4(ndc, 1.0, 1.0);
+  return glm::normalize(glm::dvec3(far) / far.w - glm::dvec3(near) / near.w);
+}
+
+double sceneSize(const FeatureFrame& frame) {
+  glm::dvec3 lo(1e300), hi(-1e300);
+  for (std::size_t i = 0; i < frame.hit.size(); ++i) {
+    if (frame.hit[i] <= 0) continue;
+    lo = glm::min(lo, at3(frame.position, i));
+    hi = glm::max(hi, at3(frame.position, i));
+  }
+  return lo.x <= hi.x ? glm::length(hi - lo) : 0.0;
+}
+
+Thresholds absoluteThresholds(const Thresholds& t, const FeatureFrame& current, double size) {
+  Thresholds a = t;
+  if (t.relativePosition) a.position = t.position * size;
+  if (!t.absoluteRadiance) {
+    a.direct = t.direct * meanLuminance(current.direct);
+    a.indirect = t.indirect * meanLuminance(current.indirect);
+  }
+  a.relativePosition = false;
+  a.absoluteRadiance = true;
+  return a;
+}
+
+DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& previous, const Thresholds& t) {
+  DiscardResult result;
+  const int w = current.width, h = current.height;
+  const auto n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+  result.mask.assign(n, 0);
+  std::size_t counts[5] = {0, 0, 0, 0, 0};
+  const bool noise = t.noiseAware && current.hasVariance() && previous.hasVariance();
+  // Eq. (3.3) on the thesis's pixel-index coordinates (pixel i at x = i): outside [0, w - 1].
+  auto outside = [&](const glm::dvec2& q) {
+    const double x = q.x - 0.5, y = q.y - 0.5;
+    return x < 0 || x > previous.width - 1 || y < 0 || y > previous.height - 1;
+  };
+  for (int py = 0; py < h; ++py)
+    for (int px = 0; px < w; ++px) {
+      const std::size_t i = static_cast<std::size_t>(py) * static_cast<std::size_t>(w) + static_cast<std::size_t>(px);
+      unsigned char bits = 0;
+      if (current.hit[i] <= 0) {
+        // Background: the environment at infinity; its history is only lost at the frustum edge.
+        const auto q = reprojectDirection(previous.camera, pixelDirection(current.camera, px + 0.5, py + 0.5));
+        if (!q || outside(*q)) bits |= kFrustum;
+      } else {
+        const glm::dvec3 p = at3(current.position, i);
+        const auto q = reproject(previous.camera, p);
+        if (!q || outside(*q)) {
+          bits |= kFrustum;
+        } else {
+          const BilinearTaps taps = bilinearTaps(q->x, q->y, previous.width, previous.height);
+          bool historyMissesGeometry = false;
+          for (int k = 0; k < 4; ++k)
+            if (taps.weight[k] > 0 && previous.hit[taps.index[k]] <= 0) historyMissesGeometry = true;
+          // Position and normal history of a surface cannot come from the background.
+          if (historyMissesGeometry || glm::length(p - sample3(previous.position, taps)) > t.position) bits |= kPosition;
+          if (historyMissesGeometry || glm::length(at3(current.normal, i) - sample3(previous.normal, taps)) > t.normal) bits |= kNormal;
+          auto radianceChanged = [&](const std::vector<float>& now, const std::vector<float>& before, double threshold,
+                                     const std::vector<float>& varNow, const std::vector<float>& varBefore) {
+            const glm::dvec3 a = at3(now, i), b = sample3(before, taps);
+            if (!(glm::length(a - b) > threshold)) return false;
+            if (!noise) return true;
+            // Variance of the bilinear sample: sum of w_k^2 var_k (independent pixels).
+            double var = varNow[i];
+            for (int k = 0; k < 4; ++k) var += taps.weight[k] * taps.weight[k] * varBefore[taps.index[k]];
+            return std::abs(luminance(a) - luminance(b)) > t.noiseSigmas * std::sqrt(var);
+          };
+          if (radianceChanged(current.direct, previous.direct, t.direct, current.directVariance, previous.directVariance)) bits |= kDirect;
+          if (radianceChanged(current.indirect, previous.indirect, t.indirect, current.indirectVariance, previous.indirectVariance))
+            bits |= kIndirect;
+        }
+      }
+      result.mask[i] = bits;
+      for (int b = 0; b < 5; ++b)
+        if (bits & (1u << b)) ++counts[b];
+    }
+  const double scale = 100.0 / static_cast<double>(n);  // Eq. (3.4), as a percentage
+  result.percentages = {current.frame, current.time, counts[0] * scale, counts[1] * scale, counts[2] * scale, counts[3] * scale,
+                        counts[4] * scale};
+  return result;
+}
+
+}  // namespace dynbench::discard
+
+namespace dynbench::discard {
+
+Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thresholds& thresholds, const MaskSink& masks,
+                                   const DiscardProgress& progress) {
+  auto entries = listFrames(dir);
+  if (!entries) return std::unexpected(entries.error());
+  DiscardRun run;
+  run.thresholds = thresholds;
+  std::optional<FeatureFrame> previous;
+  for (std::size_t k = 0; k < entries->size(); ++k) {
+    auto frame = readFeatureFrame((*entries)[k], thresholds.noiseAware);
+    if (!frame) return std::unexpected(frame.error());
+    if (k == 0) {
+      run.width = frame->width;
+      run.height = frame->height;
+      run.sceneSize = sceneSize(*frame);
+      if (thresholds.relativePosition && run.sceneSize <= 0)
+        return fail(ErrorCode::kInvalidData, "{}: --relative-position needs geometry in the first frame to size the scene",
+                    (*entries)[k].image.string());
+    } else if (frame->width != run.width || frame->height != run.height) {
+      return fail(ErrorCode::kInvalidData, "{}: is {}x{}, but the frames before it are {}x{}", (*entries)[k].image.string(), frame->width,
+                  frame->height, run.width, run.height);
+    }
+    if (thresholds.noiseAware && !frame->hasVariance())
+      return fail(ErrorCode::kInvalidData, "{}: --noise-aware needs the direct.var and indirect.var channels", (*entries)[k].image.string());
+    if (previous) {
+      if (previous->frame + 1 != frame->frame) {
+        run.warnings.push_back(fmt::format("frames {} and {} are not consecutive: pair skipped", previous->frame, frame->frame));
+      } else {
+        const DiscardResult r = discardFrame(*frame, *previous, absoluteThresholds(thresholds, *frame, run.sceneSize));
+        run.frames.push_back(r.percentages);
+        if (masks)
+          if (auto ok = masks(*frame, r); !ok) return std::unexpected(ok.error());
+      }
+    }
+    previous = std::move(*frame);
+    if (progress) progress(k + 1, entries->size());
+  }
+  if (run.frames.empty()) return fail(ErrorCode::kInvalidData, "{}: no two consecutive frames to compare", dir.string());
+  run.mean.frame = -1;
+  for (const auto& f : run.frames) {
+    run.mean.frustum += f.frustum;
+    run.mean.position += f.position;
+    run.mean.normal += f.normal;
+    run.mean.direct += f.direct;
+    run.mean.indirect += f.indirect;
+  }
+  const double n = static_cast<double>(run.frames.size());  // Eq. (3.5)
+  for (double* v : {&run.mean.frustum, &run.mean.position, &run.mean.normal, &run.mean.direct, &run.mean.indirect}) *v /= n;
+  return run;
+}
+
+std::vector<float> maskImage(const FeatureFrame& frame, const std::vector<unsigned char>& mask) {
+  static const glm::dvec3 colours[5] = {{1, 0.1, 0.1}, {1, 0.9, 0.1}, {0.2, 0.4, 1}, {1, 0.2, 1}, {0.1, 1, 1}};
+  const std::size_t n = mask.size();
+  // Tone mapping: Reinhard on luminance scaled so the frame's mean maps to 0.18.
+  double mean = 0;
+  for (std::size_t i = 0; i < n; ++i) mean += luminance(at3(frame.direct, i) + at3(frame.indirect, i));
+  mean = std::max(mean / static_cast<double>(std::max<std::size_t>(n, 1)), 1e-12);
+  std::vector<float> rgb(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    glm::dvec3 c = (at3(frame.direct, i) + at3(frame.indirect, i)) * (0.18 / mean);
+    c = c / (1.0 + c);
+    c = glm::pow(glm::clamp(c, 0.0, 1.0), glm::dvec3(1.0 / 2.2)) * 0.45;  // dimmed
+    for (int b = 0; b < 5; ++b)
+      if (mask[i] & (1u << b)) {
+        c = 0.3 * c + 0.7 * colours[b];
+        break;
+      }
+    for (int k = 0; k < 3; ++k) rgb[3 * i + static_cast<std::size_t>(k)] = static_cast<float>(c[k]);
+  }
+  return rgb;
+}
+
+}  // namespace dynbench::discard

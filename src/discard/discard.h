@@ -1,0 +1,113 @@
+#pragma once
+// Reprojection discard (thesis §3.2.2, §6.3, Table 6.7): how much of a frame's history a temporal
+// method must throw away. Every pixel of frame i is reprojected into frame i-1 (Eqs. 2.2, 2.3);
+// it is a frustum discard when it lands outside the image (Eq. 3.3), otherwise frame i-1's
+// buffers are sampled bilinearly there and compared feature by feature (the discard functions of
+// §3.2.2). Percentages are of all w x h pixels (Eq. 3.4), averaged over the frames (Eq. 3.5).
+// docs/metrics.md states every definition, default and the treatment of pixels that hit nothing.
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "discard/feature_frames.h"
+
+namespace dynbench::discard {
+
+struct Thresholds {
+  // World-position distance, in scene units; with relativePosition, a fraction of the scene's size
+  // (the diagonal of the first frame's world-position bounding box).
+  double position = 0.05;
+  bool relativePosition = false;
+  // Shading-normal vector distance ||n_i - n_{i-1}|| (0.1 is a turn of about 5.7 degrees).
+  double normal = 0.1;
+  // Radiance vector distance ||L_i - L_{i-1}|| (RGB). By default a fraction of the current frame's
+  // mean luminance of that buffer (the exposure-like tuning the thesis did by hand);
+  // absoluteRadiance takes it in radiance units, as the thesis's functions literally do.
+  double direct = 0.1, indirect = 0.1;
+  bool absoluteRadiance = false;
+  // noiseAware: a radiance difference also has to exceed noiseSigmas standard deviations of the
+  // two pixels' Monte Carlo noise (their variance channels), so noise alone is not change.
+  bool noiseAware = false;
+  double noiseSigmas = 3.0;
+};
+
+// Why a pixel was discarded, per feature (a pixel may be discarded for several features).
+enum DiscardBit : unsigned char {
+  kFrustum = 1,
+  kPosition = 2,
+  kNormal = 4,
+  kDirect = 8,
+  kIndirect = 16,
+};
+
+struct FramePercentages {
+  long frame = 0;       // the current frame i (compared with i - 1)
+  double time = 0.0;
+  double frustum = 0, position = 0, normal = 0, direct = 0, indirect = 0;  // percent of w x h
+};
+
+struct DiscardResult {
+  FramePercentages percentages;
+  std::vector<unsigned char> mask;  // DiscardBit per pixel
+};
+
+// A bilinear sample of `channels` interleaved values at continuous pixel coordinates (x, y), pixel
+// centres at +0.5, clamped at the image's edges. Also returns the weights of the four taps.
+struct BilinearTaps {
+  std::size_t index[4];
+  double weight[4];
+};
+BilinearTaps bilinearTaps(double x, double y, int width, int height);
+glm::dvec3 sample3(const std::vector<float>& buffer, const BilinearTaps& taps);
+double sample1(const std::vector<float>& buffer, const BilinearTaps& taps);
+
+// Where world point p lands in a frame's image, in continuous pixel coordinates; nullopt behind
+// the camera (clip w <= 0). Eq. (2.2) then perspective division and Eq. (2.3).
+std::optional<glm::dvec2> reproject(const FrameCamera& camera, const glm::dvec3& p);
+// The same for a direction (a point at infinity: the background).
+std::optional<glm::dvec2> reprojectDirection(const FrameCamera& camera, const glm::dvec3& direction);
+// The world direction of the ray through continuous pixel coordinates of a frame's camera.
+glm::dvec3 pixelDirection(const FrameCamera& camera, double x, double y);
+
+// Scales thresholds that are relative (position by scene size, radiance by the current frame's
+// mean luminance) into absolute ones for this pair.
+Thresholds absoluteThresholds(const Thresholds& thresholds, const FeatureFrame& current, double sceneSize);
+
+// Compares frame `current` (i) with `previous` (i - 1); thresholds are absolute here.
+DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& previous, const Thresholds& absolute);
+
+// The diagonal of the world-position bounding box of a frame's hit pixels (0 when none).
+double sceneSize(const FeatureFrame& frame);
+
+}  // namespace dynbench::discard
+
+namespace dynbench::discard {
+
+struct DiscardRun {
+  std::vector<FramePercentages> frames;  // one per compared pair (i - 1, i)
+  FramePercentages mean;                 // Eq. (3.5) over those pairs (frame = -1)
+  Thresholds thresholds;                 // as given
+  double sceneSize = 0.0;                // used by relativePosition
+  int width = 0, height = 0;
+  std::vector<std::string> warnings;
+};
+
+// Called with each compared frame (the current one and its mask), e.g. to write a mask image.
+using MaskSink = std::function<Expected<void>(const FeatureFrame& current, const DiscardResult& result)>;
+// Called after each frame read: (frames done, frames total).
+using DiscardProgress = std::function<void(std::size_t, std::size_t)>;
+
+// Streams a frames folder (two frames in memory at a time) and compares each frame with the one
+// before it. Frames must be consecutive; a gap skips that pair with a warning.
+Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thresholds& thresholds, const MaskSink& masks = {},
+                                   const DiscardProgress& progress = {});
+
+// The mask image of Figure 6.2: the frame's direct + indirect radiance, tone-mapped and dimmed,
+// with discarded pixels coloured by their first reason (frustum red, world position yellow,
+// shading normal blue, direct magenta, indirect cyan). 8-bit RGB values in [0, 1].
+std::vector<float> maskImage(const FeatureFrame& frame, const std::vector<unsigned char>& mask);
+
+}  // namespace dynbench::discard
