@@ -96,9 +96,12 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
   std::size_t counts[5] = {0, 0, 0, 0, 0};
   const bool noise = t.noiseAware && current.hasVariance() && previous.hasVariance();
   // Eq. (3.3) on the thesis's pixel-index coordinates (pixel i at x = i): outside [0, w - 1].
+  // A pixel that reprojects onto an edge pixel's centre stays inside despite rounding: buffers store
+  // float positions, about 1e-7 relative, i.e. up to a few 1e-6 px; the slack is 1e-3 px.
+  constexpr double kEdge = 1e-3;
   auto outside = [&](const glm::dvec2& q) {
     const double x = q.x - 0.5, y = q.y - 0.5;
-    return x < 0 || x > previous.width - 1 || y < 0 || y > previous.height - 1;
+    return x < -kEdge || x > previous.width - 1 + kEdge || y < -kEdge || y > previous.height - 1 + kEdge;
   };
   for (int py = 0; py < h; ++py)
     for (int px = 0; px < w; ++px) {

@@ -1,0 +1,308 @@
+// Reprojection discard against answers derived by hand: a static view discards nothing, a yaw
+// turn discards exactly the columns that leave the frustum, a sliding quad discards its covered
+// and uncovered area, noise alone is not change with --noise-aware, a light switched off discards
+// the lit area; bilinear sampling at centres, edges and corners; bad frames folders.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fmt/format.h>
+
+#include "core/files.h"
+#include "core/image_io.h"
+#include "core/math.h"
+#include "discard/discard.h"
+#include "gltf_builder.h"
+#include "render/camera.h"
+#include "render/frame_output.h"
+#include "run_cli.h"
+
+namespace dynbench::discard {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A camera at the origin with the given yaw (degrees, about +Y) and horizontal field of view.
+render::RenderCamera camera(double yawDegrees, int w, int h, double yfovDegrees) {
+  glm::dmat4 world = glm::mat4_cast(quatFromYawPitchRoll(radians(yawDegrees), 0.0, 0.0));
+  scene::Camera lens;
+  lens.yfov = radians(yfovDegrees);
+  lens.znear = 0.1;
+  lens.zfar = 1000;
+  return render::RenderCamera(world, lens, w, h);
+}
+
+// What a frame sees: the hit point along a ray (or nothing), its normal and radiances.
+struct Surface {
+  bool hit = false;
+  glm::dvec3 position{0.0}, normal{0.0}, direct{0.0}, indirect{0.0};
+};
+
+template <typename Scene>
+FeatureFrame makeFrame(long index, const render::RenderCamera& cam, Scene&& scene) {
+  FeatureFrame f;
+  f.frame = index;
+  f.width = cam.width();
+  f.height = cam.height();
+  f.camera = {cam.view(), cam.projection(), cam.width(), cam.height()};
+  const auto n = static_cast<std::size_t>(f.width) * f.height;
+  for (auto* b : {&f.position, &f.normal, &f.direct, &f.indirect}) b->assign(3 * n, 0.0f);
+  f.hit.assign(n, 0.0f);
+  f.directVariance.assign(n, 0.0f);
+  f.indirectVariance.assign(n, 0.0f);
+  for (int y = 0; y < f.height; ++y)
+    for (int x = 0; x < f.width; ++x) {
+      const auto i = static_cast<std::size_t>(y * f.width + x);
+      const render::Ray ray = cam.ray(x + 0.5, y + 0.5);
+      const Surface s = scene(ray, x, y);
+      f.hit[i] = s.hit ? 1.0f : 0.0f;
+      for (int c = 0; c < 3; ++c) {
+        f.position[3 * i + c] = static_cast<float>(s.position[c]);
+        f.normal[3 * i + c] = static_cast<float>(s.normal[c]);
+        f.direct[3 * i + c] = static_cast<float>(s.direct[c]);
+        f.indirect[3 * i + c] = static_cast<float>(s.indirect[c]);
+      }
+    }
+  return f;
+}
+
+// A sphere of radius 50 around the origin, seen from inside.
+Surface farSphere(const render::Ray& ray, int, int) {
+  return {true, ray.origin + 50.0 * ray.direction, -ray.direction, glm::dvec3(1.0), glm::dvec3(0.5)};
+}
+
+Thresholds absolute(double position, double normal, double direct, double indirect) {
+  Thresholds t;
+  t.position = position;
+  t.normal = normal;
+  t.direct = direct;
+  t.indirect = indirect;
+  t.absoluteRadiance = true;
+  return t;
+}
+
+TEST(Discard, StaticCameraAndSceneDiscardNothing) {
+  const auto cam = camera(30.0, 64, 36, 50.0);
+  const FeatureFrame a = makeFrame(0, cam, farSphere), b = makeFrame(1, cam, farSphere);
+  const auto r = discardFrame(b, a, absolute(1e-3, 1e-3, 1e-3, 1e-3));
+  EXPECT_EQ(r.percentages.frustum, 0.0);
+  EXPECT_EQ(r.percentages.position, 0.0);
+  EXPECT_EQ(r.percentages.normal, 0.0);
+  EXPECT_EQ(r.percentages.direct, 0.0);
+  EXPECT_EQ(r.percentages.indirect, 0.0);
+}
+
+TEST(Discard, YawTurnDiscardsTheColumnsThatLeaveTheFrustum) {
+  // One row of 1000 pixels, 90 degrees across (tan(hfov/2) = 1). The previous camera looked 10
+  // degrees further left (yaw +10). A pixel at angle phi right of the axis (tan phi = 2(x + 0.5)/w - 1)
+  // was at phi + 10 degrees in the previous image, i.e. at pixel index w/2 (1 + tan(phi + 10)) - 0.5.
+  // It is outside (Eq. 3.3) when that exceeds w - 1: tan(phi + 10) > 0.999, phi > 44.9713 - 10
+  // = 34.9713 degrees, tan phi > 0.69946, x + 0.5 > 849.73: columns 850..999, 150 pixels = 15.0%.
+  // A single row keeps the vertical coordinate at the centre (y_cam = 0) whatever the yaw.
+  const int w = 1000, h = 1;
+  const double yfov = degrees(2.0 * std::atan(1.0 / w));  // square pixels: tan(yfov/2) = tan(hfov/2) h / w
+  const auto now = camera(0.0, w, h, yfov), before = camera(10.0, w, h, yfov);
+  for (bool background : {false, true}) {
+    auto scene = [&](const render::Ray& ray, int x, int y) { return background ? Surface{} : farSphere(ray, x, y); };
+    const auto r = discardFrame(makeFrame(1, now, scene), makeFrame(0, before, scene), absolute(1e-2, 1e-2, 1e-2, 1e-2));
+    EXPECT_NEAR(r.percentages.frustum, 15.0, 1e-9) << (background ? "background" : "geometry");
+    for (int x = 0; x < w; ++x) EXPECT_EQ((r.mask[static_cast<std::size_t>(x)] & kFrustum) != 0, x >= 850) << x;
+    if (!background) EXPECT_EQ(r.percentages.position, 0.0);  // the rest has valid history
+  }
+}
+
+TEST(Discard, SlidingQuadDiscardsItsCoveredAndUncoveredArea) {
+  // A static camera looking down -Z at a wall at z = -10 and a 2 x 2 quad at z = -5 that moves
+  // 0.5 to the right between the frames. With a static camera every pixel reprojects onto itself,
+  // so the history of a pixel is what that pixel saw before. Where the quad covers a pixel in both
+  // frames the ray meets the quad's plane at the same world point, so only the area it newly
+  // covers (wall before, quad now) and the area it uncovers (quad before, wall now) is discarded.
+  const int w = 80, h = 60;
+  const auto cam = camera(0.0, w, h, 60.0);
+  auto quadAt = [](double cx) {
+    return [cx](const render::Ray& ray, int, int) {
+      const double tq = (-5.0 - ray.origin.z) / ray.direction.z;
+      const glm::dvec3 q = ray.origin + tq * ray.direction;
+      if (std::abs(q.x - cx) <= 1.0 && std::abs(q.y) <= 1.0) return Surface{true, q, {0, 0, 1}, glm::dvec3(1.0), glm::dvec3(0.1)};
+      const double tw = (-10.0 - ray.origin.z) / ray.direction.z;
+      return Surface{true, ray.origin + tw * ray.direction, {0, 0, 1}, glm::dvec3(1.0), glm::dvec3(0.1)};
+    };
+  };
+  const auto r = discardFrame(makeFrame(1, cam, quadAt(0.5)), makeFrame(0, cam, quadAt(0.0)), absolute(0.1, 0.1, 0.1, 0.1));
+  int expected = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const render::Ray ray = cam.ray(x + 0.5, y + 0.5);
+      const glm::dvec3 q = ray.origin + ((-5.0 - ray.origin.z) / ray.direction.z) * ray.direction;
+      const bool now = std::abs(q.x - 0.5) <= 1.0 && std::abs(q.y) <= 1.0, before = std::abs(q.x) <= 1.0 && std::abs(q.y) <= 1.0;
+      expected += now != before;
+      EXPECT_EQ((r.mask[static_cast<std::size_t>(y * w + x)] & kPosition) != 0, now != before) << x << "," << y;
+    }
+  EXPECT_GT(expected, 50);
+  EXPECT_NEAR(r.percentages.position, 100.0 * expected / (w * h), 1e-9);
+  EXPECT_EQ(r.percentages.normal, 0.0);  // the same normal everywhere
+  EXPECT_EQ(r.percentages.frustum, 0.0);
+}
+
+TEST(Discard, NoiseAloneIsNotChangeWhenNoiseAware) {
+  // Both frames show the same surface with radiance 1 + Gaussian noise of standard deviation 0.05
+  // per pixel, and say so in their variance channels (0.05^2). A threshold of 0.02 discards most
+  // pixels; --noise-aware asks for 3 standard deviations of the difference (sqrt(2) x 0.05), which
+  // noise exceeds with probability 0.27%.
+  const auto cam = camera(0.0, 100, 100, 50.0);
+  std::mt19937 random(7);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  auto noisy = [&](const render::Ray& ray, int x, int y) {
+    Surface s = farSphere(ray, x, y);
+    const double d = 1.0 + noise(random), i = 0.5 + noise(random);
+    s.direct = glm::dvec3(d);
+    s.indirect = glm::dvec3(i);
+    return s;
+  };
+  FeatureFrame a = makeFrame(0, cam, noisy), b = makeFrame(1, cam, noisy);
+  for (auto* f : {&a, &b}) {
+    std::fill(f->directVariance.begin(), f->directVariance.end(), 0.0025f);
+    std::fill(f->indirectVariance.begin(), f->indirectVariance.end(), 0.0025f);
+  }
+  Thresholds t = absolute(0.1, 0.1, 0.02, 0.02);
+  const auto plain = discardFrame(b, a, t);
+  t.noiseAware = true;
+  const auto aware = discardFrame(b, a, t);
+  EXPECT_GT(plain.percentages.direct, 60.0);  // |N(0, 0.0707^2)| * sqrt(3) > 0.02: about 83%
+  EXPECT_GT(plain.percentages.indirect, 60.0);
+  EXPECT_LT(aware.percentages.direct, 1.0);
+  EXPECT_LT(aware.percentages.indirect, 1.0);
+}
+
+TEST(Discard, ALightSwitchedOffDiscardsTheLitArea) {
+  // The left half of the image was lit (direct 1) and is dark now: 100% of the lit area, 50% of
+  // the image, is a direct-radiance discard; nothing else changed.
+  const int w = 64, h = 32;
+  const auto cam = camera(0.0, w, h, 50.0);
+  auto lit = [](bool on) {
+    return [on](const render::Ray& ray, int x, int y) {
+      Surface s = farSphere(ray, x, y);
+      s.direct = glm::dvec3(on && x < 32 ? 1.0 : 0.0);
+      return s;
+    };
+  };
+  const auto r = discardFrame(makeFrame(1, cam, lit(false)), makeFrame(0, cam, lit(true)), absolute(0.1, 0.1, 0.5, 0.1));
+  EXPECT_NEAR(r.percentages.direct, 50.0, 1e-9);
+  for (int x = 0; x < w; ++x) EXPECT_EQ((r.mask[static_cast<std::size_t>(x)] & kDirect) != 0, x < 32);
+  EXPECT_EQ(r.percentages.indirect, 0.0);
+  EXPECT_EQ(r.percentages.position, 0.0);
+}
+
+TEST(Discard, BilinearSamplingAtCentresEdgesAndCorners) {
+  // A 3 x 2 image with value = 10 x column + row.
+  std::vector<float> v{0, 10, 20, 1, 11, 21};
+  auto at = [&](double x, double y) { return sample1(v, bilinearTaps(x, y, 3, 2)); };
+  EXPECT_DOUBLE_EQ(at(0.5, 0.5), 0.0);   // pixel centres are exact
+  EXPECT_DOUBLE_EQ(at(2.5, 1.5), 21.0);
+  EXPECT_DOUBLE_EQ(at(1.0, 0.5), 5.0);   // half-way between two centres
+  EXPECT_DOUBLE_EQ(at(1.5, 1.0), 10.5);
+  EXPECT_DOUBLE_EQ(at(1.0, 1.0), 5.5);   // the middle of four
+  EXPECT_DOUBLE_EQ(at(0.0, 0.0), 0.0);   // the image corner clamps to the corner pixel
+  EXPECT_DOUBLE_EQ(at(3.0, 2.0), 21.0);
+  EXPECT_DOUBLE_EQ(at(3.0, 1.0), 20.5);  // the right edge clamps horizontally, interpolates vertically
+}
+
+TEST(Discard, ReprojectionRoundTripsThroughThePixelDirection) {
+  const auto cam = camera(25.0, 320, 180, 40.0);
+  const FrameCamera fc{cam.view(), cam.projection(), 320, 180};
+  for (double x : {0.5, 100.25, 319.5})
+    for (double y : {0.5, 90.0, 179.5}) {
+      const auto q = reprojectDirection(fc, pixelDirection(fc, x, y));
+      ASSERT_TRUE(q);
+      EXPECT_NEAR(q->x, x, 1e-7);
+      EXPECT_NEAR(q->y, y, 1e-7);
+      const auto p = reproject(fc, cam.position() + 7.0 * pixelDirection(fc, x, y));
+      ASSERT_TRUE(p);
+      EXPECT_NEAR(p->x, x, 1e-7);
+    }
+}
+
+// A frames folder written to the contract (through the renderer's own sidecar writer).
+void writeFrames(const fs::path& dir, int count, int w, int h) {
+  for (int k = 0; k < count; ++k) {
+    const auto cam = camera(2.0 * k, w, h, 50.0);
+    const FeatureFrame f = makeFrame(k, cam, farSphere);
+    FloatImage image;
+    image.width = w;
+    image.height = h;
+    image.channelNames = {"P.X", "P.Y", "P.Z", "N.X", "N.Y", "N.Z", "direct.R", "direct.G", "direct.B", "indirect.R", "indirect.G", "indirect.B", "hit"};
+    image.channels = static_cast<int>(image.channelNames.size());
+    for (std::size_t i = 0; i < f.hit.size(); ++i) {
+      for (const auto* b : {&f.position, &f.normal, &f.direct, &f.indirect})
+        for (int c = 0; c < 3; ++c) image.pixels.push_back((*b)[3 * i + c]);
+      image.pixels.push_back(f.hit[i]);
+    }
+    ASSERT_TRUE(writeImage(render::frameImagePath(dir, k), image));
+    ASSERT_TRUE(writeFileAtomic(render::frameSidecarPath(dir, k), render::frameSidecar(k, k / 24.0, cam, {}).dump()));
+  }
+}
+
+TEST(DiscardCli, TableJsonCsvAndMasks) {
+  const auto dir = test::freshDir("discard_cli");
+  writeFrames(dir / "frames", 4, 48, 27);
+  const auto r = dynbench(fmt::format("discard {} --json {} --csv {} --masks {}", (dir / "frames").string(), (dir / "d.json").string(),
+                                      (dir / "d.csv").string(), (dir / "masks").string()),
+                          dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("| frustum % |"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(*readWholeFile(dir / "d.json"));
+  ASSERT_EQ(j["frames"].size(), 3u);
+  // A 2-degree yaw per frame over a 50-degree-high, 16:9 image: the same frustum share each frame.
+  const double f1 = j["frames"][0]["frustum"].get<double>();
+  EXPECT_GT(f1, 1.0);
+  EXPECT_NEAR(j["frames"][2]["frustum"].get<double>(), f1, 1e-9);
+  EXPECT_NEAR(j["mean"]["frustum"].get<double>(), f1, 1e-9);
+  EXPECT_EQ(j["mean"]["world_position"].get<double>(), 0.0);
+  const auto csv = *readWholeFile(dir / "d.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);
+  auto mask = readImageHeader(dir / "masks" / "discard_00003.png");
+  ASSERT_TRUE(mask) << mask.error().message;
+  EXPECT_EQ(mask->width, 48);
+}
+
+TEST(DiscardCli, BadFramesFoldersFailClearly) {
+  const auto dir = test::freshDir("discard_bad");
+  writeFrames(dir / "f", 3, 16, 9);
+  fs::remove(dir / "f" / "frame_00001.json");
+  auto r = dynbench(fmt::format("discard {} --json {}", (dir / "f").string(), (dir / "out.json").string()), dir);
+  EXPECT_EQ(r.status, 5) << r.err;
+  EXPECT_NE(r.err.find("frame_00001.exr: has no frame_00001.json"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out.json"));
+
+  writeFrames(dir / "g", 2, 16, 9);
+  writeFrames(dir / "g2", 2, 20, 9);  // a frame of another size
+  fs::copy_file(dir / "g2" / "frame_00001.exr", dir / "g" / "frame_00001.exr", fs::copy_options::overwrite_existing);
+  r = dynbench(fmt::format("discard {}", (dir / "g").string()), dir);
+  EXPECT_EQ(r.status, 5) << r.err;
+  EXPECT_NE(r.err.find("frame_00001.exr: is 20x9 but its sidecar says 16x9"), std::string::npos) << r.err;
+
+  writeFrames(dir / "h", 2, 16, 9);
+  FloatImage bare{16, 9, 3, std::vector<float>(16 * 9 * 3, 0.0f), {"P.X", "P.Y", "P.Z"}};
+  ASSERT_TRUE(writeImage(dir / "h" / "frame_00001.exr", bare));
+  r = dynbench(fmt::format("discard {}", (dir / "h").string()), dir);
+  EXPECT_EQ(r.status, 5) << r.err;
+  EXPECT_NE(r.err.find("lacks the channel(s) N.X, N.Y, N.Z"), std::string::npos) << r.err;
+
+  r = dynbench(fmt::format("discard {} --noise-aware", (dir / "g2").string()), dir);
+  EXPECT_EQ(r.status, 5) << r.err;
+  EXPECT_NE(r.err.find("direct.var"), std::string::npos) << r.err;
+
+  writeFrames(dir / "k", 2, 16, 9);
+  ASSERT_TRUE(writeFileAtomic(dir / "k" / "frame_00000.json", R"({"width": 16, "height": 9, "camera": {"view": [1, 2]}})"));
+  r = dynbench(fmt::format("discard {}", (dir / "k").string()), dir);
+  EXPECT_EQ(r.status, 5) << r.err;
+  EXPECT_NE(r.err.find("frame_00000.json: /camera/view: expected an array of 16 numbers"), std::string::npos) << r.err;
+
+  r = dynbench(fmt::format("discard {}", (dir / "nowhere").string()), dir);
+  EXPECT_EQ(r.status, 3) << r.err;
+}
+
+}  // namespace
+}  // namespace dynbench::discard
