@@ -1,7 +1,10 @@
 #include "discard/discard.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+
+#include <tbb/parallel_for.h>
 
 #include <fmt/format.h>
 
@@ -59,11 +62,20 @@ std::optional<glm::dvec2> reprojectDirection(const FrameCamera& camera, const gl
   return glm::dvec2((ndc.x + 1.0) * 0.5 * camera.width, (1.0 - ndc.y) * 0.5 * camera.height);
 }
 
-glm::dvec3 pixelDirection(const FrameCamera& camera, double x, double y) {
-  const glm::dvec2 ndc(2.0 * x / camera.width - 1.0, 1.0 - 2.0 * y / camera.height);
-  const glm::dmat4 inverse = glm::inverse(camera.projection * camera.view);
-  const glm::dvec4 near = inverse * glm::dvec4(ndc, -1.0, 1.0), far = inverse * glm::dvec4(ndc, 1.0, 1.0);
+namespace {
+
+// The direction from the near to the far plane through continuous pixel coordinates, given the
+// inverse of projection x view.
+glm::dvec3 directionThrough(const glm::dmat4& inverseViewProjection, double x, double y, int width, int height) {
+  const glm::dvec2 ndc(2.0 * x / width - 1.0, 1.0 - 2.0 * y / height);
+  const glm::dvec4 near = inverseViewProjection * glm::dvec4(ndc, -1.0, 1.0), far = inverseViewProjection * glm::dvec4(ndc, 1.0, 1.0);
   return glm::normalize(glm::dvec3(far) / far.w - glm::dvec3(near) / near.w);
+}
+
+}  // namespace
+
+glm::dvec3 pixelDirection(const FrameCamera& camera, double x, double y) {
+  return directionThrough(glm::inverse(camera.projection * camera.view), x, y, camera.width, camera.height);
 }
 
 double sceneSize(const FeatureFrame& frame) {
@@ -103,13 +115,17 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
     const double x = q.x - 0.5, y = q.y - 0.5;
     return x < -kEdge || x > previous.width - 1 + kEdge || y < -kEdge || y > previous.height - 1 + kEdge;
   };
-  for (int py = 0; py < h; ++py)
+  const glm::dmat4 inverseCurrent = glm::inverse(current.camera.projection * current.camera.view);
+  // Rows in parallel (TBB); each row's counts are summed at the end, so the result is exact.
+  std::vector<std::array<std::size_t, 5>> rowCounts(static_cast<std::size_t>(h), std::array<std::size_t, 5>{});
+  tbb::parallel_for(0, h, [&](int py) {
+    auto& rowCount = rowCounts[static_cast<std::size_t>(py)];
     for (int px = 0; px < w; ++px) {
       const std::size_t i = static_cast<std::size_t>(py) * static_cast<std::size_t>(w) + static_cast<std::size_t>(px);
       unsigned char bits = 0;
       if (current.hit[i] <= 0) {
         // Background: the environment at infinity; its history is only lost at the frustum edge.
-        const auto q = reprojectDirection(previous.camera, pixelDirection(current.camera, px + 0.5, py + 0.5));
+        const auto q = reprojectDirection(previous.camera, directionThrough(inverseCurrent, px + 0.5, py + 0.5, w, h));
         if (!q || outside(*q)) bits |= kFrustum;
       } else {
         const glm::dvec3 p = at3(current.position, i);
@@ -141,8 +157,11 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
       }
       result.mask[i] = bits;
       for (int b = 0; b < 5; ++b)
-        if (bits & (1u << b)) ++counts[b];
+        if (bits & (1u << b)) ++rowCount[static_cast<std::size_t>(b)];
     }
+  });
+  for (const auto& row : rowCounts)
+    for (int b = 0; b < 5; ++b) counts[b] += row[static_cast<std::size_t>(b)];
   const double scale = 100.0 / static_cast<double>(n);  // Eq. (3.4), as a percentage
   result.percentages = {current.frame, current.time, counts[0] * scale, counts[1] * scale, counts[2] * scale, counts[3] * scale,
                         counts[4] * scale};
