@@ -247,8 +247,8 @@ void writeFrames(const fs::path& dir, int count, int w, int h) {
 TEST(DiscardCli, TableJsonCsvAndMasks) {
   const auto dir = test::freshDir("discard_cli");
   writeFrames(dir / "frames", 4, 48, 27);
-  const auto r = dynbench(fmt::format("discard {} --json {} --csv {} --masks {}", (dir / "frames").string(), (dir / "d.json").string(),
-                                      (dir / "d.csv").string(), (dir / "masks").string()),
+  const auto r = dynbench(fmt::format("discard {} --json {} --csv {} --masks {} --plots {}", (dir / "frames").string(),
+                                      (dir / "d.json").string(), (dir / "d.csv").string(), (dir / "masks").string(), (dir / "plots").string()),
                           dir);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("| frustum % |"), std::string::npos) << r.out;
@@ -262,6 +262,12 @@ TEST(DiscardCli, TableJsonCsvAndMasks) {
   EXPECT_EQ(j["mean"]["world_position"].get<double>(), 0.0);
   const auto csv = *readWholeFile(dir / "d.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);
+  const auto png = readImageHeader(dir / "plots" / "frames_discard.png");
+  ASSERT_TRUE(png) << png.error().message;
+  EXPECT_EQ(png->width, 1200);
+  const std::string svg = *readWholeFile(dir / "plots" / "frames_discard.svg");
+  EXPECT_NE(svg.find("</svg>"), std::string::npos);
+  EXPECT_NE(svg.find("shading normal"), std::string::npos);  // the legend names the features
   auto mask = readImageHeader(dir / "masks" / "discard_00003.png");
   ASSERT_TRUE(mask) << mask.error().message;
   EXPECT_EQ(mask->width, 48);

@@ -10,6 +10,7 @@
 #include "core/image_io.h"
 #include "core/progress.h"
 #include "discard/discard.h"
+#include "report/plots.h"
 
 namespace dynbench::cli {
 namespace {
@@ -17,7 +18,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct DiscardCli {
-  std::string frames, json, csv, masks;
+  std::string frames, json, csv, masks, plots;
   discard::Thresholds thresholds;
 };
 
@@ -82,6 +83,11 @@ Expected<void> runDiscard(const DiscardCli& cli) {
       csv += fmt::format("{},{},{},{},{},{},{}\n", f.frame, f.time, f.frustum, f.position, f.normal, f.direct, f.indirect);
     if (auto ok = writeFileAtomic(cli.csv, csv); !ok) return ok;
   }
+  if (!cli.plots.empty()) {
+    const std::string name = fs::path(cli.frames).filename().string();
+    auto written = report::writeDiscardPlot(run->frames, name, cli.plots, name.empty() ? "frames" : name);
+    if (!written) return std::unexpected(written.error());
+  }
   return {};
 }
 
@@ -106,6 +112,7 @@ void addDiscardCommand(CLI::App& app, CommandRun& run) {
                 "Discard radiance only when the change exceeds 3 standard deviations of the pixels' noise (needs *.var channels)");
   cmd->add_option("--json", o->json, "Per-frame and mean percentages as JSON");
   cmd->add_option("--csv", o->csv, "Per-frame percentages as CSV");
+  cmd->add_option("--plots", o->plots, "Write NAME_discard.png and .svg: per-frame discard percentages (gnuplot)");
   cmd->add_option("--masks", o->masks, "Write discard_NNNNN.png per frame: discarded pixels coloured by reason over the dimmed image");
   cmd->callback([o, &run] { run = [o] { return runDiscard(*o); }; });
 }

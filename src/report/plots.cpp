@@ -50,27 +50,20 @@ Expected<void> runGnuplot(const fs::path& script, const fs::path& log) {
   return {};
 }
 
-}  // namespace
+// One gnuplot run for several line figures over one CSV (columns named by its header), each as
+// PNG and SVG; `plot` holds gnuplot's plot command with {data} standing for the CSV's path.
+struct LineFigure {
+  std::string name, title, ylabel, plot;
+};
 
-Expected<std::vector<fs::path>> writeRotationPlots(const metrics::CameraMotion& motion, const std::string& title,
-                                                   const fs::path& dir, const std::string& stem) {
+Expected<std::vector<fs::path>> writeLineFigures(const fs::path& dir, const std::string& stem, const std::string& csv,
+                                                 const std::vector<LineFigure>& figures) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) return fail(ErrorCode::kIo, "{}: cannot create folder: {}", dir.string(), ec.message());
   const fs::path data = temporarySibling(dir / (stem + "_series.csv"));
-  if (auto ok = writeFileAtomic(data, cameraSeriesCsv(motion)); !ok) return std::unexpected(ok.error());
-
-  struct Figure {
-    std::string name, ylabel, plot;
-  };
+  if (auto ok = writeFileAtomic(data, csv); !ok) return std::unexpected(ok.error());
   const std::string d = quoted(data.string());
-  const std::vector<Figure> figures = {
-      {"rotation_per_axis", "degrees / frame",
-       fmt::format("plot {0} using 1:12 with lines lw 1.5 title 'pitch', {0} using 1:11 with lines lw 1.5 title 'yaw', "
-                   "{0} using 1:13 with lines lw 1.5 title 'roll'",
-                   d)},
-      {"rotation_geodesic", "degrees / frame", fmt::format("plot {} using 1:10 with lines lw 1.5 title 'geodesic rotation'", d)},
-  };
   std::vector<fs::path> written;
   std::vector<std::pair<fs::path, fs::path>> moves;
   std::string script = "set datafile separator ','\nset key autotitle columnhead\nset grid\nset xlabel 'frame'\n";
@@ -79,11 +72,10 @@ Expected<std::vector<fs::path>> writeRotationPlots(const metrics::CameraMotion& 
                                         std::pair{"svg size 1200,450 dynamic font ',10'", ".svg"}}) {
       const fs::path target = dir / (stem + "_" + figure.name + ext);
       const fs::path tmp = temporarySibling(target);
+      std::string plot = figure.plot;
+      for (std::size_t at; (at = plot.find("{data}")) != std::string::npos;) plot.replace(at, 6, d);
       script += fmt::format("set terminal {}\nset output {}\nset title {}\nset ylabel {}\n{}\nunset output\n", terminal,
-                            quoted(tmp.string()),
-                            quoted(title + (figure.name == "rotation_per_axis" ? ": change in pitch, yaw and roll per frame (Fig. A.1)"
-                                                                               : ": geodesic change in rotation per frame (Fig. A.2)")),
-                            quoted(figure.ylabel), figure.plot);
+                            quoted(tmp.string()), quoted(figure.title), quoted(figure.ylabel), plot);
       moves.push_back({tmp, target});
     }
   }
@@ -112,6 +104,30 @@ Expected<std::vector<fs::path>> writeRotationPlots(const metrics::CameraMotion& 
   }
   cleanup();
   return written;
+}
+
+}  // namespace
+
+Expected<std::vector<fs::path>> writeRotationPlots(const metrics::CameraMotion& motion, const std::string& title,
+                                                   const fs::path& dir, const std::string& stem) {
+  return writeLineFigures(
+      dir, stem, cameraSeriesCsv(motion),
+      {{"rotation_per_axis", title + ": change in pitch, yaw and roll per frame (Fig. A.1)", "degrees / frame",
+        "plot {data} using 1:12 with lines lw 1.5 title 'pitch', {data} using 1:11 with lines lw 1.5 title 'yaw', "
+        "{data} using 1:13 with lines lw 1.5 title 'roll'"},
+       {"rotation_geodesic", title + ": geodesic change in rotation per frame (Fig. A.2)", "degrees / frame",
+        "plot {data} using 1:10 with lines lw 1.5 title 'geodesic rotation'"}});
+}
+
+Expected<std::vector<fs::path>> writeDiscardPlot(const std::vector<discard::FramePercentages>& frames, const std::string& title,
+                                                 const fs::path& dir, const std::string& stem) {
+  std::string csv = "frame,frustum,world position,shading normal,direct radiance,indirect radiance\n";
+  for (const auto& f : frames)
+    csv += fmt::format("{},{},{},{},{},{}\n", f.frame, f.frustum, f.position, f.normal, f.direct, f.indirect);
+  std::string plot = "plot ";
+  for (int column = 2; column <= 6; ++column)
+    plot += fmt::format("{}{{data}} using 1:{} with lines lw 1.5 title columnhead", column > 2 ? ", " : "", column);
+  return writeLineFigures(dir, stem, csv, {{"discard", title + ": discarded pixels per frame (Eq. 3.4)", "% of the image", plot}});
 }
 
 }  // namespace dynbench::report

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "discard/discard.h"
 #include "metrics/camera_motion.h"
 
 namespace dynbench::report {
@@ -17,5 +18,10 @@ Expected<std::vector<std::filesystem::path>> writeRotationPlots(const metrics::C
                                                                 const std::string& title,
                                                                 const std::filesystem::path& dir,
                                                                 const std::string& stem);
+
+// Writes <dir>/<stem>_discard.{png,svg}: the per-frame discard percentages of each feature.
+Expected<std::vector<std::filesystem::path>> writeDiscardPlot(const std::vector<discard::FramePercentages>& frames,
+                                                              const std::string& title, const std::filesystem::path& dir,
+                                                              const std::string& stem);
 
 }  // namespace dynbench::report
