@@ -20,6 +20,8 @@ packages=(
   # Blender: `render --engine cycles` (the thesis's renderer) and the tests that check dynbench's
   # datasets with Blender's glTF importer and its P/N buffers against Cycles
   blender python3-numpy
+  # headless Chromium: the tests open `dynbench report`'s HTML in a real browser
+  chromium
 )
 
 missing=()

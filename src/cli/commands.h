@@ -28,6 +28,9 @@ void addRenderCommand(CLI::App& app, CommandRun& run);
 // Registers `discard`.
 void addDiscardCommand(CLI::App& app, CommandRun& run);
 
+// Registers `report`.
+void addReportCommand(CLI::App& app, CommandRun& run);
+
 // Exit status for an error (docs/cli.md lists them).
 int exitCode(const Error& error);
 

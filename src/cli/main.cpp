@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   cli::addMergeCameraCommand(app, run);
   cli::addRenderCommand(app, run);
   cli::addDiscardCommand(app, run);
+  cli::addReportCommand(app, run);
 
   // `dynbench help [COMMAND]`
   std::string helpTopic;

@@ -110,8 +110,13 @@ Expected<std::vector<fs::path>> writeLineFigures(const fs::path& dir, const std:
 
 Expected<std::vector<fs::path>> writeRotationPlots(const metrics::CameraMotion& motion, const std::string& title,
                                                    const fs::path& dir, const std::string& stem) {
+  return writeRotationPlotsFromCsv(cameraSeriesCsv(motion), title, dir, stem);
+}
+
+Expected<std::vector<fs::path>> writeRotationPlotsFromCsv(const std::string& csv, const std::string& title, const fs::path& dir,
+                                                          const std::string& stem) {
   return writeLineFigures(
-      dir, stem, cameraSeriesCsv(motion),
+      dir, stem, csv,
       {{"rotation_per_axis", title + ": change in pitch, yaw and roll per frame (Fig. A.1)", "degrees / frame",
         "plot {data} using 1:12 with lines lw 1.5 title 'pitch', {data} using 1:11 with lines lw 1.5 title 'yaw', "
         "{data} using 1:13 with lines lw 1.5 title 'roll'"},

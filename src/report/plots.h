@@ -19,6 +19,10 @@ Expected<std::vector<std::filesystem::path>> writeRotationPlots(const metrics::C
                                                                 const std::filesystem::path& dir,
                                                                 const std::string& stem);
 
+// Figures A.1 and A.2 from a camera series CSV as `dynbench stats --series` writes it.
+Expected<std::vector<std::filesystem::path>> writeRotationPlotsFromCsv(const std::string& csv, const std::string& title,
+                                                                       const std::filesystem::path& dir, const std::string& stem);
+
 // Writes <dir>/<stem>_discard.{png,svg}: the per-frame discard percentages of each feature.
 Expected<std::vector<std::filesystem::path>> writeDiscardPlot(const std::vector<discard::FramePercentages>& frames,
                                                               const std::string& title, const std::filesystem::path& dir,

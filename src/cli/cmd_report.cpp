@@ -1,0 +1,44 @@
+// `dynbench report RUN... -o report.html`: datasets side by side (Tables 6.1-6.7, figures).
+#include "cli/commands.h"
+#include "report/html_report.h"
+
+namespace dynbench::cli {
+namespace {
+
+struct ReportCli {
+  std::vector<std::string> runs;
+  std::string output, title = "dynbench report";
+  int thumbnails = 3;
+};
+
+Expected<void> runReport(const ReportCli& cli) {
+  report::ReportOptions options;
+  for (const auto& r : cli.runs) options.runs.emplace_back(r);
+  options.output = cli.output;
+  options.title = cli.title;
+  options.thumbnails = cli.thumbnails;
+  if (options.output.extension() != ".html")
+    return fail(ErrorCode::kUsage, "-o {}: the report is an .html file (its Markdown twin is written beside it)", cli.output);
+  auto files = report::writeReport(options);
+  if (!files) return std::unexpected(files.error());
+  fmt::print("{}\n{}\n", files->html.string(), files->markdown.string());
+  return {};
+}
+
+}  // namespace
+
+void addReportCommand(CLI::App& app, CommandRun& run) {
+  auto o = std::make_shared<ReportCli>();
+  auto* cmd = app.add_subcommand("report", "Compare datasets: Tables 6.1-6.7 and figures in one HTML file and a Markdown twin");
+  cmd->footer("A RUN folder holds stats.json (dynbench stats DATASET --json RUN/stats.json) and discard.json (dynbench discard\n"
+              "FRAMES --json RUN/discard.json); optionally *_camera.csv (stats --series RUN) for Figures A.1/A.2, frames/\n"
+              "(feature buffers) for thumbnails and masks/ (discard --masks RUN/masks).\n"
+              "Example: dynbench report runs/cube2 runs/flythrough -o report.html");
+  cmd->add_option("RUN", o->runs, "Run folders, one row per run")->required();
+  cmd->add_option("-o,--output", o->output, "The report (.html; report.md and report_files/ beside it)")->required();
+  cmd->add_option("--title", o->title, "Report title");
+  cmd->add_option("--thumbnails", o->thumbnails, "Thumbnails and masks per run (default: 3)");
+  cmd->callback([o, &run] { run = [o] { return runReport(*o); }; });
+}
+
+}  // namespace dynbench::cli

@@ -1,0 +1,36 @@
+#pragma once
+// `dynbench report`: datasets side by side in the thesis's layout (Tables 6.1-6.7), with the
+// camera rotation plots (Figures A.1, A.2), discard time series, thumbnails and discard masks.
+// One self-contained HTML file (images inline, no network) and a Markdown twin whose images sit
+// in a folder beside it.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+
+namespace dynbench::report {
+
+// A RUN folder (docs/cli.md, `dynbench report`):
+//   stats.json      from `dynbench stats DATASET --json RUN/stats.json` (required)
+//   discard.json    from `dynbench discard FRAMES --json RUN/discard.json` (required)
+//   *_camera.csv    from `dynbench stats DATASET --series RUN` (optional: Figures A.1, A.2)
+//   frames/         the feature-buffer frames (optional: thumbnails)
+//   masks/          from `dynbench discard ... --masks RUN/masks` (optional)
+struct ReportOptions {
+  std::vector<std::filesystem::path> runs;
+  std::filesystem::path output;  // report.html; the Markdown twin is report.md beside it
+  std::string title = "dynbench report";
+  int thumbnails = 3;  // per run, evenly spaced
+};
+
+struct ReportFiles {
+  std::filesystem::path html, markdown, assets;
+};
+
+Expected<ReportFiles> writeReport(const ReportOptions& options);
+
+// RFC 4648 base64 (a dozen lines; no Debian library in our set offers a plain encoder).
+std::string base64Encode(const std::string& bytes);
+
+}  // namespace dynbench::report
