@@ -1,0 +1,86 @@
+// `dynbench report` end to end: two runs made by the real chain (stats, render, discard), the
+// Markdown twin's tables, and the HTML opened in headless Chromium (Debian `chromium`), which
+// must find every table row and decode every inline image.
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+
+#include "core/files.h"
+#include "gltf_builder.h"
+#include "run_cli.h"
+
+namespace dynbench {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kOrbit = fs::path(DYNBENCH_SOURCE_DIR) / "examples" / "orbit" / "orbit.gltf";
+
+void makeRun(const fs::path& run, const std::string& frames) {
+  for (const auto& args : {fmt::format("stats {} --json {} --series {}", kOrbit.string(), (run / "stats.json").string(), run.string()),
+                           fmt::format("render {} -o {} --frames {} --res 32x18 --spp 2", kOrbit.string(), (run / "frames").string(), frames),
+                           fmt::format("discard {} --json {} --masks {}", (run / "frames").string(), (run / "discard.json").string(),
+                                       (run / "masks").string())}) {
+    const auto r = dynbench(args, run.parent_path());
+    ASSERT_EQ(r.status, 0) << args << ": " << r.err;
+  }
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+TEST(Report, TablesAndImagesInTheBrowser) {
+  const auto dir = test::freshDir("report");
+  makeRun(dir / "slow", "0:4");
+  makeRun(dir / "fast", "20:24");
+  const auto r = dynbench(fmt::format("report {} {} -o {} --title 'Two runs'", (dir / "slow").string(), (dir / "fast").string(),
+                                      (dir / "out" / "report.html").string()),
+                          dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string md = *readWholeFile(dir / "out" / "report.md");
+  for (int t = 1; t <= 7; ++t) EXPECT_NE(md.find(fmt::format("Table 6.{}.", t)), std::string::npos) << t;
+  EXPECT_EQ(count(md, "| slow "), 7u);  // one row per table
+  EXPECT_EQ(count(md, "| fast "), 7u);
+  // Per run: A.1, A.2, the discard series, 3 thumbnails, 3 masks.
+  EXPECT_EQ(count(md, "!["), 18u);
+  const std::string html = *readWholeFile(dir / "out" / "report.html");
+  EXPECT_EQ(html.find("http://"), std::string::npos);  // self-contained: nothing to fetch
+  EXPECT_EQ(html.find("src=\"report_files"), std::string::npos);
+
+  std::string dom;
+  const int status = runShell("command -v chromium >/dev/null 2>&1", dom);
+  if (status != 0) GTEST_SKIP() << "chromium is not installed (apt-get install chromium): browser check skipped";
+  dom.clear();
+  ASSERT_EQ(runShell(fmt::format("timeout 120 chromium --headless --no-sandbox --disable-gpu --virtual-time-budget=5000 --dump-dom "
+                                 "file://{} 2>/dev/null",
+                                 fs::absolute(dir / "out" / "report.html").string()),
+                     dom),
+            0);
+  EXPECT_NE(dom.find("data-images-decoded=\"18\""), std::string::npos) << dom.substr(0, 400);
+  EXPECT_NE(dom.find("data-images=\"18\""), std::string::npos);
+  EXPECT_EQ(count(dom, "<table>"), 7u);
+  EXPECT_EQ(count(dom, "<th scope=\"row\">slow</th>"), 7u);
+  EXPECT_EQ(count(dom, "<th scope=\"row\">fast</th>"), 7u);
+}
+
+TEST(Report, BadRunsFailClearly) {
+  const auto dir = test::freshDir("report_bad");
+  fs::create_directories(dir / "empty");
+  auto r = dynbench(fmt::format("report {} -o {}", (dir / "empty").string(), (dir / "r.html").string()), dir);
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("empty/stats.json: missing"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "r.html"));
+  ASSERT_TRUE(writeFileAtomic(dir / "empty" / "stats.json", R"({"datasets": [{"properties": {}, "camera_motion": {}}]})"));
+  ASSERT_TRUE(writeFileAtomic(dir / "empty" / "discard.json", R"({"frames": []})"));
+  r = dynbench(fmt::format("report {} -o {}", (dir / "empty").string(), (dir / "r.html").string()), dir);
+  EXPECT_EQ(r.status, 5) << r.err;
+  EXPECT_NE(r.err.find("discard.json: /mean: missing"), std::string::npos) << r.err;
+  r = dynbench(fmt::format("report {} -o {}", (dir / "empty").string(), (dir / "r.txt").string()), dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+}
+
+}  // namespace
+}  // namespace dynbench
