@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Fetches the Cube 2: Sauerbraten engine source from Debian (source package `cube2`, the December
+# 2020 release, zlib licence) and builds its client against Debian's libraries:
+#   bash integrations/cube2/build.sh [BUILD_DIR=build/cube2]
+# Prints the client's path. Needs: a deb-src entry for bookworm (added here when missing, as root),
+# libsdl2-dev libsdl2-image-dev libsdl2-mixer-dev libenet-dev zlib1g-dev libgl-dev, and for running
+# it cube2-data and xvfb. The capture hooks (issue 6) are not applied yet: this is the plain game.
+set -euo pipefail
+
+build_dir=${1:-build/cube2}
+version=0.0.20201227+dfsg
+orig=cube2_${version}.orig.tar.xz
+mkdir -p "$build_dir"
+build_dir=$(cd "$build_dir" && pwd)
+
+if [[ ! -f "$build_dir/$orig" ]]; then
+  if ! grep -rqs "deb-src" /etc/apt/sources.list /etc/apt/sources.list.d/; then
+    [[ $(id -u) -eq 0 ]] || { echo "cube2: need root to add a deb-src entry for bookworm" >&2; exit 1; }
+    cat > /etc/apt/sources.list.d/dynbench-src.sources <<'SOURCES'
+Types: deb-src
+URIs: http://deb.debian.org/debian
+Suites: bookworm
+Components: main
+Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg
+SOURCES
+    apt-get update -qq
+  fi
+  # The mirror has the .orig tarball but not always the Debian packaging tarball, and apt-get then
+  # exits 100 after fetching the one we need: judge by the file, not the exit status.
+  (cd "$build_dir" && apt-get source --download-only "cube2=0.0.20201227+dfsg-2" >/dev/null 2>&1 || true)
+  if [[ ! -f "$build_dir/$orig" ]]; then
+    echo "cube2: apt-get source did not deliver $orig (is there a deb-src entry for bookworm?)" >&2
+    exit 1
+  fi
+fi
+
+src="$build_dir/cube2-$version"
+if [[ ! -d "$src" ]]; then
+  tar -xf "$build_dir/$orig" -C "$build_dir"
+fi
+# The tarball ships without the bundled enet: an empty enet/ with a no-op Makefile satisfies the
+# game's Makefile, and -lenet then finds Debian's libenet.
+mkdir -p "$src/enet/include"
+printf 'all:\n\t@true\n' > "$src/enet/Makefile"
+make -C "$src" -j"$(nproc)" client >"$build_dir/build.log" 2>&1 || { tail -20 "$build_dir/build.log" >&2; exit 1; }
+echo "$src/sauer_client"
