@@ -1,13 +1,18 @@
 #!/usr/bin/env bash
 # Fetches the Cube 2: Sauerbraten engine source from Debian (source package `cube2`, the December
-# 2020 release, zlib licence) and builds its client against Debian's libraries:
-#   bash integrations/cube2/build.sh [BUILD_DIR=build/cube2]
+# 2020 release, zlib licence), applies dynbench's capture hooks (capture-hooks.patch and
+# src/dynbench_capture.cpp) and builds the client against Debian's libraries and dynbench's capture
+# SDK:
+#   bash integrations/cube2/build.sh [BUILD_DIR=build/cube2] [DYNBENCH_BUILD=build/release]
 # Prints the client's path. Needs: a deb-src entry for bookworm (added here when missing, as root),
-# libsdl2-dev libsdl2-image-dev libsdl2-mixer-dev libenet-dev zlib1g-dev libgl-dev, and for running
-# it cube2-data and xvfb. The capture hooks (issue 6) are not applied yet: this is the plain game.
+# libsdl2-dev libsdl2-image-dev libsdl2-mixer-dev libenet-dev zlib1g-dev libgl-dev, dynbench built
+# (libdynbench_capture.a), and for running it cube2-data and xvfb.
 set -euo pipefail
 
 build_dir=${1:-build/cube2}
+dynbench_build=$(cd "${2:-build/release}" && pwd)
+here=$(cd "$(dirname "$0")" && pwd)
+repo=$(cd "$here/../.." && pwd)
 version=0.0.20201227+dfsg
 orig=cube2_${version}.orig.tar.xz
 mkdir -p "$build_dir"
@@ -35,12 +40,25 @@ SOURCES
 fi
 
 src="$build_dir/cube2-$version"
-if [[ ! -d "$src" ]]; then
+# A fresh tree whenever the patch changes; the adapter is copied in every time.
+if ! cmp -s "$here/capture-hooks.patch" "$src/.dynbench-patch" 2>/dev/null; then
+  rm -rf "$src"
   tar -xf "$build_dir/$orig" -C "$build_dir"
+  patch -d "$src" -p1 --quiet < "$here/capture-hooks.patch"
+  cp "$here/capture-hooks.patch" "$src/.dynbench-patch"
 fi
+for f in dynbench_capture.h dynbench_capture.cpp; do
+  cmp -s "$here/src/$f" "$src/engine/$f" || cp "$here/src/$f" "$src/engine/$f"
+done
+for lib in libdynbench_capture.a libdynbench_core.a; do
+  [[ -f "$dynbench_build/$lib" ]] || { echo "cube2: $dynbench_build/$lib missing: build dynbench first (cmake --build build/release)" >&2; exit 1; }
+done
 # The tarball ships without the bundled enet: an empty enet/ with a no-op Makefile satisfies the
 # game's Makefile, and -lenet then finds Debian's libenet.
 mkdir -p "$src/enet/include"
 printf 'all:\n\t@true\n' > "$src/enet/Makefile"
-make -C "$src" -j"$(nproc)" client >"$build_dir/build.log" 2>&1 || { tail -20 "$build_dir/build.log" >&2; exit 1; }
+make -C "$src" -j"$(nproc)" client \
+  DYNBENCH_INCLUDES="-I$repo/include" \
+  DYNBENCH_LIBS="$dynbench_build/libdynbench_capture.a $dynbench_build/libdynbench_core.a -lfmt" \
+  >"$build_dir/build.log" 2>&1 || { tail -20 "$build_dir/build.log" >&2; exit 1; }
 echo "$src/sauer_client"
