@@ -299,6 +299,35 @@ TEST(Convert, LightRules) {
   EXPECT_NE(bad.error().message.find("/typo"), std::string::npos) << bad.error().message;
 }
 
+TEST(Convert, NegativeLightColoursBecomeZero) {
+  // Cube 2's darkening lights have negative channels; KHR_lights_punctual colours are in [0, 1].
+  const fs::path dir = freshDir("convert_negative_light");
+  dbc_session* s = nullptr;
+  ASSERT_EQ(dbc_open((dir / "capture").c_str(), "test", &s), DBC_OK);
+  const uint64_t camera = dbc_new_id(s), lamp = dbc_new_id(s);
+  const float origin[3] = {0, 0, 0}, rgb[3] = {-0.2f, 0.5f, 1.0f};
+  for (int f = 0; f < 2; ++f) {
+    ASSERT_EQ(dbc_frame_begin(s, static_cast<uint64_t>(f), f / 60.0), DBC_OK);
+    ASSERT_EQ(dbc_camera(s, camera, origin, 0, 0, 0), DBC_OK);
+    ASSERT_EQ(dbc_light(s, lamp, origin, rgb, DBC_LIGHT_POINT, 1, "explosion"), DBC_OK);
+    ASSERT_EQ(dbc_frame_end(s), DBC_OK);
+  }
+  ASSERT_EQ(dbc_close(s), DBC_OK);
+  ConvertOptions options;
+  options.capture = dir / "capture";
+  options.output = dir / "out" / "neg.gltf";
+  auto report = convertCapture(options);
+  ASSERT_TRUE(report) << report.error().message;
+  const auto j = readJson(dir / "out" / "neg.gltf");
+  const auto& light = j["extensions"]["KHR_lights_punctual"]["lights"][0];
+  EXPECT_EQ(light["color"], nlohmann::json({0.0, 0.5, 1.0}));
+  EXPECT_DOUBLE_EQ(light["intensity"].get<double>(), 100.0);
+  int status = 0;
+  const std::string validation = validate(dir / "out" / "neg.gltf", status);
+  EXPECT_EQ(status, 0) << validation;
+  EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
+}
+
 TEST(Convert, TruncatedCaptureKeepsCompleteFrames) {
   const fs::path capture = writeCapture("convert_truncated");
   // Cut Capture.txt inside frame 109 (the last): keep everything before its end record.

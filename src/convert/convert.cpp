@@ -525,9 +525,12 @@ class Converter {
   }
 
   int lightDefinition(const LightRecord& l, double share) {
-    const double peak = std::max({l.color.r, l.color.g, l.color.b});
+    // Engines have negative lights that darken (Cube 2 does); glTF lights only add light, and
+    // KHR_lights_punctual colours are in [0, 1]: negative channels become 0.
+    const glm::dvec3 captured = glm::max(l.color, glm::dvec3(0.0));
+    const double peak = std::max({captured.r, captured.g, captured.b});
     const LightRule& rule = options_.lightRules.rule(l.modelType);
-    const glm::dvec3 color = peak > 0 ? l.color / peak : glm::dvec3(1.0);
+    const glm::dvec3 color = peak > 0 ? captured / peak : glm::dvec3(1.0);
     json light = {{"type", l.type == LightType::kSpot ? "spot" : l.type == LightType::kDirectional ? "directional" : "point"},
                   {"color", vec(color)},
                   {"intensity", options_.lightRules.candelaPerUnit * peak * rule.intensityScale * share},

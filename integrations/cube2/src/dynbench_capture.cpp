@@ -9,9 +9,14 @@
 //   DYNBENCH_CAPTURE_WARMUP   seconds of game time after the map loads before recording (default 2)
 //   DYNBENCH_CAPTURE_SECONDS  seconds of game time recorded (default 30)
 //
-// Coordinates: Cube 2 is Z-up (x east, y north); the capture format is Y-up, right-handed:
-// (x, y, z)_cube -> (x, z, -y). Cube's yaw (0 = looking along +y, growing to the left) and pitch
-// (up positive) are the capture convention's yaw and pitch (docs/metrics.md) after that mapping.
+// Only the engine's containers here (vector, hashtable, string): its tools.h defines placement new,
+// which clashes with the standard library's <new>.
+//
+// Coordinates: Cube 2 is Z-up, and its view matrix (engine/rendergl.cpp, `viewmatrix`) sends a
+// world point (x, y, z) to eye space (-x, z, -y): +x is on the left when looking along +y. The
+// capture format is Y-up and right-handed, so the adapter uses that same map,
+// (x, y, z)_cube -> (-x, z, -y), which keeps what the player saw. Cube's yaw then becomes -yaw
+// (it grows to the left along -x) and roll -roll; pitch (up positive) stays.
 // Length unit: 8 Cube units to the metre, the Sauerbraten mappers' rule (the player's eyes are 14
 // units, 1.75 m, above the ground).
 #include "engine.h"
@@ -57,9 +62,129 @@ void failCapture(const char *what) {
 }
 
 void toCapture(const vec &cube, float out[3]) {
-  out[0] = cube.x;
+  out[0] = -cube.x;
   out[1] = cube.z;
   out[2] = -cube.y;
+}
+
+// The map's geometry, as the engine's own writeobj (engine/worldio.cpp) walks it: every vertex
+// array, its index ranges per texture slot. One capture mesh per texture slot, with positions and
+// normals in capture space, texture coordinates as the engine has them (v down, as glTF) and the
+// slot's first texture relative to the data root.
+struct MapMesh {
+  int slot = -1;
+  vector<float> positions, normals, uvs;
+  vector<uint> indices;
+};
+
+void exportMap(const char *map) {
+  vector<MapMesh *> meshes;
+  auto meshFor = [&](int slot) -> MapMesh & {
+    loopv(meshes) if (meshes[i]->slot == slot) return *meshes[i];
+    MapMesh *m = new MapMesh;
+    m->slot = slot;
+    meshes.add(m);
+    return *m;
+  };
+  loopv(valist) {
+    vtxarray &va = *valist[i];
+    ushort *edata = nullptr;
+    vertex *vdata = nullptr;
+    if (!readva(&va, edata, vdata)) continue;
+    // Per vertex array and slot, each engine vertex becomes one mesh vertex.
+    int *remap = new int[va.verts];
+    ushort *idx = edata;
+    loopj(va.texs) {
+      elementset &es = va.eslist[j];
+      MapMesh &mesh = meshFor(es.texture);
+      loopk(va.verts) remap[k] = -1;
+      loopk(es.length[1]) {
+        const int n = idx[k] - va.voffset;
+        if (remap[n] < 0) {
+          const vertex &v = vdata[n];
+          remap[n] = mesh.positions.length() / 3;
+          float p[3], nrm[3];
+          toCapture(v.pos, p);
+          const vec cubeNormal(v.norm.x * (2.0f / 255.0f) - 1.0f, v.norm.y * (2.0f / 255.0f) - 1.0f, v.norm.z * (2.0f / 255.0f) - 1.0f);
+          toCapture(cubeNormal, nrm);
+          const float length = sqrtf(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+          loopl(3) {
+            mesh.positions.add(p[l]);
+            mesh.normals.add(length > 0 ? nrm[l] / length : (l == 1 ? 1.0f : 0.0f));
+          }
+          mesh.uvs.add(v.tc.x);
+          mesh.uvs.add(v.tc.y);
+        }
+        mesh.indices.add(uint(remap[n]));
+      }
+      idx += es.length[1];
+    }
+    delete[] remap;
+    delete[] edata;
+    delete[] vdata;
+  }
+  if (dbc_model_begin(state.session, map) != DBC_OK) failCapture("map model");
+  int meshId = 0;
+  loopv(meshes) {
+    MapMesh &mesh = *meshes[i];
+    if (mesh.indices.length() < 3) continue;
+    // The engine draws with glFrontFace(GL_CW): in eye space, which the capture space is, front faces
+    // wind clockwise; glTF's wind counter-clockwise, so two corners of every triangle swap.
+    for (int t = 0; t + 2 < mesh.indices.length(); t += 3) swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+    VSlot &vslot = lookupvslot(mesh.slot, false);
+    string texture = "";
+    if (vslot.slot && !vslot.slot->sts.empty()) {
+      // Texture commands prefix load options such as <dds> or <mad:...>: the file name follows them.
+      const char *file = vslot.slot->sts[0].name;
+      while (*file == '<') {
+        const char *end = strchr(file, '>');
+        if (!end) break;
+        file = end + 1;
+      }
+      formatstring(texture, "packages/%s", file);
+    }
+    defformatstring(name, "slot%d", mesh.slot);
+    dbc_mesh m = {};
+    m.mesh_id = meshId++;
+    m.name = name;
+    m.texture = texture[0] ? texture : nullptr;
+    m.vertex_count = size_t(mesh.positions.length() / 3);
+    m.positions = mesh.positions.getbuf();
+    m.normals = mesh.normals.getbuf();
+    m.uvs = mesh.uvs.getbuf();
+    m.triangle_count = size_t(mesh.indices.length() / 3);
+    m.indices = mesh.indices.getbuf();
+    if (dbc_model_mesh(state.session, &m) != DBC_OK) failCapture("map mesh");
+  }
+  meshes.deletecontents();
+  if (dbc_model_end(state.session) != DBC_OK) failCapture("map model end");
+}
+
+// Map lights (ET_LIGHT entities: attr1 radius, attr2-4 colour 0-255): static, written once.
+void recordStaticLights() {
+  const vector<extentity *> &ents = entities::getents();
+  loopv(ents) {
+    const extentity &e = *ents[i];
+    if (e.type != ET_LIGHT) continue;
+    float position[3];
+    toCapture(e.o, position);
+    const float rgb[3] = {e.attr2 / 255.0f, e.attr3 / 255.0f, e.attr4 / 255.0f};
+    if (dbc_light(state.session, dbc_new_id(state.session), position, rgb, DBC_LIGHT_POINT, 0, "none") != DBC_OK)
+      failCapture("static light");
+  }
+}
+
+// Dynamic lights (engine/dynlight.cpp) this frame, classified by how the game makes them
+// (fpsgame/weapon.cpp): DL_FLASH is a muzzle flash; a fading light is an explosion; a light that
+// lives one frame follows a projectile: rockets make radius-20 lights, grenades smaller ones.
+void recordDynamicLight(const vec &o, const vec &color, float radius, int flags, bool fading) {
+  float position[3];
+  toCapture(o, position);
+  const float rgb[3] = {color.x, color.y, color.z};
+  const char *type = (flags & DL_FLASH) ? "flash" : fading ? "explosion" : radius >= 16 ? "rocket" : "bouncer";
+  // A dynamic light is a new capturable each frame: the engine keeps no identity for it.
+  if (dbc_light(state.session, dbc_new_id(state.session), position, rgb, DBC_LIGHT_POINT, 1, type) != DBC_OK)
+    failCapture("dynamic light");
 }
 
 }  // namespace
@@ -76,7 +201,10 @@ void dynbench_capture_init() {
   seedMT(state.seed);
   if (dbc_open(dir, "Cube 2: Sauerbraten 2020-12-27 (Debian cube2 0.0.20201227+dfsg)", &state.session) != DBC_OK)
     failCapture("cannot open the capture folder");
-  if (dbc_set_metres_per_unit(state.session, 0.125f) != DBC_OK) failCapture("settings");
+  const char *dataRoot = std::getenv("DYNBENCH_CAPTURE_DATA_ROOT");
+  if (dbc_set_metres_per_unit(state.session, 0.125f) != DBC_OK ||
+      (dataRoot && *dataRoot && dbc_set_data_root(state.session, dataRoot) != DBC_OK))
+    failCapture("settings");
   state.cameraId = dbc_new_id(state.session);
 }
 
@@ -102,13 +230,16 @@ void dynbench_capture_frame() {
     if (dbc_set_camera_settings(state.session, aspectRatio, yfov, nearplane, float(farplane)) != DBC_OK) failCapture("camera settings");
     const float offset[3] = {0, 0, 0};
     if (dbc_set_map(state.session, map, offset) != DBC_OK) failCapture("map");
+    exportMap(map);
   }
   if (lastmillis - state.firstMapMillis < static_cast<long long>(state.warmupSeconds * 1000.0)) return;
   const double time = static_cast<double>(state.recorded) / state.fps;
   if (dbc_frame_begin(state.session, static_cast<uint64_t>(state.recorded), time) != DBC_OK) failCapture("frame");
   float position[3];
   toCapture(camera1->o, position);
-  if (dbc_camera(state.session, state.cameraId, position, camera1->pitch, camera1->yaw, camera1->roll) != DBC_OK) failCapture("camera");
+  if (dbc_camera(state.session, state.cameraId, position, camera1->pitch, -camera1->yaw, -camera1->roll) != DBC_OK) failCapture("camera");
+  if (state.recorded == 0) recordStaticLights();
+  dynbench_visit_dynlights(recordDynamicLight);
   if (dbc_frame_end(state.session) != DBC_OK) failCapture("frame end");
   ++state.recorded;
   if (static_cast<double>(state.recorded) >= state.seconds * state.fps) {
