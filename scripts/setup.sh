@@ -22,6 +22,10 @@ packages=(
   blender python3-numpy
   # headless Chromium: the tests open `dynbench report`'s HTML in a real browser
   chromium
+  # Cube 2: Sauerbraten (`dynbench capture cube2`): the engine's build needs, its game data, and
+  # a virtual X server with Mesa's software OpenGL to run it headless
+  libsdl2-dev libsdl2-image-dev libsdl2-mixer-dev libenet-dev libgl-dev cube2-data xvfb xauth
+  libgl1-mesa-dri
 )
 
 missing=()
@@ -58,4 +62,35 @@ if [[ ! -f "$validator/node_modules/gltf-validator/package.json" ]] ||
   (cd "$validator" && npm ci --no-audit --no-fund --loglevel=error)
 else
   echo "setup: glTF validator present"
+fi
+
+# The Cube 2 engine source: Debian's source package `cube2`, fetched once into a cache that
+# integrations/cube2/build.sh (run by the CMake build) reads. It needs a deb-src entry for bookworm.
+cube2_cache=/var/cache/dynbench/cube2
+cube2_orig=cube2_0.0.20201227+dfsg.orig.tar.xz
+if [[ ! -f "$cube2_cache/$cube2_orig" ]]; then
+  SUDO=""
+  [[ $(id -u) -eq 0 ]] || SUDO="sudo"
+  if ! grep -rqs "^Types: deb-src\|^deb-src" /etc/apt/sources.list /etc/apt/sources.list.d/; then
+    echo "setup: adding a deb-src entry for bookworm (the Cube 2 engine source)"
+    $SUDO tee /etc/apt/sources.list.d/dynbench-src.sources >/dev/null <<'SOURCES'
+Types: deb-src
+URIs: http://deb.debian.org/debian
+Suites: bookworm
+Components: main
+Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg
+SOURCES
+    $SUDO apt-get update -qq
+  fi
+  $SUDO mkdir -p "$cube2_cache"
+  # The mirror has the .orig tarball but not always Debian's packaging tarball, and apt-get then
+  # exits 100 after fetching the one we need: judge by the file, not the exit status.
+  (cd "$cube2_cache" && $SUDO apt-get source --download-only "cube2=0.0.20201227+dfsg-2" >/dev/null 2>&1 || true)
+  if [[ ! -f "$cube2_cache/$cube2_orig" ]]; then
+    echo "setup: could not fetch $cube2_orig with apt-get source (is deb.debian.org reachable?)" >&2
+    exit 1
+  fi
+  echo "setup: Cube 2 engine source in $cube2_cache"
+else
+  echo "setup: Cube 2 engine source present"
 fi

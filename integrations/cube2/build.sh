@@ -18,6 +18,9 @@ orig=cube2_${version}.orig.tar.xz
 mkdir -p "$build_dir"
 build_dir=$(cd "$build_dir" && pwd)
 
+# scripts/setup.sh fetches the tarball into this cache.
+cache=${DYNBENCH_CUBE2_CACHE:-/var/cache/dynbench/cube2}
+if [[ ! -f "$build_dir/$orig" && -f "$cache/$orig" ]]; then cp "$cache/$orig" "$build_dir/$orig"; fi
 if [[ ! -f "$build_dir/$orig" ]]; then
   if ! grep -rqs "deb-src" /etc/apt/sources.list /etc/apt/sources.list.d/; then
     [[ $(id -u) -eq 0 ]] || { echo "cube2: need root to add a deb-src entry for bookworm" >&2; exit 1; }

@@ -31,6 +31,9 @@ void addDiscardCommand(CLI::App& app, CommandRun& run);
 // Registers `report`.
 void addReportCommand(CLI::App& app, CommandRun& run);
 
+// Registers `capture cube2`.
+void addCaptureCommand(CLI::App& app, CommandRun& run);
+
 // Exit status for an error (docs/cli.md lists them).
 int exitCode(const Error& error);
 

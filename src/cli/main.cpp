@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   cli::addRenderCommand(app, run);
   cli::addDiscardCommand(app, run);
   cli::addReportCommand(app, run);
+  cli::addCaptureCommand(app, run);
 
   // `dynbench help [COMMAND]`
   std::string helpTopic;

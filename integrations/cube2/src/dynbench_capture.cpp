@@ -199,6 +199,13 @@ void dynbench_capture_init() {
   state.warmupSeconds = envNumber("DYNBENCH_CAPTURE_WARMUP", 2.0);
   state.seconds = envNumber("DYNBENCH_CAPTURE_SECONDS", 30.0);
   seedMT(state.seed);
+  // Occlusion queries answer when the GPU gets to them, not at a fixed frame: what is drawn, and
+  // so where a muzzle flash starts (a model tag), would vary from run to run. Off while capturing.
+  execute("oqfrags 0");
+  // The first-person gun is a screen overlay, not part of the world, and the muzzle position the
+  // game takes from it depends on that frame's overlay rendering; without it the game places
+  // muzzle flashes and grenades from the player's body, as it does for every other player.
+  execute("hudgun 0");
   if (dbc_open(dir, "Cube 2: Sauerbraten 2020-12-27 (Debian cube2 0.0.20201227+dfsg)", &state.session) != DBC_OK)
     failCapture("cannot open the capture folder");
   const char *dataRoot = std::getenv("DYNBENCH_CAPTURE_DATA_ROOT");
@@ -242,7 +249,13 @@ void dynbench_capture_frame() {
   dynbench_visit_dynlights(recordDynamicLight);
   if (dbc_frame_end(state.session) != DBC_OK) failCapture("frame end");
   ++state.recorded;
-  if (static_cast<double>(state.recorded) >= state.seconds * state.fps) {
+  const long long total = static_cast<long long>(state.seconds * state.fps + 0.5);
+  // One line per second of game time for `dynbench capture cube2`'s progress.
+  if (state.recorded % max(1, int(state.fps)) == 0 || state.recorded >= total) {
+    printf("dynbench-capture: %lld/%lld frames\n", state.recorded, total);
+    fflush(stdout);
+  }
+  if (state.recorded >= total) {
     if (dbc_close(state.session) != DBC_OK) failCapture("close");
     state.session = nullptr;
     state.done = true;

@@ -1,0 +1,137 @@
+#include "capture/cube2.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "capture/check.h"
+
+namespace dynbench::capture {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string shellQuote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+bool executable(const fs::path& p) { return ::access(p.c_str(), X_OK) == 0; }
+
+bool onPath(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  std::string dirs = path ? path : "/usr/bin:/bin";
+  for (std::size_t start = 0; start <= dirs.size();) {
+    const auto end = std::min(dirs.find(':', start), dirs.size());
+    if (executable(fs::path(dirs.substr(start, end - start)) / name)) return true;
+    start = end + 1;
+  }
+  return false;
+}
+
+}  // namespace
+
+Expected<fs::path> findCube2Client(const fs::path& requested) {
+  if (!requested.empty()) {
+    if (executable(requested)) return requested;
+    return fail(ErrorCode::kExternalTool, "--client {}: not an executable file", requested.string());
+  }
+  if (const char* env = std::getenv("DYNBENCH_CUBE2_CLIENT"); env && *env && executable(env)) return fs::path(env);
+  const fs::path built = DYNBENCH_CUBE2_CLIENT_BUILD_PATH;
+  if (!built.empty() && executable(built)) return built;
+  return fail(ErrorCode::kExternalTool,
+              "the Cube 2 client with dynbench's capture hooks is not built: run scripts/setup.sh, then cmake --build "
+              "(target cube2_client), or pass --client PATH");
+}
+
+Expected<std::string> cube2Script(const Cube2Options& o) {
+  static const std::map<std::string, int> modes = {{"ffa", 0}, {"teamplay", 2}, {"instagib", 3}, {"efficiency", 5}, {"tactics", 7}};
+  const auto mode = modes.find(o.mode);
+  if (mode == modes.end()) return fail(ErrorCode::kUsage, "--mode '{}': expected ffa, teamplay, instagib, efficiency or tactics", o.mode);
+  if (o.map.empty() || o.map.find_first_of(" ;[]\"$@") != std::string::npos)
+    return fail(ErrorCode::kUsage, "--map '{}': expected a map name such as colos", o.map);
+  if (o.bots < 1 || o.bots > 32) return fail(ErrorCode::kUsage, "--bots must be 1 to 32 (got {})", o.bots);
+  if (o.skill < 1 || o.skill > 101) return fail(ErrorCode::kUsage, "--skill must be 1 to 101 (got {})", o.skill);
+  std::string follow;
+  if (o.follow == "auto") follow = "nextfollow 1";
+  else if (!o.follow.empty() && o.follow.find_first_not_of("0123456789") == std::string::npos) follow = "follow " + o.follow;
+  else return fail(ErrorCode::kUsage, "--follow '{}': expected auto or a client number (bots are 128, 129, ...)", o.follow);
+  std::string bots;
+  for (int b = 0; b < o.bots; ++b) bots += fmt::format("addbot {}; ", o.skill);
+  // Map at 0.1 s, bots and spectating at 0.7 s, following at 1.2 s of game time (the server
+  // answers each step a few frames later); recording starts after the warm-up.
+  return fmt::format("sleep 100 [mode {}; map {}]; sleep 700 [{}spectator 1]; sleep 1200 [{}]", mode->second, o.map, bots, follow);
+}
+
+Expected<Cube2Report> captureCube2(const Cube2Options& o, const Cube2Progress& progress) {
+  if (!(o.fps > 0 && o.fps <= 1000)) return fail(ErrorCode::kUsage, "--fps must be in (0, 1000] (got {})", o.fps);
+  if (!(o.seconds > 0)) return fail(ErrorCode::kUsage, "--seconds must be positive (got {})", o.seconds);
+  if (!(o.warmup >= 1.5)) return fail(ErrorCode::kUsage, "--warmup must be at least 1.5 s (the bots join and the camera starts following by then)");
+  if (o.width < 64 || o.height < 64) return fail(ErrorCode::kUsage, "--width and --height must be at least 64");
+  auto script = cube2Script(o);
+  if (!script) return std::unexpected(script.error());
+  auto client = findCube2Client(o.client);
+  if (!client) return std::unexpected(client.error());
+  std::error_code ec;
+  if (!fs::exists(o.data / "packages" / "base" / (o.map + ".ogz"), ec))
+    return fail(ErrorCode::kIo, "map '{}' not found in {} (Debian's cube2-data has colos, cyber1, md2, ...)", o.map,
+                (o.data / "packages" / "base").string());
+  if (!o.window && !onPath("xvfb-run")) return fail(ErrorCode::kExternalTool, "xvfb-run is missing: install Debian's xvfb (scripts/setup.sh does)");
+  if (fs::exists(o.output / "Capture.txt", ec))
+    return fail(ErrorCode::kUsage, "{}: already holds a capture; choose an empty folder", o.output.string());
+  fs::create_directories(o.output, ec);
+  if (ec) return fail(ErrorCode::kIo, "{}: cannot create: {}", o.output.string(), ec.message());
+  // A fresh home for the game's configuration: a config saved by one run cannot change the next.
+  const fs::path home = o.output / fmt::format(".cube2-home-{}", ::getpid());
+  fs::remove_all(home, ec);
+  fs::create_directories(home, ec);
+
+  const std::size_t total = static_cast<std::size_t>(o.seconds * o.fps + 0.5);
+  // A stalled game is stopped: at least 2 frames/s of wall time plus a minute for loading.
+  const int timeout = 60 + static_cast<int>((o.seconds + o.warmup) * o.fps / 2.0);
+  const std::string env = fmt::format(
+      "DYNBENCH_CAPTURE_DIR={} DYNBENCH_CAPTURE_DATA_ROOT={} DYNBENCH_CAPTURE_FPS={} DYNBENCH_CAPTURE_SEED={} "
+      "DYNBENCH_CAPTURE_WARMUP={} DYNBENCH_CAPTURE_SECONDS={}",
+      shellQuote(fs::absolute(o.output).string()), shellQuote(fs::absolute(o.data).string()), o.fps, o.seed, o.warmup, o.seconds);
+  const std::string game = fmt::format("{} -q{} -k{} -r -t0 -w{} -h{} {}", shellQuote("./" + client->filename().string()),
+                                       shellQuote(fs::absolute(home).string()), shellQuote(fs::absolute(o.data).string()), o.width, o.height,
+                                       shellQuote("-x" + *script));
+  const std::string display = o.window ? "" : fmt::format("xvfb-run -a -s {} ", shellQuote(fmt::format("-screen 0 {}x{}x24", o.width, o.height)));
+  const std::string command = fmt::format("cd {} && {} timeout {} {}{} 2>&1", shellQuote(client->parent_path().string()), env, timeout,
+                                          display, game);
+  const auto started = std::chrono::steady_clock::now();
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return fail(ErrorCode::kExternalTool, "cannot start the Cube 2 client");
+  std::string tail;
+  char line[4096];
+  std::size_t frames = 0;
+  while (std::fgets(line, sizeof line, pipe)) {
+    tail += line;
+    if (tail.size() > 3000) tail.erase(0, tail.size() - 3000);
+    unsigned long long done = 0, all = 0;
+    if (std::sscanf(line, "dynbench-capture: %llu/%llu frames", &done, &all) == 2) {
+      frames = static_cast<std::size_t>(done);
+      if (progress) progress(frames, total);
+    }
+  }
+  const int status = ::pclose(pipe);
+  fs::remove_all(home, ec);
+  if (status != 0 || frames < total) {
+    while (!tail.empty() && tail.back() == '\n') tail.pop_back();
+    return fail(ErrorCode::kExternalTool, "the Cube 2 client stopped after {} of {} frames (status {}); its last output:\n{}", frames, total,
+                status, tail);
+  }
+  auto summary = checkCapture(o.output);
+  if (!summary) return std::unexpected(summary.error());
+  Cube2Report report;
+  report.frames = frames;
+  report.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return report;
+}
+
+}  // namespace dynbench::capture

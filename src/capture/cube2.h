@@ -1,0 +1,46 @@
+#pragma once
+// `dynbench capture cube2`: runs Cube 2: Sauerbraten with dynbench's capture hooks
+// (integrations/cube2) headless under Xvfb, sets up a bot match, spectates a bot in first person
+// and records a fixed-clock, seeded capture.
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "core/error.h"
+
+namespace dynbench::capture {
+
+struct Cube2Options {
+  std::filesystem::path output;  // the capture folder
+  std::string map = "colos";
+  std::string mode = "ffa";      // ffa, teamplay, instagib, efficiency, tactics
+  int bots = 6;
+  int skill = 80;                // 50-100, Sauerbraten's bot skill
+  double seconds = 30.0;         // recorded game time
+  double fps = 60.0;             // fixed clock
+  unsigned seed = 1;
+  std::string follow = "auto";   // auto: the first bot; or a client number (bots are 128, 129, ...)
+  double warmup = 2.0;           // game seconds between the map loading and recording
+  int width = 640, height = 360;
+  bool window = false;           // on the user's display instead of Xvfb
+  std::filesystem::path client;  // empty: the one the build made
+  std::filesystem::path data = "/usr/share/games/cube2";  // Debian's cube2-data
+};
+
+struct Cube2Report {
+  std::size_t frames = 0;
+  double wallSeconds = 0.0;
+};
+
+// (frames recorded, frames total)
+using Cube2Progress = std::function<void(std::size_t, std::size_t)>;
+
+// The client the build made (integrations/cube2/build.sh), or an error saying how to get one.
+Expected<std::filesystem::path> findCube2Client(const std::filesystem::path& requested);
+
+Expected<Cube2Report> captureCube2(const Cube2Options& options, const Cube2Progress& progress = {});
+
+// The cubescript that sets the match up (exposed for tests).
+Expected<std::string> cube2Script(const Cube2Options& options);
+
+}  // namespace dynbench::capture

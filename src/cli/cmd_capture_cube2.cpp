@@ -1,0 +1,58 @@
+// `dynbench capture cube2 -o DIR`: record a headless, seeded Cube 2 bot match (integrations/cube2).
+#include <optional>
+
+#include "capture/cube2.h"
+#include "cli/commands.h"
+#include "core/progress.h"
+
+namespace dynbench::cli {
+namespace {
+
+Expected<void> runCube2(const capture::Cube2Options& options) {
+  std::optional<Progress> progress;
+  capture::Cube2Progress report;
+  if (Progress("capture", 0, "frames").enabled())
+    report = [&](std::size_t done, std::size_t total) {
+      if (!progress) progress.emplace("capture", total, "frames");
+      progress->update(done, "game time at the fixed clock");
+    };
+  auto result = capture::captureCube2(options, report);
+  progress.reset();
+  if (!result) return std::unexpected(result.error());
+  fmt::print("{}: {} frames ({:.1f} s of game time at {} frames/s) in {:.1f} s; next: dynbench convert {} -o DATASET.gltf\n",
+             options.output.string(), result->frames, result->frames / options.fps, options.fps, result->wallSeconds,
+             options.output.string());
+  return {};
+}
+
+}  // namespace
+
+void addCaptureCommand(CLI::App& app, CommandRun& run) {
+  auto* capture = app.add_subcommand("capture", "Capture animations from a running program");
+  capture->require_subcommand(1);
+  auto o = std::make_shared<capture::Cube2Options>();
+  auto* cmd = capture->add_subcommand("cube2", "Record a Cube 2: Sauerbraten bot match, headless, at a fixed clock and seed");
+  cmd->footer("Runs the game built with dynbench's capture hooks under Xvfb, sets up the match, spectates a bot in first\n"
+              "person and records --seconds of game time after --warmup. The same --seed and options give a byte-identical\n"
+              "Capture.txt. Then: dynbench convert DIR -o dataset.gltf\n"
+              "Example: dynbench capture cube2 -o captures/colos --map colos --bots 6 --seconds 10");
+  std::string output;
+  cmd->add_option("-o,--output", o->output, "Capture folder (new or empty)")->required();
+  cmd->add_option("--map", o->map, "Map (default: colos; others with bot waypoints: cyber1, md2, ...)");
+  cmd->add_option("--mode", o->mode, "Game mode: ffa, teamplay, instagib, efficiency, tactics (default: ffa)");
+  cmd->add_option("--bots", o->bots, "Number of bots (default: 6)");
+  cmd->add_option("--skill", o->skill, "Bot skill 1-101 (default: 80)");
+  cmd->add_option("--seconds", o->seconds, "Game seconds recorded (default: 30)");
+  cmd->add_option("--fps", o->fps, "Fixed clock, frames per game second (default: 60)");
+  cmd->add_option("--seed", o->seed, "Seed of every random choice (default: 1)");
+  cmd->add_option("--follow", o->follow, "auto (the first bot) or a bot's client number (128, 129, ...)");
+  cmd->add_option("--warmup", o->warmup, "Game seconds after the map loads before recording (default: 2, at least 1.5)");
+  cmd->add_option("--width", o->width, "Window width (default: 640)");
+  cmd->add_option("--height", o->height, "Window height (default: 360)");
+  cmd->add_flag("--window", o->window, "Use the current display instead of Xvfb");
+  cmd->add_option("--client", o->client, "The Cube 2 client with the capture hooks (default: the one the build made)");
+  cmd->add_option("--data", o->data, "Game data (default: /usr/share/games/cube2, Debian's cube2-data)");
+  cmd->callback([o, &run] { run = [o] { return runCube2(*o); }; });
+}
+
+}  // namespace dynbench::cli

@@ -1,0 +1,86 @@
+// `dynbench capture cube2` end to end on Debian's Cube 2 data: a seeded 5-second bot match on
+// colos, twice, must give the same Capture.txt byte for byte; it converts to a dataset the Khronos
+// validator accepts, whose stats show the followed bot's camera, the map and the game's lights.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fmt/format.h>
+
+#include "capture/cube2.h"
+#include "core/files.h"
+#include "gltf_builder.h"
+#include "run_cli.h"
+
+namespace dynbench {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string skipReason() {
+  if (!capture::findCube2Client({})) return "the Cube 2 client is not built (scripts/setup.sh, then cmake --build)";
+  if (!fs::exists("/usr/share/games/cube2/packages/base/colos.ogz")) return "Debian's cube2-data is not installed";
+  std::string out;
+  if (runShell("command -v xvfb-run >/dev/null 2>&1", out) != 0) return "xvfb-run is not installed";
+  return {};
+}
+
+TEST(Cube2, SeededMatchIsDeterministicAndConverts) {
+  if (const auto why = skipReason(); !why.empty()) GTEST_SKIP() << why << ": Cube 2 capture skipped";
+  const auto dir = test::freshDir("cube2");
+  for (const char* run : {"a", "b"}) {
+    const auto r = dynbench(fmt::format("capture cube2 -o {} --map colos --bots 4 --seconds 5 --seed 3", (dir / run).string()), dir);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("300 frames"), std::string::npos) << r.out;
+  }
+  const auto a = readWholeFile(dir / "a" / "Capture.txt"), b = readWholeFile(dir / "b" / "Capture.txt");
+  ASSERT_TRUE(a && b);
+  EXPECT_GT(a->size(), 10000u);
+  EXPECT_TRUE(*a == *b) << "the same seed gave different captures";
+
+  auto r = dynbench(fmt::format("convert {} -o {}", (dir / "a").string(), (dir / "ds" / "colos.gltf").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::string validation;
+  const int status = runShell(fmt::format("node {}/tools/gltf-validator/validate.mjs {} 2>&1", DYNBENCH_SOURCE_DIR,
+                                          (dir / "ds" / "colos.gltf").string()),
+                              validation);
+  EXPECT_EQ(status, 0) << validation;
+  EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
+
+  r = dynbench(fmt::format("stats {} --fps 60 --json {}", (dir / "ds" / "colos.gltf").string(), (dir / "stats.json").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(*readWholeFile(dir / "stats.json"))["datasets"][0];
+  EXPECT_TRUE(j["properties"]["animated_camera"].get<bool>());
+  EXPECT_GE(j["properties"]["static_objects"].get<int>(), 1);        // the map
+  EXPECT_GT(j["properties"]["faces"].get<int>(), 5000);              // colos has ~7,800 triangles
+  EXPECT_GT(j["properties"]["dynamic_point_lights"].get<int>(), 0);  // muzzle flashes, explosions
+  EXPECT_GT(j["properties"]["static_point_lights"].get<int>(), 0);   // the map's lights
+  // A bot's first-person view turns far faster than a slow fly-through: over 15 degrees per second
+  // on average (0.25 per frame at 60 fps), three times a slow 5 degrees-per-second pan.
+  EXPECT_GT(j["camera_motion"]["rotation_degrees"]["mean"].get<double>() * 60.0, 15.0);
+  std::printf("camera rotation %.3f deg/frame (mean), %.3f (max); position %.3f units/frame\n",
+              j["camera_motion"]["rotation_degrees"]["mean"].get<double>(), j["camera_motion"]["rotation_degrees"]["max"].get<double>(),
+              j["camera_motion"]["position"]["mean"].get<double>());
+}
+
+TEST(Cube2, BadOptionsFailClearly) {
+  const auto dir = test::freshDir("cube2_bad");
+  auto r = dynbench(fmt::format("capture cube2 -o {} --mode deathmatch", (dir / "x").string()), dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("--mode 'deathmatch'"), std::string::npos) << r.err;
+  r = dynbench(fmt::format("capture cube2 -o {} --bots 0", (dir / "x").string()), dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  r = dynbench(fmt::format("capture cube2 -o {} --warmup 0.2", (dir / "x").string()), dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  r = dynbench(fmt::format("capture cube2 -o {} --client {}", (dir / "x").string(), (dir / "nothing").string()), dir);
+  EXPECT_EQ(r.status, 7) << r.err;
+  EXPECT_NE(r.err.find("nothing"), std::string::npos) << r.err;
+  if (skipReason().empty()) {
+    r = dynbench(fmt::format("capture cube2 -o {} --map nosuchmap", (dir / "x").string()), dir);
+    EXPECT_EQ(r.status, 3) << r.err;
+    EXPECT_NE(r.err.find("map 'nosuchmap' not found"), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "x" / "Capture.txt"));
+}
+
+}  // namespace
+}  // namespace dynbench
