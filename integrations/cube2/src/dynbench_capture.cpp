@@ -8,6 +8,8 @@
 //   DYNBENCH_CAPTURE_SEED     seed of the game's random numbers (default 1)
 //   DYNBENCH_CAPTURE_WARMUP   seconds of game time after the map loads before recording (default 2)
 //   DYNBENCH_CAPTURE_SECONDS  seconds of game time recorded (default 30)
+//   DYNBENCH_CAPTURE_RECORD   0: run the same fixed-clock, seeded match without writing anything
+//                             (bench/bench_capture.sh measures the capture's cost against it)
 //
 // Only the engine's containers here (vector, hashtable, string): its tools.h defines placement new,
 // which clashes with the standard library's <new>.
@@ -40,6 +42,8 @@ struct CaptureState {
   long long recorded = 0;         // frames recorded
   uint64_t cameraId = 0;
   bool done = false;
+  bool record = true;
+  Uint32 windowStart = 0;  // wall clock when the capture window opened (SDL milliseconds)
 };
 
 CaptureState state;
@@ -198,6 +202,7 @@ void dynbench_capture_init() {
   state.seed = static_cast<unsigned>(envNumber("DYNBENCH_CAPTURE_SEED", 1.0));
   state.warmupSeconds = envNumber("DYNBENCH_CAPTURE_WARMUP", 2.0);
   state.seconds = envNumber("DYNBENCH_CAPTURE_SECONDS", 30.0);
+  state.record = envNumber("DYNBENCH_CAPTURE_RECORD", 1.0) != 0.0;
   seedMT(state.seed);
   // Occlusion queries answer when the GPU gets to them, not at a fixed frame: what is drawn, and
   // so where a muzzle flash starts (a model tag), would vary from run to run. Off while capturing.
@@ -206,6 +211,7 @@ void dynbench_capture_init() {
   // game takes from it depends on that frame's overlay rendering; without it the game places
   // muzzle flashes and grenades from the player's body, as it does for every other player.
   execute("hudgun 0");
+  if (!state.record) return;
   if (dbc_open(dir, "Cube 2: Sauerbraten 2020-12-27 (Debian cube2 0.0.20201227+dfsg)", &state.session) != DBC_OK)
     failCapture("cannot open the capture folder");
   const char *dataRoot = std::getenv("DYNBENCH_CAPTURE_DATA_ROOT");
@@ -229,6 +235,7 @@ void dynbench_capture_frame() {
   if (!map || !*map || !camera1) return;
   if (state.firstMapMillis < 0) {
     state.firstMapMillis = lastmillis;
+    if (!state.record) return;
     // The camera's lens: the engine's horizontal field of view and the window's aspect ratio.
     extern float nearplane;
     extern int farplane;
@@ -240,6 +247,17 @@ void dynbench_capture_frame() {
     exportMap(map);
   }
   if (lastmillis - state.firstMapMillis < static_cast<long long>(state.warmupSeconds * 1000.0)) return;
+  if (state.recorded == 0) state.windowStart = SDL_GetTicks();
+  if (!state.record) {
+    ++state.recorded;
+    if (static_cast<double>(state.recorded) >= state.seconds * state.fps) {
+      printf("dynbench-capture: window of %lld frames took %u ms of wall time (not recorded)\n", state.recorded, SDL_GetTicks() - state.windowStart);
+      fflush(stdout);
+      state.done = true;
+      execute("quit");
+    }
+    return;
+  }
   const double time = static_cast<double>(state.recorded) / state.fps;
   if (dbc_frame_begin(state.session, static_cast<uint64_t>(state.recorded), time) != DBC_OK) failCapture("frame");
   float position[3];
@@ -257,6 +275,8 @@ void dynbench_capture_frame() {
   }
   if (state.recorded >= total) {
     if (dbc_close(state.session) != DBC_OK) failCapture("close");
+    printf("dynbench-capture: window of %lld frames took %u ms of wall time (recorded)\n", state.recorded, SDL_GetTicks() - state.windowStart);
+    fflush(stdout);
     state.session = nullptr;
     state.done = true;
     execute("quit");
