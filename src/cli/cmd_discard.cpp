@@ -22,11 +22,6 @@ struct DiscardCli {
   discard::Thresholds thresholds;
 };
 
-nlohmann::json percentagesJson(const discard::FramePercentages& p) {
-  return {{"frustum", p.frustum}, {"world_position", p.position}, {"shading_normal", p.normal}, {"direct_radiance", p.direct},
-          {"indirect_radiance", p.indirect}};
-}
-
 Expected<void> runDiscard(const DiscardCli& cli) {
   const auto& t = cli.thresholds;
   for (const auto& [name, value] : {std::pair{"--threshold-position", t.position}, {"--threshold-normal", t.normal},
@@ -57,26 +52,8 @@ Expected<void> runDiscard(const DiscardCli& cli) {
   fmt::print("| {} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} |\n", fs::path(cli.frames).filename().string().empty() ? cli.frames : fs::path(cli.frames).filename().string(),
              m.frustum, m.position, m.normal, m.direct, m.indirect);
 
-  if (!cli.json.empty()) {
-    nlohmann::json j;
-    j["frames_dir"] = cli.frames;
-    j["width"] = run->width;
-    j["height"] = run->height;
-    j["scene_size"] = run->sceneSize;
-    j["thresholds"] = {{"position", t.position},       {"relative_position", t.relativePosition}, {"normal", t.normal},
-                       {"direct", t.direct},           {"indirect", t.indirect},                 {"absolute_radiance", t.absoluteRadiance},
-                       {"noise_aware", t.noiseAware}, {"noise_sigmas", t.noiseSigmas}};
-    j["mean"] = percentagesJson(m);
-    j["frames"] = nlohmann::json::array();
-    for (const auto& f : run->frames) {
-      auto row = percentagesJson(f);
-      row["frame"] = f.frame;
-      row["time"] = f.time;
-      j["frames"].push_back(row);
-    }
-    j["warnings"] = run->warnings;
-    if (auto ok = writeFileAtomic(cli.json, j.dump(2) + "\n"); !ok) return ok;
-  }
+  if (!cli.json.empty())
+    if (auto ok = writeFileAtomic(cli.json, discard::discardJson(*run, cli.frames)); !ok) return ok;
   if (!cli.csv.empty()) {
     std::string csv = "frame,time,frustum,world_position,shading_normal,direct_radiance,indirect_radiance\n";
     for (const auto& f : run->frames)

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 namespace dynbench::discard {
 namespace {
@@ -242,6 +243,37 @@ std::vector<float> maskImage(const FeatureFrame& frame, const std::vector<unsign
     for (int k = 0; k < 3; ++k) rgb[3 * i + static_cast<std::size_t>(k)] = static_cast<float>(c[k]);
   }
   return rgb;
+}
+
+namespace {
+
+nlohmann::json percentagesJson(const FramePercentages& p) {
+  return {{"frustum", p.frustum}, {"world_position", p.position}, {"shading_normal", p.normal}, {"direct_radiance", p.direct},
+          {"indirect_radiance", p.indirect}};
+}
+
+}  // namespace
+
+std::string discardJson(const DiscardRun& run, const std::string& framesDir) {
+  const auto& t = run.thresholds;
+  nlohmann::json j;
+  j["frames_dir"] = framesDir;
+  j["width"] = run.width;
+  j["height"] = run.height;
+  j["scene_size"] = run.sceneSize;
+  j["thresholds"] = {{"position", t.position},       {"relative_position", t.relativePosition}, {"normal", t.normal},
+                     {"direct", t.direct},           {"indirect", t.indirect},                 {"absolute_radiance", t.absoluteRadiance},
+                     {"noise_aware", t.noiseAware}, {"noise_sigmas", t.noiseSigmas}};
+  j["mean"] = percentagesJson(run.mean);
+  j["frames"] = nlohmann::json::array();
+  for (const auto& f : run.frames) {
+    auto row = percentagesJson(f);
+    row["frame"] = f.frame;
+    row["time"] = f.time;
+    j["frames"].push_back(row);
+  }
+  j["warnings"] = run.warnings;
+  return j.dump(2) + "\n";
 }
 
 }  // namespace dynbench::discard

@@ -105,6 +105,10 @@ using DiscardProgress = std::function<void(std::size_t, std::size_t)>;
 Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thresholds& thresholds, const MaskSink& masks = {},
                                    const DiscardProgress& progress = {});
 
+// The `discard --json` document: frames folder, size, thresholds, mean and per-frame percentages
+// (docs/cli.md); what `dynbench report` reads.
+std::string discardJson(const DiscardRun& run, const std::string& framesDir);
+
 // The mask image of Figure 6.2: the frame's direct + indirect radiance, tone-mapped and dimmed,
 // with discarded pixels coloured by their first reason (frustum red, world position yellow,
 // shading normal blue, direct magenta, indirect cyan). 8-bit RGB values in [0, 1].
