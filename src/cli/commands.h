@@ -34,6 +34,9 @@ void addReportCommand(CLI::App& app, CommandRun& run);
 // Registers `capture cube2`.
 void addCaptureCommand(CLI::App& app, CommandRun& run);
 
+// Registers `demo`.
+void addDemoCommand(CLI::App& app, CommandRun& run);
+
 // Exit status for an error (docs/cli.md lists them).
 int exitCode(const Error& error);
 

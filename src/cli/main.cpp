@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   cli::addDiscardCommand(app, run);
   cli::addReportCommand(app, run);
   cli::addCaptureCommand(app, run);
+  cli::addDemoCommand(app, run);
 
   // `dynbench help [COMMAND]`
   std::string helpTopic;

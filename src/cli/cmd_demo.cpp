@@ -1,0 +1,46 @@
+// `dynbench demo [-o DIR]`: the whole chain on a seeded Cube 2 match (src/demo/demo.h).
+#include "cli/commands.h"
+#include "demo/demo.h"
+
+namespace dynbench::cli {
+namespace {
+
+struct DemoCli {
+  demo::DemoOptions options;
+  std::string resolution = "320x180";
+};
+
+Expected<void> runDemo(const DemoCli& cli) {
+  demo::DemoOptions o = cli.options;
+  char x = 0;
+  if (std::sscanf(cli.resolution.c_str(), "%d%c%d", &o.width, &x, &o.height) != 3 || x != 'x' || o.width <= 0 || o.height <= 0)
+    return fail(ErrorCode::kUsage, "--res '{}': expected WIDTHxHEIGHT", cli.resolution);
+  auto report = demo::runDemo(o, [](const std::string& line) {
+    fmt::print("{}\n", line);
+    std::fflush(stdout);
+  });
+  if (!report) return std::unexpected(report.error());
+  fmt::print("report: {}\n", report->string());
+  return {};
+}
+
+}  // namespace
+
+void addDemoCommand(CLI::App& app, CommandRun& run) {
+  auto o = std::make_shared<DemoCli>();
+  auto* cmd = app.add_subcommand("demo", "The whole chain on a seeded Cube 2 bot match: capture, convert, stats, render, discard, report");
+  cmd->footer("Also makes a smooth fly-through over the same match as a second dataset, so the report shows the contrast.\n"
+              "A rerun reuses the capture and the frames already rendered. Example: dynbench demo -o demo --seconds 20");
+  cmd->add_option("-o,--output", o->options.output, "Output folder (default: dynbench-demo)");
+  cmd->add_option("--map", o->options.map, "Map (default: colos)");
+  cmd->add_option("--bots", o->options.bots, "Bots (default: 6)");
+  cmd->add_option("--seconds", o->options.seconds, "Game seconds captured (default: 10)");
+  cmd->add_option("--seed", o->options.seed, "Seed (default: 1)");
+  cmd->add_option("--fps", o->options.fps, "Sampling rate of stats, render and discard (default: 24)");
+  cmd->add_option("--res", o->resolution, "Render resolution (default: 320x180)");
+  cmd->add_option("--spp", o->options.samplesPerPixel, "Samples per pixel (default: 8)");
+  cmd->add_option("--bounces", o->options.bounces, "Bounces (default: 2)");
+  cmd->callback([o, &run] { run = [o] { return runDemo(*o); }; });
+}
+
+}  // namespace dynbench::cli

@@ -1,0 +1,174 @@
+#include "demo/demo.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "capture/cube2.h"
+#include "convert/convert.h"
+#include "convert/merge_camera.h"
+#include "core/files.h"
+#include "core/math.h"
+#include "discard/discard.h"
+#include "metrics/camera_motion.h"
+#include "metrics/properties.h"
+#include "render/render_job.h"
+#include "report/html_report.h"
+#include "report/stats_output.h"
+#include "scene/evaluate.h"
+#include "scene/load.h"
+
+namespace dynbench::demo {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Catmull-Rom through p1..p2 with neighbours p0, p3, at s in [0, 1].
+glm::dvec3 catmullRom(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2, const glm::dvec3& p3, double s) {
+  const double s2 = s * s, s3 = s2 * s;
+  return 0.5 * ((2.0 * p1) + (-p0 + p2) * s + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * s2 + (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * s3);
+}
+
+// stats, render, discard for one dataset into RUN.
+Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, const DemoOptions& o, const DemoLog& log) {
+  auto scene = scene::loadScene(dataset);
+  if (!scene) return std::unexpected(scene.error());
+  report::StatsRow row;
+  row.name = dataset.filename().string();
+  row.path = dataset.string();
+  row.properties = metrics::measureProperties(*scene, o.fps);
+  auto motion = metrics::measureCameraMotion(*scene, o.fps, std::nullopt);
+  if (!motion) return std::unexpected(motion.error());
+  row.motion = std::move(*motion);
+  if (auto ok = writeFileAtomic(run / "stats.json", report::statsJson({row}, o.fps)); !ok) return ok;
+  if (auto ok = writeFileAtomic(run / (dataset.stem().string() + "_camera.csv"), report::cameraSeriesCsv(row.motion)); !ok) return ok;
+
+  render::RenderJob job;
+  job.dataset = dataset;
+  job.output = run / "frames";
+  job.fps = o.fps;
+  job.settings.width = o.width;
+  job.settings.height = o.height;
+  job.settings.samplesPerPixel = o.samplesPerPixel;
+  job.settings.bounces = o.bounces;
+  job.settings.seed = o.seed;
+  auto rendered = render::renderDataset(*scene, job);
+  if (!rendered) return std::unexpected(rendered.error());
+  log(fmt::format("  rendered {} frames ({} already there) in {:.0f} s", rendered->rendered.size(), rendered->skipped.size(), rendered->seconds));
+
+  discard::Thresholds thresholds;
+  thresholds.relativePosition = true;
+  thresholds.position = 0.01;  // 1% of the scene's size
+  thresholds.noiseAware = true;
+  const fs::path masks = run / "masks";
+  auto discarded = discard::discardFolder(job.output, thresholds, [&](const discard::FeatureFrame& f, const discard::DiscardResult& r) {
+    FloatImage image{f.width, f.height, 3, discard::maskImage(f, r.mask), {}};
+    return writeImage(masks / fmt::format("discard_{:05d}.png", f.frame), image);
+  });
+  if (!discarded) return std::unexpected(discarded.error());
+  if (auto ok = writeFileAtomic(run / "discard.json", discard::discardJson(*discarded, job.output.string())); !ok) return ok;
+  log(fmt::format("  discard: frustum {:.2f} %, world position {:.2f} %, shading normal {:.2f} %, direct {:.2f} %, indirect {:.2f} %",
+                  discarded->mean.frustum, discarded->mean.position, discarded->mean.normal, discarded->mean.direct, discarded->mean.indirect));
+  return {};
+}
+
+}  // namespace
+
+Expected<void> writeFlythroughCsv(const fs::path& dataset, const fs::path& csv, int keys, double rate) {
+  auto scene = scene::loadScene(dataset);
+  if (!scene) return std::unexpected(scene.error());
+  auto cameraNode = metrics::selectCameraNode(*scene, std::nullopt);
+  if (!cameraNode) return std::unexpected(cameraNode.error());
+  const auto range = scene->timeRange();
+  if (!(range.end > range.start)) return fail(ErrorCode::kInvalidData, "{}: no animation to fly along", dataset.string());
+  keys = std::max(keys, 2);
+  const scene::Evaluator evaluator(*scene);
+  std::vector<glm::dvec3> points;
+  for (int k = 0; k < keys; ++k) {
+    const double t = range.start + (range.end - range.start) * k / (keys - 1);
+    points.emplace_back(evaluator.worldMatrix(*cameraNode, t)[3]);
+  }
+  auto position = [&](double u) {  // u in [0, keys - 1]
+    const int i = std::clamp(static_cast<int>(std::floor(u)), 0, keys - 2);
+    const double s = u - i;
+    const auto& p0 = points[static_cast<std::size_t>(std::max(i - 1, 0))];
+    const auto& p3 = points[static_cast<std::size_t>(std::min(i + 2, keys - 1))];
+    return catmullRom(p0, points[static_cast<std::size_t>(i)], points[static_cast<std::size_t>(i + 1)], p3, s);
+  };
+  std::string out = "time,x,y,z,qx,qy,qz,qw\n";
+  const int samples = std::max(2, static_cast<int>(std::ceil((range.end - range.start) * rate)) + 1);
+  double yaw = 0.0;
+  for (int n = 0; n < samples; ++n) {
+    const double t = (range.end - range.start) * n / (samples - 1);  // evenly spaced, ending at the last key
+    const double u = t / (range.end - range.start) * (keys - 1);
+    const glm::dvec3 p = position(u);
+    // Look along the path, level, turning at most kMaxTurn degrees per second towards the
+    // horizontal tangent: a fly-through pans, it does not snap (ORCA's cameras turn slowly).
+    constexpr double kMaxTurn = 30.0;
+    const glm::dvec3 ahead = position(std::min(u + 0.05, static_cast<double>(keys - 1))) - position(std::max(u - 0.05, 0.0));
+    if (ahead.x * ahead.x + ahead.z * ahead.z > 1e-12) {
+      const double target = std::atan2(-ahead.x, -ahead.z);
+      if (n == 0) yaw = target;
+      const double step = kMaxTurn * kPi / 180.0 / rate;
+      yaw += std::clamp(std::remainder(target - yaw, 2.0 * kPi), -step, step);
+    }
+    const glm::dquat q = glm::angleAxis(yaw, glm::dvec3(0, 1, 0));
+    out += fmt::format("{},{},{},{},{},{},{},{}\n", t, p.x, p.y, p.z, q.x, q.y, q.z, q.w);
+  }
+  return writeFileAtomic(csv, out);
+}
+
+Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
+  const fs::path capture = o.output / "capture";
+  const fs::path datasets = o.output / "datasets";
+  const fs::path bot = datasets / (o.map + "_bot.gltf"), fly = datasets / (o.map + "_flythrough.gltf");
+  std::error_code ec;
+
+  if (!fs::exists(capture / "Capture.txt", ec)) {
+    log(fmt::format("capture: {} s of a {}-bot match on {} (seed {})", o.seconds, o.bots, o.map, o.seed));
+    capture::Cube2Options c;
+    c.output = capture;
+    c.map = o.map;
+    c.bots = o.bots;
+    c.seconds = o.seconds;
+    c.seed = o.seed;
+    auto captured = capture::captureCube2(c);
+    if (!captured) return std::unexpected(captured.error());
+    log(fmt::format("  {} frames in {:.0f} s", captured->frames, captured->wallSeconds));
+  } else {
+    log(fmt::format("capture: {} exists, reused", (capture / "Capture.txt").string()));
+  }
+  log("convert: capture -> " + bot.string());
+  convert::ConvertOptions convertOptions;
+  convertOptions.capture = capture;
+  convertOptions.output = bot;
+  auto converted = convert::convertCapture(convertOptions);
+  if (!converted) return std::unexpected(converted.error());
+
+  log("fly-through: a smooth camera over the same match -> " + fly.string());
+  const fs::path csv = datasets / "flythrough.csv";
+  if (auto ok = writeFlythroughCsv(bot, csv, o.flythroughKeys, 60.0); !ok) return std::unexpected(ok.error());
+  convert::MergeCameraOptions merge;
+  merge.dataset = bot;
+  merge.run = csv;
+  merge.output = fly;
+  if (auto merged = convert::mergeCamera(merge); !merged) return std::unexpected(merged.error());
+
+  std::vector<fs::path> runs;
+  for (const auto& [name, dataset] : {std::pair{"first-person bot", bot}, std::pair{"fly-through", fly}}) {
+    const fs::path run = o.output / "runs" / dataset.stem();
+    log(fmt::format("{}: stats, render ({}x{}, {} spp, {} bounces, {} fps), discard -> {}", name, o.width, o.height, o.samplesPerPixel,
+                    o.bounces, o.fps, run.string()));
+    if (auto ok = measureDataset(dataset, run, o, log); !ok) return std::unexpected(ok.error());
+    runs.push_back(run);
+  }
+  report::ReportOptions r;
+  r.runs = runs;
+  r.output = o.output / "report.html";
+  r.title = fmt::format("dynbench demo: {} with {} bots, first-person bot vs fly-through", o.map, o.bots);
+  auto files = report::writeReport(r);
+  if (!files) return std::unexpected(files.error());
+  return files->html;
+}
+
+}  // namespace dynbench::demo

@@ -1,0 +1,35 @@
+#pragma once
+// `dynbench demo`: the whole chain on a seeded Cube 2 bot match. Capture, convert, a smooth
+// fly-through of the same match as a second dataset (the contrast the thesis found against
+// the ORCA fly-throughs), then per dataset stats, render, discard, and one report.
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "core/error.h"
+
+namespace dynbench::demo {
+
+struct DemoOptions {
+  std::filesystem::path output = "dynbench-demo";
+  std::string map = "colos";
+  int bots = 6;
+  double seconds = 10.0;  // game time captured
+  unsigned seed = 1;
+  double fps = 24.0;      // stats, render and discard sample the datasets at this rate
+  int width = 320, height = 180, samplesPerPixel = 8, bounces = 2;
+  int flythroughKeys = 4;  // key points of the fly-through's spline
+};
+
+// One line per stage (for the terminal and logs).
+using DemoLog = std::function<void(const std::string&)>;
+
+// Returns the report's path.
+Expected<std::filesystem::path> runDemo(const DemoOptions& options, const DemoLog& log);
+
+// A smooth fly-through over the camera path of `dataset`: a Catmull-Rom spline through `keys`
+// of its camera positions, evenly spaced in time, level, turning towards the spline's horizontal
+// direction at most 30 degrees per second. Written as a merge-camera CSV pose log (time,x,y,z,qx,qy,qz,qw) at `rate` poses/s.
+Expected<void> writeFlythroughCsv(const std::filesystem::path& dataset, const std::filesystem::path& csv, int keys, double rate);
+
+}  // namespace dynbench::demo
