@@ -1,0 +1,82 @@
+// `dynbench demo`: the fly-through's camera path (known answers on a synthetic dataset), and the
+// whole chain on a short Cube 2 match (skipped, saying why, without the game).
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+
+#include "capture/cube2.h"
+#include "core/files.h"
+#include "core/math.h"
+#include "demo/demo.h"
+#include "gltf_builder.h"
+#include "run_cli.h"
+
+namespace dynbench {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(Demo, FlythroughPassesThroughTheKeysAndTurnsSlowly) {
+  // A camera that zigzags: (0,0,0) -> (10,0,0) -> (10,0,-10) -> (20,0,-10) -> (20,0,-20) over 4 s.
+  const fs::path dir = test::freshDir("demo_fly");
+  test::GltfBuilder b;
+  const int cam = b.node({{"name", "eye"}, {"camera", b.perspectiveCamera()}});
+  b.channel(cam, "translation", {0, 1, 2, 3, 4}, {0, 0, 0, 10, 0, 0, 10, 0, -10, 20, 0, -10, 20, 0, -20});
+  const fs::path dataset = b.write(dir, "zigzag");
+  ASSERT_TRUE(demo::writeFlythroughCsv(dataset, dir / "fly.csv", 5, 60.0));
+  const std::string csv = *readWholeFile(dir / "fly.csv");
+  std::vector<std::array<double, 8>> rows;
+  std::size_t start = csv.find('\n') + 1;
+  for (std::size_t end; (end = csv.find('\n', start)) != std::string::npos; start = end + 1) {
+    std::array<double, 8> r{};
+    ASSERT_EQ(std::sscanf(csv.substr(start, end - start).c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &r[0], &r[1], &r[2], &r[3], &r[4],
+                          &r[5], &r[6], &r[7]),
+              8);
+    rows.push_back(r);
+  }
+  ASSERT_EQ(rows.size(), 241u);  // 4 s at 60 poses/s, both ends
+  // Catmull-Rom interpolates its control points: at t = 0, 1, 2, 3, 4 s the keys themselves.
+  const double keys[5][3] = {{0, 0, 0}, {10, 0, 0}, {10, 0, -10}, {20, 0, -10}, {20, 0, -20}};
+  for (int k = 0; k < 5; ++k) {
+    const auto& r = rows[static_cast<std::size_t>(60 * k)];
+    EXPECT_NEAR(r[0], k, 1e-9);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(r[static_cast<std::size_t>(1 + c)], keys[k][c], 1e-6) << k;
+  }
+  // Level (rotation about +Y only) and never faster than 30 degrees per second.
+  double fastest = 0;
+  for (std::size_t n = 0; n < rows.size(); ++n) {
+    EXPECT_NEAR(rows[n][4], 0.0, 1e-12);
+    EXPECT_NEAR(rows[n][6], 0.0, 1e-12);
+    if (n == 0) continue;
+    const glm::dquat a(rows[n - 1][7], rows[n - 1][4], rows[n - 1][5], rows[n - 1][6]), c(rows[n][7], rows[n][4], rows[n][5], rows[n][6]);
+    fastest = std::max(fastest, degrees(geodesicAngle(a, c)) * 60.0);
+  }
+  EXPECT_LE(fastest, 30.0 + 1e-6);
+  EXPECT_GT(fastest, 29.0);  // the zigzag's corners make it turn at the limit
+}
+
+TEST(Demo, WholeChainOnAShortMatch) {
+  if (!capture::findCube2Client({}) || !fs::exists("/usr/share/games/cube2/packages/base/colos.ogz"))
+    GTEST_SKIP() << "the Cube 2 client or Debian's cube2-data is missing: demo skipped";
+  const fs::path dir = test::freshDir("demo_chain");
+  const auto r = dynbench(fmt::format("demo -o {} --seconds 3 --bots 4 --res 64x36 --spp 1 --bounces 1", (dir / "demo").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("report: "), std::string::npos) << r.out;
+  const std::string md = *readWholeFile(dir / "demo" / "report.md");
+  EXPECT_NE(md.find("| colos_bot "), std::string::npos);
+  EXPECT_NE(md.find("| colos_flythrough "), std::string::npos);
+  // Table 6.5: the fly-through turns no faster than 30 deg/s, i.e. 1.25 deg per frame at 24 fps.
+  const auto table = md.find("Table 6.5.");
+  const auto row = md.find("| colos_flythrough ", table);
+  ASSERT_NE(row, std::string::npos);
+  double mean = 0, variance = 0, max = 0;
+  ASSERT_EQ(std::sscanf(md.c_str() + md.find('|', row + 2), "| %lf | %lf | %lf", &mean, &variance, &max), 3) << md.substr(row, 80);
+  EXPECT_LE(max, 1.25 + 1e-3);
+  EXPECT_TRUE(fs::exists(dir / "demo" / "report.html"));
+  EXPECT_TRUE(fs::exists(dir / "demo" / "runs" / "colos_bot" / "discard.json"));
+}
+
+}  // namespace
+}  // namespace dynbench
