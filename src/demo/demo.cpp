@@ -109,7 +109,7 @@ Expected<void> writeFlythroughCsv(const fs::path& dataset, const fs::path& csv, 
     if (ahead.x * ahead.x + ahead.z * ahead.z > 1e-12) {
       const double target = std::atan2(-ahead.x, -ahead.z);
       if (n == 0) yaw = target;
-      const double step = kMaxTurn * kPi / 180.0 / rate;
+      const double step = kMaxTurn * kPi / 180.0 * (range.end - range.start) / (samples - 1);  // per actual sample spacing
       yaw += std::clamp(std::remainder(target - yaw, 2.0 * kPi), -step, step);
     }
     const glm::dquat q = glm::angleAxis(yaw, glm::dvec3(0, 1, 0));
