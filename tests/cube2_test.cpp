@@ -46,6 +46,12 @@ TEST(Cube2, SeededMatchIsDeterministicAndConverts) {
   EXPECT_EQ(status, 0) << validation;
   EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
 
+  // The dataset README lists the licences of the Cube 2 assets (cube2-data's copyright file).
+  const std::string readme = *readWholeFile(dir / "ds" / "colos.README.md");
+  EXPECT_NE(readme.find("cube2-data"), std::string::npos);
+  EXPECT_NE(readme.find("License: CC-BY-3.0"), std::string::npos);
+  EXPECT_NE(readme.find("zlib"), std::string::npos);
+
   r = dynbench(fmt::format("stats {} --fps 60 --json {}", (dir / "ds" / "colos.gltf").string(), (dir / "stats.json").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(*readWholeFile(dir / "stats.json"))["datasets"][0];

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "capture/check.h"
+#include "core/files.h"
 
 namespace dynbench::capture {
 namespace {
@@ -101,7 +102,10 @@ Expected<Cube2Report> captureCube2(const Cube2Options& o, const Cube2Progress& p
   const std::string game = fmt::format("{} -q{} -k{} -r -t0 -w{} -h{} {}", shellQuote("./" + client->filename().string()),
                                        shellQuote(fs::absolute(home).string()), shellQuote(fs::absolute(o.data).string()), o.width, o.height,
                                        shellQuote("-x" + *script));
-  const std::string display = o.window ? "" : fmt::format("xvfb-run -a -s {} ", shellQuote(fmt::format("-screen 0 {}x{}x24", o.width, o.height)));
+  // xvfb-run -a searches upwards from -n for a free display; two runs starting together from the
+  // same number can race for it, so each starts from its own (by process id).
+  const std::string display = o.window ? "" : fmt::format("xvfb-run -a -n {} -s {} ", 100 + ::getpid() % 5000,
+                                                          shellQuote(fmt::format("-screen 0 {}x{}x24", o.width, o.height)));
   const std::string command = fmt::format("cd {} && {} timeout {} {}{} 2>&1", shellQuote(client->parent_path().string()), env, timeout,
                                           display, game);
   const auto started = std::chrono::steady_clock::now();
@@ -128,6 +132,16 @@ Expected<Cube2Report> captureCube2(const Cube2Options& o, const Cube2Progress& p
   }
   auto summary = checkCapture(o.output);
   if (!summary) return std::unexpected(summary.error());
+  // The licences of what the capture holds, which `convert` copies into the dataset's README:
+  // the game data's Debian copyright file (maps, textures, models) and the engine's licence.
+  std::string licences =
+      "This dataset was captured from Cube 2: Sauerbraten (engine: zlib licence, Debian source package cube2 "
+      "0.0.20201227+dfsg) playing with the game data of Debian's cube2-data package. The maps, textures and models in it "
+      "come from that package, whose copyright file follows.\n\n";
+  const fs::path copyright = "/usr/share/doc/cube2-data/copyright";
+  if (auto text = readWholeFile(copyright)) licences += "```\n" + *text + "```\n";
+  else licences += fmt::format("({} was not found: check the game data's licences before publishing.)\n", copyright.string());
+  if (auto ok = writeFileAtomic(o.output / "LICENSES.txt", licences); !ok) return std::unexpected(ok.error());
   Cube2Report report;
   report.frames = frames;
   report.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
