@@ -82,6 +82,20 @@ TEST(RenderCli, WritesTheContractAndResumes) {
     EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
 }
 
+TEST(RenderCli, AChangedDatasetIsRenderedAgain) {
+  const auto dir = test::freshDir("render_changed");
+  fs::copy_file(kOrbit, dir / "orbit.gltf");
+  const std::string args = fmt::format("render {} -o {} --res 16x9 --spp 1 --frames 3", (dir / "orbit.gltf").string(), (dir / "f").string());
+  auto r = dynbench(args, dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = dynbench(args, dir);
+  EXPECT_NE(r.out.find("0 frame(s) rendered, 1 already complete"), std::string::npos) << r.out;
+  // The same path, a newer file (re-converted, edited): its old frames are not complete for it.
+  fs::last_write_time(dir / "orbit.gltf", fs::last_write_time(dir / "orbit.gltf") + std::chrono::seconds(5));
+  r = dynbench(args, dir);
+  EXPECT_NE(r.out.find("1 frame(s) rendered, 0 already complete"), std::string::npos) << r.out;
+}
+
 TEST(RenderCli, TheDatasetEnvironmentLightsTheBackground) {
   const auto dir = test::freshDir("render_env");
   FloatImage sky;

@@ -138,21 +138,34 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
   } else {
     log(fmt::format("capture: {} exists, reused", (capture / "Capture.txt").string()));
   }
-  log("convert: capture -> " + bot.string());
-  convert::ConvertOptions convertOptions;
-  convertOptions.capture = capture;
-  convertOptions.output = bot;
-  auto converted = convert::convertCapture(convertOptions);
-  if (!converted) return std::unexpected(converted.error());
-
-  log("fly-through: a smooth camera over the same match -> " + fly.string());
-  const fs::path csv = datasets / "flythrough.csv";
-  if (auto ok = writeFlythroughCsv(bot, csv, o.flythroughKeys, 60.0); !ok) return std::unexpected(ok.error());
-  convert::MergeCameraOptions merge;
-  merge.dataset = bot;
-  merge.run = csv;
-  merge.output = fly;
-  if (auto merged = convert::mergeCamera(merge); !merged) return std::unexpected(merged.error());
+  // A rerun keeps what is up to date, so the frames rendered from it stay valid too.
+  auto newer = [&](const fs::path& a, const fs::path& b) {
+    std::error_code e1, e2;
+    const auto ta = fs::last_write_time(a, e1), tb = fs::last_write_time(b, e2);
+    return !e1 && !e2 && ta > tb;
+  };
+  if (!newer(bot, capture / "Capture.txt")) {
+    log("convert: capture -> " + bot.string());
+    convert::ConvertOptions convertOptions;
+    convertOptions.capture = capture;
+    convertOptions.output = bot;
+    auto converted = convert::convertCapture(convertOptions);
+    if (!converted) return std::unexpected(converted.error());
+  } else {
+    log("convert: " + bot.string() + " is newer than the capture, reused");
+  }
+  if (!newer(fly, bot)) {
+    log("fly-through: a smooth camera over the same match -> " + fly.string());
+    const fs::path csv = datasets / "flythrough.csv";
+    if (auto ok = writeFlythroughCsv(bot, csv, o.flythroughKeys, 60.0); !ok) return std::unexpected(ok.error());
+    convert::MergeCameraOptions merge;
+    merge.dataset = bot;
+    merge.run = csv;
+    merge.output = fly;
+    if (auto merged = convert::mergeCamera(merge); !merged) return std::unexpected(merged.error());
+  } else {
+    log("fly-through: " + fly.string() + " is newer than its source, reused");
+  }
 
   std::vector<fs::path> runs;
   for (const auto& [name, dataset] : {std::pair{"first-person bot", bot}, std::pair{"fly-through", fly}}) {

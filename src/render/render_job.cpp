@@ -97,6 +97,13 @@ nlohmann::json renderRecord(const RenderJob& job) {
                       {"width", s.width},
                       {"height", s.height},
                       {"environment", s.constantEnvironment ? "constant" : (s.useEnvironment ? "dataset" : "none")}};
+  // The dataset file's size and modification time: frames of an older version of a dataset at the
+  // same path are not complete for the new one.
+  std::error_code ec;
+  const auto bytes = fs::file_size(job.dataset, ec);
+  if (!ec) r["dataset_bytes"] = bytes;
+  const auto modified = fs::last_write_time(job.dataset, ec);
+  if (!ec) r["dataset_modified_ns"] = static_cast<long long>(std::chrono::duration_cast<std::chrono::nanoseconds>(modified.time_since_epoch()).count());
   if (job.camera) r["camera"] = *job.camera;
   if (s.constantEnvironment) r["environment_radiance"] = {s.constantEnvironment->r, s.constantEnvironment->g, s.constantEnvironment->b};
   return r;
