@@ -12,39 +12,16 @@
 #include "core/files.h"
 
 namespace dynbench::capture {
-namespace {
-
 namespace fs = std::filesystem;
-
-std::string shellQuote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-bool executable(const fs::path& p) { return ::access(p.c_str(), X_OK) == 0; }
-
-bool onPath(const std::string& name) {
-  const char* path = std::getenv("PATH");
-  std::string dirs = path ? path : "/usr/bin:/bin";
-  for (std::size_t start = 0; start <= dirs.size();) {
-    const auto end = std::min(dirs.find(':', start), dirs.size());
-    if (executable(fs::path(dirs.substr(start, end - start)) / name)) return true;
-    start = end + 1;
-  }
-  return false;
-}
-
-}  // namespace
 
 Expected<fs::path> findCube2Client(const fs::path& requested) {
   if (!requested.empty()) {
-    if (executable(requested)) return requested;
+    if (isExecutable(requested)) return requested;
     return fail(ErrorCode::kExternalTool, "--client {}: not an executable file", requested.string());
   }
-  if (const char* env = std::getenv("DYNBENCH_CUBE2_CLIENT"); env && *env && executable(env)) return fs::path(env);
+  if (const char* env = std::getenv("DYNBENCH_CUBE2_CLIENT"); env && *env && isExecutable(env)) return fs::path(env);
   const fs::path built = DYNBENCH_CUBE2_CLIENT_BUILD_PATH;
-  if (!built.empty() && executable(built)) return built;
+  if (!built.empty() && isExecutable(built)) return built;
   return fail(ErrorCode::kExternalTool,
               "the Cube 2 client with dynbench's capture hooks is not built: run scripts/setup.sh, then cmake --build "
               "(target cube2_client), or pass --client PATH");
@@ -82,7 +59,7 @@ Expected<Cube2Report> captureCube2(const Cube2Options& o, const Cube2Progress& p
   if (!fs::exists(o.data / "packages" / "base" / (o.map + ".ogz"), ec))
     return fail(ErrorCode::kIo, "map '{}' not found in {} (Debian's cube2-data has colos, cyber1, md2, ...)", o.map,
                 (o.data / "packages" / "base").string());
-  if (!o.window && !onPath("xvfb-run")) return fail(ErrorCode::kExternalTool, "xvfb-run is missing: install Debian's xvfb (scripts/setup.sh does)");
+  if (!o.window && findOnPath("xvfb-run").empty()) return fail(ErrorCode::kExternalTool, "xvfb-run is missing: install Debian's xvfb (scripts/setup.sh does)");
   if (fs::exists(o.output / "Capture.txt", ec))
     return fail(ErrorCode::kUsage, "{}: already holds a capture; choose an empty folder", o.output.string());
   fs::create_directories(o.output, ec);

@@ -1,6 +1,8 @@
 #include "core/files.h"
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <system_error>
@@ -65,6 +67,26 @@ Expected<std::uint64_t> fileSize(const std::filesystem::path& path) {
   const auto size = std::filesystem::file_size(path, ec);
   if (ec) return fail(ErrorCode::kIo, "{}: {}", path.string(), ec.message());
   return static_cast<std::uint64_t>(size);
+}
+
+bool isExecutable(const std::filesystem::path& path) { return ::access(path.c_str(), X_OK) == 0; }
+
+std::filesystem::path findOnPath(const std::string& name) {
+  const char* env = std::getenv("PATH");
+  const std::string dirs = env ? env : "/usr/bin:/bin";
+  for (std::size_t start = 0; start <= dirs.size();) {
+    const auto end = std::min(dirs.find(':', start), dirs.size());
+    const std::filesystem::path candidate = std::filesystem::path(dirs.substr(start, end - start)) / name;
+    if (isExecutable(candidate)) return candidate;
+    start = end + 1;
+  }
+  return {};
+}
+
+std::string shellQuote(std::string_view s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
 }
 
 }  // namespace dynbench

@@ -31,12 +31,6 @@ Expected<fs::path> renderScript() {
   return fail(ErrorCode::kExternalTool, "cannot find tools/blender/render_cycles.py (set DYNBENCH_BLENDER_SCRIPT)");
 }
 
-std::string shellQuote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
 // Channel lookup by Blender's names ("ViewLayer.DiffDir.R" or "DiffDir.R").
 struct Passes {
   const FloatImage& image;
@@ -64,17 +58,10 @@ struct Passes {
 
 Expected<fs::path> findBlender(const std::string& blender) {
   if (blender.find('/') != std::string::npos) {
-    if (::access(blender.c_str(), X_OK) == 0) return fs::path(blender);
+    if (isExecutable(blender)) return fs::path(blender);
     return fail(ErrorCode::kExternalTool, "--blender {}: not an executable file", blender);
   }
-  const char* path = std::getenv("PATH");
-  std::string dirs = path ? path : "/usr/bin:/bin";
-  for (std::size_t start = 0; start <= dirs.size();) {
-    const auto end = std::min(dirs.find(':', start), dirs.size());
-    const fs::path candidate = fs::path(dirs.substr(start, end - start)) / blender;
-    if (::access(candidate.c_str(), X_OK) == 0) return candidate;
-    start = end + 1;
-  }
+  if (auto found = findOnPath(blender); !found.empty()) return found;
   return fail(ErrorCode::kExternalTool,
               "--engine cycles needs Blender, and '{}' is not on PATH: install Debian's blender package "
               "(apt-get install blender) or pass --blender PATH",
