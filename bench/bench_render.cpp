@@ -16,6 +16,7 @@
 
 #include "convert/sky.h"
 #include "core/image_io.h"
+#include "core/math.h"
 #include "gltf_builder.h"
 #include "render/frame_output.h"
 #include "render/render_job.h"
@@ -134,8 +135,7 @@ std::vector<double> radiance(const fs::path& dir, const std::vector<long>& frame
       at.push_back(static_cast<std::size_t>(std::find(image->channelNames.begin(), image->channelNames.end(), name) - image->channelNames.begin()));
     for (std::size_t i = 0; i < static_cast<std::size_t>(image->width) * image->height; ++i) {
       const float* p = &image->pixels[i * static_cast<std::size_t>(image->channels)];
-      const double r = p[at[0]] + p[at[3]], g = p[at[1]] + p[at[4]], b = p[at[2]] + p[at[5]];
-      out.push_back(0.2126 * r + 0.7152 * g + 0.0722 * b);
+      out.push_back(luminance(glm::dvec3(p[at[0]] + p[at[3]], p[at[1]] + p[at[4]], p[at[2]] + p[at[5]])));
     }
   }
   return out;

@@ -57,6 +57,10 @@ glm::dmat4 matrixOf(const DualQuaternion& q);
 // by 2°, not 358°.
 double wrapDegrees(double degreesValue);
 
+// Luminance of linear Rec.709 RGB (ITU-R BT.709 Y): the one scalar the renderer's variance
+// channels, light choice and the discard's noise test use.
+inline double luminance(const glm::dvec3& rgb) { return 0.2126 * rgb.r + 0.7152 * rgb.g + 0.0722 * rgb.b; }
+
 // The equirectangular mapping of dataset environments (docs/dataset.md): image point (u, v) in
 // [0, 1]² to a unit direction; u = 0.5 looks down -Z, u grows towards +X; v = 0 is straight up (+Y).
 glm::dvec3 equirectDirection(double u, double v);

@@ -1,5 +1,7 @@
 #include "discard/discard.h"
 
+#include "core/math.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -11,8 +13,6 @@
 
 namespace dynbench::discard {
 namespace {
-
-double luminance(const glm::dvec3& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
 
 glm::dvec3 at3(const std::vector<float>& b, std::size_t i) { return {b[3 * i], b[3 * i + 1], b[3 * i + 2]}; }
 

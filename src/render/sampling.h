@@ -4,11 +4,12 @@
 // whatever the thread schedule (pbrt-v4 keeps the same routines in its own util/sampling.h).
 #include <cmath>
 #include <cstdint>
-#include <numbers>
 #include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
+
+#include "core/math.h"  // luminance
 
 namespace dynbench::render {
 
@@ -47,7 +48,6 @@ class Random {
   std::uint64_t state_ = 0, increment_ = 1;
 };
 
-constexpr double kPi = std::numbers::pi;
 
 // An orthonormal basis around a unit normal (Duff et al. 2017, "Building an orthonormal basis,
 // revisited").
@@ -116,7 +116,5 @@ inline double powerHeuristic(double pdfF, double pdfG) {
   const double f = pdfF * pdfF, g = pdfG * pdfG;
   return f + g > 0.0 ? f / (f + g) : 0.0;
 }
-
-inline double luminance(const glm::dvec3& rgb) { return 0.2126 * rgb.r + 0.7152 * rgb.g + 0.0722 * rgb.b; }
 
 }  // namespace dynbench::render
