@@ -142,7 +142,7 @@ Expected<void> renderWithCycles(const scene::Scene& scene, int cameraNode, const
   std::vector<FrameCameras> cameras;
   scene::ScenePose pose;
   for (long f : frames) {
-    auto c = frameCameras(scene, cameraNode, job, f);
+    auto c = frameCameras(evaluator, cameraNode, job, f);
     if (!c) return std::unexpected(c.error());
     nlohmann::json frame = {{"frame", f},
                             {"time", c->time},

@@ -217,7 +217,8 @@ void PathTracer::setTime(double time, double previousTime) {
   rayTracing_->update(time);
   time_ = time;
   // The scene's size for the light choice: from the first frame's geometry.
-  if (sceneRadius_ == 1.0) {
+  if (!sceneRadius_) {
+    sceneRadius_ = 1.0;
     glm::dvec3 lo(kInfinity), hi(-kInfinity);
     rayTracing_->forEachPrimitive([&](const PrimitiveView& v) {
       for (const auto& p : *v.positions) {
@@ -227,7 +228,7 @@ void PathTracer::setTime(double time, double previousTime) {
     });
     if (lo.x <= hi.x) sceneRadius_ = std::max(1e-3, 0.5 * glm::length(hi - lo));
   }
-  lights_.build(scene_, *rayTracing_, environment_ ? &*environment_ : nullptr, sceneRadius_,
+  lights_.build(scene_, *rayTracing_, environment_ ? &*environment_ : nullptr, *sceneRadius_,
                 [this](int node, int primitive, unsigned triangle, glm::dvec2 b) { return emission(node, primitive, triangle, b); });
 }
 

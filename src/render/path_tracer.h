@@ -86,7 +86,7 @@ class PathTracer {
   std::optional<EnvironmentLight> environment_;
   std::unique_ptr<RayTracingScene> rayTracing_;
   LightSet lights_;
-  double sceneRadius_ = 1.0;
+  std::optional<double> sceneRadius_;  // from the first frame's geometry (1 when there is none)
   std::optional<double> time_;
 };
 

@@ -72,8 +72,8 @@ Expected<std::vector<long>> jobFrames(const scene::Scene& scene, const RenderJob
   return frames;
 }
 
-Expected<FrameCameras> frameCameras(const scene::Scene& scene, int cameraNode, const RenderJob& job, long frame) {
-  const scene::Evaluator evaluator(scene);
+Expected<FrameCameras> frameCameras(const scene::Evaluator& evaluator, int cameraNode, const RenderJob& job, long frame) {
+  const scene::Scene& scene = evaluator.scene();
   const auto& node = scene.nodes[static_cast<std::size_t>(cameraNode)];
   const scene::Camera& lens = scene.cameras[static_cast<std::size_t>(node.camera)];
   if (lens.type == scene::Camera::Type::kPerspective && !(lens.yfov > 0 && lens.yfov < 3.14159))
@@ -138,9 +138,10 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
   auto tracer = PathTracer::create(scene, job.settings, summary.warnings);
   if (!tracer) return std::unexpected(tracer.error());
   const std::size_t rowsTotal = todo.size() * static_cast<std::size_t>(job.settings.height);
+  const scene::Evaluator evaluator(scene);
   for (std::size_t i = 0; i < todo.size(); ++i) {
     const long f = todo[i];
-    auto cameras = frameCameras(scene, *cameraNode, job, f);
+    auto cameras = frameCameras(evaluator, *cameraNode, job, f);
     if (!cameras) return std::unexpected(cameras.error());
     (*tracer)->setTime(cameras->time, cameras->previousTime);
     std::atomic<int> rows{0};

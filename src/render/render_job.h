@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "render/path_tracer.h"
+#include "scene/evaluate.h"
 #include "scene/scene.h"
 
 namespace dynbench::render {
@@ -57,7 +58,7 @@ struct FrameCameras {
   double time = 0.0, previousTime = 0.0;
   RenderCamera camera, previous;
 };
-Expected<FrameCameras> frameCameras(const scene::Scene& scene, int cameraNode, const RenderJob& job, long frame);
+Expected<FrameCameras> frameCameras(const scene::Evaluator& evaluator, int cameraNode, const RenderJob& job, long frame);
 
 // The settings a frame's sidecar records (`render` object), compared when resuming.
 nlohmann::json renderRecord(const RenderJob& job);
