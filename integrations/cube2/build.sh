@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# Fetches the Cube 2: Sauerbraten engine source from Debian (source package `cube2`, the December
-# 2020 release, zlib licence), applies dynbench's capture hooks (capture-hooks.patch and
-# src/dynbench_capture.cpp) and builds the client against Debian's libraries and dynbench's capture
-# SDK:
+# Takes the Cube 2: Sauerbraten engine source that scripts/setup.sh fetched from Debian (source
+# package `cube2`, the December 2020 release, zlib licence), applies dynbench's capture hooks
+# (capture-hooks.patch and src/dynbench_capture.cpp) and builds the client against Debian's
+# libraries and dynbench's capture SDK:
 #   bash integrations/cube2/build.sh [BUILD_DIR=build/cube2] [DYNBENCH_BUILD=build/release]
-# Prints the client's path. Needs: a deb-src entry for bookworm (added here when missing, as root),
-# libsdl2-dev libsdl2-image-dev libsdl2-mixer-dev libenet-dev zlib1g-dev libgl-dev, dynbench built
-# (libdynbench_capture.a), and for running it cube2-data and xvfb.
+# Prints the client's path. Needs scripts/setup.sh run first (the source tarball and libsdl2-dev,
+# libsdl2-image-dev, libsdl2-mixer-dev, libenet-dev, zlib1g-dev, libgl-dev) and dynbench built
+# (libdynbench_capture.a); running it needs cube2-data and xvfb.
 set -euo pipefail
 
 build_dir=${1:-build/cube2}
@@ -18,28 +18,12 @@ orig=cube2_${version}.orig.tar.xz
 mkdir -p "$build_dir"
 build_dir=$(cd "$build_dir" && pwd)
 
-# scripts/setup.sh fetches the tarball into this cache.
+# scripts/setup.sh fetches the tarball (apt-get source, with the deb-src entry it needs) into this
+# cache; fetching lives there only, so this script never touches apt.
 cache=${DYNBENCH_CUBE2_CACHE:-/var/cache/dynbench/cube2}
-if [[ ! -f "$build_dir/$orig" && -f "$cache/$orig" ]]; then cp "$cache/$orig" "$build_dir/$orig"; fi
 if [[ ! -f "$build_dir/$orig" ]]; then
-  if ! grep -rqs "deb-src" /etc/apt/sources.list /etc/apt/sources.list.d/; then
-    [[ $(id -u) -eq 0 ]] || { echo "cube2: need root to add a deb-src entry for bookworm" >&2; exit 1; }
-    cat > /etc/apt/sources.list.d/dynbench-src.sources <<'SOURCES'
-Types: deb-src
-URIs: http://deb.debian.org/debian
-Suites: bookworm
-Components: main
-Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg
-SOURCES
-    apt-get update -qq
-  fi
-  # The mirror has the .orig tarball but not always the Debian packaging tarball, and apt-get then
-  # exits 100 after fetching the one we need: judge by the file, not the exit status.
-  (cd "$build_dir" && apt-get source --download-only "cube2=0.0.20201227+dfsg-2" >/dev/null 2>&1 || true)
-  if [[ ! -f "$build_dir/$orig" ]]; then
-    echo "cube2: apt-get source did not deliver $orig (is there a deb-src entry for bookworm?)" >&2
-    exit 1
-  fi
+  [[ -f "$cache/$orig" ]] || { echo "cube2: $cache/$orig missing: run scripts/setup.sh (it fetches the engine source)" >&2; exit 1; }
+  cp "$cache/$orig" "$build_dir/$orig"
 fi
 
 src="$build_dir/cube2-$version"
