@@ -12,9 +12,9 @@ struct DemoCli {
 
 Expected<void> runDemo(const DemoCli& cli) {
   demo::DemoOptions o = cli.options;
-  char x = 0;
-  if (std::sscanf(cli.resolution.c_str(), "%d%c%d", &o.width, &x, &o.height) != 3 || x != 'x' || o.width <= 0 || o.height <= 0)
-    return fail(ErrorCode::kUsage, "--res '{}': expected WIDTHxHEIGHT", cli.resolution);
+  auto res = parseResolution(cli.resolution);
+  if (!res) return std::unexpected(res.error());
+  std::tie(o.width, o.height) = *res;
   auto report = demo::runDemo(o, [](const std::string& line) {
     fmt::print("{}\n", line);
     std::fflush(stdout);

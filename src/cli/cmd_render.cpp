@@ -23,15 +23,6 @@ struct RenderCli {
   bool noEnvironment = false;
 };
 
-Expected<std::pair<int, int>> parseResolution(const std::string& text) {
-  int w = 0, h = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w <= 0 || h <= 0 || w > 65536 ||
-      h > 65536)
-    return fail(ErrorCode::kUsage, "--res '{}': expected WIDTHxHEIGHT, e.g. 480x270", text);
-  return std::pair{w, h};
-}
-
 Expected<void> runRender(const RenderCli& cli) {
   render::RenderJob job;
   job.dataset = cli.dataset;
@@ -99,6 +90,15 @@ Expected<void> runRender(const RenderCli& cli) {
 }
 
 }  // namespace
+
+Expected<std::pair<int, int>> parseResolution(const std::string& text) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w <= 0 || h <= 0 || w > 65536 ||
+      h > 65536)
+    return fail(ErrorCode::kUsage, "--res '{}': expected WIDTHxHEIGHT, e.g. 480x270", text);
+  return std::pair{w, h};
+}
 
 void addRenderCommand(CLI::App& app, CommandRun& run) {
   auto o = std::make_shared<RenderCli>();

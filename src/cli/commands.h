@@ -1,6 +1,8 @@
 #pragma once
 // Each subcommand registers itself on the CLI11 app and leaves a function to run after parsing.
 #include <functional>
+#include <string>
+#include <utility>
 
 #include <CLI/CLI.hpp>
 
@@ -36,6 +38,9 @@ void addCaptureCommand(CLI::App& app, CommandRun& run);
 
 // Registers `demo`.
 void addDemoCommand(CLI::App& app, CommandRun& run);
+
+// "WIDTHxHEIGHT" of a --res option (render, demo).
+Expected<std::pair<int, int>> parseResolution(const std::string& text);
 
 // Exit status for an error (docs/cli.md lists them).
 int exitCode(const Error& error);
