@@ -34,8 +34,12 @@ if ! cmp -s "$here/capture-hooks.patch" "$src/.dynbench-patch" 2>/dev/null; then
   patch -d "$src" -p1 --quiet < "$here/capture-hooks.patch"
   cp "$here/capture-hooks.patch" "$src/.dynbench-patch"
 fi
-for f in dynbench_capture.h dynbench_capture.cpp; do
-  cmp -s "$here/src/$f" "$src/engine/$f" || cp "$here/src/$f" "$src/engine/$f"
+# The game's Makefile does not know these files: a changed adapter drops the objects that include it.
+for f in dynbench_capture.h dynbench_capture.cpp dynbench_models.h; do
+  if ! cmp -s "$here/src/$f" "$src/engine/$f"; then
+    cp "$here/src/$f" "$src/engine/$f"
+    rm -f "$src"/engine/{main,dynlight,rendermodel,dynbench_capture}.o
+  fi
 done
 for lib in libdynbench_capture.a libdynbench_core.a; do
   [[ -f "$dynbench_build/$lib" ]] || { echo "cube2: $dynbench_build/$lib missing: build dynbench first (cmake --build build/release)" >&2; exit 1; }

@@ -618,10 +618,13 @@ class Converter {
       ++report_.capturables;
       if (t.kind == Kind::kStaticModel) {
         const int mesh = meshOfModel_[static_cast<std::size_t>(t.model)];
+        const auto& model = reader_->models()[static_cast<std::size_t>(t.model)];
         json node = trs(translationOf(t.staticPose), rotationOf(t.staticPose));
-        node["name"] = fmt::format("static_{}_{}", t.id, reader_->models()[static_cast<std::size_t>(t.model)].path);
-        if (mesh >= 0) node["mesh"] = mesh;
+        node["name"] = fmt::format("static_{}_{}", t.id, model.path);
+        if (mesh >= 0 && model.joints.empty()) node["mesh"] = mesh;
         t.node = addNode(node, staticObjects);
+        // A skinned model placed as a static one keeps its bind pose: a skin whose joints never move.
+        if (!model.joints.empty()) addSkin(t, mesh);
         continue;
       }
       if (t.kind == Kind::kLight && !t.light.dynamic) {
@@ -672,29 +675,42 @@ class Converter {
     if (!channels.empty()) doc_["animations"] = {{{"name", "capture"}, {"samplers", samplers}, {"channels", channels}}};
   }
 
-  template <typename Channel, typename Region>
-  void buildSkin(Track& t, int mesh, int input, Channel& channel, Region& region) {
+  // Joint nodes in the bind pose under the capturable's node, the skin, and the skinned mesh node;
+  // returns the joint nodes.
+  std::vector<int> addSkin(const Track& t, int mesh) {
     const auto& model = reader_->models()[static_cast<std::size_t>(t.model)];
     std::vector<int> jointNodes;
+    int roots = 0;
     for (const auto& j : model.joints) {
       json node = trs(translationOf(j.bindPose), rotationOf(j.bindPose));
       node["name"] = fmt::format("{}_{}", j.name.empty() ? "joint" : j.name, t.id);
       jointNodes.push_back(addNode(node, j.parent < 0 ? t.node : jointNodes[static_cast<std::size_t>(j.parent)]));
-      std::uint64_t offset = 0;
-      int view = -1;
-      region(t.span(), 12, offset, view);
-      t.jointTranslationOffsets.push_back(offset);
-      channel(input, accessor(view, 0, kFloat, t.span(), "VEC3"), "LINEAR", jointNodes.back(), "translation");
-      region(t.span(), 16, offset, view);
-      t.jointRotationOffsets.push_back(offset);
-      channel(input, accessor(view, 0, kFloat, t.span(), "VEC4"), "LINEAR", jointNodes.back(), "rotation");
+      roots += j.parent < 0 ? 1 : 0;
     }
-    json skin = {{"joints", jointNodes}, {"skeleton", jointNodes.front()}, {"name", fmt::format("skin_{}", t.id)}};
+    // glTF: the skeleton is the joints' closest common root or an ancestor of it; with several
+    // root joints that is the capturable's node.
+    json skin = {{"joints", jointNodes}, {"skeleton", roots == 1 ? jointNodes.front() : t.node}, {"name", fmt::format("skin_{}", t.id)}};
     if (auto it = ibmOfModel_.find(t.model); it != ibmOfModel_.end()) skin["inverseBindMatrices"] = it->second;
     doc_["skins"].push_back(skin);
     ++report_.skins;
     if (mesh >= 0)
       addNode({{"name", fmt::format("skinned_{}", t.id)}, {"mesh", mesh}, {"skin", doc_["skins"].size() - 1}}, t.node);
+    return jointNodes;
+  }
+
+  template <typename Channel, typename Region>
+  void buildSkin(Track& t, int mesh, int input, Channel& channel, Region& region) {
+    const auto& model = reader_->models()[static_cast<std::size_t>(t.model)];
+    for (const int jointNode : addSkin(t, mesh)) {
+      std::uint64_t offset = 0;
+      int view = -1;
+      region(t.span(), 12, offset, view);
+      t.jointTranslationOffsets.push_back(offset);
+      channel(input, accessor(view, 0, kFloat, t.span(), "VEC3"), "LINEAR", jointNode, "translation");
+      region(t.span(), 16, offset, view);
+      t.jointRotationOffsets.push_back(offset);
+      channel(input, accessor(view, 0, kFloat, t.span(), "VEC4"), "LINEAR", jointNode, "rotation");
+    }
     // Until the first joint record, joints hold the bind pose.
     for (const auto& j : model.joints) {
       t.heldJointTranslation.push_back(translationOf(j.bindPose));

@@ -40,6 +40,13 @@ void alphaFilter(const RTCFilterFunctionNArguments* args) {
   }
 }
 
+// All vertices at one point (or none): the geometry covers no area.
+bool collapsed(const std::vector<glm::dvec3>& positions) {
+  for (const auto& p : positions)
+    if (p != positions.front()) return false;
+  return true;
+}
+
 }  // namespace
 
 struct RayTracingScene::Impl {
@@ -86,6 +93,9 @@ struct RayTracingScene::Impl {
       rtcSetGeometryIntersectFilterFunction(geometry, alphaFilter);
       rtcSetGeometryOccludedFilterFunction(geometry, alphaFilter);
     }
+    // A dynamic geometry hidden at rest (a capturable that appears later, held at scale 0) starts
+    // disabled: degenerate bounds of many such geometries trip Embree's two-level builder.
+    if (dynamicGeometry && !entry.enabled) rtcDisableGeometry(geometry);
     rtcCommitGeometry(geometry);
     const unsigned id = rtcAttachGeometry(target, geometry);
     if (dynamicGeometry) entry.geometry = geometry;  // the scene holds a reference too
@@ -136,7 +146,9 @@ Expected<std::unique_ptr<RayTracingScene>> RayTracingScene::create(const scene::
       if (mesh.primitives[p].triangleCount() == 0) continue;
       if (dynamic[i] || node.skin >= 0 || morphing[i]) {
         // Created once with the rest pose; update() refits it to each frame.
-        impl->addTriangles(impl->dynamicScene, impl->dynamicEntries, impl->evaluate(static_cast<int>(i), static_cast<int>(p), 0.0), true);
+        Entry e = impl->evaluate(static_cast<int>(i), static_cast<int>(p), 0.0);
+        e.enabled = impl->evaluator.visible(static_cast<int>(i), 0.0) && !collapsed(e.positions);
+        impl->addTriangles(impl->dynamicScene, impl->dynamicEntries, std::move(e), true);
       } else if (impl->evaluator.visible(static_cast<int>(i), 0.0)) {
         Entry e = impl->evaluate(static_cast<int>(i), static_cast<int>(p), 0.0);
         impl->stats.staticTriangles += e.indices.size() / 3;
@@ -167,7 +179,14 @@ void RayTracingScene::update(double t) {
   m.evaluator.evaluate(t, m.pose);  // all world matrices and visibility once, then look them up
   for (auto& e : m.dynamicEntries) {
     if (!e.geometry) continue;
-    const bool visible = m.pose.visible[static_cast<std::size_t>(e.node)] != 0;
+    bool visible = m.pose.visible[static_cast<std::size_t>(e.node)] != 0;
+    if (visible) {
+      std::swap(e.previousPositions, e.positions);
+      m.evaluator.worldGeometry(e.node, static_cast<std::size_t>(e.primitive), t, m.pose, e.positions, e.normals);
+      // Shrunk to a point (a skinned mesh whose model node is held at scale 0): nothing to hit.
+      visible = !collapsed(e.positions);
+      if (!visible) std::swap(e.previousPositions, e.positions);
+    }
     if (!visible) {
       if (e.enabled) rtcDisableGeometry(e.geometry);
       e.enabled = false;
@@ -175,8 +194,6 @@ void RayTracingScene::update(double t) {
       continue;
     }
     e.previousValid = e.enabled && m.updated;
-    std::swap(e.previousPositions, e.positions);
-    m.evaluator.worldGeometry(e.node, static_cast<std::size_t>(e.primitive), t, m.pose, e.positions, e.normals);
     Impl::copyVertices(e.geometry, e.positions);
     rtcUpdateGeometryBuffer(e.geometry, RTC_BUFFER_TYPE_VERTEX, 0);
     if (!e.enabled) rtcEnableGeometry(e.geometry);

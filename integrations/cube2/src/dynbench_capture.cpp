@@ -28,6 +28,10 @@
 #include "dynbench/capture.h"
 #include "dynbench_capture.h"
 
+// The engine's clip planes (engine/rendergl.cpp), not in its headers.
+extern float nearplane;
+extern int farplane;
+
 namespace {
 
 struct CaptureState {
@@ -191,6 +195,65 @@ void recordDynamicLight(const vec &o, const vec &color, float radius, int flags,
     failCapture("dynamic light");
 }
 
+
+// One rendered frame with the map loaded: exports the map first, records inside the window.
+void recordFrame(const char *map) {
+  if (state.firstMapMillis < 0) {
+    state.firstMapMillis = lastmillis;
+    if (!state.record) return;
+    // The camera's lens: the engine's horizontal field of view and the window's aspect ratio.
+    const float aspectRatio = float(screenw) / float(max(screenh, 1));
+    const float yfov = 2.0f * atan(tan(curfov * 0.5f * RAD) / aspectRatio) / RAD;
+    if (dbc_set_camera_settings(state.session, aspectRatio, yfov, nearplane, float(farplane)) != DBC_OK) failCapture("camera settings");
+    const float offset[3] = {0, 0, 0};
+    if (dbc_set_map(state.session, map, offset) != DBC_OK) failCapture("map");
+    exportMap(map);
+  }
+  if (lastmillis - state.firstMapMillis < static_cast<long long>(state.warmupSeconds * 1000.0)) {
+    dynbench_models_next_frame(false);
+    return;
+  }
+  if (state.recorded == 0) state.windowStart = SDL_GetTicks();
+  if (!state.record) {
+    ++state.recorded;
+    if (static_cast<double>(state.recorded) >= state.seconds * state.fps) {
+      printf("dynbench-capture: window of %lld frames took %u ms of wall time (not recorded)\n", state.recorded, SDL_GetTicks() - state.windowStart);
+      fflush(stdout);
+      state.done = true;
+      execute("quit");
+    }
+    return;
+  }
+  const double time = static_cast<double>(state.recorded) / state.fps;
+  const bool firstFrame = state.recorded == 0;
+  if (firstFrame && !dynbench_models_capture_static(state.session)) failCapture("map models");
+  if (!dynbench_models_export(state.session)) failCapture("models");
+  if (dbc_frame_begin(state.session, static_cast<uint64_t>(state.recorded), time) != DBC_OK) failCapture("frame");
+  float position[3];
+  toCapture(camera1->o, position);
+  if (dbc_camera(state.session, state.cameraId, position, camera1->pitch, -camera1->yaw, -camera1->roll) != DBC_OK) failCapture("camera");
+  if (firstFrame) recordStaticLights();
+  if (!dynbench_models_write(state.session, firstFrame)) failCapture("model instances");
+  dynbench_visit_dynlights(recordDynamicLight);
+  if (dbc_frame_end(state.session) != DBC_OK) failCapture("frame end");
+  dynbench_models_next_frame(true);
+  ++state.recorded;
+  const long long total = static_cast<long long>(state.seconds * state.fps + 0.5);
+  // One line per second of game time for `dynbench capture cube2`'s progress.
+  if (state.recorded % max(1, int(state.fps)) == 0 || state.recorded >= total) {
+    printf("dynbench-capture: %lld/%lld frames, %d models drawn\n", state.recorded, total, dynbench_models_count());
+    fflush(stdout);
+  }
+  if (state.recorded >= total) {
+    if (dbc_close(state.session) != DBC_OK) failCapture("close");
+    printf("dynbench-capture: window of %lld frames took %u ms of wall time (recorded)\n", state.recorded, SDL_GetTicks() - state.windowStart);
+    fflush(stdout);
+    state.session = nullptr;
+    state.done = true;
+    execute("quit");
+  }
+}
+
 }  // namespace
 
 void dynbench_capture_init() {
@@ -211,6 +274,10 @@ void dynbench_capture_init() {
   // game takes from it depends on that frame's overlay rendering; without it the game places
   // muzzle flashes and grenades from the player's body, as it does for every other player.
   execute("hudgun 0");
+  // Debian's cube2-data ships one player model, snoutx10k (1); bots otherwise pick models at random
+  // from five and are not drawn when theirs is missing.
+  execute("playermodel 1");
+  execute("forceplayermodels 1");
   if (!state.record) return;
   if (dbc_open(dir, "Cube 2: Sauerbraten 2020-12-27 (Debian cube2 0.0.20201227+dfsg)", &state.session) != DBC_OK)
     failCapture("cannot open the capture folder");
@@ -228,57 +295,12 @@ int dynbench_capture_clock_millis() {
   return state.clockBase + static_cast<int>(static_cast<double>(state.clockFrames) * 1000.0 / state.fps + 0.5);
 }
 
+bool dynbench_capture_recording() { return state.enabled && state.record && state.session && !state.done && state.firstMapMillis >= 0; }
+
 void dynbench_capture_frame() {
   if (!state.enabled || state.done) return;
   ++state.clockFrames;
   const char *map = game::getclientmap();
   if (!map || !*map || !camera1) return;
-  if (state.firstMapMillis < 0) {
-    state.firstMapMillis = lastmillis;
-    if (!state.record) return;
-    // The camera's lens: the engine's horizontal field of view and the window's aspect ratio.
-    extern float nearplane;
-    extern int farplane;
-    const float aspectRatio = float(screenw) / float(max(screenh, 1));
-    const float yfov = 2.0f * atan(tan(curfov * 0.5f * RAD) / aspectRatio) / RAD;
-    if (dbc_set_camera_settings(state.session, aspectRatio, yfov, nearplane, float(farplane)) != DBC_OK) failCapture("camera settings");
-    const float offset[3] = {0, 0, 0};
-    if (dbc_set_map(state.session, map, offset) != DBC_OK) failCapture("map");
-    exportMap(map);
-  }
-  if (lastmillis - state.firstMapMillis < static_cast<long long>(state.warmupSeconds * 1000.0)) return;
-  if (state.recorded == 0) state.windowStart = SDL_GetTicks();
-  if (!state.record) {
-    ++state.recorded;
-    if (static_cast<double>(state.recorded) >= state.seconds * state.fps) {
-      printf("dynbench-capture: window of %lld frames took %u ms of wall time (not recorded)\n", state.recorded, SDL_GetTicks() - state.windowStart);
-      fflush(stdout);
-      state.done = true;
-      execute("quit");
-    }
-    return;
-  }
-  const double time = static_cast<double>(state.recorded) / state.fps;
-  if (dbc_frame_begin(state.session, static_cast<uint64_t>(state.recorded), time) != DBC_OK) failCapture("frame");
-  float position[3];
-  toCapture(camera1->o, position);
-  if (dbc_camera(state.session, state.cameraId, position, camera1->pitch, -camera1->yaw, -camera1->roll) != DBC_OK) failCapture("camera");
-  if (state.recorded == 0) recordStaticLights();
-  dynbench_visit_dynlights(recordDynamicLight);
-  if (dbc_frame_end(state.session) != DBC_OK) failCapture("frame end");
-  ++state.recorded;
-  const long long total = static_cast<long long>(state.seconds * state.fps + 0.5);
-  // One line per second of game time for `dynbench capture cube2`'s progress.
-  if (state.recorded % max(1, int(state.fps)) == 0 || state.recorded >= total) {
-    printf("dynbench-capture: %lld/%lld frames\n", state.recorded, total);
-    fflush(stdout);
-  }
-  if (state.recorded >= total) {
-    if (dbc_close(state.session) != DBC_OK) failCapture("close");
-    printf("dynbench-capture: window of %lld frames took %u ms of wall time (recorded)\n", state.recorded, SDL_GetTicks() - state.windowStart);
-    fflush(stdout);
-    state.session = nullptr;
-    state.done = true;
-    execute("quit");
-  }
+  recordFrame(map);
 }

@@ -1,6 +1,7 @@
 // dynbench capture hooks for Cube 2: Sauerbraten (integrations/cube2/README.md). The engine patch
-// calls these four functions (and provides dynbench_visit_dynlights); everything else lives in dynbench_capture.cpp. Capturing is on
-// only when DYNBENCH_CAPTURE_DIR is set, so the patched game plays as before otherwise.
+// calls the first four functions (and provides dynbench_visit_dynlights and the model part hook);
+// the work lives in dynbench_capture.cpp and dynbench_models.h. Capturing is on only when
+// DYNBENCH_CAPTURE_DIR is set, so the patched game plays as before otherwise.
 #ifndef DYNBENCH_CUBE2_CAPTURE_H
 #define DYNBENCH_CUBE2_CAPTURE_H
 
@@ -17,5 +18,25 @@ void dynbench_capture_frame();
 // Implemented in engine/dynlight.cpp by the patch (struct dynlight is private to that file):
 // calls `visit` for every queued dynamic light.
 void dynbench_visit_dynlights(void (*visit)(const vec &o, const vec &color, float radius, int flags, bool fading));
+
+// True while a capture session is open and the map is loaded: the model part hook collects then.
+bool dynbench_capture_recording();
+
+// engine/dynbench_models.h (compiled into engine/rendermodel.cpp, where the model classes are
+// complete). All return false when the capture SDK refuses a call (dbc_last_error says why).
+struct dbc_session;
+// Records every map model entity once as a static model (its mesh, then its pose at the first
+// frame).
+bool dynbench_models_capture_static(dbc_session *session);
+// Outside a frame: records the meshes of models first drawn this frame and gives every part drawn
+// this frame its capturable id.
+bool dynbench_models_export(dbc_session *session);
+// Inside a frame: the static models (first frame only), then this frame's model transforms and
+// joints.
+bool dynbench_models_write(dbc_session *session, bool firstFrame);
+// Starts collecting the next frame; keepIds: this frame was recorded, so its parts lend their ids.
+void dynbench_models_next_frame(bool keepIds);
+// Parts recorded in the last recorded frame.
+int dynbench_models_count();
 
 #endif

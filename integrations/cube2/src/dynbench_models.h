@@ -1,0 +1,359 @@
+// dynbench capture adapter, model half: included at the end of engine/rendermodel.cpp (by
+// capture-hooks.patch), the one translation unit where the engine's model classes (animmodel,
+// skelmodel, vertmodel) are complete. engine/dynbench_capture.cpp drives it once per frame through
+// the functions declared in dynbench_capture.h.
+//
+// What is recorded: every model part the engine renders in a frame (players, their weapons,
+// projectiles, gibs and debris, items), taken at animmodel::part::render where the engine has the
+// part's world transform (its matrix stack) and, for skeletal models, the bone dual quaternions
+// after animation blending (the skeleton's cache entry, skelmodel.h interpbones). Map models
+// (ET_MAPMODEL entities) are recorded once as static models when the recording starts.
+//
+// Space. The engine draws a part with world = M . S(scale) . T(translate) . skin(v): M the rigid
+// matrix stack, then the model's uniform scale and the part's offset, then the bone transforms
+// (bdata) applied to the bind-pose vertex v. The capture format has rigid dual quaternions only, so
+// the scale and offset A = S . T move into the model: vertices are exported as A v, and every
+// bone transform B as A B A^-1, which is rigid again (rotation R, translation s (p + t - R t)).
+// Then world = M . skin'(A v) with skin' built from the conjugated transforms. Everything then goes
+// through the same change of basis as the map, (x, y, z) -> (-x, z, -y) (dynbench_capture.cpp); as
+// that is a reflection, a rotation quaternion (x, y, z, w) becomes (x, -z, y, w) and triangles swap
+// two corners.
+//
+// Identity. The engine keeps no id for a rendered thing, so one is inferred: a part rendered for a
+// game entity (players, their attachments) keeps its id while it is rendered in consecutive frames
+// for the same entity; a part rendered without one (projectiles, gibs, items) takes the id of the
+// nearest instance of the same part in the previous frame, within kMaxStepUnits. The same thing
+// rendered again in one frame (shadow, reflection passes) is recorded once.
+//
+// Limits: vertex-animated models (MD2/MD3 with several frames) are exported in their first frame
+// and move rigidly; the engine blends bones as dual quaternions, glTF skins blend matrices.
+
+#include "dynbench/capture.h"
+#include "dynbench_capture.h"
+
+namespace dynbench_models {
+
+// How far (Cube units) a part without an entity may move between two frames and keep its id: a
+// rocket flies about 3 units per frame at 60 fps, gibs and grenades less.
+static const float kMaxStepUnits = 48.0f;
+
+struct PartInstance {
+  animmodel::part *part;
+  const dynent *owner;  // NULL for parts rendered without a game entity
+  vec origin;           // world position of the part's origin (for matching)
+  quat rotation;        // world rotation (engine space)
+  vec translation;      // world translation (engine space)
+  vector<dualquat> joints;  // model-space joint transforms after animation, conjugated by A
+  uint64_t id;
+};
+
+static vector<PartInstance *> current, previous, staticParts;
+static bool exportingStatic = false;
+
+static void clearList(vector<PartInstance *> &list) { list.deletecontents(); }
+
+static void engineToCapture(const vec &v, float out[3]) {
+  out[0] = -v.x;
+  out[1] = v.z;
+  out[2] = -v.y;
+}
+
+static dbc_dual_quat captureDualQuat(const quat &engineRotation, const vec &engineTranslation) {
+  quat r(engineRotation.x, -engineRotation.z, engineRotation.y, engineRotation.w);
+  r.normalize();
+  float t[3];
+  engineToCapture(engineTranslation, t);
+  // d = 1/2 (t, 0) r (quaternion product).
+  dbc_dual_quat q;
+  q.rx = r.x; q.ry = r.y; q.rz = r.z; q.rw = r.w;
+  q.dx = 0.5f * (r.w * t[0] + t[1] * r.z - t[2] * r.y);
+  q.dy = 0.5f * (r.w * t[1] + t[2] * r.x - t[0] * r.z);
+  q.dz = 0.5f * (r.w * t[2] + t[0] * r.y - t[1] * r.x);
+  q.dw = -0.5f * (t[0] * r.x + t[1] * r.y + t[2] * r.z);
+  return q;
+}
+
+// A B A^-1 for A = S(scale) T(offset) and a rigid B = (R, p): (R, s (p + t - R t)).
+static dualquat conjugateByPartScale(const dualquat &b, float scale, const vec &offset) {
+  vec p = b.gettranslation();
+  vec rotatedOffset = b.real.rotate(offset);
+  vec translation = vec(p).add(offset).sub(rotatedOffset).mul(scale);
+  return dualquat(b.real, translation);
+}
+
+static dbc_dual_quat captureBone(const dualquat &b) { return captureDualQuat(b.real, b.gettranslation()); }
+
+static bool isSkeletal(const animmodel::part *p) {
+  const int type = p->model->type();
+  return type == MDL_MD5 || type == MDL_SMD || type == MDL_IQM;
+}
+
+static void capturePath(const animmodel::part *p, char *out, size_t size) {
+  animmodel *m = p->model;
+  if (m->parts.length() > 1)
+    nformatstring(out, size, "%s#%d", m->name, m->parts.find(const_cast<animmodel::part *>(p)));
+  else
+    nformatstring(out, size, "%s", m->name);
+}
+
+// A texture's file relative to the data root, without the engine's load options (<dds>, <ffmask:..>).
+static const char *textureFile(const Texture *t) {
+  if (!t || t == notexture || !t->name) return NULL;
+  const char *file = t->name;
+  while (*file == '<') {
+    const char *end = strchr(file, '>');
+    if (!end) break;
+    file = end + 1;
+  }
+  return *file ? file : NULL;
+}
+
+struct MeshArrays {
+  vector<float> positions, normals, uvs, weights;
+  vector<uint16_t> joints;
+  vector<uint32_t> indices;
+};
+
+static bool exportMesh(dbc_session *session, int meshId, const char *name, const animmodel::skin *skin, MeshArrays &a) {
+  dbc_mesh m = {};
+  m.mesh_id = meshId;
+  m.name = name;
+  m.texture = skin ? textureFile(skin->tex) : NULL;
+  m.mask_texture = skin ? textureFile(skin->masks) : NULL;
+  m.vertex_count = size_t(a.positions.length() / 3);
+  m.positions = a.positions.getbuf();
+  m.normals = a.normals.getbuf();
+  m.uvs = a.uvs.getbuf();
+  m.joints = a.joints.empty() ? NULL : a.joints.getbuf();
+  m.weights = a.weights.empty() ? NULL : a.weights.getbuf();
+  m.triangle_count = size_t(a.indices.length() / 3);
+  m.indices = a.indices.getbuf();
+  return dbc_model_mesh(session, &m) == DBC_OK;
+}
+
+static void addVertex(MeshArrays &a, const vec &pos, const vec &norm, const vec2 &tc, float scale, const vec &offset) {
+  float p[3], n[3];
+  engineToCapture(vec(pos).add(offset).mul(scale), p);
+  engineToCapture(norm, n);
+  loopk(3) { a.positions.add(p[k]); a.normals.add(n[k]); }
+  a.uvs.add(tc.x);
+  a.uvs.add(tc.y);
+}
+
+static void addTriangle(MeshArrays &a, const ushort vert[3]) {
+  // The change of basis is a reflection: swap two corners to keep the faces' orientation.
+  a.indices.add(vert[0]);
+  a.indices.add(vert[2]);
+  a.indices.add(vert[1]);
+}
+
+static bool exportSkeletal(dbc_session *session, animmodel::part *p) {
+  skelmodel::skelmeshgroup *group = (skelmodel::skelmeshgroup *)p->meshes;
+  skelmodel::skeleton *skel = group->skel;
+  const float scale = p->model->scale;
+  const vec &offset = p->translate;
+  int meshId = 0;
+  loopv(group->meshes) {
+    skelmodel::skelmesh &mesh = *(skelmodel::skelmesh *)group->meshes[i];
+    if (mesh.numtris <= 0 || mesh.numverts <= 0) continue;
+    MeshArrays a;
+    loopj(mesh.numverts) {
+      const skelmodel::vert &v = mesh.verts[j];
+      addVertex(a, v.pos, v.norm, v.tc, scale, offset);
+      const skelmodel::blendcombo &c = group->blendcombos[v.blend];
+      float sum = 0;
+      loopk(4) sum += c.weights[k];
+      loopk(4) {
+        a.joints.add(c.weights[k] > 0 ? c.bones[k] : 0);
+        a.weights.add(sum > 0 ? c.weights[k] : (k == 0 ? 1.0f : 0.0f));
+      }
+    }
+    loopj(mesh.numtris) addTriangle(a, mesh.tris[j].vert);
+    if (!exportMesh(session, meshId++, mesh.name, p->skins.inrange(i) ? &p->skins[i] : NULL, a)) return false;
+  }
+  loopi(skel->numbones) {
+    const skelmodel::boneinfo &b = skel->bones[i];
+    if (b.parent >= i) {
+      fprintf(stderr, "dynbench capture: %s: bone %d has parent %d after it\n", p->model->name, i, b.parent);
+      return false;
+    }
+    dualquat local = b.base;
+    if (b.parent >= 0) local.mul(skel->bones[b.parent].invbase, b.base);
+    const dbc_dual_quat bind = captureBone(conjugateByPartScale(local, scale, offset));
+    const dbc_dual_quat inverseBind = captureBone(conjugateByPartScale(b.invbase, scale, offset));
+    defformatstring(name, "%s", b.name ? b.name : "");
+    if (!name[0]) formatstring(name, "bone%d", i);
+    if (dbc_model_joint(session, i, name, b.parent, bind, inverseBind) != DBC_OK) return false;
+  }
+  return true;
+}
+
+static bool exportVertexModel(dbc_session *session, animmodel::part *p) {
+  vertmodel::vertmeshgroup *group = (vertmodel::vertmeshgroup *)p->meshes;
+  const float scale = p->model->scale;
+  const vec &offset = p->translate;
+  int meshId = 0;
+  loopv(group->meshes) {
+    vertmodel::vertmesh &mesh = *(vertmodel::vertmesh *)group->meshes[i];
+    if (mesh.numtris <= 0 || mesh.numverts <= 0) continue;
+    MeshArrays a;
+    // The first animation frame (vertex-animated models move rigidly in the capture).
+    loopj(mesh.numverts) addVertex(a, mesh.verts[j].pos, mesh.verts[j].norm, mesh.tcverts[j].tc, scale, offset);
+    loopj(mesh.numtris) addTriangle(a, mesh.tris[j].vert);
+    if (!exportMesh(session, meshId++, mesh.name, p->skins.inrange(i) ? &p->skins[i] : NULL, a)) return false;
+  }
+  return true;
+}
+
+static bool exportModel(dbc_session *session, animmodel::part *p) {
+  string path;
+  capturePath(p, path, sizeof(path));
+  if (dbc_has_model(session, path)) return true;
+  if (dbc_model_begin(session, path) != DBC_OK) return false;
+  if (!(isSkeletal(p) ? exportSkeletal(session, p) : exportVertexModel(session, p))) return false;
+  return dbc_model_end(session) == DBC_OK;
+}
+
+static bool isMapModel(const model *m) {
+  loopv(mapmodels) if (mapmodels[i].m == m) return true;
+  return false;
+}
+
+// Model-space joint transforms of a skeletal part as it was just drawn: J = bdata . base per bone
+// (bdata is the skinning transform, base the bind pose), found again in the skeleton's cache.
+static void skeletalJoints(animmodel::part *p, const animmodel::animstate *as, float pitch, const vec &axis, const vec &forward,
+                           dynent *d, vector<dualquat> &joints) {
+  skelmodel::skelmeshgroup *group = (skelmodel::skelmeshgroup *)p->meshes;
+  skelmodel::skeleton *skel = group->skel;
+  const dualquat *bdata = NULL;
+  if (skel->numframes) {
+    // The same arguments as skelmeshgroup::render: a cache hit, the entry it drew with.
+    ragdolldata *rdata = as->cur.anim & ANIM_RAGDOLL || !d || !d->ragdoll || d->ragdoll->skel != skel->ragdoll ? NULL : d->ragdoll;
+    bdata = skel->checkskelcache(p, as, pitch, axis, forward, rdata).bdata;
+  }
+  const float scale = p->model->scale;
+  const vec &offset = p->translate;
+  vector<dualquat> modelSpace;
+  loopi(skel->numbones) {
+    const skelmodel::boneinfo &b = skel->bones[i];
+    dualquat j;
+    if (bdata && b.interpindex >= 0) j.mul(bdata[b.interpindex], b.base);
+    else if (b.parent >= 0) {
+      // A bone no vertex follows: it keeps its bind pose relative to its parent.
+      dualquat local;
+      local.mul(skel->bones[b.parent].invbase, b.base);
+      j.mul(modelSpace[b.parent], local);
+    } else j = b.base;
+    modelSpace.add(j);
+    joints.add(conjugateByPartScale(j, scale, offset));
+  }
+}
+
+}  // namespace dynbench_models
+
+void animmodel::dynbench_capture_part(part *p, const animstate *as, float pitch, const vec &axis, const vec &forward, dynent *d, int anim) {
+  using namespace dynbench_models;
+  if (!dynbench_capture_recording() || !p->meshes) return;
+  if (!exportingStatic) {
+    if (anim & ANIM_NORENDER) return;  // not drawn (e.g. computed only for its tags)
+    if (!d && isMapModel(p->model)) return;  // recorded once, as a static model
+  }
+  const matrix4 &world = matrixstack[matrixpos];
+  const vec origin = world.gettranslation();
+  vector<PartInstance *> &list = exportingStatic ? staticParts : current;
+  // Drawn again this frame (shadow map, reflection, refraction): recorded once.
+  loopv(list) {
+    const PartInstance &other = *list[i];
+    if (other.part == p && other.owner == d && (d || other.origin.dist(origin) < 1e-3f)) return;
+  }
+  PartInstance *instance = new PartInstance;
+  instance->part = p;
+  instance->owner = d;
+  instance->origin = origin;
+  instance->rotation = quat(world);
+  instance->rotation.normalize();
+  instance->translation = origin;
+  instance->id = 0;
+  if (isSkeletal(p)) skeletalJoints(p, as, pitch, axis, forward, d, instance->joints);
+  list.add(instance);
+}
+
+bool dynbench_models_capture_static(dbc_session *session) {
+  using namespace dynbench_models;
+  // Every map model entity as renderva.cpp's rendermapmodel draws it, without drawing: the part
+  // hook sees its transforms.
+  exportingStatic = true;
+  const vector<extentity *> &ents = entities::getents();
+  loopv(ents) {
+    extentity &e = *ents[i];
+    if (e.type != ET_MAPMODEL) continue;
+    model *m = loadmapmodel(e.attr2);
+    if (!m) continue;
+    int anim = ANIM_MAPMODEL | ANIM_LOOP, basetime = 0;
+    if (e.flags & EF_ANIM) entities::animatemapmodel(e, anim, basetime);
+    m->render(anim | ANIM_NORENDER, basetime, 0, e.o, e.attr1, 0, NULL, NULL, vec(1, 1, 1), vec(0, 0, 1), 1);
+  }
+  exportingStatic = false;
+  loopv(staticParts) if (!exportModel(session, staticParts[i]->part)) return false;
+  return true;
+}
+
+bool dynbench_models_export(dbc_session *session) {
+  using namespace dynbench_models;
+  loopv(current) if (!exportModel(session, current[i]->part)) return false;
+  // Ids: the same entity's part in the previous frame, else the nearest unclaimed instance of the
+  // same part without an entity.
+  vector<bool> claimed;
+  loopv(previous) claimed.add(false);
+  loopv(current) {
+    PartInstance &c = *current[i];
+    int best = -1;
+    float bestDistance = kMaxStepUnits;
+    loopvj(previous) {
+      const PartInstance &p = *previous[j];
+      if (claimed[j] || p.part != c.part || p.owner != c.owner) continue;
+      if (c.owner) { best = j; break; }
+      const float distance = p.origin.dist(c.origin);
+      if (distance < bestDistance) { bestDistance = distance; best = j; }
+    }
+    if (best >= 0) {
+      claimed[best] = true;
+      c.id = previous[best]->id;
+    } else c.id = dbc_new_id(session);
+  }
+  return true;
+}
+
+static bool writeInstance(dbc_session *session, const dynbench_models::PartInstance &instance, bool isStatic) {
+  using namespace dynbench_models;
+  string path;
+  capturePath(instance.part, path, sizeof(path));
+  const dbc_dual_quat pose = captureDualQuat(instance.rotation, instance.translation);
+  if (isStatic) return dbc_static_model(session, instance.id, path, pose) == DBC_OK;
+  if (dbc_model(session, instance.id, path, pose) != DBC_OK) return false;
+  if (instance.joints.empty()) return true;
+  vector<dbc_dual_quat> joints;
+  loopv(instance.joints) joints.add(captureBone(instance.joints[i]));
+  return dbc_joints(session, instance.id, path, size_t(joints.length()), joints.getbuf()) == DBC_OK;
+}
+
+bool dynbench_models_write(dbc_session *session, bool firstFrame) {
+  using namespace dynbench_models;
+  if (firstFrame) loopv(staticParts) {
+    staticParts[i]->id = dbc_new_id(session);
+    if (!writeInstance(session, *staticParts[i], true)) return false;
+  }
+  loopv(current) if (!writeInstance(session, *current[i], false)) return false;
+  return true;
+}
+
+void dynbench_models_next_frame(bool keepIds) {
+  using namespace dynbench_models;
+  clearList(previous);
+  if (keepIds) {
+    loopv(current) previous.add(current[i]);
+    current.setsize(0);
+  } else clearList(current);
+}
+
+int dynbench_models_count() { return dynbench_models::previous.length(); }
