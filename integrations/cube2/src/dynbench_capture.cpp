@@ -295,6 +295,17 @@ int dynbench_capture_clock_millis() {
   return state.clockBase + static_cast<int>(static_cast<double>(state.clockFrames) * 1000.0 / state.fps + 0.5);
 }
 
+unsigned dynbench_capture_entity_seed(const void *entity) {
+  if (!entity) return 0;
+  static vector<const void *> seen;  // a few dozen players and ragdolls: a linear search is enough
+  int index = seen.find(entity);
+  if (index < 0) {
+    index = seen.length();
+    seen.add(entity);
+  }
+  return (uint(index) + 1u) * 2654435761u;  // Knuth's multiplicative hash spreads the low bits
+}
+
 bool dynbench_capture_recording() { return state.enabled && state.record && state.session && !state.done && state.firstMapMillis >= 0; }
 
 void dynbench_capture_frame() {

@@ -19,6 +19,10 @@ void dynbench_capture_frame();
 // calls `visit` for every queued dynamic light.
 void dynbench_visit_dynlights(void (*visit)(const vec &o, const vec &color, float radius, int flags, bool fading));
 
+// A stand-in for an entity's address where the engine seeds animation variety and phase from it
+// (animmodel.h calcanim): entities numbered in order of first appearance, scrambled.
+unsigned dynbench_capture_entity_seed(const void *entity);
+
 // True while a capture session is open and the map is loaded: the model part hook collects then.
 bool dynbench_capture_recording();
 

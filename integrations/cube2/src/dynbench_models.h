@@ -249,6 +249,20 @@ static void skeletalJoints(animmodel::part *p, const animmodel::animstate *as, f
   }
 }
 
+// A canonical order for the parts drawn in a frame: the engine batches models in an order that
+// follows their addresses, which differ from run to run; ids and records follow this order instead.
+static bool drawnBefore(const PartInstance *a, const PartInstance *b) {
+  if (int c = strcmp(a->part->model->name, b->part->model->name)) return c < 0;
+  const int pa = a->part->model->parts.find(a->part), pb = b->part->model->parts.find(b->part);
+  if (pa != pb) return pa < pb;
+  const unsigned sa = dynbench_capture_entity_seed(a->owner), sb = dynbench_capture_entity_seed(b->owner);
+  if (sa != sb) return sa < sb;
+  const float ka[7] = {a->origin.x, a->origin.y, a->origin.z, a->rotation.x, a->rotation.y, a->rotation.z, a->rotation.w};
+  const float kb[7] = {b->origin.x, b->origin.y, b->origin.z, b->rotation.x, b->rotation.y, b->rotation.z, b->rotation.w};
+  loopi(7) if (ka[i] != kb[i]) return ka[i] < kb[i];
+  return false;
+}
+
 }  // namespace dynbench_models
 
 void animmodel::dynbench_capture_part(part *p, const animstate *as, float pitch, const vec &axis, const vec &forward, dynent *d, int anim) {
@@ -294,12 +308,14 @@ bool dynbench_models_capture_static(dbc_session *session) {
     m->render(anim | ANIM_NORENDER, basetime, 0, e.o, e.attr1, 0, NULL, NULL, vec(1, 1, 1), vec(0, 0, 1), 1);
   }
   exportingStatic = false;
+  staticParts.sort(drawnBefore);
   loopv(staticParts) if (!exportModel(session, staticParts[i]->part)) return false;
   return true;
 }
 
 bool dynbench_models_export(dbc_session *session) {
   using namespace dynbench_models;
+  current.sort(drawnBefore);
   loopv(current) if (!exportModel(session, current[i]->part)) return false;
   // Ids: the same entity's part in the previous frame, else the nearest unclaimed instance of the
   // same part without an entity.
