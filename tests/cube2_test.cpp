@@ -1,13 +1,23 @@
 // `dynbench capture cube2` end to end on Debian's Cube 2 data: a seeded 5-second bot match on
 // colos, twice, must give the same Capture.txt byte for byte; it converts to a dataset the Khronos
-// validator accepts, whose stats show the followed bot's camera, the map and the game's lights.
+// validator accepts, whose stats show the followed bot's camera, the map, the players' skinned
+// models, projectiles and debris and the game's lights; the dataset's skinned players match the
+// engine's own skinning of the same frame vertex by vertex.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <set>
+
 #include "capture/cube2.h"
 #include "core/files.h"
+#include "scene/evaluate.h"
+#include "scene/load.h"
 #include "gltf_builder.h"
 #include "run_cli.h"
 
@@ -27,6 +37,8 @@ std::string skipReason() {
 TEST(Cube2, SeededMatchIsDeterministicAndConverts) {
   if (const auto why = skipReason(); !why.empty()) GTEST_SKIP() << why << ": Cube 2 capture skipped";
   const auto dir = test::freshDir("cube2");
+  // The adapter also writes the engine's own skinned vertices of frame 120 (2 s).
+  ::setenv("DYNBENCH_CAPTURE_VERIFY_FRAME", "120", 1);
   for (const char* run : {"a", "b"}) {
     const auto r = dynbench(fmt::format("capture cube2 -o {} --map colos --bots 4 --seconds 5 --seed 3", (dir / run).string()), dir);
     ASSERT_EQ(r.status, 0) << r.err;
@@ -36,6 +48,7 @@ TEST(Cube2, SeededMatchIsDeterministicAndConverts) {
   ASSERT_TRUE(a && b);
   EXPECT_GT(a->size(), 10000u);
   EXPECT_TRUE(*a == *b) << "the same seed gave different captures";
+  ::unsetenv("DYNBENCH_CAPTURE_VERIFY_FRAME");
 
   auto r = dynbench(fmt::format("convert {} -o {}", (dir / "a").string(), (dir / "ds" / "colos.gltf").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
@@ -60,6 +73,43 @@ TEST(Cube2, SeededMatchIsDeterministicAndConverts) {
   EXPECT_GT(j["properties"]["faces"].get<int>(), 5000);              // colos has ~7,800 triangles
   EXPECT_GT(j["properties"]["dynamic_point_lights"].get<int>(), 0);  // muzzle flashes, explosions
   EXPECT_GT(j["properties"]["static_point_lights"].get<int>(), 0);   // the map's lights
+  EXPECT_GE(j["properties"]["armatures"].get<int>(), 4);              // players (snoutx10k), grenades, flags
+  EXPECT_GT(j["properties"]["dynamic_rigid_objects"].get<int>(), 0);  // weapons in hand, debris
+  std::printf("armatures %d, dynamic rigid objects %d, dynamic point lights %d\n", j["properties"]["armatures"].get<int>(),
+              j["properties"]["dynamic_rigid_objects"].get<int>(), j["properties"]["dynamic_point_lights"].get<int>());
+
+  // Skinning: the engine blends dual quaternions in its vertex shader; the dataset stores joint
+  // transforms and glTF blends matrices. Vertices bound to one bone must agree to float precision,
+  // blended ones within the difference of the two blends (a few centimetres at most).
+  std::ifstream reference(dir / "a" / "skinning_frame_120.txt");
+  ASSERT_TRUE(reference) << "the adapter wrote no skinning reference";
+  std::map<std::pair<std::string, int>, std::vector<glm::dvec3>> engineVertices;
+  std::string id;
+  int mesh = 0, vertex = 0;
+  glm::dvec3 p;
+  while (reference >> id >> mesh >> vertex >> p.x >> p.y >> p.z) engineVertices[{id, mesh}].push_back(p);
+  auto dataset = scene::loadScene(dir / "ds" / "colos.gltf");
+  ASSERT_TRUE(dataset) << dataset.error().message;
+  const scene::Evaluator evaluator(*dataset);
+  std::vector<double> errors;
+  std::set<std::string> parts;
+  for (const auto& [key, points] : engineVertices) {
+    const auto node = std::find_if(dataset->nodes.begin(), dataset->nodes.end(), [&](const auto& n) { return n.name == "skinned_" + key.first; });
+    ASSERT_NE(node, dataset->nodes.end()) << "no skinned node for capturable " << key.first;
+    std::vector<glm::dvec3> positions, normals;
+    evaluator.worldGeometry(static_cast<int>(node - dataset->nodes.begin()), static_cast<std::size_t>(key.second), 2.0, positions, normals);
+    ASSERT_EQ(positions.size(), points.size());
+    for (std::size_t v = 0; v < points.size(); ++v) errors.push_back(glm::distance(positions[v], points[v]));
+    parts.insert(key.first);
+  }
+  ASSERT_GE(parts.size(), 3u) << "fewer than 3 skinned models drawn at frame 120";
+  std::sort(errors.begin(), errors.end());
+  const double median = errors[errors.size() / 2], p99 = errors[errors.size() * 99 / 100], worst = errors.back();
+  std::printf("skinning vs the engine: %zu vertices of %zu models, median %.2g, 99th percentile %.3f, max %.3f units (8 per metre)\n",
+              errors.size(), parts.size(), median, p99, worst);
+  EXPECT_LT(median, 1e-3);
+  EXPECT_LT(p99, 0.15);
+  EXPECT_LT(worst, 0.5);
   // A bot's first-person view turns far faster than a slow fly-through: over 15 degrees per second
   // on average (0.25 per frame at 60 fps), three times a slow 5 degrees-per-second pan.
   EXPECT_GT(j["camera_motion"]["rotation_degrees"]["mean"].get<double>() * 60.0, 15.0);

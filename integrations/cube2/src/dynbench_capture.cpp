@@ -8,6 +8,8 @@
 //   DYNBENCH_CAPTURE_SEED     seed of the game's random numbers (default 1)
 //   DYNBENCH_CAPTURE_WARMUP   seconds of game time after the map loads before recording (default 2)
 //   DYNBENCH_CAPTURE_SECONDS  seconds of game time recorded (default 30)
+//   DYNBENCH_CAPTURE_VERIFY_FRAME  N: also write DIR/skinning_frame_N.txt, the engine's own skinned
+//                             vertices of frame N (tests/cube2_test.cpp checks the dataset with it)
 //   DYNBENCH_CAPTURE_RECORD   0: run the same fixed-clock, seeded match without writing anything
 //                             (bench/bench_capture.sh measures the capture's cost against it)
 //
@@ -47,6 +49,8 @@ struct CaptureState {
   uint64_t cameraId = 0;
   bool done = false;
   bool record = true;
+  long long verifyFrame = -1;
+  string directory = "";
   Uint32 windowStart = 0;  // wall clock when the capture window opened (SDL milliseconds)
 };
 
@@ -234,6 +238,10 @@ void recordFrame(const char *map) {
   if (dbc_camera(state.session, state.cameraId, position, camera1->pitch, -camera1->yaw, -camera1->roll) != DBC_OK) failCapture("camera");
   if (firstFrame) recordStaticLights();
   if (!dynbench_models_write(state.session, firstFrame)) failCapture("model instances");
+  if (state.recorded == state.verifyFrame) {
+    defformatstring(path, "%s/skinning_frame_%lld.txt", state.directory, state.recorded);
+    if (!dynbench_models_write_verification(path)) failCapture("skinning verification file");
+  }
   dynbench_visit_dynlights(recordDynamicLight);
   if (dbc_frame_end(state.session) != DBC_OK) failCapture("frame end");
   dynbench_models_next_frame(true);
@@ -266,6 +274,8 @@ void dynbench_capture_init() {
   state.warmupSeconds = envNumber("DYNBENCH_CAPTURE_WARMUP", 2.0);
   state.seconds = envNumber("DYNBENCH_CAPTURE_SECONDS", 30.0);
   state.record = envNumber("DYNBENCH_CAPTURE_RECORD", 1.0) != 0.0;
+  state.verifyFrame = static_cast<long long>(envNumber("DYNBENCH_CAPTURE_VERIFY_FRAME", -1.0));
+  copystring(state.directory, dir);
   seedMT(state.seed);
   // Occlusion queries answer when the GPU gets to them, not at a fixed frame: what is drawn, and
   // so where a muzzle flash starts (a model tag), would vary from run to run. Off while capturing.

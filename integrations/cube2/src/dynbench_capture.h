@@ -38,6 +38,8 @@ bool dynbench_models_export(dbc_session *session);
 // Inside a frame: the static models (first frame only), then this frame's model transforms and
 // joints.
 bool dynbench_models_write(dbc_session *session, bool firstFrame);
+// Writes the engine's own skinning of this frame's skeletal parts to `path` (a test's reference).
+bool dynbench_models_write_verification(const char *path);
 // Starts collecting the next frame; keepIds: this frame was recorded, so its parts lend their ids.
 void dynbench_models_next_frame(bool keepIds);
 // Parts recorded in the last recorded frame.

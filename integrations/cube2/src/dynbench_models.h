@@ -44,6 +44,8 @@ struct PartInstance {
   quat rotation;        // world rotation (engine space)
   vec translation;      // world translation (engine space)
   vector<dualquat> joints;  // model-space joint transforms after animation, conjugated by A
+  vector<dualquat> bones;   // the engine's skinning transforms (bdata) as drawn, for verifyFrame
+  matrix4 world;
   uint64_t id;
 };
 
@@ -222,7 +224,7 @@ static bool isMapModel(const model *m) {
 // Model-space joint transforms of a skeletal part as it was just drawn: J = bdata . base per bone
 // (bdata is the skinning transform, base the bind pose), found again in the skeleton's cache.
 static void skeletalJoints(animmodel::part *p, const animmodel::animstate *as, float pitch, const vec &axis, const vec &forward,
-                           dynent *d, vector<dualquat> &joints) {
+                           dynent *d, vector<dualquat> &joints, vector<dualquat> &bones) {
   skelmodel::skelmeshgroup *group = (skelmodel::skelmeshgroup *)p->meshes;
   skelmodel::skeleton *skel = group->skel;
   const dualquat *bdata = NULL;
@@ -233,6 +235,7 @@ static void skeletalJoints(animmodel::part *p, const animmodel::animstate *as, f
   }
   const float scale = p->model->scale;
   const vec &offset = p->translate;
+  if (bdata) loopi(skel->numinterpbones) bones.add(bdata[i]);
   vector<dualquat> modelSpace;
   loopi(skel->numbones) {
     const skelmodel::boneinfo &b = skel->bones[i];
@@ -288,7 +291,8 @@ void animmodel::dynbench_capture_part(part *p, const animstate *as, float pitch,
   instance->rotation.normalize();
   instance->translation = origin;
   instance->id = 0;
-  if (isSkeletal(p)) skeletalJoints(p, as, pitch, axis, forward, d, instance->joints);
+  instance->world = world;
+  if (isSkeletal(p)) skeletalJoints(p, as, pitch, axis, forward, d, instance->joints, instance->bones);
   list.add(instance);
 }
 
@@ -351,6 +355,43 @@ static bool writeInstance(dbc_session *session, const dynbench_models::PartInsta
   vector<dbc_dual_quat> joints;
   loopv(instance.joints) joints.add(captureBone(instance.joints[i]));
   return dbc_joints(session, instance.id, path, size_t(joints.length()), joints.getbuf()) == DBC_OK;
+}
+
+// The engine's own skinning of every skeletal part drawn this frame, as its vertex shader does it
+// (dual quaternions blended per vertex, then scale, offset and the matrix stack), in capture space:
+// lines `id mesh vertex x y z`. The Cube 2 test compares the converted dataset's skins with it.
+bool dynbench_models_write_verification(const char *path) {
+  using namespace dynbench_models;
+  // stdio, not the engine's streams: those put written files under the game's home folder.
+  FILE *out = fopen(path, "w");
+  if (!out) return false;
+  loopv(current) {
+    const PartInstance &instance = *current[i];
+    if (!isSkeletal(instance.part) || instance.bones.empty()) continue;
+    skelmodel::skelmeshgroup *group = (skelmodel::skelmeshgroup *)instance.part->meshes;
+    const float scale = instance.part->model->scale;
+    int meshId = 0;
+    loopvj(group->meshes) {
+      skelmodel::skelmesh &mesh = *(skelmodel::skelmesh *)group->meshes[j];
+      if (mesh.numtris <= 0 || mesh.numverts <= 0) continue;
+      loopk(mesh.numverts) {
+        const skelmodel::vert &v = mesh.verts[k];
+        const skelmodel::blendcombo &c = group->blendcombos[v.blend];
+        dualquat blended = instance.bones[c.interpbones[0]];
+        blended.mul(c.weights[0]);
+        for (int w = 1; w < 4 && c.weights[w]; ++w) blended.accumulate(instance.bones[c.interpbones[w]], c.weights[w]);
+        blended.normalize();
+        const vec skinned = blended.transform(v.pos);
+        vec world;
+        instance.world.transform(vec(skinned).add(instance.part->translate).mul(scale), world);
+        float p[3];
+        engineToCapture(world, p);
+        fprintf(out, "%llu %d %d %.6f %.6f %.6f\n", (unsigned long long)instance.id, meshId, k, p[0], p[1], p[2]);
+      }
+      ++meshId;
+    }
+  }
+  return fclose(out) == 0;
 }
 
 bool dynbench_models_write(dbc_session *session, bool firstFrame) {
