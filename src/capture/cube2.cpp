@@ -74,8 +74,9 @@ Expected<Cube2Report> captureCube2(const Cube2Options& o, const Cube2Progress& p
   const int timeout = 60 + static_cast<int>((o.seconds + o.warmup) * o.fps / 2.0);
   const std::string env = fmt::format(
       "DYNBENCH_CAPTURE_DIR={} DYNBENCH_CAPTURE_DATA_ROOT={} DYNBENCH_CAPTURE_FPS={} DYNBENCH_CAPTURE_SEED={} "
-      "DYNBENCH_CAPTURE_WARMUP={} DYNBENCH_CAPTURE_SECONDS={}",
-      shellQuote(fs::absolute(o.output).string()), shellQuote(fs::absolute(o.data).string()), o.fps, o.seed, o.warmup, o.seconds);
+      "DYNBENCH_CAPTURE_WARMUP={} DYNBENCH_CAPTURE_SECONDS={} DYNBENCH_CAPTURE_FOLLOW_AUTO={}",
+      shellQuote(fs::absolute(o.output).string()), shellQuote(fs::absolute(o.data).string()), o.fps, o.seed, o.warmup, o.seconds,
+      o.follow == "auto" ? 1 : 0);
   const std::string game = fmt::format("{} -q{} -k{} -r -t0 -w{} -h{} {}", shellQuote("./" + client->filename().string()),
                                        shellQuote(fs::absolute(home).string()), shellQuote(fs::absolute(o.data).string()), o.width, o.height,
                                        shellQuote("-x" + *script));

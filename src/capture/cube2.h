@@ -19,7 +19,7 @@ struct Cube2Options {
   double seconds = 30.0;         // recorded game time
   double fps = 60.0;             // fixed clock
   unsigned seed = 1;
-  std::string follow = "auto";   // auto: the first bot; or a client number (bots are 128, 129, ...)
+  std::string follow = "auto";   // auto: the first bot, then the next whenever the followed one dies; or a client number (bots are 128, 129, ...)
   double warmup = 2.0;           // game seconds between the map loading and recording
   int width = 640, height = 360;
   bool window = false;           // on the user's display instead of Xvfb

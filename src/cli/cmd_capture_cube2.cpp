@@ -45,7 +45,7 @@ void addCaptureCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--seconds", o->seconds, "Game seconds recorded (default: 30)");
   cmd->add_option("--fps", o->fps, "Fixed clock, frames per game second (default: 60)");
   cmd->add_option("--seed", o->seed, "Seed of every random choice (default: 1)");
-  cmd->add_option("--follow", o->follow, "auto (the first bot) or a bot's client number (128, 129, ...)");
+  cmd->add_option("--follow", o->follow, "auto (a bot, then the next whenever the followed one dies, as a spectator would) or a bot's client number (128, 129, ...)");
   cmd->add_option("--warmup", o->warmup, "Game seconds after the map loads before recording (default: 2, at least 1.5)");
   cmd->add_option("--width", o->width, "Window width (default: 640)");
   cmd->add_option("--height", o->height, "Window height (default: 360)");

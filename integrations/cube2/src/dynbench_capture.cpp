@@ -10,6 +10,7 @@
 //   DYNBENCH_CAPTURE_SECONDS  seconds of game time recorded (default 30)
 //   DYNBENCH_CAPTURE_VERIFY_FRAME  N: also write DIR/skinning_frame_N.txt, the engine's own skinned
 //                             vertices of frame N (tests/cube2_test.cpp checks the dataset with it)
+//   DYNBENCH_CAPTURE_FOLLOW_AUTO  1: when the followed bot dies, follow the next one (nextfollow)
 //   DYNBENCH_CAPTURE_RECORD   0: run the same fixed-clock, seeded match without writing anything
 //                             (bench/bench_capture.sh measures the capture's cost against it)
 //
@@ -50,6 +51,7 @@ struct CaptureState {
   bool done = false;
   bool record = true;
   long long verifyFrame = -1;
+  bool followAuto = false;
   string directory = "";
   Uint32 windowStart = 0;  // wall clock when the capture window opened (SDL milliseconds)
 };
@@ -275,6 +277,7 @@ void dynbench_capture_init() {
   state.seconds = envNumber("DYNBENCH_CAPTURE_SECONDS", 30.0);
   state.record = envNumber("DYNBENCH_CAPTURE_RECORD", 1.0) != 0.0;
   state.verifyFrame = static_cast<long long>(envNumber("DYNBENCH_CAPTURE_VERIFY_FRAME", -1.0));
+  state.followAuto = envNumber("DYNBENCH_CAPTURE_FOLLOW_AUTO", 0.0) != 0.0;
   copystring(state.directory, dir);
   seedMT(state.seed);
   // Occlusion queries answer when the GPU gets to them, not at a fixed frame: what is drawn, and
@@ -324,4 +327,6 @@ void dynbench_capture_frame() {
   const char *map = game::getclientmap();
   if (!map || !*map || !camera1) return;
   recordFrame(map);
+  // As a spectator would: when the followed bot dies, follow the next one from the next frame on.
+  if (state.followAuto && !state.done && execute("dynbench_followdead")) execute("nextfollow 1");
 }
