@@ -118,6 +118,28 @@ TEST(Cube2, SeededMatchIsDeterministicAndConverts) {
               j["camera_motion"]["position"]["mean"].get<double>());
 }
 
+// A second map, another mode and the default --follow auto: cyber1, a 3-second team match.
+TEST(Cube2, SecondMapConvertsAndValidates) {
+  if (const auto why = skipReason(); !why.empty()) GTEST_SKIP() << why << ": Cube 2 capture skipped";
+  const auto dir = test::freshDir("cube2_cyber1");
+  auto r = dynbench(fmt::format("capture cube2 -o {} --map cyber1 --mode teamplay --bots 4 --seconds 3 --seed 5", (dir / "cap").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = dynbench(fmt::format("convert {} -o {}", (dir / "cap").string(), (dir / "ds" / "cyber1.gltf").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::string validation;
+  runShell(fmt::format("node {}/tools/gltf-validator/validate.mjs {} 2>&1", DYNBENCH_SOURCE_DIR, (dir / "ds" / "cyber1.gltf").string()), validation);
+  EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
+  r = dynbench(fmt::format("stats {} --fps 60 --json {}", (dir / "ds" / "cyber1.gltf").string(), (dir / "stats.json").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(*readWholeFile(dir / "stats.json"))["datasets"][0];
+  EXPECT_TRUE(j["properties"]["animated_camera"].get<bool>());
+  EXPECT_GT(j["properties"]["faces"].get<int>(), 5000);
+  EXPECT_GE(j["properties"]["armatures"].get<int>(), 3);  // the followed bot's three opponents and team mate
+  std::printf("cyber1: %d faces, %d armatures, %d dynamic rigid objects, camera rotation %.3f deg/frame (mean)\n",
+              j["properties"]["faces"].get<int>(), j["properties"]["armatures"].get<int>(), j["properties"]["dynamic_rigid_objects"].get<int>(),
+              j["camera_motion"]["rotation_degrees"]["mean"].get<double>());
+}
+
 TEST(Cube2, BadOptionsFailClearly) {
   const auto dir = test::freshDir("cube2_bad");
   auto r = dynbench(fmt::format("capture cube2 -o {} --mode deathmatch", (dir / "x").string()), dir);
