@@ -40,9 +40,8 @@ static const float kMaxStepUnits = 48.0f;
 struct PartInstance {
   animmodel::part *part;
   const dynent *owner;  // NULL for parts rendered without a game entity
-  vec origin;           // world position of the part's origin (for matching)
+  vec origin;           // world position of the part's origin (its translation; also for matching)
   quat rotation;        // world rotation (engine space)
-  vec translation;      // world translation (engine space)
   vector<dualquat> joints;  // model-space joint transforms after animation, conjugated by A
   vector<dualquat> bones;   // the engine's skinning transforms (bdata) as drawn, for verifyFrame
   matrix4 world;
@@ -289,7 +288,6 @@ void animmodel::dynbench_capture_part(part *p, const animstate *as, float pitch,
   instance->origin = origin;
   instance->rotation = quat(world);
   instance->rotation.normalize();
-  instance->translation = origin;
   instance->id = 0;
   instance->world = world;
   if (isSkeletal(p)) skeletalJoints(p, as, pitch, axis, forward, d, instance->joints, instance->bones);
@@ -348,7 +346,7 @@ static bool writeInstance(dbc_session *session, const dynbench_models::PartInsta
   using namespace dynbench_models;
   string path;
   capturePath(instance.part, path, sizeof(path));
-  const dbc_dual_quat pose = captureDualQuat(instance.rotation, instance.translation);
+  const dbc_dual_quat pose = captureDualQuat(instance.rotation, instance.origin);
   if (isStatic) return dbc_static_model(session, instance.id, path, pose) == DBC_OK;
   if (dbc_model(session, instance.id, path, pose) != DBC_OK) return false;
   if (instance.joints.empty()) return true;
