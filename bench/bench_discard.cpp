@@ -13,7 +13,7 @@
 #include "core/math.h"
 #include "discard/discard.h"
 #include "render/camera.h"
-#include "render/frame_output.h"
+#include "frames/frame_io.h"
 
 namespace fs = std::filesystem;
 using namespace dynbench;
@@ -37,7 +37,7 @@ discard::FeatureFrame frame(int k) {
   f.frame = k;
   f.width = 1920;
   f.height = 1080;
-  f.camera = {cam.view(), cam.projection(), 1920, 1080};
+  f.camera = cam.frameCamera();
   const std::size_t n = 1920u * 1080u;
   for (auto* b : {&f.position, &f.normal, &f.direct, &f.indirect}) b->resize(3 * n);
   f.hit.assign(n, 1.0f);
@@ -99,8 +99,8 @@ int main(int argc, char** argv) {
         for (int c = 0; c < 3; ++c) image.pixels.push_back((*buf)[3 * i + c]);
       image.pixels.push_back(1.0f);
     }
-    if (!writeImage(render::frameImagePath(dir, k), image) ||
-        !writeFileAtomic(render::frameSidecarPath(dir, k), render::frameSidecar(k, k / 24.0, cameraAt(k), {}).dump())) {
+    if (!writeImage(frames::frameImagePath(dir, k), image) ||
+        !writeFileAtomic(frames::frameSidecarPath(dir, k), frames::sidecarJson(k, k / 24.0, cameraAt(k).frameCamera(), {}).dump())) {
       std::fprintf(stderr, "cannot write %s\n", dir.c_str());
       return 1;
     }
@@ -113,6 +113,6 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::printf("end to end from EXR: %d frames in %.2f s, %.2f pairs/s (%.0f ms per pair; EXR size %.1f MB each)\n", frames, files,
-              (frames - 1) / files, files / (frames - 1) * 1e3, static_cast<double>(fs::file_size(render::frameImagePath(dir, 0))) / 1e6);
+              (frames - 1) / files, files / (frames - 1) * 1e3, static_cast<double>(fs::file_size(frames::frameImagePath(dir, 0))) / 1e6);
   return 0;
 }

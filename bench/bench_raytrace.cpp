@@ -9,7 +9,7 @@
 
 #include "render/camera.h"
 #include "render/raytracing_scene.h"
-#include "metrics/camera_motion.h"
+#include "scene/queries.h"
 #include "scene/load.h"
 
 using namespace dynbench;
@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
               t, stats.staticTriangles, staticBuild * 1e3, stats.dynamicTriangles, dynamicBuild * 1e3);
 
   // Primary rays through the dataset's camera (or a default view of the origin).
-  auto node = metrics::selectCameraNode(*scene, std::nullopt);
+  auto node = scene::selectCameraNode(*scene, std::nullopt);
   const scene::Evaluator evaluator(*scene);
   scene::Camera lens;
   lens.yfov = 1.0;

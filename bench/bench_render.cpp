@@ -18,7 +18,7 @@
 #include "core/image_io.h"
 #include "core/math.h"
 #include "gltf_builder.h"
-#include "render/frame_output.h"
+#include "frames/frame_io.h"
 #include "render/render_job.h"
 #include "scene/load.h"
 
@@ -125,7 +125,7 @@ fs::path buildArena(const fs::path& dir) {
 std::vector<double> radiance(const fs::path& dir, const std::vector<long>& frames) {
   std::vector<double> out;
   for (long f : frames) {
-    auto image = readImage(render::frameImagePath(dir, f));
+    auto image = readImage(frames::frameImagePath(dir, f));
     if (!image) {
       std::fprintf(stderr, "%s\n", image.error().message.c_str());
       std::exit(1);

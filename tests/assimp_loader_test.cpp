@@ -10,6 +10,7 @@
 
 #include "core/files.h"
 #include "metrics/camera_motion.h"
+#include "scene/queries.h"
 #include "metrics/properties.h"
 #include "scene/load.h"
 
@@ -233,7 +234,7 @@ TEST(Collada, LightsAndCamerasMatchTheXml) {
   EXPECT_EQ(cameraScene->cameras.size(), countMatches(cameras, "<camera "));
   // --camera picks any of them by name; the DAE node names are Camera, Camera_002, Camera_003.
   for (const char* name : {"Camera", "Camera_002", "Camera_003"})
-    EXPECT_TRUE(metrics::selectCameraNode(*cameraScene, std::string(name))) << name;
+    EXPECT_TRUE(scene::selectCameraNode(*cameraScene, std::string(name))) << name;
 }
 
 TEST(Collada, TrianglesMatchThePolylistCounts) {

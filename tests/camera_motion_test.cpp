@@ -5,6 +5,7 @@
 
 #include "gltf_builder.h"
 #include "metrics/camera_motion.h"
+#include "scene/queries.h"
 #include "scene/load.h"
 
 namespace dynbench::metrics {
@@ -135,11 +136,11 @@ TEST(CameraMotion, CameraSelection) {
   const auto dir = test::freshDir("select");
   auto scene = scene::loadScene(b.write(dir, "select"));
   ASSERT_TRUE(scene);
-  EXPECT_EQ(*selectCameraNode(*scene, std::nullopt), moving);  // the first *animated* camera
-  EXPECT_EQ(*selectCameraNode(*scene, std::string("0")), 0);
-  EXPECT_EQ(*selectCameraNode(*scene, std::string("overview")), 0);
-  EXPECT_EQ(*selectCameraNode(*scene, std::string("eye")), moving);
-  auto missing = selectCameraNode(*scene, std::string("nope"));
+  EXPECT_EQ(*scene::selectCameraNode(*scene, std::nullopt), moving);  // the first *animated* camera
+  EXPECT_EQ(*scene::selectCameraNode(*scene, std::string("0")), 0);
+  EXPECT_EQ(*scene::selectCameraNode(*scene, std::string("overview")), 0);
+  EXPECT_EQ(*scene::selectCameraNode(*scene, std::string("eye")), moving);
+  auto missing = scene::selectCameraNode(*scene, std::string("nope"));
   ASSERT_FALSE(missing);
   EXPECT_NE(missing.error().message.find("overview"), std::string::npos);  // lists what exists
   auto m = measureCameraMotion(*scene, 24.0, std::string("still"));

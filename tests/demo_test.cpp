@@ -9,7 +9,7 @@
 #include "capture/cube2.h"
 #include "core/files.h"
 #include "core/math.h"
-#include "demo/demo.h"
+#include "pipeline/demo.h"
 #include "gltf_builder.h"
 #include "run_cli.h"
 

@@ -16,7 +16,7 @@
 #include "discard/discard.h"
 #include "gltf_builder.h"
 #include "render/camera.h"
-#include "render/frame_output.h"
+#include "frames/frame_io.h"
 #include "run_cli.h"
 
 namespace dynbench::discard {
@@ -46,7 +46,7 @@ FeatureFrame makeFrame(long index, const render::RenderCamera& cam, Scene&& scen
   f.frame = index;
   f.width = cam.width();
   f.height = cam.height();
-  f.camera = {cam.view(), cam.projection(), cam.width(), cam.height()};
+  f.camera = cam.frameCamera();
   const auto n = static_cast<std::size_t>(f.width) * f.height;
   for (auto* b : {&f.position, &f.normal, &f.direct, &f.indirect}) b->assign(3 * n, 0.0f);
   f.hit.assign(n, 0.0f);
@@ -211,7 +211,7 @@ TEST(Discard, BilinearSamplingAtCentresEdgesAndCorners) {
 
 TEST(Discard, ReprojectionRoundTripsThroughThePixelDirection) {
   const auto cam = camera(25.0, 320, 180, 40.0);
-  const FrameCamera fc{cam.view(), cam.projection(), 320, 180};
+  const FrameCamera fc = cam.frameCamera();
   for (double x : {0.5, 100.25, 319.5})
     for (double y : {0.5, 90.0, 179.5}) {
       const auto q = reprojectDirection(fc, pixelDirection(fc, x, y));
@@ -239,8 +239,8 @@ void writeFrames(const fs::path& dir, int count, int w, int h) {
         for (int c = 0; c < 3; ++c) image.pixels.push_back((*b)[3 * i + c]);
       image.pixels.push_back(f.hit[i]);
     }
-    ASSERT_TRUE(writeImage(render::frameImagePath(dir, k), image));
-    ASSERT_TRUE(writeFileAtomic(render::frameSidecarPath(dir, k), render::frameSidecar(k, k / 24.0, cam, {}).dump()));
+    ASSERT_TRUE(writeImage(frames::frameImagePath(dir, k), image));
+    ASSERT_TRUE(writeFileAtomic(frames::frameSidecarPath(dir, k), frames::sidecarJson(k, k / 24.0, cam.frameCamera(), {}).dump()));
   }
 }
 
@@ -301,10 +301,23 @@ TEST(DiscardCli, BadFramesFoldersFailClearly) {
   EXPECT_NE(r.err.find("direct.var"), std::string::npos) << r.err;
 
   writeFrames(dir / "k", 2, 16, 9);
-  ASSERT_TRUE(writeFileAtomic(dir / "k" / "frame_00000.json", R"({"width": 16, "height": 9, "camera": {"view": [1, 2]}})"));
+  ASSERT_TRUE(writeFileAtomic(dir / "k" / "frame_00000.json",
+                              R"({"format": "dynbench-frame", "version": 1, "width": 16, "height": 9, "camera": {"view": [1, 2]}})"));
   r = dynbench(fmt::format("discard {}", (dir / "k").string()), dir);
   EXPECT_EQ(r.status, 5) << r.err;
   EXPECT_NE(r.err.find("frame_00000.json: /camera/view: expected an array of 16 numbers"), std::string::npos) << r.err;
+
+  // The sidecar's format and version are checked: a file that is not a frame sidecar, and one
+  // from a newer dynbench.
+  ASSERT_TRUE(writeFileAtomic(dir / "k" / "frame_00000.json", R"({"width": 16, "height": 9})"));
+  r = dynbench(fmt::format("discard {}", (dir / "k").string()), dir);
+  EXPECT_EQ(r.status, 5) << r.err;
+  EXPECT_NE(r.err.find("frame_00000.json: /format: expected \"dynbench-frame\""), std::string::npos) << r.err;
+  ASSERT_TRUE(writeFileAtomic(dir / "k" / "frame_00000.json", R"({"format": "dynbench-frame", "version": 2, "width": 16, "height": 9})"));
+  r = dynbench(fmt::format("discard {}", (dir / "k").string()), dir);
+  EXPECT_EQ(r.status, 6) << r.err;
+  EXPECT_NE(r.err.find("frame_00000.json: /version: 2 is not a sidecar version this dynbench reads (it reads 1)"), std::string::npos)
+      << r.err;
 
   r = dynbench(fmt::format("discard {}", (dir / "nowhere").string()), dir);
   EXPECT_EQ(r.status, 3) << r.err;

@@ -5,6 +5,7 @@
 
 #include "gltf_builder.h"
 #include "metrics/properties.h"
+#include "scene/queries.h"
 #include "scene/load.h"
 
 namespace dynbench::metrics {
@@ -85,10 +86,10 @@ TEST(Properties, SeparateClipsOnOneNodeAreFlaggedAndSelectable) {
 }
 
 TEST(Properties, FrameCount) {
-  EXPECT_EQ(frameCount({0.0, 2.0}, true, 24.0), 49u);
-  EXPECT_EQ(frameCount({1.25, 2.5}, true, 24.0), 31u);
-  EXPECT_EQ(frameCount({0.0, 0.0}, true, 24.0), 1u);
-  EXPECT_EQ(frameCount({0.0, 5.0}, false, 24.0), 0u);
+  EXPECT_EQ(scene::frameCount({0.0, 2.0}, true, 24.0), 49u);
+  EXPECT_EQ(scene::frameCount({1.25, 2.5}, true, 24.0), 31u);
+  EXPECT_EQ(scene::frameCount({0.0, 0.0}, true, 24.0), 1u);
+  EXPECT_EQ(scene::frameCount({0.0, 5.0}, false, 24.0), 0u);
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
-// `dynbench demo [-o DIR]`: the whole chain on a seeded Cube 2 match (src/demo/demo.h).
+// `dynbench demo [-o DIR]`: the whole chain on a seeded Cube 2 match (src/pipeline/demo.h).
 #include "cli/commands.h"
-#include "demo/demo.h"
+#include "pipeline/demo.h"
 
 namespace dynbench::cli {
 namespace {

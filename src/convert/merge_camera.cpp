@@ -12,7 +12,7 @@
 #include "capture/reader.h"
 #include "core/files.h"
 #include "core/math.h"
-#include "metrics/camera_motion.h"
+#include "scene/queries.h"
 #include "scene/load.h"
 
 namespace dynbench::convert {
@@ -102,7 +102,7 @@ Expected<MergeCameraReport> mergeCamera(const MergeCameraOptions& options) {
   // Validates the dataset and finds its camera with the same rules as `stats`.
   auto scene = scene::loadScene(options.dataset);
   if (!scene) return std::unexpected(scene.error());
-  auto node = metrics::selectCameraNode(*scene, options.camera);
+  auto node = scene::selectCameraNode(*scene, options.camera);
   if (!node) return std::unexpected(node.error());
   if (*node < 0) return fail(ErrorCode::kInvalidData, "{}: the dataset has no camera", options.dataset.string());
   auto run = readCameraRun(options.run);

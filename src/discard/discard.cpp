@@ -1,6 +1,7 @@
 #include "discard/discard.h"
 
 #include "core/math.h"
+#include "frames/preview.h"
 
 #include <algorithm>
 #include <array>
@@ -175,13 +176,14 @@ namespace dynbench::discard {
 
 Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thresholds& thresholds, const MaskSink& masks,
                                    const DiscardProgress& progress) {
-  auto entries = listFrames(dir);
+  auto entries = frames::listFrames(dir);
   if (!entries) return std::unexpected(entries.error());
+  if (entries->size() < 2) return fail(ErrorCode::kInvalidData, "{}: needs at least two frames (found {})", dir.string(), entries->size());
   DiscardRun run;
   run.thresholds = thresholds;
   std::optional<FeatureFrame> previous;
   for (std::size_t k = 0; k < entries->size(); ++k) {
-    auto frame = readFeatureFrame((*entries)[k], thresholds.noiseAware);
+    auto frame = frames::readFrame((*entries)[k]);
     if (!frame) return std::unexpected(frame.error());
     if (k == 0) {
       run.width = frame->width;
@@ -226,15 +228,10 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
 std::vector<float> maskImage(const FeatureFrame& frame, const std::vector<unsigned char>& mask) {
   static const glm::dvec3 colours[5] = {{1, 0.1, 0.1}, {1, 0.9, 0.1}, {0.2, 0.4, 1}, {1, 0.2, 1}, {0.1, 1, 1}};
   const std::size_t n = mask.size();
-  // Tone mapping: Reinhard on luminance scaled so the frame's mean maps to 0.18.
-  double mean = 0;
-  for (std::size_t i = 0; i < n; ++i) mean += luminance(at3(frame.direct, i) + at3(frame.indirect, i));
-  mean = std::max(mean / static_cast<double>(std::max<std::size_t>(n, 1)), 1e-12);
+  const frames::PreviewToneMap toneMap(frame);
   std::vector<float> rgb(3 * n);
   for (std::size_t i = 0; i < n; ++i) {
-    glm::dvec3 c = (at3(frame.direct, i) + at3(frame.indirect, i)) * (0.18 / mean);
-    c = c / (1.0 + c);
-    c = glm::pow(glm::clamp(c, 0.0, 1.0), glm::dvec3(1.0 / 2.2)) * 0.45;  // dimmed
+    glm::dvec3 c = toneMap(frame, i) * 0.45;  // dimmed, so the reasons' colours stand out
     for (int b = 0; b < 5; ++b)
       if (mask[i] & (1u << b)) {
         c = 0.3 * c + 0.7 * colours[b];

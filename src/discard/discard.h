@@ -12,9 +12,12 @@
 
 #include <glm/glm.hpp>
 
-#include "discard/feature_frames.h"
+#include "frames/frame_io.h"
 
 namespace dynbench::discard {
+
+using frames::FeatureFrame;
+using frames::FrameCamera;
 
 struct Thresholds {
   // World-position distance, in scene units; with relativePosition, a fraction of the scene's size

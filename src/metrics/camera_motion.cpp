@@ -5,6 +5,7 @@
 #include <charconv>
 
 #include "metrics/properties.h"
+#include "scene/queries.h"
 #include "scene/evaluate.h"
 
 namespace dynbench::metrics {
@@ -22,44 +23,6 @@ Summary summarize(const std::vector<double>& values) {
   s.variance = squares / static_cast<double>(values.size());
   s.max = *std::max_element(values.begin(), values.end());
   return s;
-}
-
-Expected<int> selectCameraNode(const Scene& scene, const std::optional<std::string>& selector) {
-  std::vector<int> cameraNodes;
-  for (std::size_t i = 0; i < scene.nodes.size(); ++i)
-    if (scene.nodes[i].camera >= 0) cameraNodes.push_back(static_cast<int>(i));
-  auto available = [&] {
-    std::string list;
-    for (int n : cameraNodes) {
-      const auto& node = scene.nodes[static_cast<std::size_t>(n)];
-      const auto& camera = scene.cameras[static_cast<std::size_t>(node.camera)];
-      list += fmt::format("{}{} (camera {} '{}')", list.empty() ? "" : ", ", node.name.empty() ? "<unnamed node>" : node.name,
-                          node.camera, camera.name);
-    }
-    return list.empty() ? std::string("none") : list;
-  };
-  if (!selector) {
-    if (cameraNodes.empty()) return -1;
-    const auto dynamic = dynamicNodes(scene);
-    for (int n : cameraNodes)
-      if (dynamic[static_cast<std::size_t>(n)]) return n;
-    return cameraNodes.front();
-  }
-  int index = -1;
-  const auto& s = *selector;
-  if (!s.empty() && std::from_chars(s.data(), s.data() + s.size(), index).ec == std::errc() &&
-      std::all_of(s.begin(), s.end(), ::isdigit)) {
-    for (int n : cameraNodes)
-      if (scene.nodes[static_cast<std::size_t>(n)].camera == index) return n;
-    return fail(ErrorCode::kUsage, "{}: --camera {}: no node uses camera {} (cameras in the file: {})",
-                scene.source.path.string(), s, index, available());
-  }
-  for (int n : cameraNodes) {
-    const auto& node = scene.nodes[static_cast<std::size_t>(n)];
-    if (node.name == s || scene.cameras[static_cast<std::size_t>(node.camera)].name == s) return n;
-  }
-  return fail(ErrorCode::kUsage, "{}: --camera '{}' names no camera (cameras in the file: {})", scene.source.path.string(),
-              s, available());
 }
 
 Expected<CameraMotion> measureCameraMotion(const Scene& scene, double fps, const std::optional<std::string>& cameraSelector) {

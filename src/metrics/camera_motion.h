@@ -43,10 +43,6 @@ struct CameraMotion {
   Summary pitch, yaw, roll;  // Table 6.6, degrees per frame
 };
 
-// The camera node `selector` names: a camera index ("0": the first node using cameras[0]), or the
-// name of a camera node or of a camera. Without a selector, the first dynamic camera node, else the
-// first camera node. Returns -1 when the scene has no camera and no selector was given.
-Expected<int> selectCameraNode(const scene::Scene& scene, const std::optional<std::string>& selector);
 
 Expected<CameraMotion> measureCameraMotion(const scene::Scene& scene, double fps,
                                            const std::optional<std::string>& cameraSelector);

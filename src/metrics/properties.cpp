@@ -6,46 +6,11 @@
 
 #include <fmt/format.h>
 
+#include "scene/queries.h"
+
 namespace dynbench::metrics {
 
 using namespace dynbench::scene;
-
-std::size_t frameCount(const Scene::TimeRange& range, bool animated, double fps) {
-  if (!animated || !(fps > 0)) return 0;
-  // The small epsilon keeps 2.0 s at 24 fps at 49 frames despite float key times.
-  return static_cast<std::size_t>(std::floor((range.end - range.start) * fps + 1e-6)) + 1;
-}
-
-std::size_t frameCount(const Scene& scene, double fps) {
-  bool animated = false;
-  for (const auto& a : scene.animations) animated = animated || !a.channels.empty();
-  return frameCount(scene.timeRange(), animated, fps);
-}
-
-std::vector<char> dynamicNodes(const Scene& scene) {
-  std::vector<char> animated(scene.nodes.size(), 0);
-  for (const auto& animation : scene.animations)
-    for (const auto& channel : animation.channels)
-      if (channel.path != AnimationPath::kWeights) animated[static_cast<std::size_t>(channel.node)] = 1;
-  std::vector<char> dynamic(scene.nodes.size(), 0);
-  for (std::size_t i = 0; i < scene.nodes.size(); ++i)
-    for (int n = static_cast<int>(i); n >= 0 && !dynamic[i]; n = scene.nodes[static_cast<std::size_t>(n)].parent)
-      dynamic[i] = animated[static_cast<std::size_t>(n)];
-  return dynamic;
-}
-
-std::vector<char> nodesInScene(const Scene& scene) {
-  std::vector<char> in(scene.nodes.size(), 0);
-  std::vector<int> stack(scene.roots.begin(), scene.roots.end());
-  while (!stack.empty()) {
-    const int n = stack.back();
-    stack.pop_back();
-    if (in[static_cast<std::size_t>(n)]) continue;
-    in[static_cast<std::size_t>(n)] = 1;
-    for (int c : scene.nodes[static_cast<std::size_t>(n)].children) stack.push_back(c);
-  }
-  return in;
-}
 
 DatasetProperties measureProperties(const Scene& scene, double fps) {
   DatasetProperties p;

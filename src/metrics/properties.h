@@ -9,17 +9,6 @@
 
 namespace dynbench::metrics {
 
-// Frames sampled at `fps` over [start, end]: floor((end - start) * fps) + 1, or 0 without animation.
-std::size_t frameCount(const scene::Scene::TimeRange& range, bool animated, double fps);
-// The same for a whole scene: its time range, 0 when no animation has a channel.
-std::size_t frameCount(const scene::Scene& scene, double fps);
-
-// Per node: 1 when the node or an ancestor has a translation, rotation, scale or visibility channel.
-std::vector<char> dynamicNodes(const scene::Scene& scene);
-
-// Nodes reachable from the displayed scene's roots.
-std::vector<char> nodesInScene(const scene::Scene& scene);
-
 struct DatasetProperties {
   // Table 6.1
   std::string fileFormat;

@@ -60,4 +60,18 @@ PixelProjection RenderCamera::project(const glm::dvec3& world) const {
   return p;
 }
 
+frames::FrameCamera RenderCamera::frameCamera() const {
+  frames::FrameCamera c;
+  c.world = world_;
+  c.view = view_;
+  c.projection = projection_;
+  c.position = position();
+  c.yfov = yfov();
+  c.znear = znear();
+  c.zfar = zfar();
+  c.width = width_;
+  c.height = height_;
+  return c;
+}
+
 }  // namespace dynbench::render

@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 
 #include "core/error.h"
+#include "frames/feature_frame.h"
 #include "scene/scene.h"
 
 namespace dynbench::render {
@@ -45,6 +46,8 @@ class RenderCamera {
   double yfov() const { return lens_.yfov; }
   double znear() const { return lens_.znear; }
   double zfar() const { return zfarUsed_; }  // glTF's infinite far plane becomes 1e6 x znear
+  // What a frame's sidecar records of this camera.
+  frames::FrameCamera frameCamera() const;
 
  private:
   glm::dmat4 world_, view_, projection_;

@@ -10,7 +10,7 @@
 
 #include "core/files.h"
 #include "core/math.h"
-#include "render/frame_output.h"
+#include "frames/frame_io.h"
 #include "scene/evaluate.h"
 
 namespace dynbench::render {
@@ -68,32 +68,31 @@ Expected<fs::path> findBlender(const std::string& blender) {
               blender);
 }
 
-Expected<FloatImage> cyclesPassesToContract(const FloatImage& passes, const fs::path& source, const RenderCamera& camera) {
+Expected<frames::FeatureFrame> cyclesPassesToContract(const FloatImage& passes, const fs::path& source, const RenderCamera& camera) {
   const Passes p(passes);
   for (const char* required : {"Position.X", "Normal.X", "DiffDir.R", "DiffInd.R", "DiffCol.R", "Depth.Z"})
     if (p.find(required) < 0)
       return fail(ErrorCode::kParse, "{}: Cycles output lacks the {} pass", source.string(), required);
-  FloatImage out;
+  frames::FeatureFrame out;
   out.width = passes.width;
   out.height = passes.height;
-  out.channelNames = {"P.X",      "P.Y",      "P.Z",        "N.X",        "N.Y",        "N.Z",      "direct.R", "direct.G",
-                      "direct.B", "indirect.R", "indirect.G", "indirect.B", "albedo.R", "albedo.G", "albedo.B", "Z",
-                      "hit"};
-  out.channels = static_cast<int>(out.channelNames.size());
-  const auto n = static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height);
-  out.pixels.assign(n * out.channelNames.size(), 0.0f);
+  out.camera = camera.frameCamera();
+  const auto n = out.pixelCount();
+  // Cycles has no id, motion or variance passes: those buffers stay empty (absent from the EXR).
+  for (auto* b : {&out.position, &out.normal, &out.direct, &out.indirect, &out.albedo}) b->assign(3 * n, 0.0f);
+  for (auto* b : {&out.depth, &out.hit}) b->assign(n, 0.0f);
   const char* rgb = "RGB";
   const glm::dvec3 forward = -glm::dvec3(camera.world()[2]);
   for (std::size_t i = 0; i < n; ++i) {
-    float* o = &out.pixels[i * out.channelNames.size()];
     const bool hit = p.at(i, p.find("Depth.Z")) < 1e9f;
     // Blender world (x, y, z) is glTF (x, z, -y).
     auto toGltf = [](glm::dvec3 b) { return glm::dvec3(b.x, b.z, -b.y); };
     const glm::dvec3 position = toGltf({p.at(i, p.find("Position.X")), p.at(i, p.find("Position.Y")), p.at(i, p.find("Position.Z"))});
     const glm::dvec3 normal = toGltf({p.at(i, p.find("Normal.X")), p.at(i, p.find("Normal.Y")), p.at(i, p.find("Normal.Z"))});
     for (int c = 0; c < 3; ++c) {
-      o[c] = hit ? static_cast<float>(position[c]) : 0.0f;
-      o[3 + c] = hit ? static_cast<float>(normal[c]) : 0.0f;
+      const std::size_t k = 3 * i + static_cast<std::size_t>(c);
+      out.position[k] = hit ? static_cast<float>(position[c]) : 0.0f;
+      out.normal[k] = hit ? static_cast<float>(normal[c]) : 0.0f;
       const std::string ch(1, rgb[c]);
       double direct = p.at(i, p.find("Emit." + ch)) + p.at(i, p.find("Env." + ch)), indirect = 0.0;
       for (const char* kind : {"Diff", "Gloss", "Trans"}) {
@@ -101,12 +100,12 @@ Expected<FloatImage> cyclesPassesToContract(const FloatImage& passes, const fs::
         direct += colour * p.at(i, p.find(std::string(kind) + "Dir." + ch));
         indirect += colour * p.at(i, p.find(std::string(kind) + "Ind." + ch));
       }
-      o[6 + c] = static_cast<float>(direct);
-      o[9 + c] = static_cast<float>(indirect);
-      o[12 + c] = p.at(i, p.find("DiffCol." + ch));
+      out.direct[k] = static_cast<float>(direct);
+      out.indirect[k] = static_cast<float>(indirect);
+      out.albedo[k] = p.at(i, p.find("DiffCol." + ch));
     }
-    o[15] = hit ? static_cast<float>(glm::dot(position - camera.position(), forward)) : 0.0f;
-    o[16] = hit ? 1.0f : 0.0f;
+    out.depth[i] = hit ? static_cast<float>(glm::dot(position - camera.position(), forward)) : 0.0f;
+    out.hit[i] = hit ? 1.0f : 0.0f;
   }
   return out;
 }
@@ -147,7 +146,7 @@ Expected<void> renderWithCycles(const scene::Scene& scene, int cameraNode, const
     nlohmann::json frame = {{"frame", f},
                             {"time", c->time},
                             {"output", fs::absolute(work / fmt::format("cycles_{:05d}.exr", f)).string()},
-                            {"camera", {{"world", matrixJson(c->camera.world())}, {"yfov", c->camera.yfov()}, {"znear", c->camera.znear()}, {"zfar", c->camera.zfar()}}}};
+                            {"camera", {{"world", frames::matrixJson(c->camera.world())}, {"yfov", c->camera.yfov()}, {"znear", c->camera.znear()}, {"zfar", c->camera.zfar()}}}};
     evaluator.evaluate(c->time, pose);
     frame["lights"] = nlohmann::json::array();
     for (std::size_t n = 0; n < scene.nodes.size(); ++n) {
@@ -157,7 +156,7 @@ Expected<void> renderWithCycles(const scene::Scene& scene, int cameraNode, const
       glm::dmat4 world = glm::mat4_cast(rigid.rotation);
       world[3] = glm::dvec4(rigid.position, 1.0);
       frame["lights"].push_back({{"type", toString(l.type)},
-                                 {"world", matrixJson(world)},
+                                 {"world", frames::matrixJson(world)},
                                  {"color", {l.color.r, l.color.g, l.color.b}},
                                  {"intensity", l.intensity},
                                  {"inner_cone", l.innerConeAngle},
@@ -198,13 +197,9 @@ Expected<void> renderWithCycles(const scene::Scene& scene, int cameraNode, const
         ::pclose(pipe);
         return std::unexpected(image.error());
       }
-      const long f = frames[k];
-      if (auto w = writeImage(frameImagePath(job.output, f), *image); !w) {
-        ::pclose(pipe);
-        return std::unexpected(w.error());
-      }
-      const auto sidecar = frameSidecar(f, cameras[k].time, cameras[k].camera, record);
-      if (auto w = writeFileAtomic(frameSidecarPath(job.output, f), sidecar.dump(2) + "\n"); !w) {
+      image->frame = frames[k];
+      image->time = cameras[k].time;
+      if (auto w = frames::writeFrame(job.output, *image, record); !w) {
         ::pclose(pipe);
         return std::unexpected(w.error());
       }

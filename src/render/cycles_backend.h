@@ -14,6 +14,7 @@
 
 #include "core/error.h"
 #include "core/image_io.h"
+#include "frames/feature_frame.h"
 #include "render/render_job.h"
 
 namespace dynbench::render {
@@ -25,6 +26,6 @@ Expected<void> renderWithCycles(const scene::Scene& scene, int cameraNode, const
                                 const nlohmann::json& record, const RenderProgress& progress);
 
 // One Cycles multilayer EXR (Blender's pass names) to the contract's channels.
-Expected<FloatImage> cyclesPassesToContract(const FloatImage& passes, const std::filesystem::path& source, const RenderCamera& camera);
+Expected<frames::FeatureFrame> cyclesPassesToContract(const FloatImage& passes, const std::filesystem::path& source, const RenderCamera& camera);
 
 }  // namespace dynbench::render

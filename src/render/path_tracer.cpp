@@ -36,48 +36,6 @@ struct PathTracer::Shading {
   double emissiveWeight = 0.0;      // luminance of the emissive factor (the light choice's weight)
 };
 
-void FrameBuffers::resize(int w, int h) {
-  width = w;
-  height = h;
-  const auto n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-  for (auto* b : {&position, &normal, &direct, &indirect, &albedo}) b->assign(3 * n, 0.0f);
-  for (auto* b : {&depth, &directVariance, &indirectVariance, &hit}) b->assign(n, 0.0f);
-  id.assign(n, -1.0f);
-  motion.assign(2 * n, 0.0f);
-}
-
-const std::vector<std::string>& FrameBuffers::channelNames() {
-  static const std::vector<std::string> names{
-      "P.X",    "P.Y",    "P.Z",      "N.X",        "N.Y",        "N.Z",          "direct.R", "direct.G",
-      "direct.B", "indirect.R", "indirect.G", "indirect.B", "albedo.R", "albedo.G", "albedo.B", "Z",
-      "id",     "motion.X", "motion.Y", "direct.var", "indirect.var", "hit"};
-  return names;
-}
-
-FloatImage FrameBuffers::toImage() const {
-  FloatImage image;
-  image.width = width;
-  image.height = height;
-  image.channelNames = channelNames();
-  image.channels = static_cast<int>(image.channelNames.size());
-  const auto n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-  image.pixels.resize(n * image.channelNames.size());
-  for (std::size_t i = 0; i < n; ++i) {
-    float* out = &image.pixels[i * image.channelNames.size()];
-    for (const auto* b : {&position, &normal, &direct, &indirect, &albedo}) {
-      for (int c = 0; c < 3; ++c) *out++ = (*b)[3 * i + static_cast<std::size_t>(c)];
-    }
-    *out++ = depth[i];
-    *out++ = id[i];
-    *out++ = motion[2 * i];
-    *out++ = motion[2 * i + 1];
-    *out++ = directVariance[i];
-    *out++ = indirectVariance[i];
-    *out++ = hit[i];
-  }
-  return image;
-}
-
 PathTracer::PathTracer(const scene::Scene& scene, const RenderSettings& settings) : scene_(scene), settings_(settings) {}
 PathTracer::~PathTracer() = default;
 
@@ -236,6 +194,7 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
                                 std::atomic<int>* rowsDone, RenderStatistics* statistics) const {
   FrameBuffers out;
   out.resize(camera.width(), camera.height());
+  std::fill(out.id.begin(), out.id.end(), -1.0f);  // the contract's "no instance"
   const int width = camera.width(), height = camera.height(), spp = settings_.samplesPerPixel;
   const glm::dvec3 forward = -glm::dvec3(camera.world()[2]);
   std::atomic<std::uint64_t> rays{0};

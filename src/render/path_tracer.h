@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "core/error.h"
-#include "core/image_io.h"
+#include "frames/feature_frame.h"
 #include "render/bsdf.h"
 #include "render/camera.h"
 #include "render/lights.h"
@@ -37,18 +37,8 @@ struct RenderSettings {
   bool nextEventEstimation = true;
 };
 
-// One frame's buffers, channels interleaved per pixel, row 0 at the top.
-struct FrameBuffers {
-  int width = 0, height = 0;
-  std::vector<float> position, normal, direct, indirect, albedo;  // 3 per pixel
-  std::vector<float> depth, id, directVariance, indirectVariance, hit;  // 1 per pixel
-  std::vector<float> motion;  // 2 per pixel
-
-  void resize(int width, int height);
-  // All buffers as one image with the contract's channel names (P.X P.Y P.Z N.X ... hit).
-  FloatImage toImage() const;
-  static const std::vector<std::string>& channelNames();
-};
+// One frame's buffers: the feature-buffer contract's frame (frames/feature_frame.h).
+using FrameBuffers = frames::FeatureFrame;
 
 struct RenderStatistics {
   std::uint64_t cameraSamples = 0, rays = 0;

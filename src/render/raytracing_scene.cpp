@@ -4,7 +4,7 @@
 
 #include <embree3/rtcore.h>
 
-#include "metrics/properties.h"
+#include "scene/queries.h"
 
 namespace dynbench::render {
 namespace {
@@ -132,8 +132,8 @@ Expected<std::unique_ptr<RayTracingScene>> RayTracingScene::create(const scene::
   rtcSetSceneFlags(impl->dynamicScene, RTC_SCENE_FLAG_DYNAMIC);
 
   // Static: not dynamic (docs/metrics.md), not skinned, no morph animation, visible at rest.
-  const auto dynamic = metrics::dynamicNodes(scene);
-  const auto inScene = metrics::nodesInScene(scene);
+  const auto dynamic = scene::dynamicNodes(scene);
+  const auto inScene = scene::nodesInScene(scene);
   std::vector<char> morphing(scene.nodes.size(), 0);
   for (const auto& a : scene.animations)
     for (const auto& c : a.channels)

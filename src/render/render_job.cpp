@@ -7,10 +7,9 @@
 #include <tbb/global_control.h>
 
 #include "core/files.h"
-#include "metrics/camera_motion.h"
 #include "render/cycles_backend.h"
-#include "metrics/properties.h"
-#include "render/frame_output.h"
+#include "scene/queries.h"
+#include "frames/frame_io.h"
 #include "scene/evaluate.h"
 
 namespace dynbench::render {
@@ -62,7 +61,7 @@ Expected<FrameRange> parseFrameRange(const std::string& text) {
 
 Expected<std::vector<long>> jobFrames(const scene::Scene& scene, const RenderJob& job) {
   if (!(job.fps > 0)) return fail(ErrorCode::kUsage, "--fps must be positive (got {})", job.fps);
-  const long count = static_cast<long>(std::max<std::size_t>(1, metrics::frameCount(scene, job.fps)));
+  const long count = static_cast<long>(std::max<std::size_t>(1, scene::frameCount(scene, job.fps)));
   const long last = job.frames.last < 0 ? count - 1 : job.frames.last;
   if (job.frames.first > last || job.frames.first >= count)
     return fail(ErrorCode::kUsage, "--frames {}:{}: the animation has frames 0 to {} at {} fps", job.frames.first, last, count - 1,
@@ -112,7 +111,7 @@ nlohmann::json renderRecord(const RenderJob& job) {
 Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob& job, const RenderProgress& progress) {
   auto frames = jobFrames(scene, job);
   if (!frames) return std::unexpected(frames.error());
-  auto cameraNode = metrics::selectCameraNode(scene, job.camera);
+  auto cameraNode = scene::selectCameraNode(scene, job.camera);
   if (!cameraNode) return std::unexpected(cameraNode.error());
   std::error_code ec;
   fs::create_directories(job.output, ec);
@@ -121,7 +120,7 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
   const nlohmann::json record = renderRecord(job);
   RenderSummary summary;
   std::vector<long> todo;
-  for (long f : *frames) (frameComplete(job.output, f, record) ? summary.skipped : todo).push_back(f);
+  for (long f : *frames) (frames::frameComplete(job.output, f, record) ? summary.skipped : todo).push_back(f);
   if (todo.empty()) return summary;
 
   const auto started = std::chrono::steady_clock::now();
@@ -160,9 +159,10 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
     }
     summary.cameraSamples += stats.cameraSamples;
     summary.rays += stats.rays;
-    if (auto w = writeImage(frameImagePath(job.output, f), buffers.toImage()); !w) return std::unexpected(w.error());
-    const auto sidecar = frameSidecar(f, cameras->time, cameras->camera, record);
-    if (auto w = writeFileAtomic(frameSidecarPath(job.output, f), sidecar.dump(2) + "\n"); !w) return std::unexpected(w.error());
+    buffers.frame = f;
+    buffers.time = cameras->time;
+    buffers.camera = cameras->camera.frameCamera();
+    if (auto w = frames::writeFrame(job.output, buffers, record); !w) return std::unexpected(w.error());
     summary.rendered.push_back(f);
     if (progress) progress((i + 1) * static_cast<std::size_t>(job.settings.height), rowsTotal, i + 1, todo.size());
   }

@@ -9,6 +9,8 @@
 #include "core/files.h"
 #include "core/image_io.h"
 #include "discard/discard.h"
+#include "frames/frame_io.h"
+#include "frames/preview.h"
 #include "report/plots.h"
 #include "report/stats_output.h"
 
@@ -24,7 +26,7 @@ struct Run {
   json stats, discard;
   std::string cameraCsv;
   std::vector<fs::path> masks;
-  std::vector<discard::FrameEntry> frames;
+  std::vector<frames::FrameEntry> frames;
 };
 
 struct Table {
@@ -94,7 +96,7 @@ Expected<Run> readRun(const fs::path& dir) {
     std::sort(run.masks.begin(), run.masks.end());
   }
   if (fs::is_directory(dir / "frames", ec))
-    if (auto frames = discard::listFrames(dir / "frames")) run.frames = *frames;
+    if (auto listed = frames::listFrames(dir / "frames")) run.frames = *listed;
   return run;
 }
 
@@ -235,11 +237,9 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
     const int n = std::max(1, options.thumbnails);
     for (int t = 0; t < n && !r.frames.empty(); ++t) {
       const auto& entry = r.frames[static_cast<std::size_t>(t) * (r.frames.size() - 1) / static_cast<std::size_t>(std::max(1, n - 1))];
-      auto frame = discard::readFeatureFrame(entry, false);
+      auto frame = frames::readFrame(entry);
       if (!frame) return std::unexpected(frame.error());
-      // The mask image with an empty mask is the tone-mapped frame, dimmed; undo the dimming.
-      auto rgb = discard::maskImage(*frame, std::vector<unsigned char>(frame->hit.size(), 0));
-      for (auto& v : rgb) v = std::min(1.0f, v / 0.45f);
+      auto rgb = frames::previewImage(*frame);
       const fs::path png = files.assets / fmt::format("{}_frame_{:05d}.png", stem, entry.frame);
       if (auto ok = writeImage(png, FloatImage{frame->width, frame->height, 3, std::move(rgb), {}}); !ok) return std::unexpected(ok.error());
       list.push_back({fmt::format("Frame {} (direct + indirect, tone-mapped)", entry.frame), png});

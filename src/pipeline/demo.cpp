@@ -1,4 +1,4 @@
-#include "demo/demo.h"
+#include "pipeline/demo.h"
 
 #include <cmath>
 
@@ -8,6 +8,7 @@
 #include "convert/convert.h"
 #include "convert/merge_camera.h"
 #include "core/files.h"
+#include "core/image_io.h"
 #include "core/math.h"
 #include "discard/discard.h"
 #include "metrics/camera_motion.h"
@@ -17,6 +18,7 @@
 #include "report/stats_output.h"
 #include "scene/evaluate.h"
 #include "scene/load.h"
+#include "scene/queries.h"
 
 namespace dynbench::demo {
 namespace {
@@ -77,7 +79,7 @@ Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, cons
 Expected<void> writeFlythroughCsv(const fs::path& dataset, const fs::path& csv, int keys, double rate) {
   auto scene = scene::loadScene(dataset);
   if (!scene) return std::unexpected(scene.error());
-  auto cameraNode = metrics::selectCameraNode(*scene, std::nullopt);
+  auto cameraNode = scene::selectCameraNode(*scene, std::nullopt);
   if (!cameraNode) return std::unexpected(cameraNode.error());
   const auto range = scene->timeRange();
   if (!(range.end > range.start)) return fail(ErrorCode::kInvalidData, "{}: no animation to fly along", dataset.string());

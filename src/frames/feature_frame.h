@@ -1,0 +1,62 @@
+#pragma once
+// The feature-buffer contract (ARCHITECTURE §3, docs/feature-buffers.md), in one place: the
+// channels, the frame_NNNNN naming, the camera sidecar, reading and writing a frame, and the
+// preview tone mapping. Every renderer writes through it and every consumer (discard, report,
+// evaluation) reads through it, so the contract cannot drift between them.
+#include <array>
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace dynbench::frames {
+
+// The camera a frame was rendered with, as its sidecar records it. Matrices map as glTF/OpenGL:
+// clip = projection * view * world_point; `world` is the camera's rigid transform (view's inverse).
+struct FrameCamera {
+  glm::dmat4 world{1.0}, view{1.0}, projection{1.0};
+  glm::dvec3 position{0.0};
+  double yfov = 0.0;   // radians
+  double znear = 0.0, zfar = 0.0;  // dataset length units
+  int width = 0, height = 0;       // pixels
+};
+
+// One frame's buffers: row 0 at the top, channels of a buffer interleaved per pixel. A buffer the
+// renderer did not produce is empty (Cycles writes no id, motion or variance).
+struct FeatureFrame {
+  long frame = 0;
+  double time = 0.0;  // seconds, dataset clock
+  FrameCamera camera;
+  int width = 0, height = 0;
+  std::vector<float> position, normal, direct, indirect, albedo;  // 3 per pixel
+  std::vector<float> depth, id, hit;                              // 1 per pixel
+  std::vector<float> motion;                                      // 2 per pixel
+  std::vector<float> directVariance, indirectVariance;            // 1 per pixel
+
+  std::size_t pixelCount() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(height); }
+  bool hasVariance() const { return !directVariance.empty() && !indirectVariance.empty(); }
+  // Sizes every buffer of the contract for width x height, zero-filled.
+  void resize(int width, int height);
+};
+
+// A buffer of the contract: its EXR channel names and where it lives in FeatureFrame.
+struct BufferSpec {
+  const char* name;                 // "direct"
+  std::vector<std::string> channels;  // {"direct.R", "direct.G", "direct.B"}
+  std::vector<float> FeatureFrame::*member;
+  bool required;                    // every frames folder has it
+};
+
+// The contract's buffers in the order dynbench writes them (P N direct indirect albedo Z id
+// motion direct.var indirect.var hit).
+const std::vector<BufferSpec>& contractBuffers();
+// Every channel name of the contract, in that order.
+std::vector<std::string> contractChannelNames();
+
+// frame_NNNNN.exr and frame_NNNNN.json in `dir` (NNNNN: at least five digits, zero-padded).
+std::filesystem::path frameImagePath(const std::filesystem::path& dir, long frame);
+std::filesystem::path frameSidecarPath(const std::filesystem::path& dir, long frame);
+
+}  // namespace dynbench::frames

@@ -1,0 +1,58 @@
+#pragma once
+// Reading and writing frames folders to the contract (docs/feature-buffers.md): the EXR image with
+// the named channels and, written after it, the camera sidecar frame_NNNNN.json. A frame is
+// complete exactly when its sidecar exists and records the settings that made it.
+#include <filesystem>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "frames/feature_frame.h"
+
+namespace dynbench::frames {
+
+// The sidecar's format name and the version this build writes and reads.
+inline constexpr const char* kSidecarFormat = "dynbench-frame";
+inline constexpr int kSidecarVersion = 1;
+
+// A matrix as 16 numbers, column-major (glTF's order).
+nlohmann::json matrixJson(const glm::dmat4& m);
+
+// The sidecar: format and version, frame, time, resolution, camera, conventions, and `render`,
+// the engine and settings that made the frame (compared when resuming).
+nlohmann::json sidecarJson(long frame, double time, const FrameCamera& camera, const nlohmann::json& render);
+
+struct Sidecar {
+  long frame = 0;
+  double time = 0.0;
+  FrameCamera camera;
+  nlohmann::json render;  // null when absent (another renderer's frames)
+};
+// Reads and checks a sidecar: /format must be "dynbench-frame" and /version one this build reads;
+// errors name the file and the JSON pointer.
+Expected<Sidecar> readSidecar(const std::filesystem::path& path);
+
+struct FrameEntry {
+  long frame = 0;
+  std::filesystem::path image, sidecar;
+};
+// The frames of a folder in frame order; every frame_NNNNN.exr must have its frame_NNNNN.json and
+// the other way round. An empty list is not an error here (callers say how many they need).
+Expected<std::vector<FrameEntry>> listFrames(const std::filesystem::path& dir);
+
+struct ReadOptions {
+  bool requireVariance = false;  // fail when direct.var / indirect.var are absent
+};
+// Reads one frame: every channel of the contract the image has (optional buffers stay empty
+// when absent), the camera from the sidecar. Errors name the file and what is missing.
+Expected<FeatureFrame> readFrame(const FrameEntry& entry, const ReadOptions& options = {});
+
+// Writes frame_NNNNN.exr (every non-empty buffer, contract order) and then its sidecar, each
+// through a temporary name, so an interrupted write never leaves a frame that looks complete.
+Expected<void> writeFrame(const std::filesystem::path& dir, const FeatureFrame& frame, const nlohmann::json& render);
+
+// True when frame `frame` of `dir` exists and its sidecar records exactly `render`.
+bool frameComplete(const std::filesystem::path& dir, long frame, const nlohmann::json& render);
+
+}  // namespace dynbench::frames
