@@ -50,14 +50,48 @@ TEST(Cli, VersionAndHelp) {
   r = dynbench("help stats", dir);
   EXPECT_EQ(r.status, 0);
   EXPECT_NE(r.out.find("--fps"), std::string::npos);
-  EXPECT_NE(r.out.find("default: 24"), std::string::npos);
+  EXPECT_NE(r.out.find("--fps FLOAT:POSITIVE=24"), std::string::npos) << r.out;  // the default, from the options struct
   r = dynbench("--help", dir);
   EXPECT_NE(r.out.find("stats"), std::string::npos);
   r = dynbench("help frobnicate", dir);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("frobnicate"), std::string::npos);
   r = dynbench("stats", dir);  // FILE is required
-  EXPECT_NE(r.status, 0);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("FILE is required"), std::string::npos) << r.err;
+}
+
+// docs/cli.md: the same mistake gets the same status, 2, in every command, with a message naming
+// the option.
+TEST(Cli, SameMistakeSameStatusInEveryCommand) {
+  const auto dir = test::freshDir("cli_same_status");
+  for (const std::string command : {"stats x.gltf", "capture-check x", "convert x -o y.gltf", "merge-camera a.gltf b.csv -o c.gltf",
+                                    "render x.gltf -o y", "discard x", "report x -o y.html", "capture cube2 -o x", "demo"}) {
+    const auto r = dynbench(command + " --no-such-option", dir);
+    EXPECT_EQ(r.status, 2) << command << ": " << r.err;
+    EXPECT_NE(r.err.find("dynbench: error: The following argument was not expected: --no-such-option"), std::string::npos)
+        << command << ": " << r.err;
+  }
+  struct Case {
+    std::string args, message;
+  };
+  for (const Case& c : {Case{"stats x.gltf --fps -3", "--fps: must be positive (got -3)"},
+                        Case{"render x.gltf -o y --fps -3", "--fps: must be positive (got -3)"},
+                        Case{"demo --fps -3", "--fps: must be positive (got -3)"},
+                        Case{"capture cube2 -o x --fps -3", "--fps: must be from 0.001 to 1000 (got -3)"},
+                        Case{"stats x.gltf --sequence-rate 0", "--sequence-rate: must be positive (got 0)"},
+                        Case{"render x.gltf -o y --threads -2", "--threads: must be 0 or more (got -2)"},
+                        Case{"render x.gltf -o y --bounces -1", "--bounces: must be 0 or more (got -1)"},
+                        Case{"demo --spp 0", "--spp: must be positive (got 0)"},
+                        Case{"demo --bots 40", "--bots: must be from 1 to 32 (got 40)"},
+                        Case{"discard x --threshold-normal -1", "--threshold-normal: must be 0 or more (got -1)"},
+                        Case{"report x -o y.html --thumbnails -1", "--thumbnails: must be 0 or more (got -1)"},
+                        Case{"convert x -o y.gltf --turbidity 1", "--turbidity: must be from 1.7 to 10 (got 1)"},
+                        Case{"render x.gltf -o y --spp many", "--spp: expected a number, got 'many'"}}) {
+    const auto r = dynbench(c.args, dir);
+    EXPECT_EQ(r.status, 2) << c.args << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << ": " << r.err;
+  }
 }
 
 TEST(Cli, StatsWritesTablesJsonCsvSeriesAndPlots) {

@@ -154,9 +154,10 @@ TEST(RenderCli, BadOptionsFailClearly) {
   };
   for (const Case& c : {Case{"--frames 5:2", "--frames '5:2'", 2}, Case{"--frames 9999", "the animation has frames 0 to", 2},
                         Case{"--frames a:b", "--frames 'a:b'", 2}, Case{"--res 0x5", "--res '0x5'", 2},
-                        Case{"--res 64", "--res '64'", 2}, Case{"--engine optix", "--engine 'optix'", 2},
-                        Case{"--spp 0", "--spp must be at least 1", 2}, Case{"--camera nobody", "nobody", 2},
-                        Case{"--env-constant x", "--env-constant 'x'", 2}}) {
+                        Case{"--res 64", "--res '64'", 2}, Case{"--engine optix", "--engine: optix not in {embree,cycles}", 2},
+                        Case{"--spp 0", "--spp: must be positive (got 0)", 2}, Case{"--camera nobody", "nobody", 2},
+                        Case{"--env-constant x", "--env-constant 'x'", 2},
+                        Case{"--threads -2", "--threads: must be 0 or more (got -2)", 2}}) {
     const auto r = dynbench(base + c.args, dir);
     EXPECT_EQ(r.status, c.status) << c.args << ": " << r.err;
     EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << ": " << r.err;

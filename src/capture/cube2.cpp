@@ -33,8 +33,10 @@ Expected<std::string> cube2Script(const Cube2Options& o) {
   if (mode == modes.end()) return fail(ErrorCode::kUsage, "--mode '{}': expected ffa, teamplay, instagib, efficiency or tactics", o.mode);
   if (o.map.empty() || o.map.find_first_of(" ;[]\"$@") != std::string::npos)
     return fail(ErrorCode::kUsage, "--map '{}': expected a map name such as colos", o.map);
-  if (o.bots < 1 || o.bots > 32) return fail(ErrorCode::kUsage, "--bots must be 1 to 32 (got {})", o.bots);
-  if (o.skill < 1 || o.skill > 101) return fail(ErrorCode::kUsage, "--skill must be 1 to 101 (got {})", o.skill);
+  if (o.bots < kBotsRange.first || o.bots > kBotsRange.second)
+    return fail(ErrorCode::kUsage, "--bots must be {} to {} (got {})", kBotsRange.first, kBotsRange.second, o.bots);
+  if (o.skill < kSkillRange.first || o.skill > kSkillRange.second)
+    return fail(ErrorCode::kUsage, "--skill must be {} to {} (got {})", kSkillRange.first, kSkillRange.second, o.skill);
   std::string follow;
   if (o.follow == "auto") follow = "nextfollow 1";
   else if (!o.follow.empty() && o.follow.find_first_not_of("0123456789") == std::string::npos) follow = "follow " + o.follow;
@@ -47,10 +49,11 @@ Expected<std::string> cube2Script(const Cube2Options& o) {
 }
 
 Expected<Cube2Report> captureCube2(const Cube2Options& o, const Cube2Progress& progress) {
-  if (!(o.fps > 0 && o.fps <= 1000)) return fail(ErrorCode::kUsage, "--fps must be in (0, 1000] (got {})", o.fps);
+  if (!(o.fps > 0 && o.fps <= kMaxFps)) return fail(ErrorCode::kUsage, "--fps must be in (0, {}] (got {})", kMaxFps, o.fps);
   if (!(o.seconds > 0)) return fail(ErrorCode::kUsage, "--seconds must be positive (got {})", o.seconds);
-  if (!(o.warmup >= 1.5)) return fail(ErrorCode::kUsage, "--warmup must be at least 1.5 s (the bots join and the camera starts following by then)");
-  if (o.width < 64 || o.height < 64) return fail(ErrorCode::kUsage, "--width and --height must be at least 64");
+  if (!(o.warmup >= kMinWarmup))
+    return fail(ErrorCode::kUsage, "--warmup must be at least {} s (the bots join and the camera starts following by then)", kMinWarmup);
+  if (o.width < kMinWindow || o.height < kMinWindow) return fail(ErrorCode::kUsage, "--width and --height must be at least {}", kMinWindow);
   auto script = cube2Script(o);
   if (!script) return std::unexpected(script.error());
   auto client = findCube2Client(o.client);

@@ -5,17 +5,25 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <utility>
 
 #include "core/error.h"
 
 namespace dynbench::capture {
+
+// Accepted ranges (the CLI's checks and captureCube2's are these).
+inline constexpr std::pair<int, int> kBotsRange{1, 32};
+inline constexpr std::pair<int, int> kSkillRange{1, 101};  // the game's own addbot clamp
+inline constexpr double kMaxFps = 1000.0;                  // fps in (0, kMaxFps]
+inline constexpr double kMinWarmup = 1.5;                  // s: bots join at 0.7 s, following starts at 1.2 s
+inline constexpr int kMinWindow = 64;                      // pixels, each side
 
 struct Cube2Options {
   std::filesystem::path output;  // the capture folder
   std::string map = "colos";
   std::string mode = "ffa";      // ffa, teamplay, instagib, efficiency, tactics
   int bots = 6;
-  int skill = 80;                // 50-100, Sauerbraten's bot skill
+  int skill = 80;                // Sauerbraten's bot skill, kSkillRange
   double seconds = 30.0;         // recorded game time
   double fps = 60.0;             // fixed clock
   unsigned seed = 1;

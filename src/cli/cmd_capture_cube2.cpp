@@ -38,20 +38,22 @@ void addCaptureCommand(CLI::App& app, CommandRun& run) {
               "Example: dynbench capture cube2 -o captures/colos --map colos --bots 6 --seconds 10");
   std::string output;
   cmd->add_option("-o,--output", o->output, "Capture folder (new or empty)")->required();
-  cmd->add_option("--map", o->map, "Map (default: colos; others with bot waypoints: cyber1, md2, ...)");
-  cmd->add_option("--mode", o->mode, "Game mode: ffa, teamplay, instagib, efficiency, tactics (default: ffa)");
-  cmd->add_option("--bots", o->bots, "Number of bots (default: 6)");
-  cmd->add_option("--skill", o->skill, "Bot skill 1-101 (default: 80)");
-  cmd->add_option("--seconds", o->seconds, "Game seconds recorded (default: 30)");
-  cmd->add_option("--fps", o->fps, "Fixed clock, frames per game second (default: 60)");
-  cmd->add_option("--seed", o->seed, "Seed of every random choice (default: 1)");
+  cmd->add_option("--map", o->map, "Map (others with bot waypoints: cyber1, md2, ...)");
+  cmd->add_option("--mode", o->mode, "Game mode")
+      ->check(CLI::IsMember({"ffa", "teamplay", "instagib", "efficiency", "tactics"}));
+  cmd->add_option("--bots", o->bots, "Number of bots")->check(between(capture::kBotsRange.first, capture::kBotsRange.second));
+  cmd->add_option("--skill", o->skill, "Bot skill (Sauerbraten's)")->check(between(capture::kSkillRange.first, capture::kSkillRange.second));
+  cmd->add_option("--seconds", o->seconds, "Game seconds recorded")->check(positive());
+  cmd->add_option("--fps", o->fps, "Fixed clock, frames per game second")->check(between(1e-3, capture::kMaxFps));
+  cmd->add_option("--seed", o->seed, "Seed of every random choice");
   cmd->add_option("--follow", o->follow, "auto (a bot, then the next whenever the followed one dies, as a spectator would) or a bot's client number (128, 129, ...)");
-  cmd->add_option("--warmup", o->warmup, "Game seconds after the map loads before recording (default: 2, at least 1.5)");
-  cmd->add_option("--width", o->width, "Window width (default: 640)");
-  cmd->add_option("--height", o->height, "Window height (default: 360)");
+  cmd->add_option("--warmup", o->warmup, "Game seconds after the map loads before recording (the bots join and the camera follows by 1.5)")
+      ->check(between(capture::kMinWarmup, 3600.0));
+  cmd->add_option("--width", o->width, "Window width")->check(between(capture::kMinWindow, 16384));
+  cmd->add_option("--height", o->height, "Window height")->check(between(capture::kMinWindow, 16384));
   cmd->add_flag("--window", o->window, "Use the current display instead of Xvfb");
-  cmd->add_option("--client", o->client, "The Cube 2 client with the capture hooks (default: the one the build made)");
-  cmd->add_option("--data", o->data, "Game data (default: /usr/share/games/cube2, Debian's cube2-data)");
+  cmd->add_option("--client", o->client, "The Cube 2 client with the capture hooks (empty: the one the build made)");
+  cmd->add_option("--data", o->data, "Game data (Debian's cube2-data)");
   cmd->callback([o, &run] { run = [o] { return runCube2(*o); }; });
 }
 

@@ -66,20 +66,20 @@ void addConvertCommand(CLI::App& app, CommandRun& run) {
               "Layout and conventions: docs/dataset.md. Example: dynbench convert captures/run1 -o datasets/run1.gltf");
   cmd->add_option("CAPTURE_DIR", options->capture, "The capture directory (docs/capture-format.md)")->required();
   cmd->add_option("-o,--output", options->output, "The dataset to write, .gltf or .glb")->required();
-  cmd->add_flag("--glb", options->glb, "Write one binary .glb (default: .gltf with an external .bin)");
+  cmd->add_flag("--glb", options->glb, "Write one binary .glb instead of .gltf with an external .bin");
   cmd->add_option("--visibility", options->visibility,
                   "How appearing/disappearing objects are switched: node (KHR_node_visibility), scale (scale 0), "
-                  "or both (default: both; lights never use scale)")
+                  "or both (lights never use scale)")
       ->check(CLI::IsMember({"node", "scale", "both"}));
   cmd->add_option("--light-rules", options->lightRules, "JSON file overriding the light rules (docs/dataset.md)");
   cmd->add_option("--env", options->environment,
-                  "Equirectangular .hdr/.exr environment copied beside the dataset (default: a generated daylight sky)");
-  cmd->add_option("--sun-elevation", options->sky.sunElevationDegrees, "Generated sky: sun elevation, degrees (default: 45)")
-      ->check(CLI::Range(0.0, 90.0));
-  cmd->add_option("--sun-azimuth", options->sky.sunAzimuthDegrees, "Generated sky: sun azimuth from -Z towards +X, degrees (default: 135)");
-  cmd->add_option("--turbidity", options->sky.turbidity, "Generated sky: turbidity, 2 (clear) to 10 (hazy) (default: 3)")
-      ->check(CLI::Range(1.7, 10.0));
-  cmd->add_option("--data-root", options->dataRoot, "Where texture names are resolved (default: the capture's data root)");
+                  "Equirectangular .hdr/.exr environment copied beside the dataset (without it: a generated daylight sky)");
+  cmd->add_option("--sun-elevation", options->sky.sunElevationDegrees, "Generated sky: sun elevation, degrees")
+      ->check(between(0.0, 90.0));
+  cmd->add_option("--sun-azimuth", options->sky.sunAzimuthDegrees, "Generated sky: sun azimuth from -Z towards +X, degrees");
+  cmd->add_option("--turbidity", options->sky.turbidity, "Generated sky: turbidity, from clear to hazy")
+      ->check(between(convert::kTurbidityRange.first, convert::kTurbidityRange.second));
+  cmd->add_option("--data-root", options->dataRoot, "Where texture names are resolved (empty: the capture's data root)");
   cmd->callback([options, &run] { run = [options] { return runConvert(*options); }; });
 }
 

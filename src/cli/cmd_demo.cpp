@@ -1,4 +1,5 @@
 // `dynbench demo [-o DIR]`: the whole chain on a seeded Cube 2 match (src/pipeline/demo.h).
+#include "capture/cube2.h"
 #include "cli/commands.h"
 #include "pipeline/demo.h"
 
@@ -7,7 +8,7 @@ namespace {
 
 struct DemoCli {
   demo::DemoOptions options;
-  std::string resolution = "320x180";
+  std::string resolution = fmt::format("{}x{}", demo::DemoOptions{}.width, demo::DemoOptions{}.height);
 };
 
 Expected<void> runDemo(const DemoCli& cli) {
@@ -31,15 +32,15 @@ void addDemoCommand(CLI::App& app, CommandRun& run) {
   auto* cmd = app.add_subcommand("demo", "The whole chain on a seeded Cube 2 bot match: capture, convert, stats, render, discard, report");
   cmd->footer("Also makes a smooth fly-through over the same match as a second dataset, so the report shows the contrast.\n"
               "A rerun reuses the capture and the frames already rendered. Example: dynbench demo -o demo --seconds 20");
-  cmd->add_option("-o,--output", o->options.output, "Output folder (default: dynbench-demo)");
-  cmd->add_option("--map", o->options.map, "Map (default: colos)");
-  cmd->add_option("--bots", o->options.bots, "Bots (default: 6)");
-  cmd->add_option("--seconds", o->options.seconds, "Game seconds captured (default: 10)");
-  cmd->add_option("--seed", o->options.seed, "Seed (default: 1)");
-  cmd->add_option("--fps", o->options.fps, "Sampling rate of stats, render and discard (default: 24)");
-  cmd->add_option("--res", o->resolution, "Render resolution (default: 320x180)");
-  cmd->add_option("--spp", o->options.samplesPerPixel, "Samples per pixel (default: 8)");
-  cmd->add_option("--bounces", o->options.bounces, "Bounces (default: 2)");
+  cmd->add_option("-o,--output", o->options.output, "Output folder");
+  cmd->add_option("--map", o->options.map, "Map");
+  cmd->add_option("--bots", o->options.bots, "Bots")->check(between(capture::kBotsRange.first, capture::kBotsRange.second));
+  cmd->add_option("--seconds", o->options.seconds, "Game seconds captured")->check(positive());
+  cmd->add_option("--seed", o->options.seed, "Seed");
+  cmd->add_option("--fps", o->options.fps, "Sampling rate of stats, render and discard")->check(positive());
+  cmd->add_option("--res", o->resolution, "Render resolution");
+  cmd->add_option("--spp", o->options.samplesPerPixel, "Samples per pixel")->check(positive());
+  cmd->add_option("--bounces", o->options.bounces, "Bounces")->check(nonNegative());
   cmd->callback([o, &run] { run = [o] { return runDemo(*o); }; });
 }
 

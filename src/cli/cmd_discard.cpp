@@ -77,13 +77,16 @@ void addDiscardCommand(CLI::App& app, CommandRun& run) {
               "`dynbench render`. Definitions and defaults: docs/metrics.md.\n"
               "Example: dynbench discard frames/run1 --relative-position --noise-aware --json discard.json --masks masks/");
   cmd->add_option("FRAMES_DIR", o->frames, "Folder of feature-buffer frames")->required();
-  cmd->add_option("--threshold-position", o->thresholds.position, "World-position distance (default: 0.05 scene units)");
+  cmd->add_option("--threshold-position", o->thresholds.position, "World-position distance, scene units (a fraction of the scene's size with --relative-position)")
+      ->check(nonNegative());
   cmd->add_flag("--relative-position", o->thresholds.relativePosition, "Position threshold as a fraction of the scene's size");
-  cmd->add_option("--threshold-normal", o->thresholds.normal, "Shading-normal vector distance (default: 0.1, about 5.7 degrees)");
+  cmd->add_option("--threshold-normal", o->thresholds.normal, "Shading-normal vector distance (0.1: a turn of about 5.7 degrees)")->check(nonNegative());
   cmd->add_option("--threshold-direct", o->thresholds.direct,
-                  "Direct radiance distance, a fraction of the frame's mean luminance (default: 0.1)");
+                  "Direct radiance distance, a fraction of the frame's mean luminance")
+      ->check(nonNegative());
   cmd->add_option("--threshold-indirect", o->thresholds.indirect,
-                  "Indirect radiance distance, a fraction of the frame's mean luminance (default: 0.1)");
+                  "Indirect radiance distance, a fraction of the frame's mean luminance")
+      ->check(nonNegative());
   cmd->add_flag("--absolute-radiance", o->thresholds.absoluteRadiance, "Radiance thresholds in radiance units, not relative");
   cmd->add_flag("--noise-aware", o->thresholds.noiseAware,
                 "Discard radiance only when the change exceeds 3 standard deviations of the pixels' noise (needs *.var channels)");

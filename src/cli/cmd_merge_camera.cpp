@@ -39,7 +39,7 @@ void addMergeCameraCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("CAMERA_RUN", options->run, "Capture directory or CSV pose log")->required();
   cmd->add_option("-o,--output", options->output, "The new dataset (.gltf, beside DATASET)")->required();
   cmd->add_option("--camera", options->camera, "Camera node to replace: index or name (default: the first animated camera)");
-  cmd->add_option("--offset", options->offset, "Seconds added to the run's times after aligning its start (default: 0)");
+  cmd->add_option("--offset", options->offset, "Seconds added to the run's times after aligning its start");
   cmd->callback([options, &run] { run = [options] { return runMerge(*options); }; });
 }
 

@@ -14,28 +14,25 @@
 namespace dynbench::cli {
 namespace {
 
+// The job's defaults are the library's (render::RenderJob, render::RenderSettings); the help text
+// prints them from there.
 struct RenderCli {
-  std::string dataset, output, resolution = "480x270", frames, engine = "embree", blender = "blender";
-  std::optional<std::string> camera, animation, envConstant;
-  int spp = 16, bounces = 4, threads = 0;
-  double fps = 24.0;
-  std::uint64_t seed = 1;
+  render::RenderJob job;
+  std::string dataset, output, frames, engine = "embree";
+  std::string resolution = fmt::format("{}x{}", render::RenderSettings{}.width, render::RenderSettings{}.height);
+  std::optional<std::string> animation, envConstant;
   bool noEnvironment = false;
 };
 
 Expected<void> runRender(const RenderCli& cli) {
-  render::RenderJob job;
+  render::RenderJob job = cli.job;
   job.dataset = cli.dataset;
   job.output = cli.output;
+  job.animation = cli.animation;
   auto res = parseResolution(cli.resolution);
   if (!res) return std::unexpected(res.error());
   job.settings.width = res->first;
   job.settings.height = res->second;
-  if (cli.spp < 1) return fail(ErrorCode::kUsage, "--spp must be at least 1 (got {})", cli.spp);
-  if (cli.bounces < 0) return fail(ErrorCode::kUsage, "--bounces must be 0 or more (got {})", cli.bounces);
-  job.settings.samplesPerPixel = cli.spp;
-  job.settings.bounces = cli.bounces;
-  job.settings.seed = cli.seed;
   job.settings.useEnvironment = !cli.noEnvironment;
   if (cli.envConstant) {
     double r = 0, g = 0, b = 0;
@@ -45,10 +42,6 @@ Expected<void> runRender(const RenderCli& cli) {
     if (!(r >= 0 && g >= 0 && b >= 0)) return fail(ErrorCode::kUsage, "--env-constant '{}': radiance must be non-negative", *cli.envConstant);
     job.settings.constantEnvironment = glm::dvec3(r, g, b);
   }
-  job.fps = cli.fps;
-  job.camera = cli.camera;
-  job.threads = cli.threads;
-  job.blender = cli.blender;
   if (cli.engine == "embree") job.engine = render::Engine::kEmbree;
   else if (cli.engine == "cycles") job.engine = render::Engine::kCycles;
   else return fail(ErrorCode::kUsage, "--engine '{}': expected embree or cycles", cli.engine);
@@ -66,7 +59,7 @@ Expected<void> runRender(const RenderCli& cli) {
   // Progress on a terminal only: rows (of all frames) done, frames done, samples per second.
   std::optional<Progress> progress;
   render::RenderProgress report;
-  const double samplesPerRow = static_cast<double>(cli.spp) * job.settings.width;
+  const double samplesPerRow = static_cast<double>(job.settings.samplesPerPixel) * job.settings.width;
   const auto started = std::chrono::steady_clock::now();
   if (Progress("render", 0, "rows").enabled()) {
     report = [&](std::size_t rows, std::size_t rowsTotal, std::size_t frames, std::size_t framesTotal) {
@@ -108,17 +101,19 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
               "Example: dynbench render dataset.gltf -o frames --frames 0:47 --spp 64");
   cmd->add_option("DATASET", o->dataset, "Animated dataset (glTF, GLB, FBX, DAE, ...)")->required();
   cmd->add_option("-o,--output", o->output, "Output folder")->required();
-  cmd->add_option("--res", o->resolution, "Resolution WIDTHxHEIGHT (default: 480x270; the thesis used 1920x1080)");
-  cmd->add_option("--spp", o->spp, "Samples per pixel (default: 16; the thesis used 1024)");
-  cmd->add_option("--bounces", o->bounces, "Bounces after the first hit, as Cycles counts them (default: 4; the thesis used 12)");
-  cmd->add_option("--fps", o->fps, "Frames per second: frame i is at t = start + i / fps (default: 24)");
-  cmd->add_option("--frames", o->frames, "Frames A:B[:STEP] (inclusive), A: or A (default: every frame)");
-  cmd->add_option("--camera", o->camera, "Camera node: index or name (default: the first animated camera)");
+  cmd->add_option("--res", o->resolution, "Resolution WIDTHxHEIGHT (the thesis used 1920x1080)");
+  cmd->add_option("--spp", o->job.settings.samplesPerPixel, "Samples per pixel (the thesis used 1024)")->check(positive());
+  cmd->add_option("--bounces", o->job.settings.bounces, "Bounces after the first hit, as Cycles counts them (the thesis used 12)")
+      ->check(nonNegative());
+  cmd->add_option("--fps", o->job.fps, "Frames per second: frame i is at t = start + i / fps")->check(positive());
+  cmd->add_option("--frames", o->frames, "Frames A:B[:STEP] (inclusive), A: or A (empty: every frame)");
+  cmd->add_option("--camera", o->job.camera, "Camera node: index or name (default: the first animated camera)");
   cmd->add_option("--animation", o->animation, "Play only this animation (index or name)");
-  cmd->add_option("--seed", o->seed, "Random seed; the same seed and options give the same images (default: 1)");
-  cmd->add_option("--engine", o->engine, "embree (dynbench's path tracer) or cycles (Blender, when installed)");
-  cmd->add_option("--threads", o->threads, "Threads (default: all cores)");
-  cmd->add_option("--blender", o->blender, "Blender executable for --engine cycles (default: blender)");
+  cmd->add_option("--seed", o->job.settings.seed, "Random seed; the same seed and options give the same images");
+  cmd->add_option("--engine", o->engine, "embree (dynbench's path tracer) or cycles (Blender, when installed)")
+      ->check(CLI::IsMember({"embree", "cycles"}));
+  cmd->add_option("--threads", o->job.threads, "Threads (0: all cores)")->check(nonNegative());
+  cmd->add_option("--blender", o->job.blender, "Blender executable for --engine cycles");
   cmd->add_option("--env-constant", o->envConstant, "Light with a constant environment of radiance L or R,G,B instead of the dataset's");
   cmd->add_flag("--no-environment", o->noEnvironment, "No image-based light (black background)");
   cmd->callback([o, &run] { run = [o] { return runRender(*o); }; });

@@ -37,7 +37,7 @@ void addReportCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("RUN", o->runs, "Run folders, one row per run")->required();
   cmd->add_option("-o,--output", o->output, "The report (.html; report.md and report_files/ beside it)")->required();
   cmd->add_option("--title", o->title, "Report title");
-  cmd->add_option("--thumbnails", o->thumbnails, "Thumbnails and masks per run (default: 3)");
+  cmd->add_option("--thumbnails", o->thumbnails, "Thumbnails and masks per run (0: none)")->check(nonNegative());
   cmd->callback([o, &run] { run = [o] { return runReport(*o); }; });
 }
 

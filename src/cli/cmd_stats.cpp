@@ -110,8 +110,8 @@ void addStatsCommand(CLI::App& app, CommandRun& run) {
       "folder of .obj files or a quoted glob ('frames/*.obj'). Tables go to stdout as Markdown.\n"
       "Example: dynbench stats scene.glb other.fbx --json stats.json --plots plots/");
   cmd->add_option("FILE", options->inputs, "Datasets to measure (one table row each)")->required();
-  cmd->add_option("--fps", options->fps, "Sampling rate in frames per second (default: 24, as the thesis)")
-      ->check(CLI::PositiveNumber);
+  cmd->add_option("--fps", options->fps, "Sampling rate in frames per second")
+      ->check(positive());
   cmd->add_option("--camera", options->camera,
                   "Camera to measure: a camera index or a camera/node name (default: the first animated camera)");
   cmd->add_option("--animation", options->animation,
@@ -122,8 +122,8 @@ void addStatsCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--plots", options->plotsDir,
                   "Write Figures A.1 and A.2 (rotation per frame) as PNG and SVG to DIR (needs gnuplot)");
   cmd->add_option("--sequence-rate", options->sequenceRate,
-                  "Key frames per second of an OBJ sequence (default: 24)")
-      ->check(CLI::PositiveNumber);
+                  "Key frames per second of an OBJ sequence")
+      ->check(positive());
   cmd->callback([options, &run] { run = [options] { return runStats(*options); }; });
 }
 

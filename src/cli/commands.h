@@ -39,6 +39,12 @@ void addCaptureCommand(CLI::App& app, CommandRun& run);
 // Registers `demo`.
 void addDemoCommand(CLI::App& app, CommandRun& run);
 
+// Number checks for options (CLI11's own print the limits of double in full). A failed check is a
+// usage error, status 2, like every other malformed argument.
+CLI::Validator positive();     // > 0
+CLI::Validator nonNegative();  // >= 0
+CLI::Validator between(double low, double high);  // [low, high]
+
 // "WIDTHxHEIGHT" of a --res option (render, demo).
 Expected<std::pair<int, int>> parseResolution(const std::string& text);
 

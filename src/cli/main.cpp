@@ -12,6 +12,28 @@ namespace dynbench::cli {
 
 int exitCode(const Error& error) { return static_cast<int>(error.code); }
 
+namespace {
+
+// A number check on an option's text: empty when `accept` holds, else the reason.
+CLI::Validator numberCheck(std::string description, std::function<bool(double)> accept, std::string expected) {
+  return CLI::Validator(
+      [accept, expected](std::string& text) -> std::string {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(text, value)) return fmt::format("expected a number, got '{}'", text);
+        return accept(value) ? std::string() : fmt::format("must be {} (got {})", expected, text);
+      },
+      std::move(description));
+}
+
+}  // namespace
+
+CLI::Validator positive() { return numberCheck("POSITIVE", [](double v) { return v > 0; }, "positive"); }
+CLI::Validator nonNegative() { return numberCheck("NON-NEGATIVE", [](double v) { return v >= 0; }, "0 or more"); }
+CLI::Validator between(double low, double high) {
+  return numberCheck(fmt::format("IN [{}, {}]", low, high), [=](double v) { return v >= low && v <= high; },
+                     fmt::format("from {} to {}", low, high));
+}
+
 }  // namespace dynbench::cli
 
 int main(int argc, char** argv) {
@@ -22,6 +44,9 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("dynbench ") + kVersion);
   app.require_subcommand(0, 1);
   app.fallthrough(false);
+  // Every option's help shows its default, taken from the options struct it is bound to: the
+  // struct is the one place a default is written.
+  app.option_defaults()->always_capture_default();
   spdlog::set_pattern("dynbench: %l: %v");
 
   cli::CommandRun run;
@@ -43,7 +68,11 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version end parsing with a "success" exception.
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
+    // Any other: a usage error, with the same status in every command (docs/cli.md).
+    std::cerr << "dynbench: error: " << e.what() << "\n(`dynbench help COMMAND` lists the options)\n";
+    return static_cast<int>(ErrorCode::kUsage);
   }
   if (help->parsed()) {
     if (helpTopic.empty()) {
@@ -62,7 +91,14 @@ int main(int argc, char** argv) {
     std::cout << app.help();
     return 0;
   }
-  auto result = run();
+  Expected<void> result;
+  try {
+    result = run();
+  } catch (const std::exception& e) {
+    // Library code returns errors as values; an exception reaching here is a bug.
+    std::cerr << "dynbench: internal error (please report it): " << e.what() << "\n";
+    return static_cast<int>(ErrorCode::kInternal);
+  }
   if (!result) {
     std::cerr << "dynbench: error: " << result.error().message << "\n";
     return cli::exitCode(result.error());

@@ -8,6 +8,7 @@
 // Sun: direct normal illuminance from the ESRA clear-sky model (Rigollier, Bauer and Wald 2000),
 // B_n = I_0 exp(-0.8662 T m δ_R(m)), with Kasten-Young air mass m, turned to lux with a luminous
 // efficacy of 93 lm/W, spread evenly over the pixels of the sun's disc.
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -16,8 +17,11 @@
 
 namespace dynbench::convert {
 
+// The turbidity convert accepts: 1.7 (very clear) to 10 (hazy).
+inline constexpr std::pair<double, double> kTurbidityRange{1.7, 10.0};
+
 struct SkyParameters {
-  double turbidity = 3.0;             // 2 (very clear) to 10 (hazy)
+  double turbidity = 3.0;             // kTurbidityRange: very clear to hazy
   double sunElevationDegrees = 45.0;  // above the horizon
   double sunAzimuthDegrees = 135.0;   // from -Z (the image centre) towards +X
   int width = 1024;                   // equirectangular: height = width / 2

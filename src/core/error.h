@@ -10,6 +10,7 @@
 namespace dynbench {
 
 enum class ErrorCode {
+  kInternal = 1,       // a bug: an exception escaped the library (main catches it)
   kUsage = 2,          // bad command-line arguments
   kIo = 3,             // a file could not be read or written
   kParse = 4,          // a file is not valid syntax (JSON, GLB container, OBJ, ...)

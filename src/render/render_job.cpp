@@ -104,11 +104,13 @@ nlohmann::json renderRecord(const RenderJob& job) {
   const auto modified = fs::last_write_time(job.dataset, ec);
   if (!ec) r["dataset_modified_ns"] = static_cast<long long>(std::chrono::duration_cast<std::chrono::nanoseconds>(modified.time_since_epoch()).count());
   if (job.camera) r["camera"] = *job.camera;
+  if (job.animation) r["animation"] = *job.animation;
   if (s.constantEnvironment) r["environment_radiance"] = {s.constantEnvironment->r, s.constantEnvironment->g, s.constantEnvironment->b};
   return r;
 }
 
 Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob& job, const RenderProgress& progress) {
+  if (job.threads < 0) return fail(ErrorCode::kUsage, "--threads must be 0 (all cores) or more (got {})", job.threads);
   auto frames = jobFrames(scene, job);
   if (!frames) return std::unexpected(frames.error());
   auto cameraNode = scene::selectCameraNode(scene, job.camera);

@@ -34,6 +34,9 @@ struct RenderJob {
   double fps = 24.0;
   FrameRange frames;
   std::optional<std::string> camera;
+  // The animation played (index or name), when the scene was reduced to one with
+  // scene::keepOnlyAnimation; recorded so that frames of another animation are not reused.
+  std::optional<std::string> animation;
   int threads = 0;  // 0: all cores
   std::string blender = "blender";  // the Blender executable for --engine cycles
 };

@@ -234,7 +234,7 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
       if (!written) return std::unexpected(written.error());
       list.push_back({"Discarded pixels per frame (Eq. 3.4)", files.assets / (stem + "_discard.png")});
     }
-    const int n = std::max(1, options.thumbnails);
+    const int n = std::max(0, options.thumbnails);
     for (int t = 0; t < n && !r.frames.empty(); ++t) {
       const auto& entry = r.frames[static_cast<std::size_t>(t) * (r.frames.size() - 1) / static_cast<std::size_t>(std::max(1, n - 1))];
       auto frame = frames::readFrame(entry);
