@@ -26,6 +26,11 @@ void makeRun(const fs::path& run, const std::string& frames) {
   }
 }
 
+std::string slurp(const fs::path& p) {
+  auto text = readWholeFile(p);
+  return text ? *text : std::string();
+}
+
 std::size_t count(const std::string& text, const std::string& what) {
   std::size_t n = 0;
   for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
@@ -73,11 +78,35 @@ TEST(Report, BadRunsFailClearly) {
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_NE(r.err.find("empty/stats.json: missing"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "r.html"));
-  ASSERT_TRUE(writeFileAtomic(dir / "empty" / "stats.json", R"({"datasets": [{"properties": {}, "camera_motion": {}}]})"));
-  ASSERT_TRUE(writeFileAtomic(dir / "empty" / "discard.json", R"({"frames": []})"));
-  r = dynbench(fmt::format("report {} -o {}", (dir / "empty").string(), (dir / "r.html").string()), dir);
-  EXPECT_EQ(r.status, 5) << r.err;
-  EXPECT_NE(r.err.find("discard.json: /mean: missing"), std::string::npos) << r.err;
+  // A real run, then one malformed value at a time: the error names the file and the JSON
+  // pointer, the status is 5, and no report is written (it used to print "-" and exit 0).
+  makeRun(dir / "good", "0:1");
+  const std::string stats = slurp(dir / "good" / "stats.json"), discard = slurp(dir / "good" / "discard.json");
+  struct Case {
+    std::string file, from, to, message;
+  };
+  for (const Case& c : {Case{"stats.json", "\"faces\": ", "\"faces\": \"many\", \"was\": ",
+                             "stats.json: /datasets/0/properties/faces: expected a whole number >= 0, found \"many\""},
+                        Case{"stats.json", "\"animated_camera\": ", "\"animated_camera\": 3, \"was\": ",
+                             "stats.json: /datasets/0/properties/animated_camera: expected true or false, found 3"},
+                        Case{"stats.json", "\"variance\": ", "\"variance\": null, \"was\": ",
+                             "stats.json: /datasets/0/camera_motion/pitch_degrees/variance: expected a number, found null"},
+                        Case{"discard.json", "\"frustum\": ", "\"frustum\": \"x\", \"was\": ",
+                             "discard.json: /frames/0/frustum: expected a number, found \"x\""},
+                        Case{"discard.json", "\"mean\"", "\"average\"", "discard.json: /mean/frustum: missing"}}) {
+    fs::remove_all(dir / "bad");
+    fs::create_directories(dir / "bad");
+    std::string text = c.file == "stats.json" ? stats : discard;
+    const auto at = text.find(c.from);
+    ASSERT_NE(at, std::string::npos) << c.from;
+    text.replace(at, c.from.size(), c.to);
+    ASSERT_TRUE(writeFileAtomic(dir / "bad" / "stats.json", c.file == "stats.json" ? text : stats));
+    ASSERT_TRUE(writeFileAtomic(dir / "bad" / "discard.json", c.file == "discard.json" ? text : discard));
+    r = dynbench(fmt::format("report {} -o {}", (dir / "bad").string(), (dir / "r.html").string()), dir);
+    EXPECT_EQ(r.status, 5) << c.message << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "r.html"));
+  }
   r = dynbench(fmt::format("report {} -o {}", (dir / "empty").string(), (dir / "r.txt").string()), dir);
   EXPECT_EQ(r.status, 2) << r.err;
 }

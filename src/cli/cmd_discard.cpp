@@ -11,6 +11,7 @@
 #include "core/progress.h"
 #include "discard/discard.h"
 #include "report/plots.h"
+#include "report/tables.h"
 
 namespace dynbench::cli {
 namespace {
@@ -44,13 +45,9 @@ Expected<void> runDiscard(const DiscardCli& cli) {
   if (!run) return std::unexpected(run.error());
   for (const auto& w : run->warnings) spdlog::warn("{}: {}", cli.frames, w);
 
-  fmt::print("Table 6.7. Discarded pixels (% of the image), mean over {} frame pairs ({}x{}).\n\n", run->frames.size(), run->width,
-             run->height);
-  fmt::print("| frames | frustum % | world position % | shading normal % | direct radiance % | indirect radiance % |\n");
-  fmt::print("| ------ | --------: | ---------------: | ---------------: | ----------------: | ------------------: |\n");
-  const auto& m = run->mean;
-  fmt::print("| {} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} |\n", fs::path(cli.frames).filename().string().empty() ? cli.frames : fs::path(cli.frames).filename().string(),
-             m.frustum, m.position, m.normal, m.direct, m.indirect);
+  const std::string name = fs::path(cli.frames).filename().string().empty() ? cli.frames : fs::path(cli.frames).filename().string();
+  fmt::print("{}", report::markdownTable(report::discardTable(
+                       {{name, run->mean}}, fmt::format("{} frame pairs, {}x{}", run->frames.size(), run->width, run->height))));
 
   if (!cli.json.empty())
     if (auto ok = writeFileAtomic(cli.json, discard::discardJson(*run, cli.frames)); !ok) return ok;

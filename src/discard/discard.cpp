@@ -1,5 +1,6 @@
 #include "discard/discard.h"
 
+#include "core/json_fields.h"
 #include "core/math.h"
 #include "frames/preview.h"
 
@@ -271,6 +272,53 @@ std::string discardJson(const DiscardRun& run, const std::string& framesDir) {
   }
   j["warnings"] = run.warnings;
   return j.dump(2) + "\n";
+}
+
+namespace {
+
+Expected<FramePercentages> readPercentages(const JsonFields& f, const std::string& base) {
+  FramePercentages p;
+  for (auto [key, target] : {std::pair{"frustum", &p.frustum}, {"world_position", &p.position}, {"shading_normal", &p.normal},
+                             {"direct_radiance", &p.direct}, {"indirect_radiance", &p.indirect}}) {
+    auto v = f.number(base + "/" + key);
+    if (!v) return std::unexpected(v.error());
+    *target = *v;
+  }
+  return p;
+}
+
+}  // namespace
+
+Expected<DiscardRun> readDiscardJson(const std::filesystem::path& path) {
+  auto j = readJsonFile(path);
+  if (!j) return std::unexpected(j.error());
+  const JsonFields f(*j, path);
+  DiscardRun run;
+  for (auto [key, target] : {std::pair{"/width", &run.width}, {"/height", &run.height}}) {
+    auto v = f.integer(key);
+    if (!v) return std::unexpected(v.error());
+    *target = static_cast<int>(*v);
+  }
+  auto mean = readPercentages(f, "/mean");
+  if (!mean) return std::unexpected(mean.error());
+  run.mean = *mean;
+  run.mean.frame = -1;
+  auto frames = f.value("/frames");
+  if (!frames) return std::unexpected(frames.error());
+  if (!(*frames)->is_array()) return fail(ErrorCode::kInvalidData, "{}: /frames: expected an array", path.string());
+  for (std::size_t k = 0; k < (*frames)->size(); ++k) {
+    const std::string base = fmt::format("/frames/{}", k);
+    auto p = readPercentages(f, base);
+    if (!p) return std::unexpected(p.error());
+    auto frame = f.integer(base + "/frame");
+    if (!frame) return std::unexpected(frame.error());
+    auto time = f.number(base + "/time");
+    if (!time) return std::unexpected(time.error());
+    p->frame = static_cast<long>(*frame);
+    p->time = *time;
+    run.frames.push_back(*p);
+  }
+  return run;
 }
 
 }  // namespace dynbench::discard

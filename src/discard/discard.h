@@ -111,6 +111,9 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
 // The `discard --json` document: frames folder, size, thresholds, mean and per-frame percentages
 // (docs/cli.md); what `dynbench report` reads.
 std::string discardJson(const DiscardRun& run, const std::string& framesDir);
+// Reads back what discardJson wrote: size, mean and per-frame percentages (thresholds and warnings
+// are not read). Errors name the file and the JSON pointer of a missing or malformed value.
+Expected<DiscardRun> readDiscardJson(const std::filesystem::path& path);
 
 // The mask image of Figure 6.2: the frame's direct + indirect radiance, tone-mapped and dimmed,
 // with discarded pixels coloured by their first reason (frustum red, world position yellow,

@@ -13,75 +13,43 @@
 #include "frames/preview.h"
 #include "report/plots.h"
 #include "report/stats_output.h"
+#include "report/tables.h"
+#include "core/json_fields.h"
 
 namespace dynbench::report {
 namespace {
 
 namespace fs = std::filesystem;
-using nlohmann::json;
 
 struct Run {
   std::string name;
   fs::path dir;
-  json stats, discard;
+  StatsRow stats;
+  discard::DiscardRun discard;
   std::string cameraCsv;
   std::vector<fs::path> masks;
   std::vector<frames::FrameEntry> frames;
 };
 
-struct Table {
-  std::string title;
-  std::vector<std::string> header;
-  std::vector<std::vector<std::string>> rows;
-};
-
-std::string escapeHtml(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '&') out += "&amp;";
-    else if (c == '"') out += "&quot;";
-    else out += c;
-  }
-  return out;
-}
-
-Expected<json> readJson(const fs::path& path, const std::string& what) {
-  auto text = readWholeFile(path);
-  if (!text) return fail(ErrorCode::kIo, "{}: missing ({}); {}", path.string(), text.error().message, what);
-  try {
-    return json::parse(*text);
-  } catch (const json::parse_error& e) {
-    return fail(ErrorCode::kParse, "{}: not valid JSON: {}", path.string(), e.what());
-  }
-}
-
-// A JSON value at a pointer, with an error naming file and pointer when it is not there.
-Expected<json> at(const json& j, const fs::path& file, const std::string& pointer) {
-  const json::json_pointer p(pointer);
-  if (!j.contains(p)) return fail(ErrorCode::kInvalidData, "{}: {}: missing", file.string(), pointer);
-  return j.at(p);
-}
-
 Expected<Run> readRun(const fs::path& dir) {
   Run run;
   run.dir = dir;
   run.name = dir.filename().string().empty() ? dir.parent_path().filename().string() : dir.filename().string();
-  auto stats = readJson(dir / "stats.json", "write it with `dynbench stats DATASET --json RUN/stats.json`");
+  auto need = [&](const fs::path& file, const char* how) -> Expected<void> {
+    std::error_code ec;
+    if (!fs::is_regular_file(file, ec)) return fail(ErrorCode::kIo, "{}: missing; write it with `{}`", file.string(), how);
+    return {};
+  };
+  if (auto ok = need(dir / "stats.json", "dynbench stats DATASET --json RUN/stats.json"); !ok) return std::unexpected(ok.error());
+  if (auto ok = need(dir / "discard.json", "dynbench discard FRAMES --json RUN/discard.json"); !ok) return std::unexpected(ok.error());
+  auto stats = readJsonFile(dir / "stats.json");
   if (!stats) return std::unexpected(stats.error());
-  auto discardJson = readJson(dir / "discard.json", "write it with `dynbench discard FRAMES --json RUN/discard.json`");
-  if (!discardJson) return std::unexpected(discardJson.error());
-  auto dataset = at(*stats, dir / "stats.json", "/datasets/0");
-  if (!dataset) return std::unexpected(dataset.error());
-  run.stats = *dataset;
-  for (const char* key : {"properties", "camera_motion"})
-    if (!run.stats.contains(key))
-      return fail(ErrorCode::kInvalidData, "{}: /datasets/0/{}: missing (the stats of a dataset with a camera are needed)",
-                  (dir / "stats.json").string(), key);
-  for (const char* p : {"/mean", "/frames"})
-    if (auto ok = at(*discardJson, dir / "discard.json", p); !ok) return std::unexpected(ok.error());
-  run.discard = *discardJson;
+  auto row = readStatsRow(*stats, dir / "stats.json", 0);
+  if (!row) return std::unexpected(row.error());
+  run.stats = std::move(*row);
+  auto discarded = discard::readDiscardJson(dir / "discard.json");
+  if (!discarded) return std::unexpected(discarded.error());
+  run.discard = std::move(*discarded);
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
@@ -100,75 +68,17 @@ Expected<Run> readRun(const fs::path& dir) {
   return run;
 }
 
-std::string number(const json& j, const char* pointer, int decimals = 3) {
-  const json::json_pointer p(pointer);
-  if (!j.contains(p) || !j.at(p).is_number()) return "-";
-  return fmt::format("{:.{}f}", j.at(p).get<double>(), decimals);
-}
-std::string integer(const json& j, const char* pointer) {
-  const json::json_pointer p(pointer);
-  if (!j.contains(p) || !j.at(p).is_number()) return "-";
-  return fmt::format("{}", j.at(p).get<long long>());
-}
-std::string text(const json& j, const char* pointer) {
-  const json::json_pointer p(pointer);
-  if (!j.contains(p)) return "-";
-  if (j.at(p).is_boolean()) return j.at(p).get<bool>() ? "Yes" : "No";
-  if (j.at(p).is_string()) return j.at(p).get<std::string>();
-  return j.at(p).dump();
-}
-
 std::vector<Table> tables(const std::vector<Run>& runs) {
-  std::vector<Table> t(7);
-  t[0] = {"Table 6.1. Dataset properties.", {"dataset", "file format", "file(s) size", "faces", "animated camera", "morph targets"}, {}};
-  t[1] = {"Table 6.2. Texture details.", {"dataset", "material count", "texture count", "texture size", "material workflow"}, {}};
-  t[2] = {"Table 6.3. Animation details.",
-          {"dataset", "animation frames", "static objects", "dynamic rigid objects", "armatures", "static point lights", "dynamic point lights"},
-          {}};
-  t[3] = {"Table 6.4. Change in camera position per frame (scene units).", {"dataset", "mean", "variance", "max"}, {}};
-  t[4] = {"Table 6.5. Change in camera rotation per frame (degrees, geodesic).", {"dataset", "mean", "variance", "max"}, {}};
-  t[5] = {"Table 6.6. Change in pitch, yaw and roll per frame (degrees).",
-          {"dataset", "pitch mean", "pitch variance", "yaw mean", "yaw variance", "roll mean", "roll variance"},
-          {}};
-  t[6] = {"Table 6.7. Discarded pixels, % of the image, mean over the animation.",
-          {"dataset", "frustum %", "world position %", "shading normal %", "direct radiance %", "indirect radiance %"},
-          {}};
+  std::vector<StatsRow> statsRows;
+  std::vector<DiscardRow> discardRows;
   for (const auto& r : runs) {
-    const json& s = r.stats;
-    const auto bytes = s.contains("/properties/total_bytes"_json_pointer) ? s["properties"]["total_bytes"].get<std::uint64_t>() : 0;
-    const auto textureBytes =
-        s.contains("/properties/texture_bytes"_json_pointer) ? s["properties"]["texture_bytes"].get<std::uint64_t>() : 0;
-    t[0].rows.push_back({r.name, text(s, "/properties/file_format"), formatBytes(bytes), integer(s, "/properties/faces"),
-                         text(s, "/properties/animated_camera"), text(s, "/properties/morph_targets")});
-    t[1].rows.push_back({r.name, integer(s, "/properties/material_count"), integer(s, "/properties/texture_count"), formatBytes(textureBytes),
-                         text(s, "/properties/material_workflow")});
-    t[2].rows.push_back({r.name, integer(s, "/properties/animation_frames"), integer(s, "/properties/static_objects"),
-                         integer(s, "/properties/dynamic_rigid_objects"), integer(s, "/properties/armatures"),
-                         integer(s, "/properties/static_point_lights"), integer(s, "/properties/dynamic_point_lights")});
-    t[3].rows.push_back({r.name, number(s, "/camera_motion/position/mean"), number(s, "/camera_motion/position/variance"),
-                         number(s, "/camera_motion/position/max")});
-    t[4].rows.push_back({r.name, number(s, "/camera_motion/rotation_degrees/mean"), number(s, "/camera_motion/rotation_degrees/variance"),
-                         number(s, "/camera_motion/rotation_degrees/max")});
-    t[5].rows.push_back({r.name, number(s, "/camera_motion/pitch_degrees/mean"), number(s, "/camera_motion/pitch_degrees/variance"),
-                         number(s, "/camera_motion/yaw_degrees/mean"), number(s, "/camera_motion/yaw_degrees/variance"),
-                         number(s, "/camera_motion/roll_degrees/mean"), number(s, "/camera_motion/roll_degrees/variance")});
-    const json& d = r.discard;
-    t[6].rows.push_back({r.name, number(d, "/mean/frustum"), number(d, "/mean/world_position"), number(d, "/mean/shading_normal"),
-                         number(d, "/mean/direct_radiance"), number(d, "/mean/indirect_radiance")});
+    statsRows.push_back(r.stats);
+    statsRows.back().name = r.name;
+    discardRows.push_back({r.name, r.discard.mean});
   }
-  return t;
-}
-
-std::string htmlTable(const Table& t) {
-  std::string out = fmt::format("<table>\n<caption>{}</caption>\n<thead><tr>", escapeHtml(t.title));
-  for (const auto& h : t.header) out += "<th>" + escapeHtml(h) + "</th>";
-  out += "</tr></thead>\n<tbody>\n";
-  for (const auto& row : t.rows) {
-    out += "<tr>";
-    for (std::size_t c = 0; c < row.size(); ++c) out += (c == 0 ? "<th scope=\"row\">" : "<td>") + escapeHtml(row[c]) + (c == 0 ? "</th>" : "</td>");
-    out += "</tr>\n";
-  }
-  return out + "</tbody>\n</table>\n";
+  auto all = statsTables(statsRows);
+  all.push_back(discardTable(discardRows));
+  return all;
 }
 
 struct Figure {
@@ -225,10 +135,7 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
       list.push_back({"Figure A.1: change in pitch, yaw and roll per frame", files.assets / (stem + "_rotation_per_axis.png")});
       list.push_back({"Figure A.2: geodesic change in rotation per frame", files.assets / (stem + "_rotation_geodesic.png")});
     }
-    std::vector<discard::FramePercentages> series;
-    for (const auto& f : r.discard["frames"])
-      series.push_back({f.value("frame", 0L), f.value("time", 0.0), f.value("frustum", 0.0), f.value("world_position", 0.0),
-                        f.value("shading_normal", 0.0), f.value("direct_radiance", 0.0), f.value("indirect_radiance", 0.0)});
+    const auto& series = r.discard.frames;
     if (!series.empty()) {
       auto written = writeDiscardPlot(series, r.name, files.assets, stem);
       if (!written) return std::unexpected(written.error());
@@ -258,7 +165,7 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
   const auto allTables = tables(runs);
   // Markdown twin.
   std::string md = fmt::format("# {}\n\n", options.title);
-  for (const auto& t : allTables) md += fmt::format("{}\n\n{}\n", t.title, markdownTable(t.header, t.rows));
+  for (const auto& t : allTables) md += markdownTable(t);
   for (const auto& [name, list] : figures) {
     md += fmt::format("## {}\n\n", name);
     for (const auto& f : list)

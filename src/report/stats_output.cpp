@@ -4,13 +4,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/json_fields.h"
 #include "dynbench/version.h"
+#include "report/tables.h"
 
 namespace dynbench::report {
 namespace {
 
-std::string fixed3(double v) { return fmt::format("{:.3f}", v); }
-std::string yesNo(bool b) { return b ? "Yes" : "No"; }
 
 std::string csvField(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
@@ -67,57 +67,7 @@ std::string markdownTable(const std::vector<std::string>& header, const std::vec
 
 std::string statsMarkdown(const std::vector<StatsRow>& rows) {
   std::string out;
-  auto table = [&](const std::string& title, const std::vector<std::string>& header, auto cells) {
-    std::vector<std::vector<std::string>> body;
-    for (const auto& r : rows) {
-      std::vector<std::string> row{r.name};
-      for (auto& c : cells(r)) row.push_back(std::move(c));
-      body.push_back(std::move(row));
-    }
-    out += fmt::format("{}\n\n{}\n", title, markdownTable(header, body));
-  };
-  table("Table 6.1. Dataset properties.", {"dataset", "file format", "file(s) size", "faces", "animated camera", "morph targets"},
-        [](const StatsRow& r) {
-          const auto& p = r.properties;
-          return std::vector<std::string>{p.fileFormat, formatBytes(p.totalBytes), fmt::format("{}", p.faces),
-                                          yesNo(p.animatedCamera), yesNo(p.morphTargets)};
-        });
-  table("Table 6.2. Texture details.", {"dataset", "material count", "texture count", "texture size", "material workflow"},
-        [](const StatsRow& r) {
-          const auto& p = r.properties;
-          std::string workflow = p.materialWorkflow;
-          if (p.workflowCounts.size() > 1)
-            workflow += fmt::format(" (+{} other)", p.materialCount - p.workflowCounts.at(p.materialWorkflow));
-          return std::vector<std::string>{fmt::format("{}", p.materialCount), fmt::format("{}", p.textureCount),
-                                          formatBytes(p.textureBytes), workflow};
-        });
-  table(fmt::format("Table 6.3. Animation details (frames at {} fps).", rows.empty() ? 0.0 : rows[0].properties.fps),
-        {"dataset", "animation frames", "static objects", "dynamic rigid objects", "armatures", "static point lights",
-         "dynamic point lights"},
-        [](const StatsRow& r) {
-          const auto& p = r.properties;
-          return std::vector<std::string>{fmt::format("{}", p.animationFrames), fmt::format("{}", p.staticObjects),
-                                          fmt::format("{}", p.dynamicRigidObjects), fmt::format("{}", p.armatures),
-                                          fmt::format("{}", p.staticPointLights), fmt::format("{}", p.dynamicPointLights)};
-        });
-  auto motionCells = [](const StatsRow& r, const metrics::Summary& s, bool withMax) {
-    if (!r.motion.hasCamera) return std::vector<std::string>(withMax ? 3 : 2, "-");
-    std::vector<std::string> cells{fixed3(s.mean), fixed3(s.variance)};
-    if (withMax) cells.push_back(fixed3(s.max));
-    return cells;
-  };
-  table("Table 6.4. Change in camera position per frame (scene units).", {"dataset", "mean", "variance", "max"},
-        [&](const StatsRow& r) { return motionCells(r, r.motion.position, true); });
-  table("Table 6.5. Change in camera rotation per frame (degrees, geodesic).", {"dataset", "mean", "variance", "max"},
-        [&](const StatsRow& r) { return motionCells(r, r.motion.rotation, true); });
-  table("Table 6.6. Change in camera rotation per axis (degrees / frame).",
-        {"dataset", "pitch mean", "pitch variance", "yaw mean", "yaw variance", "roll mean", "roll variance"},
-        [&](const StatsRow& r) {
-          auto cells = motionCells(r, r.motion.pitch, false);
-          for (const auto* s : {&r.motion.yaw, &r.motion.roll})
-            for (auto& c : motionCells(r, *s, false)) cells.push_back(std::move(c));
-          return cells;
-        });
+  for (const auto& t : statsTables(rows)) out += markdownTable(t);
   return out;
 }
 
@@ -213,6 +163,76 @@ std::string cameraSeriesCsv(const metrics::CameraMotion& motion) {
                        f.yawDegrees, f.pitchDegrees, f.rollDegrees, f.positionDelta, f.rotationDelta, f.yawDelta,
                        f.pitchDelta, f.rollDelta);
   return out;
+}
+
+Expected<StatsRow> readStatsRow(const nlohmann::json& document, const std::filesystem::path& file, std::size_t index) {
+  const JsonFields f(document, file);
+  const std::string base = fmt::format("/datasets/{}", index);
+  StatsRow row;
+  auto name = f.string(base + "/name");
+  if (!name) return std::unexpected(name.error());
+  row.name = *name;
+  if (f.has(base + "/path")) {
+    auto path = f.string(base + "/path");
+    if (!path) return std::unexpected(path.error());
+    row.path = *path;
+  }
+  auto fps = f.number("/fps");
+  if (!fps) return std::unexpected(fps.error());
+  auto& p = row.properties;
+  p.fps = *fps;
+  const std::string props = base + "/properties/";
+  for (auto [key, target] : {std::pair{"file_format", &p.fileFormat}, {"material_workflow", &p.materialWorkflow}}) {
+    auto v = f.string(props + key);
+    if (!v) return std::unexpected(v.error());
+    *target = *v;
+  }
+  for (auto [key, target] : {std::pair{"animated_camera", &p.animatedCamera}, {"morph_targets", &p.morphTargets}}) {
+    auto v = f.boolean(props + key);
+    if (!v) return std::unexpected(v.error());
+    *target = *v;
+  }
+  for (auto [key, target] : {std::pair{"total_bytes", &p.totalBytes}, {"faces", &p.faces}, {"texture_bytes", &p.textureBytes}}) {
+    auto v = f.count(props + key);
+    if (!v) return std::unexpected(v.error());
+    *target = *v;
+  }
+  for (auto [key, target] : {std::pair{"material_count", &p.materialCount}, {"texture_count", &p.textureCount},
+                             {"animation_frames", &p.animationFrames}, {"static_objects", &p.staticObjects},
+                             {"dynamic_rigid_objects", &p.dynamicRigidObjects}, {"armatures", &p.armatures},
+                             {"static_point_lights", &p.staticPointLights}, {"dynamic_point_lights", &p.dynamicPointLights}}) {
+    auto v = f.count(props + key);
+    if (!v) return std::unexpected(v.error());
+    *target = static_cast<std::size_t>(*v);
+  }
+  if (f.has(props + "workflow_counts")) {
+    auto counts = f.value(props + "workflow_counts");
+    if (!counts) return std::unexpected(counts.error());
+    if (!(*counts)->is_object()) return fail(ErrorCode::kInvalidData, "{}: {}workflow_counts: expected an object", file.string(), props);
+    for (const auto& [workflow, n] : (*counts)->items()) {
+      auto v = f.count(props + "workflow_counts/" + workflow);
+      if (!v) return std::unexpected(v.error());
+      p.workflowCounts[workflow] = static_cast<std::size_t>(*v);
+    }
+  }
+  const std::string motion = base + "/camera_motion/";
+  auto camera = f.value(motion + "camera");
+  if (!camera) return std::unexpected(camera.error());
+  auto& m = row.motion;
+  m.hasCamera = !(*camera)->is_null();
+  if (m.hasCamera) {
+    auto cameraName = f.string(motion + "camera");
+    if (!cameraName) return std::unexpected(cameraName.error());
+    m.cameraName = *cameraName;
+    for (auto [key, target] : {std::pair{"position", &m.position}, {"rotation_degrees", &m.rotation}, {"pitch_degrees", &m.pitch},
+                               {"yaw_degrees", &m.yaw}, {"roll_degrees", &m.roll}})
+      for (auto [field, value] : {std::pair{"mean", &target->mean}, {"variance", &target->variance}, {"max", &target->max}}) {
+        auto v = f.number(motion + key + "/" + field);
+        if (!v) return std::unexpected(v.error());
+        *value = *v;
+      }
+  }
+  return row;
 }
 
 }  // namespace dynbench::report

@@ -1,0 +1,111 @@
+#include "report/tables.h"
+
+#include <fmt/format.h>
+
+namespace dynbench::report {
+namespace {
+
+std::string fixed3(double v) { return fmt::format("{:.3f}", v); }
+std::string yesNo(bool b) { return b ? "Yes" : "No"; }
+
+template <typename Cells>
+Table table(std::string title, std::vector<std::string> header, const std::vector<StatsRow>& rows, Cells cells) {
+  Table t{std::move(title), std::move(header), {}};
+  for (const auto& r : rows) {
+    std::vector<std::string> row{r.name};
+    for (auto& c : cells(r)) row.push_back(std::move(c));
+    t.rows.push_back(std::move(row));
+  }
+  return t;
+}
+
+// Mean, variance (and max) of a camera-motion summary; "-" without a camera.
+std::vector<std::string> motionCells(const StatsRow& r, const metrics::Summary& s, bool withMax) {
+  if (!r.motion.hasCamera) return std::vector<std::string>(withMax ? 3 : 2, "-");
+  std::vector<std::string> cells{fixed3(s.mean), fixed3(s.variance)};
+  if (withMax) cells.push_back(fixed3(s.max));
+  return cells;
+}
+
+}  // namespace
+
+std::string escapeHtml(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '<') out += "&lt;";
+    else if (c == '>') out += "&gt;";
+    else if (c == '&') out += "&amp;";
+    else if (c == '"') out += "&quot;";
+    else out += c;
+  }
+  return out;
+}
+
+std::vector<Table> statsTables(const std::vector<StatsRow>& rows) {
+  std::vector<Table> out;
+  out.push_back(table("Table 6.1. Dataset properties.",
+                      {"dataset", "file format", "file(s) size", "faces", "animated camera", "morph targets"}, rows, [](const StatsRow& r) {
+                        const auto& p = r.properties;
+                        return std::vector<std::string>{p.fileFormat, formatBytes(p.totalBytes), fmt::format("{}", p.faces),
+                                                        yesNo(p.animatedCamera), yesNo(p.morphTargets)};
+                      }));
+  out.push_back(table("Table 6.2. Texture details.", {"dataset", "material count", "texture count", "texture size", "material workflow"},
+                      rows, [](const StatsRow& r) {
+                        const auto& p = r.properties;
+                        std::string workflow = p.materialWorkflow;
+                        const auto main = p.workflowCounts.find(p.materialWorkflow);
+                        if (p.workflowCounts.size() > 1 && main != p.workflowCounts.end())
+                          workflow += fmt::format(" (+{} other)", p.materialCount - main->second);
+                        return std::vector<std::string>{fmt::format("{}", p.materialCount), fmt::format("{}", p.textureCount),
+                                                        formatBytes(p.textureBytes), workflow};
+                      }));
+  out.push_back(table(fmt::format("Table 6.3. Animation details (frames at {} fps).", rows.empty() ? 0.0 : rows[0].properties.fps),
+                      {"dataset", "animation frames", "static objects", "dynamic rigid objects", "armatures", "static point lights",
+                       "dynamic point lights"},
+                      rows, [](const StatsRow& r) {
+                        const auto& p = r.properties;
+                        return std::vector<std::string>{fmt::format("{}", p.animationFrames), fmt::format("{}", p.staticObjects),
+                                                        fmt::format("{}", p.dynamicRigidObjects), fmt::format("{}", p.armatures),
+                                                        fmt::format("{}", p.staticPointLights), fmt::format("{}", p.dynamicPointLights)};
+                      }));
+  out.push_back(table("Table 6.4. Change in camera position per frame (scene units).", {"dataset", "mean", "variance", "max"}, rows,
+                      [](const StatsRow& r) { return motionCells(r, r.motion.position, true); }));
+  out.push_back(table("Table 6.5. Change in camera rotation per frame (degrees, geodesic).", {"dataset", "mean", "variance", "max"}, rows,
+                      [](const StatsRow& r) { return motionCells(r, r.motion.rotation, true); }));
+  out.push_back(table("Table 6.6. Change in camera rotation per axis (degrees / frame).",
+                      {"dataset", "pitch mean", "pitch variance", "yaw mean", "yaw variance", "roll mean", "roll variance"}, rows,
+                      [](const StatsRow& r) {
+                        auto cells = motionCells(r, r.motion.pitch, false);
+                        for (const auto* s : {&r.motion.yaw, &r.motion.roll})
+                          for (auto& c : motionCells(r, *s, false)) cells.push_back(std::move(c));
+                        return cells;
+                      }));
+  return out;
+}
+
+Table discardTable(const std::vector<DiscardRow>& rows, const std::string& detail) {
+  Table t{"Table 6.7. Discarded pixels, % of the image, mean over the frame pairs" + (detail.empty() ? "" : " (" + detail + ")") + ".",
+          {"dataset", "frustum %", "world position %", "shading normal %", "direct radiance %", "indirect radiance %"},
+          {}};
+  for (const auto& r : rows)
+    t.rows.push_back({r.name, fixed3(r.mean.frustum), fixed3(r.mean.position), fixed3(r.mean.normal), fixed3(r.mean.direct),
+                      fixed3(r.mean.indirect)});
+  return t;
+}
+
+std::string markdownTable(const Table& t) { return fmt::format("{}\n\n{}\n", t.title, markdownTable(t.header, t.rows)); }
+
+std::string htmlTable(const Table& t) {
+  std::string out = fmt::format("<table>\n<caption>{}</caption>\n<thead><tr>", escapeHtml(t.title));
+  for (const auto& h : t.header) out += "<th>" + escapeHtml(h) + "</th>";
+  out += "</tr></thead>\n<tbody>\n";
+  for (const auto& row : t.rows) {
+    out += "<tr>";
+    for (std::size_t c = 0; c < row.size(); ++c)
+      out += (c == 0 ? "<th scope=\"row\">" : "<td>") + escapeHtml(row[c]) + (c == 0 ? "</th>" : "</td>");
+    out += "</tr>\n";
+  }
+  return out + "</tbody>\n</table>\n";
+}
+
+}  // namespace dynbench::report
