@@ -179,7 +179,7 @@ int main(int argc, char** argv) {
   double seconds[2] = {0, 0}, variance[2] = {0, 0};
   const char* names[2] = {"embree", "cycles"};
   for (int e = 0; e < 2; ++e) {
-    job.engine = e == 0 ? render::Engine::kEmbree : render::Engine::kCycles;
+    job.engine = e == 0 ? "embree" : "cycles";
     std::vector<double> y[2];
     for (int run = 0; run < 2; ++run) {
       job.settings.seed = static_cast<std::uint64_t>(run + 1);

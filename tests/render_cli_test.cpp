@@ -96,6 +96,24 @@ TEST(RenderCli, AChangedDatasetIsRenderedAgain) {
   EXPECT_NE(r.out.find("1 frame(s) rendered, 0 already complete"), std::string::npos) << r.out;
 }
 
+// The resume record covers --animation: frames rendered with one animation selection are not
+// taken as complete for another.
+TEST(RenderCli, AnotherAnimationIsRenderedAgain) {
+  const auto dir = test::freshDir("render_animation");
+  const std::string base = fmt::format("render {} -o {} --frames 0 --res 8x4 --spp 1", kOrbit.string(), (dir / "out").string());
+  auto r = dynbench(base, dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("1 frame(s) rendered, 0 already complete"), std::string::npos) << r.out;
+  EXPECT_FALSE(readJson(dir / "out" / "frame_00000.json")["render"].contains("animation"));
+  r = dynbench(base + " --animation orbit", dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("1 frame(s) rendered, 0 already complete"), std::string::npos) << r.out;
+  EXPECT_EQ(readJson(dir / "out" / "frame_00000.json")["render"]["animation"], "orbit");
+  r = dynbench(base + " --animation orbit", dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("0 frame(s) rendered, 1 already complete"), std::string::npos) << r.out;
+}
+
 TEST(RenderCli, TheDatasetEnvironmentLightsTheBackground) {
   const auto dir = test::freshDir("render_env");
   FloatImage sky;

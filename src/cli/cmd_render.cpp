@@ -8,6 +8,7 @@
 
 #include "cli/commands.h"
 #include "core/progress.h"
+#include "render/backend.h"
 #include "render/render_job.h"
 #include "scene/load.h"
 
@@ -18,7 +19,7 @@ namespace {
 // prints them from there.
 struct RenderCli {
   render::RenderJob job;
-  std::string dataset, output, frames, engine = "embree";
+  std::string dataset, output, frames;
   std::string resolution = fmt::format("{}x{}", render::RenderSettings{}.width, render::RenderSettings{}.height);
   std::optional<std::string> animation, envConstant;
   bool noEnvironment = false;
@@ -42,9 +43,6 @@ Expected<void> runRender(const RenderCli& cli) {
     if (!(r >= 0 && g >= 0 && b >= 0)) return fail(ErrorCode::kUsage, "--env-constant '{}': radiance must be non-negative", *cli.envConstant);
     job.settings.constantEnvironment = glm::dvec3(r, g, b);
   }
-  if (cli.engine == "embree") job.engine = render::Engine::kEmbree;
-  else if (cli.engine == "cycles") job.engine = render::Engine::kCycles;
-  else return fail(ErrorCode::kUsage, "--engine '{}': expected embree or cycles", cli.engine);
   if (!cli.frames.empty()) {
     auto range = render::parseFrameRange(cli.frames);
     if (!range) return std::unexpected(range.error());
@@ -110,8 +108,13 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--camera", o->job.camera, "Camera node: index or name (default: the first animated camera)");
   cmd->add_option("--animation", o->animation, "Play only this animation (index or name)");
   cmd->add_option("--seed", o->job.settings.seed, "Random seed; the same seed and options give the same images");
-  cmd->add_option("--engine", o->engine, "embree (dynbench's path tracer) or cycles (Blender, when installed)")
-      ->check(CLI::IsMember({"embree", "cycles"}));
+  std::vector<std::string> engines;
+  std::string engineHelp = "Renderer:";
+  for (const auto& b : render::renderBackends()) {
+    engines.emplace_back(b.name);
+    engineHelp += fmt::format(" {} ({}){}", b.name, b.description, &b == &render::renderBackends().back() ? "" : ";");
+  }
+  cmd->add_option("--engine", o->job.engine, engineHelp)->check(CLI::IsMember(engines));
   cmd->add_option("--threads", o->job.threads, "Threads (0: all cores)")->check(nonNegative());
   cmd->add_option("--blender", o->job.blender, "Blender executable for --engine cycles");
   cmd->add_option("--env-constant", o->envConstant, "Light with a constant environment of radiance L or R,G,B instead of the dataset's");

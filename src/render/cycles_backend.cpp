@@ -11,6 +11,7 @@
 #include "core/files.h"
 #include "core/math.h"
 #include "frames/frame_io.h"
+#include "render/backend.h"
 #include "scene/evaluate.h"
 
 namespace dynbench::render {
@@ -110,12 +111,23 @@ Expected<frames::FeatureFrame> cyclesPassesToContract(const FloatImage& passes, 
   return out;
 }
 
-Expected<void> renderWithCycles(const scene::Scene& scene, int cameraNode, const RenderJob& job, const std::vector<long>& frames,
-                                const nlohmann::json& record, const RenderProgress& progress) {
-  auto blender = findBlender(job.blender);
-  if (!blender) return std::unexpected(blender.error());
-  auto script = renderScript();
-  if (!script) return std::unexpected(script.error());
+namespace {
+
+class CyclesBackend final : public RenderBackend {
+ public:
+  CyclesBackend(const scene::Scene& scene, const RenderJob& job, fs::path blender, fs::path script)
+      : scene_(scene), job_(job), blender_(std::move(blender)), script_(std::move(script)) {}
+  Expected<void> render(const std::vector<FrameRequest>& requests, const FrameSink& done, const RowProgress& rows) override;
+
+ private:
+  const scene::Scene& scene_;
+  const RenderJob& job_;
+  fs::path blender_, script_;
+};
+
+Expected<void> CyclesBackend::render(const std::vector<FrameRequest>& requests, const FrameSink& done, const RowProgress& rows) {
+  const RenderJob& job = job_;
+  const scene::Scene& scene = scene_;
   const fs::path work = job.output / fmt::format(".cycles-{}", ::getpid());
   std::error_code ec;
   fs::create_directories(work, ec);
@@ -138,16 +150,14 @@ Expected<void> renderWithCycles(const scene::Scene& scene, int cameraNode, const
   else
     j["environment"] = {{"kind", "none"}};
   const scene::Evaluator evaluator(scene);
-  std::vector<FrameCameras> cameras;
   scene::ScenePose pose;
-  for (long f : frames) {
-    auto c = frameCameras(evaluator, cameraNode, job, f);
-    if (!c) return std::unexpected(c.error());
-    nlohmann::json frame = {{"frame", f},
-                            {"time", c->time},
-                            {"output", fs::absolute(work / fmt::format("cycles_{:05d}.exr", f)).string()},
-                            {"camera", {{"world", frames::matrixJson(c->camera.world())}, {"yfov", c->camera.yfov()}, {"znear", c->camera.znear()}, {"zfar", c->camera.zfar()}}}};
-    evaluator.evaluate(c->time, pose);
+  for (const auto& request : requests) {
+    const FrameCameras& c = request.cameras;
+    nlohmann::json frame = {{"frame", request.frame},
+                            {"time", c.time},
+                            {"output", fs::absolute(work / fmt::format("cycles_{:05d}.exr", request.frame)).string()},
+                            {"camera", {{"world", frames::matrixJson(c.camera.world())}, {"yfov", c.camera.yfov()}, {"znear", c.camera.znear()}, {"zfar", c.camera.zfar()}}}};
+    evaluator.evaluate(c.time, pose);
     frame["lights"] = nlohmann::json::array();
     for (std::size_t n = 0; n < scene.nodes.size(); ++n) {
       if (scene.nodes[n].light < 0) continue;
@@ -164,18 +174,16 @@ Expected<void> renderWithCycles(const scene::Scene& scene, int cameraNode, const
                                  {"visible", pose.visible[n] != 0}});
     }
     j["frames"].push_back(frame);
-    cameras.push_back(std::move(*c));
   }
   const fs::path jobFile = work / "job.json";
   if (auto w = writeFileAtomic(jobFile, j.dump(1)); !w) return std::unexpected(w.error());
 
-  const std::string command = fmt::format("{} --background --factory-startup --python {} -- {} 2>&1", shellQuote(blender->string()),
-                                          shellQuote(script->string()), shellQuote(jobFile.string()));
+  const std::string command = fmt::format("{} --background --factory-startup --python {} -- {} 2>&1", shellQuote(blender_.string()),
+                                          shellQuote(script_.string()), shellQuote(jobFile.string()));
   FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return fail(ErrorCode::kExternalTool, "cannot start Blender ({})", blender->string());
+  if (!pipe) return fail(ErrorCode::kExternalTool, "cannot start Blender ({})", blender_.string());
   std::string tail, line;
-  std::size_t done = 0;
-  const std::size_t rowsPerFrame = static_cast<std::size_t>(job.settings.height);
+  std::size_t finished = 0;
   char buffer[4096];
   std::string error;
   while (std::fgets(buffer, sizeof buffer, pipe)) {
@@ -184,37 +192,47 @@ Expected<void> renderWithCycles(const scene::Scene& scene, int cameraNode, const
     if (tail.size() > 4000) tail.erase(0, tail.size() - 4000);
     if (line.rfind("DYNBENCH_ERROR ", 0) == 0) error = line.substr(15);
     if (line.rfind("DYNBENCH_FRAME_DONE ", 0) == 0) {
-      // Convert the finished frame to the contract right away, so an interrupted run keeps it.
-      const std::size_t k = done++;
+      // Hand the finished frame over right away, so an interrupted run keeps it.
+      const std::size_t k = finished++;
       const fs::path raw = j["frames"][k]["output"].get<std::string>();
       auto passes = readImage(raw);
       if (!passes) {
         ::pclose(pipe);
         return std::unexpected(passes.error());
       }
-      auto image = cyclesPassesToContract(*passes, raw, cameras[k].camera);
+      auto image = cyclesPassesToContract(*passes, raw, requests[k].cameras.camera);
       if (!image) {
         ::pclose(pipe);
         return std::unexpected(image.error());
       }
-      image->frame = frames[k];
-      image->time = cameras[k].time;
-      if (auto w = frames::writeFrame(job.output, *image, record); !w) {
+      image->frame = requests[k].frame;
+      image->time = requests[k].cameras.time;
+      if (auto w = done(std::move(*image)); !w) {
         ::pclose(pipe);
-        return std::unexpected(w.error());
+        return w;
       }
       fs::remove(raw, ec);
-      if (progress) progress(done * rowsPerFrame, frames.size() * rowsPerFrame, done, frames.size());
+      if (rows && finished < requests.size()) rows(finished, 0);
     }
   }
   const int status = ::pclose(pipe);
-  if (status != 0 || done != frames.size()) {
+  if (status != 0 || finished != requests.size()) {
     while (!tail.empty() && tail.back() == '\n') tail.pop_back();
-    return fail(ErrorCode::kExternalTool, "Blender (Cycles) failed after {} of {} frames{}; its last output:\n{}", done, frames.size(),
+    return fail(ErrorCode::kExternalTool, "Blender (Cycles) failed after {} of {} frames{}; its last output:\n{}", finished, requests.size(),
                 error.empty() ? "" : ": " + error, tail);
   }
   fs::remove_all(work, ec);
   return {};
+}
+
+}  // namespace
+
+Expected<std::unique_ptr<RenderBackend>> createCyclesBackend(const BackendContext& context) {
+  auto blender = findBlender(context.job.blender);
+  if (!blender) return std::unexpected(blender.error());
+  auto script = renderScript();
+  if (!script) return std::unexpected(script.error());
+  return std::make_unique<CyclesBackend>(context.scene, context.job, std::move(*blender), std::move(*script));
 }
 
 }  // namespace dynbench::render

@@ -22,8 +22,7 @@ namespace dynbench::render {
 // Finds the Blender executable: a path, or a name looked up on PATH.
 Expected<std::filesystem::path> findBlender(const std::string& blender);
 
-Expected<void> renderWithCycles(const scene::Scene& scene, int cameraNode, const RenderJob& job, const std::vector<long>& frames,
-                                const nlohmann::json& record, const RenderProgress& progress);
+// The backend itself: createCyclesBackend (render/backend.h).
 
 // One Cycles multilayer EXR (Blender's pass names) to the contract's channels.
 Expected<frames::FeatureFrame> cyclesPassesToContract(const FloatImage& passes, const std::filesystem::path& source, const RenderCamera& camera);

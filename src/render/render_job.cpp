@@ -4,10 +4,8 @@
 #include <chrono>
 #include <thread>
 
-#include <tbb/global_control.h>
-
 #include "core/files.h"
-#include "render/cycles_backend.h"
+#include "render/backend.h"
 #include "scene/queries.h"
 #include "frames/frame_io.h"
 #include "scene/evaluate.h"
@@ -23,8 +21,6 @@ std::optional<long> parseLong(std::string_view s) {
   if (ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
   return v;
 }
-
-const char* engineName(Engine e) { return e == Engine::kCycles ? "cycles" : "embree"; }
 
 }  // namespace
 
@@ -87,7 +83,7 @@ Expected<FrameCameras> frameCameras(const scene::Evaluator& evaluator, int camer
 
 nlohmann::json renderRecord(const RenderJob& job) {
   const auto& s = job.settings;
-  nlohmann::json r = {{"engine", engineName(job.engine)},
+  nlohmann::json r = {{"engine", job.engine},
                       {"dataset", job.dataset.string()},
                       {"fps", job.fps},
                       {"samples_per_pixel", s.samplesPerPixel},
@@ -111,6 +107,8 @@ nlohmann::json renderRecord(const RenderJob& job) {
 
 Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob& job, const RenderProgress& progress) {
   if (job.threads < 0) return fail(ErrorCode::kUsage, "--threads must be 0 (all cores) or more (got {})", job.threads);
+  const auto backend = findBackend(job.engine);
+  if (!backend) return std::unexpected(backend.error());
   auto frames = jobFrames(scene, job);
   if (!frames) return std::unexpected(frames.error());
   auto cameraNode = scene::selectCameraNode(scene, job.camera);
@@ -125,49 +123,32 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
   for (long f : *frames) (frames::frameComplete(job.output, f, record) ? summary.skipped : todo).push_back(f);
   if (todo.empty()) return summary;
 
-  const auto started = std::chrono::steady_clock::now();
-  if (job.engine == Engine::kCycles) {
-    auto done = renderWithCycles(scene, *cameraNode, job, todo, record, progress);
-    if (!done) return std::unexpected(done.error());
-    summary.rendered = todo;
-    summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    return summary;
-  }
-
-  std::optional<tbb::global_control> limit;
-  if (job.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(job.threads));
-  auto tracer = PathTracer::create(scene, job.settings, summary.warnings);
-  if (!tracer) return std::unexpected(tracer.error());
-  const std::size_t rowsTotal = todo.size() * static_cast<std::size_t>(job.settings.height);
+  std::vector<FrameRequest> requests;
   const scene::Evaluator evaluator(scene);
-  for (std::size_t i = 0; i < todo.size(); ++i) {
-    const long f = todo[i];
+  for (long f : todo) {
     auto cameras = frameCameras(evaluator, *cameraNode, job, f);
     if (!cameras) return std::unexpected(cameras.error());
-    (*tracer)->setTime(cameras->time, cameras->previousTime);
-    std::atomic<int> rows{0};
-    RenderStatistics stats;
-    FrameBuffers buffers;
-    if (progress) {
-      // The frame renders on a worker thread while this one reports progress.
-      std::thread worker([&] { buffers = (*tracer)->render(static_cast<std::uint64_t>(f), cameras->camera, cameras->previous, &rows, &stats); });
-      while (rows.load() < job.settings.height) {
-        progress(i * static_cast<std::size_t>(job.settings.height) + static_cast<std::size_t>(rows.load()), rowsTotal, i, todo.size());
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      }
-      worker.join();
-    } else {
-      buffers = (*tracer)->render(static_cast<std::uint64_t>(f), cameras->camera, cameras->previous, &rows, &stats);
-    }
-    summary.cameraSamples += stats.cameraSamples;
-    summary.rays += stats.rays;
-    buffers.frame = f;
-    buffers.time = cameras->time;
-    buffers.camera = cameras->camera.frameCamera();
-    if (auto w = frames::writeFrame(job.output, buffers, record); !w) return std::unexpected(w.error());
-    summary.rendered.push_back(f);
-    if (progress) progress((i + 1) * static_cast<std::size_t>(job.settings.height), rowsTotal, i + 1, todo.size());
+    requests.push_back({f, std::move(*cameras)});
   }
+  const auto started = std::chrono::steady_clock::now();
+  auto renderer = (*backend)->create({scene, job, *cameraNode, summary.warnings});
+  if (!renderer) return std::unexpected(renderer.error());
+
+  // Around every backend alike: frames written through the contract module, progress in rows.
+  const std::size_t height = static_cast<std::size_t>(job.settings.height);
+  const std::size_t rowsTotal = requests.size() * height;
+  RowProgress rows;
+  if (progress) rows = [&](std::size_t i, int done) { progress(i * height + static_cast<std::size_t>(done), rowsTotal, i, requests.size()); };
+  const FrameSink write = [&](frames::FeatureFrame&& frame) -> Expected<void> {
+    if (auto ok = frames::writeFrame(job.output, frame, record); !ok) return ok;
+    summary.rendered.push_back(frame.frame);
+    const std::size_t done = summary.rendered.size();
+    if (progress) progress(done * height, rowsTotal, done, requests.size());
+    return {};
+  };
+  if (auto ok = (*renderer)->render(requests, write, rows); !ok) return std::unexpected(ok.error());
+  summary.cameraSamples = (*renderer)->statistics().cameraSamples;
+  summary.rays = (*renderer)->statistics().rays;
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return summary;
 }

@@ -1,5 +1,5 @@
 #pragma once
-// A render job: which frames of a dataset to render, with which engine, into which folder.
+// A render job: which frames of a dataset to render, with which backend, into which folder.
 // Frames already complete with the same settings are skipped (resumable); each file is written
 // to a temporary name and renamed.
 #include <filesystem>
@@ -24,13 +24,11 @@ struct FrameRange {
 // "A:B[:STEP]", "A:" (to the end) or "A" (one frame).
 Expected<FrameRange> parseFrameRange(const std::string& text);
 
-enum class Engine { kEmbree, kCycles };
-
 struct RenderJob {
   std::filesystem::path dataset;  // as given (recorded in sidecars)
   std::filesystem::path output;
   RenderSettings settings;
-  Engine engine = Engine::kEmbree;
+  std::string engine = "embree";  // a backend name (render/backend.h)
   double fps = 24.0;
   FrameRange frames;
   std::optional<std::string> camera;

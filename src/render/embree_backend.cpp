@@ -1,0 +1,70 @@
+// `--engine embree`: dynbench's path tracer (path_tracer.h) as a render backend.
+#include <atomic>
+#include <chrono>
+#include <optional>
+#include <thread>
+
+#include <tbb/global_control.h>
+
+#include "render/backend.h"
+#include "render/path_tracer.h"
+
+namespace dynbench::render {
+namespace {
+
+class EmbreeBackend final : public RenderBackend {
+ public:
+  EmbreeBackend(std::unique_ptr<PathTracer> tracer, int threads) : tracer_(std::move(tracer)), threads_(threads) {}
+
+  Expected<void> render(const std::vector<FrameRequest>& requests, const FrameSink& done, const RowProgress& rows) override {
+    std::optional<tbb::global_control> limit;
+    if (threads_ > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads_));
+    const int height = tracer_->settings().height;
+    for (std::size_t i = 0; i < requests.size(); ++i) {
+      const FrameRequest& request = requests[i];
+      tracer_->setTime(request.cameras.time, request.cameras.previousTime);
+      std::atomic<int> rowsDone{0};
+      RenderStatistics stats;
+      FrameBuffers buffers;
+      auto renderFrame = [&] {
+        buffers = tracer_->render(static_cast<std::uint64_t>(request.frame), request.cameras.camera, request.cameras.previous, &rowsDone,
+                                  &stats);
+      };
+      if (rows) {
+        // The frame renders on a worker thread while this one reports its rows.
+        std::thread worker(renderFrame);
+        while (rowsDone.load() < height) {
+          rows(i, rowsDone.load());
+          std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        }
+        worker.join();
+      } else {
+        renderFrame();
+      }
+      statistics_.cameraSamples += stats.cameraSamples;
+      statistics_.rays += stats.rays;
+      buffers.frame = request.frame;
+      buffers.time = request.cameras.time;
+      buffers.camera = request.cameras.camera.frameCamera();
+      if (auto ok = done(std::move(buffers)); !ok) return ok;
+    }
+    return {};
+  }
+
+  RenderStatistics statistics() const override { return statistics_; }
+
+ private:
+  std::unique_ptr<PathTracer> tracer_;
+  int threads_;
+  RenderStatistics statistics_;
+};
+
+}  // namespace
+
+Expected<std::unique_ptr<RenderBackend>> createEmbreeBackend(const BackendContext& context) {
+  auto tracer = PathTracer::create(context.scene, context.job.settings, context.warnings);
+  if (!tracer) return std::unexpected(tracer.error());
+  return std::make_unique<EmbreeBackend>(std::move(*tracer), context.job.threads);
+}
+
+}  // namespace dynbench::render
