@@ -3,7 +3,7 @@
 # Idempotent: when every package is already installed it only checks and returns.
 set -euo pipefail
 
-# Keep this list in step with docs/dependencies in README.md.
+# Keep this list in step with ../shared/ARCHITECTURE.md §4 and CONTRIBUTING.md.
 packages=(
   # build
   build-essential cmake ninja-build pkg-config git
@@ -22,6 +22,9 @@ packages=(
   blender python3-numpy
   # headless Chromium: the tests open `dynbench report`'s HTML in a real browser
   chromium
+  # fuzzing the readers of untrusted input (the `fuzz` preset, CONTRIBUTING.md): clang 16 and its
+  # libFuzzer runtime
+  clang-16 libclang-rt-16-dev
   # Cube 2: Sauerbraten (`dynbench capture cube2`): the engine's build needs, its game data, and
   # a virtual X server with Mesa's software OpenGL to run it headless
   libsdl2-dev libsdl2-image-dev libsdl2-mixer-dev libenet-dev libgl-dev cube2-data xvfb xauth

@@ -15,6 +15,7 @@
 
 #include "dynbench/version.h"
 #include "gltf_builder.h"
+#include "golden.h"
 #include "run_cli.h"
 
 namespace dynbench {
@@ -159,6 +160,13 @@ TEST(Cli, StatsWritesTablesJsonCsvSeriesAndPlots) {
   }
   for (const auto& entry : fs::directory_iterator(dir / "plots"))  // no temporaries left over
     EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos) << entry.path();
+
+  // Titles are literal text: an underscore in a dataset name is not a gnuplot subscript.
+  fs::copy_file(scene, dir / "yaw_scene.gltf");
+  const auto named = dynbench(fmt::format("stats {} --plots {}", (dir / "yaw_scene.gltf").string(), (dir / "plots2").string()), dir);
+  ASSERT_EQ(named.status, 0) << named.err;
+  const std::string svg = slurp(dir / "plots2" / "yaw_scene.gltf_rotation_geodesic.svg");
+  EXPECT_NE(svg.find("yaw_scene.gltf: geodesic change"), std::string::npos) << svg.substr(0, 3000);
 }
 
 TEST(Cli, BadInputFailsClearlyAndWritesNothing) {
@@ -201,6 +209,18 @@ TEST(Cli, SeveralDatasetsOneRowEach) {
   EXPECT_EQ(json["datasets"][0]["properties"]["armatures"], 1);
   EXPECT_TRUE(json["datasets"][0]["camera_motion"]["camera"].is_null());
   EXPECT_NE(r.out.find("| SimpleSkin.gltf |"), std::string::npos);
+}
+
+// Golden output of `stats` on fixed inputs: the bundled orbit scene and two Khronos samples.
+TEST(Golden, StatsMarkdown) {
+  const auto dir = test::freshDir("golden_stats");
+  const fs::path samples = fs::path(DYNBENCH_TESTDATA_DIR);
+  const auto r = dynbench(fmt::format("stats {} {} {}", (fs::path(DYNBENCH_SOURCE_DIR) / "examples/orbit/orbit.gltf").string(),
+                                      (samples / "BoxAnimated/BoxAnimated.gltf").string(),
+                                      (samples / "RiggedFigure/RiggedFigure.gltf").string()),
+                          dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  test::expectGolden(r.out, "stats.md");
 }
 
 }  // namespace

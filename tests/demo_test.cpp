@@ -76,6 +76,21 @@ TEST(Demo, WholeChainOnAShortMatch) {
   EXPECT_LE(max, 1.25 + 1e-3);
   EXPECT_TRUE(fs::exists(dir / "demo" / "report.html"));
   EXPECT_TRUE(fs::exists(dir / "demo" / "runs" / "colos_bot" / "discard.json"));
+
+  // A rerun with the same options reuses the capture; with another seed it captures again (it
+  // used to measure the old match under the new options' name).
+  const std::string capture = *readWholeFile(dir / "demo" / "capture" / "Capture.txt");
+  const std::string args = fmt::format("demo -o {} --seconds 3 --bots 4 --res 64x36 --spp 1 --bounces 1", (dir / "demo").string());
+  auto again = dynbench(args, dir);
+  ASSERT_EQ(again.status, 0) << again.err << again.out;
+  EXPECT_NE(again.out.find("exists, reused"), std::string::npos) << again.out;
+  EXPECT_EQ(*readWholeFile(dir / "demo" / "capture" / "Capture.txt"), capture);
+  again = dynbench(args + " --seed 2", dir);
+  ASSERT_EQ(again.status, 0) << again.err << again.out;
+  EXPECT_NE(again.out.find("was made with other options, capturing again"), std::string::npos) << again.out;
+  EXPECT_NE(*readWholeFile(dir / "demo" / "capture" / "Capture.txt"), capture);
+  EXPECT_NE(readWholeFile(dir / "demo" / "capture" / "dynbench-demo-capture.json")->find("\"seed\": 2"), std::string::npos);
+  EXPECT_NE(again.out.find("convert: capture ->"), std::string::npos) << again.out;  // the dataset follows the new capture
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "gltf_builder.h"
 #include "render/camera.h"
 #include "frames/frame_io.h"
+#include "golden.h"
 #include "run_cli.h"
 
 namespace dynbench::discard {
@@ -254,11 +255,27 @@ TEST(DiscardCli, TableJsonCsvAndMasks) {
   EXPECT_NE(r.out.find("| frustum % |"), std::string::npos) << r.out;
   const auto j = nlohmann::json::parse(*readWholeFile(dir / "d.json"));
   ASSERT_EQ(j["frames"].size(), 3u);
-  // A 2-degree yaw per frame over a 50-degree-high, 16:9 image: the same frustum share each frame.
+  // A 2-degree yaw per frame over a 50-degree-high, 48x27 image, the camera at the origin: the
+  // frustum share is the pixels whose centre ray, turned by 2 degrees about +Y, lands outside the
+  // span of the image's pixel centres (Eq. 3.3: NDC beyond 1 - 1/width or 1 - 1/height), worked out
+  // here with plain trigonometry; by the image's left-right symmetry the direction of the turn does
+  // not matter. Near the left and right edges the turn also lifts the top and bottom rows out.
+  const double tanV = std::tan(radians(25.0)), tanH = tanV * 48.0 / 27.0, turn = radians(2.0);
+  int outside = 0;
+  for (int y = 0; y < 27; ++y)
+    for (int x = 0; x < 48; ++x) {
+      const double dx = ((x + 0.5) / 48 * 2 - 1) * tanH, dy = (1 - (y + 0.5) / 27 * 2) * tanV;  // view space, z = -1
+      const double rx = dx * std::cos(turn) - std::sin(turn), rz = -dx * std::sin(turn) - std::cos(turn);
+      const double qx = (rx / -rz / tanH + 1) / 2 * 48 - 0.5, qy = (1 - dy / -rz / tanV) / 2 * 27 - 0.5;  // pixel index coordinates
+      const bool in = rz < 0 && qx >= -1e-3 && qx <= 47 + 1e-3 && qy >= -1e-3 && qy <= 26 + 1e-3;  // with discard's 1e-3 px slack
+      outside += in ? 0 : 1;
+    }
+  const double expected = 100.0 * outside / (48 * 27);
   const double f1 = j["frames"][0]["frustum"].get<double>();
-  EXPECT_GT(f1, 1.0);
-  EXPECT_NEAR(j["frames"][2]["frustum"].get<double>(), f1, 1e-9);
-  EXPECT_NEAR(j["mean"]["frustum"].get<double>(), f1, 1e-9);
+  EXPECT_GT(outside, 0);
+  EXPECT_NEAR(f1, expected, 1e-9) << outside << " pixels";
+  EXPECT_NEAR(j["frames"][2]["frustum"].get<double>(), expected, 1e-9);
+  EXPECT_NEAR(j["mean"]["frustum"].get<double>(), expected, 1e-9);
   EXPECT_EQ(j["mean"]["world_position"].get<double>(), 0.0);
   const auto csv = *readWholeFile(dir / "d.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);
@@ -321,6 +338,15 @@ TEST(DiscardCli, BadFramesFoldersFailClearly) {
 
   r = dynbench(fmt::format("discard {}", (dir / "nowhere").string()), dir);
   EXPECT_EQ(r.status, 3) << r.err;
+}
+
+// Golden output of `discard` on the analytic frames above (Table 6.7 as Markdown).
+TEST(Golden, DiscardMarkdown) {
+  const auto dir = test::freshDir("golden_discard");
+  writeFrames(dir / "frames", 4, 48, 27);
+  const auto r = dynbench(fmt::format("discard {}", (dir / "frames").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  test::expectGolden(r.out, "discard.md");
 }
 
 }  // namespace

@@ -31,6 +31,11 @@ glm::dvec3 catmullRom(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dve
   return 0.5 * ((2.0 * p1) + (-p0 + p2) * s + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * s2 + (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * s3);
 }
 
+// What makes a capture: the match options. Compared as text with the record beside a capture.
+std::string captureKey(const DemoOptions& o) {
+  return fmt::format("{{\"map\": \"{}\", \"bots\": {}, \"seconds\": {}, \"seed\": {}}}\n", o.map, o.bots, o.seconds, o.seed);
+}
+
 // stats, render, discard for one dataset into RUN.
 Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, const DemoOptions& o, const DemoLog& log) {
   auto scene = scene::loadScene(dataset);
@@ -126,7 +131,18 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
   const fs::path bot = datasets / (o.map + "_bot.gltf"), fly = datasets / (o.map + "_flythrough.gltf");
   std::error_code ec;
 
-  if (!fs::exists(capture / "Capture.txt", ec)) {
+  // The capture is reused only when it was made with the same match options (recorded beside it);
+  // anything else is captured again, and every later stage follows from the newer capture.
+  const fs::path key = capture / "dynbench-demo-capture.json";
+  const std::string wanted = captureKey(o);
+  auto recorded = readWholeFile(key);
+  const bool reusable = fs::exists(capture / "Capture.txt", ec) && recorded && *recorded == wanted;
+  if (!reusable) {
+    if (fs::exists(capture, ec)) {
+      log(fmt::format("capture: {} was made with other options, capturing again", capture.string()));
+      fs::remove_all(capture, ec);
+      if (ec) return fail(ErrorCode::kIo, "{}: cannot remove the old capture: {}", capture.string(), ec.message());
+    }
     log(fmt::format("capture: {} s of a {}-bot match on {} (seed {})", o.seconds, o.bots, o.map, o.seed));
     capture::Cube2Options c;
     c.output = capture;
@@ -137,6 +153,7 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
     auto captured = capture::captureCube2(c);
     if (!captured) return std::unexpected(captured.error());
     log(fmt::format("  {} frames in {:.0f} s", captured->frames, captured->wallSeconds));
+    if (auto ok = writeFileAtomic(key, wanted); !ok) return std::unexpected(ok.error());
   } else {
     log(fmt::format("capture: {} exists, reused", (capture / "Capture.txt").string()));
   }

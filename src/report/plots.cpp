@@ -68,8 +68,8 @@ Expected<std::vector<fs::path>> writeLineFigures(const fs::path& dir, const std:
   std::vector<std::pair<fs::path, fs::path>> moves;
   std::string script = "set datafile separator ','\nset key autotitle columnhead\nset grid\nset xlabel 'frame'\n";
   for (const auto& figure : figures) {
-    for (const auto& [terminal, ext] : {std::pair{"pngcairo size 1200,450 font ',10'", ".png"},
-                                        std::pair{"svg size 1200,450 dynamic font ',10'", ".svg"}}) {
+    for (const auto& [terminal, ext] : {std::pair{"pngcairo noenhanced size 1200,450 font ',10'", ".png"},
+                                        std::pair{"svg noenhanced size 1200,450 dynamic font ',10'", ".svg"}}) {
       const fs::path target = dir / (stem + "_" + figure.name + ext);
       const fs::path tmp = temporarySibling(target);
       std::string plot = figure.plot;
