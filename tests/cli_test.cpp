@@ -15,6 +15,7 @@
 
 #include "dynbench/version.h"
 #include "gltf_builder.h"
+#include "external_tools.h"
 #include "golden.h"
 #include "run_cli.h"
 
@@ -221,6 +222,30 @@ TEST(Golden, StatsMarkdown) {
                           dir);
   ASSERT_EQ(r.status, 0) << r.err;
   test::expectGolden(r.out, "stats.md");
+}
+
+}  // namespace
+}  // namespace dynbench
+
+namespace dynbench {
+namespace {
+
+// Run only on purpose (below): a test that needs a tool no machine has.
+TEST(ExternalTools, DISABLED_NeedsAMissingTool) { DYNBENCH_NEEDS(std::string("the tool frobnicate is not installed")); }
+
+// DYNBENCH_NEEDS skips a test whose tool is missing, and with DYNBENCH_REQUIRE_ALL=1 (.ci/run)
+// fails it instead.
+TEST(ExternalTools, RequireAllTurnsASkipIntoAFailure) {
+  const auto dir = test::freshDir("require_all");
+  std::error_code ec;
+  const std::string self = fs::read_symlink("/proc/self/exe", ec).string();
+  const std::string args = " --gtest_also_run_disabled_tests --gtest_filter=ExternalTools.DISABLED_NeedsAMissingTool 2>&1";
+  std::string out;
+  EXPECT_EQ(runShell("env -u DYNBENCH_REQUIRE_ALL " + self + args, out), 0) << out;
+  EXPECT_NE(out.find("[  SKIPPED ]"), std::string::npos) << out;
+  out.clear();
+  EXPECT_NE(runShell("DYNBENCH_REQUIRE_ALL=1 " + self + args, out), 0) << out;
+  EXPECT_NE(out.find("the tool frobnicate is not installed (DYNBENCH_REQUIRE_ALL=1: no skips)"), std::string::npos) << out;
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include "convert/merge_camera.h"
 #include "core/image_io.h"
 #include "gltf_builder.h"
+#include "external_tools.h"
 #include "run_cli.h"
 #include "scene/evaluate.h"
 #include "scene/load.h"
@@ -213,8 +214,7 @@ TEST(Convert, MaskMapBecomesMetallicRoughness) {
 
 // Blender's own glTF importer reads the dataset (the thesis rendered its datasets with Blender).
 TEST(Convert, BlenderImportsTheDataset) {
-  if (std::system("command -v blender >/dev/null 2>&1") != 0)
-    GTEST_SKIP() << "Blender is not installed (Debian package blender, with python3-numpy); the import check needs it";
+  DYNBENCH_NEEDS(test::missingBlender());
   const Converted c = convertFixture("convert_blender");
   const std::string cmd = fmt::format("blender --background --factory-startup --python {}/tools/blender/import_gltf.py -- '{}' 2>&1",
                                       DYNBENCH_SOURCE_DIR, c.dataset.string());

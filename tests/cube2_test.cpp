@@ -19,6 +19,7 @@
 #include "scene/evaluate.h"
 #include "scene/load.h"
 #include "gltf_builder.h"
+#include "external_tools.h"
 #include "run_cli.h"
 
 namespace dynbench {
@@ -26,16 +27,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string skipReason() {
-  if (!capture::findCube2Client({})) return "the Cube 2 client is not built (scripts/setup.sh, then cmake --build)";
-  if (!fs::exists("/usr/share/games/cube2/packages/base/colos.ogz")) return "Debian's cube2-data is not installed";
-  std::string out;
-  if (runShell("command -v xvfb-run >/dev/null 2>&1", out) != 0) return "xvfb-run is not installed";
-  return {};
-}
-
 TEST(Cube2, SeededMatchIsDeterministicAndConverts) {
-  if (const auto why = skipReason(); !why.empty()) GTEST_SKIP() << why << ": Cube 2 capture skipped";
+  DYNBENCH_NEEDS(test::missingCube2());
   const auto dir = test::freshDir("cube2");
   // The adapter also writes the engine's own skinned vertices of frame 120 (2 s).
   ::setenv("DYNBENCH_CAPTURE_VERIFY_FRAME", "120", 1);
@@ -120,7 +113,7 @@ TEST(Cube2, SeededMatchIsDeterministicAndConverts) {
 
 // A second map, another mode and the default --follow auto: cyber1, a 3-second team match.
 TEST(Cube2, SecondMapConvertsAndValidates) {
-  if (const auto why = skipReason(); !why.empty()) GTEST_SKIP() << why << ": Cube 2 capture skipped";
+  DYNBENCH_NEEDS(test::missingCube2());
   const auto dir = test::freshDir("cube2_cyber1");
   auto r = dynbench(fmt::format("capture cube2 -o {} --map cyber1 --mode teamplay --bots 4 --seconds 3 --seed 5", (dir / "cap").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
@@ -157,7 +150,7 @@ TEST(Cube2, BadOptionsFailClearly) {
   r = dynbench(fmt::format("capture cube2 -o {} --client {}", (dir / "x").string(), (dir / "nothing").string()), dir);
   EXPECT_EQ(r.status, 7) << r.err;
   EXPECT_NE(r.err.find("nothing"), std::string::npos) << r.err;
-  if (skipReason().empty()) {
+  if (test::missingCube2().empty()) {
     r = dynbench(fmt::format("capture cube2 -o {} --map nosuchmap", (dir / "x").string()), dir);
     EXPECT_EQ(r.status, 3) << r.err;
     EXPECT_NE(r.err.find("map 'nosuchmap' not found"), std::string::npos) << r.err;

@@ -9,6 +9,7 @@
 #include "core/image_io.h"
 #include "gltf_builder.h"
 #include "render/cycles_backend.h"
+#include "external_tools.h"
 #include "run_cli.h"
 
 namespace dynbench {
@@ -63,7 +64,7 @@ std::vector<float> channels(const FloatImage& image, const std::vector<std::stri
 }
 
 TEST(Cycles, PositionAndNormalAgreeWithDynbench) {
-  if (!render::findBlender("blender")) GTEST_SKIP() << "Blender is not installed (apt-get install blender): Cycles comparison skipped";
+  DYNBENCH_NEEDS(test::missingBlender());
   const auto dir = test::freshDir("cycles_pn");
   const fs::path scene = floorAndSphere(dir);
   const int w = 64, h = 48;

@@ -11,6 +11,7 @@
 #include "core/math.h"
 #include "pipeline/demo.h"
 #include "gltf_builder.h"
+#include "external_tools.h"
 #include "run_cli.h"
 
 namespace dynbench {
@@ -58,8 +59,7 @@ TEST(Demo, FlythroughPassesThroughTheKeysAndTurnsSlowly) {
 }
 
 TEST(Demo, WholeChainOnAShortMatch) {
-  if (!capture::findCube2Client({}) || !fs::exists("/usr/share/games/cube2/packages/base/colos.ogz"))
-    GTEST_SKIP() << "the Cube 2 client or Debian's cube2-data is missing: demo skipped";
+  DYNBENCH_NEEDS(test::missingCube2());
   const fs::path dir = test::freshDir("demo_chain");
   const auto r = dynbench(fmt::format("demo -o {} --seconds 3 --bots 4 --res 64x36 --spp 1 --bounces 1", (dir / "demo").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err << r.out;

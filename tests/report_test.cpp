@@ -7,6 +7,7 @@
 
 #include "core/files.h"
 #include "gltf_builder.h"
+#include "external_tools.h"
 #include "run_cli.h"
 
 namespace dynbench {
@@ -55,10 +56,8 @@ TEST(Report, TablesAndImagesInTheBrowser) {
   EXPECT_EQ(html.find("http://"), std::string::npos);  // self-contained: nothing to fetch
   EXPECT_EQ(html.find("src=\"report_files"), std::string::npos);
 
+  DYNBENCH_NEEDS(test::missingChromium());
   std::string dom;
-  const int status = runShell("command -v chromium >/dev/null 2>&1", dom);
-  if (status != 0) GTEST_SKIP() << "chromium is not installed (apt-get install chromium): browser check skipped";
-  dom.clear();
   ASSERT_EQ(runShell(fmt::format("timeout 120 chromium --headless --no-sandbox --disable-gpu --virtual-time-budget=5000 --dump-dom "
                                  "file://{} 2>/dev/null",
                                  fs::absolute(dir / "out" / "report.html").string()),

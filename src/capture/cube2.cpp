@@ -10,6 +10,7 @@
 
 #include "capture/check.h"
 #include "core/files.h"
+#include "core/runtime_files.h"
 
 namespace dynbench::capture {
 namespace fs = std::filesystem;
@@ -19,9 +20,9 @@ Expected<fs::path> findCube2Client(const fs::path& requested) {
     if (isExecutable(requested)) return requested;
     return fail(ErrorCode::kExternalTool, "--client {}: not an executable file", requested.string());
   }
-  if (const char* env = std::getenv("DYNBENCH_CUBE2_CLIENT"); env && *env && isExecutable(env)) return fs::path(env);
-  const fs::path built = DYNBENCH_CUBE2_CLIENT_BUILD_PATH;
-  if (!built.empty() && isExecutable(built)) return built;
+  for (const auto& c : runtimeFileCandidates({"the Cube 2 client", "DYNBENCH_CUBE2_CLIENT", "lib/dynbench/cube2/sauer_client",
+                                              DYNBENCH_CUBE2_CLIENT_BUILD_PATH}))
+    if (isExecutable(c)) return c;
   return fail(ErrorCode::kExternalTool,
               "the Cube 2 client with dynbench's capture hooks is not built: run scripts/setup.sh, then cmake --build "
               "(target cube2_client), or pass --client PATH");

@@ -7,6 +7,7 @@
 #include <mutex>
 
 #include "core/files.h"
+#include "core/runtime_files.h"
 
 namespace dynbench {
 namespace {
@@ -24,21 +25,14 @@ struct Module {
   std::string error;
 };
 
-// Finds the image module: $DYNBENCH_IMAGE_MODULE, beside the executable (or in ../lib/dynbench),
-// then where the build put it.
+// Finds the image module where core/runtime_files.h looks: $DYNBENCH_IMAGE_MODULE, the install
+// (PREFIX/lib/dynbench), then where the build put it.
 const Module& module() {
   static Module m;
   static std::once_flag once;
   std::call_once(once, [] {
-    std::vector<fs::path> candidates;
-    if (const char* env = std::getenv("DYNBENCH_IMAGE_MODULE")) candidates.emplace_back(env);
-    std::error_code ec;
-    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-    if (!ec) {
-      candidates.push_back(exe.parent_path() / "libdynbench_image.so");
-      candidates.push_back(exe.parent_path() / "../lib/dynbench/libdynbench_image.so");
-    }
-    candidates.emplace_back(DYNBENCH_IMAGE_MODULE_BUILD_PATH);
+    const auto candidates = runtimeFileCandidates({"the image module libdynbench_image.so", "DYNBENCH_IMAGE_MODULE",
+                                                   "lib/dynbench/libdynbench_image.so", DYNBENCH_IMAGE_MODULE_BUILD_PATH});
     std::string tried;
     for (const auto& c : candidates) {
       void* handle = ::dlopen(c.c_str(), RTLD_NOW | RTLD_LOCAL);

@@ -10,6 +10,7 @@
 
 #include "core/files.h"
 #include "core/math.h"
+#include "core/runtime_files.h"
 #include "frames/frame_io.h"
 #include "render/backend.h"
 #include "scene/evaluate.h"
@@ -19,17 +20,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The script beside the executable's share folder, or in the source tree the build came from.
+// The Blender side of the backend, found as every run-time file (core/runtime_files.h).
 Expected<fs::path> renderScript() {
-  std::vector<fs::path> candidates;
-  if (const char* env = std::getenv("DYNBENCH_BLENDER_SCRIPT")) candidates.emplace_back(env);
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) candidates.push_back(exe.parent_path() / "../share/dynbench/blender/render_cycles.py");
-  candidates.emplace_back(fs::path(DYNBENCH_SOURCE_DIR) / "tools" / "blender" / "render_cycles.py");
-  for (const auto& c : candidates)
-    if (fs::is_regular_file(c, ec)) return c;
-  return fail(ErrorCode::kExternalTool, "cannot find tools/blender/render_cycles.py (set DYNBENCH_BLENDER_SCRIPT)");
+  return findRuntimeFile({"the Blender script render_cycles.py", "DYNBENCH_BLENDER_SCRIPT", "share/dynbench/blender/render_cycles.py",
+                          fs::path(DYNBENCH_SOURCE_DIR) / "tools" / "blender" / "render_cycles.py"});
 }
 
 // Channel lookup by Blender's names ("ViewLayer.DiffDir.R" or "DiffDir.R").

@@ -1,0 +1,52 @@
+#pragma once
+// The external programs some tests need, each detected in one place. Each function returns an
+// empty string when the tool is there, else why not and how to install it. A test that needs one
+// uses DYNBENCH_NEEDS(...): it skips when the tool is missing, unless DYNBENCH_REQUIRE_ALL=1 (set
+// by .ci/run), where it fails, so CI can never pass by skipping Cube 2, Blender or Chromium.
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "capture/cube2.h"
+
+namespace dynbench::test {
+
+inline bool onPath(const char* program) {
+  return std::system((std::string("command -v ") + program + " >/dev/null 2>&1").c_str()) == 0;
+}
+
+inline std::string missingBlender() {
+  return onPath("blender") ? "" : "Blender is not installed (Debian packages blender and python3-numpy; scripts/setup.sh)";
+}
+inline std::string missingChromium() {
+  return onPath("chromium") ? "" : "Chromium is not installed (Debian package chromium; scripts/setup.sh)";
+}
+inline std::string missingGltfValidator() {
+  if (!onPath("node")) return "node is not installed (Debian package nodejs; scripts/setup.sh)";
+  const auto validator = std::filesystem::path(DYNBENCH_SOURCE_DIR) / "tools/gltf-validator/node_modules/gltf-validator";
+  return std::filesystem::exists(validator) ? "" : "the Khronos glTF validator is not installed (scripts/setup.sh runs npm ci)";
+}
+inline std::string missingCube2() {
+  if (!capture::findCube2Client({})) return "the Cube 2 client is not built (scripts/setup.sh, then cmake --build)";
+  if (!std::filesystem::exists("/usr/share/games/cube2/packages/base/colos.ogz")) return "Debian's cube2-data is not installed";
+  if (!onPath("xvfb-run")) return "xvfb-run is not installed (Debian package xvfb)";
+  return {};
+}
+
+inline bool requireAll() {
+  const char* v = std::getenv("DYNBENCH_REQUIRE_ALL");
+  return v && std::string(v) == "1";
+}
+
+}  // namespace dynbench::test
+
+#define DYNBENCH_NEEDS(missing)                                                                            \
+  do {                                                                                                     \
+    const std::string dynbenchMissing_ = (missing);                                                        \
+    if (!dynbenchMissing_.empty()) {                                                                       \
+      if (::dynbench::test::requireAll()) FAIL() << dynbenchMissing_ << " (DYNBENCH_REQUIRE_ALL=1: no skips)"; \
+      GTEST_SKIP() << dynbenchMissing_;                                                                    \
+    }                                                                                                      \
+  } while (0)
