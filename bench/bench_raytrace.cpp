@@ -35,7 +35,8 @@ int main(int argc, char** argv) {
   const double staticBuild = std::chrono::duration<double>(Clock::now() - start).count();
   start = Clock::now();
   constexpr int kUpdates = 10;
-  for (int i = 0; i < kUpdates; ++i) (*rt)->update(t + i / 60.0);
+  for (int i = 0; i < kUpdates; ++i)
+    if (auto ok = (*rt)->update(t + i / 60.0); !ok) std::fprintf(stderr, "%s\n", ok.error().message.c_str());
   const double dynamicBuild = std::chrono::duration<double>(Clock::now() - start).count() / kUpdates;
   const auto stats = (*rt)->stats();
   {

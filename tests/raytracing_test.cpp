@@ -47,7 +47,7 @@ TEST(RayTracing, GroundHitsEqualTheAnalyticIntersection) {
   const scene::Scene s = groundAndCrate();
   auto rt = RayTracingScene::create(s);
   ASSERT_TRUE(rt) << rt.error().message;
-  (*rt)->update(0.0);
+  ASSERT_TRUE((*rt)->update(0.0));
   EXPECT_EQ((*rt)->stats().staticTriangles, 2u);
   EXPECT_EQ((*rt)->stats().dynamicTriangles, 2u);
   // Camera at (0, 5, 8) pitched down 30 degrees.
@@ -89,14 +89,14 @@ TEST(RayTracing, DynamicGeometryFollowsTheAnimationAndDisappears) {
   auto rt = RayTracingScene::create(s);
   ASSERT_TRUE(rt);
   const Ray down{{2.2, 5, 0}, {0, -1, 0}};
-  (*rt)->update(0.0);
+  ASSERT_TRUE((*rt)->update(0.0));
   EXPECT_EQ((*rt)->intersect(down).node, 0);  // the crate (|x| <= 0.5) is not under x = 2.2 yet
-  (*rt)->update(2.0);  // the crate has slid to x = 2
+  ASSERT_TRUE((*rt)->update(2.0));  // the crate has slid to x = 2
   SurfaceHit hit = (*rt)->intersect(down);
   EXPECT_EQ(hit.node, 1);
   EXPECT_NEAR(hit.position.y, 1.0, 1e-6);
   EXPECT_NEAR(hit.position.x, 2.2, 1e-6);
-  (*rt)->update(3.0);  // scaled to zero: gone
+  ASSERT_TRUE((*rt)->update(3.0));  // scaled to zero: gone
   hit = (*rt)->intersect({{3.0, 5, 0}, {0, -1, 0}});
   EXPECT_EQ(hit.node, 0);
   EXPECT_EQ((*rt)->stats().dynamicTriangles, 0u);
@@ -109,7 +109,7 @@ TEST(RayTracing, SkinnedHitsLandOnTheEvaluatedSkin) {
   ASSERT_TRUE(rt);
   const scene::Evaluator e(*s);
   for (double t : {0.0, 2.0, 4.5}) {
-    (*rt)->update(t);
+    ASSERT_TRUE((*rt)->update(t));
     const auto world = e.worldPositions(0, 0, t);
     const auto& indices = s->meshes[0].primitives[0].indices;
     for (std::size_t tri = 0; tri < indices.size() / 3; ++tri) {

@@ -113,7 +113,7 @@ TEST(Render, WhiteFurnace) {
   settings.constantEnvironment = glm::dvec3(1.0);
   auto tracer = tracerFor(s, settings);
   ASSERT_TRUE(tracer);
-  tracer->setTime(0.0, 0.0);
+  ASSERT_TRUE(tracer->setTime(0.0, 0.0));
   const RenderCamera cam = lookCamera({0, 0, 4}, {0, 0, -1}, 40.0, 64, 64);
   const FrameBuffers f = tracer->render(0, cam, cam);
   double sum = 0.0, variance = 0.0;
@@ -161,7 +161,7 @@ TEST(Render, PointLightOverDiffusePlaneGivesTheAnalyticRadiance) {
   settings.useEnvironment = false;
   auto tracer = tracerFor(p.scene, settings);
   ASSERT_TRUE(tracer);
-  tracer->setTime(0.0, 0.0);
+  ASSERT_TRUE(tracer->setTime(0.0, 0.0));
   const int w = 80, h = 60;
   const RenderCamera cam = lookCamera({0, 4, 0}, {0, -1, 0}, 60.0, w, h);
   const FrameBuffers f = tracer->render(0, cam, cam);
@@ -209,8 +209,8 @@ TEST(Render, ManyPunctualLightsAreChosenWithoutBias) {
   settings.useEnvironment = false;
   auto a = tracerFor(one.scene, settings), c = tracerFor(ten, settings);
   ASSERT_TRUE(a && c);
-  a->setTime(0, 0);
-  c->setTime(0, 0);
+  ASSERT_TRUE(a->setTime(0, 0));
+  ASSERT_TRUE(c->setTime(0, 0));
   const RenderCamera cam = lookCamera({0, 4, 0}, {0, -1, 0}, 60.0, 40, 30);
   const FrameBuffers fa = a->render(0, cam, cam), fc = c->render(0, cam, cam);
   double sumA = 0, sumC = 0, var = 0;
@@ -241,7 +241,7 @@ TEST(Render, SpotLightConeAndRangeWindow) {
   settings.useEnvironment = false;
   auto tracer = tracerFor(s, settings);
   ASSERT_TRUE(tracer);
-  tracer->setTime(0.0, 0.0);
+  ASSERT_TRUE(tracer->setTime(0.0, 0.0));
   const RenderCamera cam = lookCamera({0, 6, 0}, {0, -1, 0}, 90.0, 101, 101);
   const FrameBuffers f = tracer->render(0, cam, cam);
   for (std::size_t i = 0; i < f.hit.size(); ++i) {
@@ -262,7 +262,7 @@ TEST(Render, GeometryBuffersOfAPlaneEqualTheAnalyticIntersection) {
   settings.samplesPerPixel = 1;
   auto tracer = tracerFor(p.scene, settings);
   ASSERT_TRUE(tracer);
-  tracer->setTime(0.0, 0.0);
+  ASSERT_TRUE(tracer->setTime(0.0, 0.0));
   const int w = 64, h = 48;
   // Looking down at 35 degrees from (0, 2, 5): the far rows see past the plane's edge.
   const RenderCamera cam = lookCamera({0, 2, 5}, {0, -std::tan(radians(35.0)), -1}, 50.0, w, h);
@@ -329,8 +329,8 @@ TEST(Render, DirectPlusIndirectEqualsAnIndependentFullRender) {
   settings.seed = 2;
   auto bsdfOnly = tracerFor(s, settings);
   ASSERT_TRUE(mis && bsdfOnly);
-  mis->setTime(0, 0);
-  bsdfOnly->setTime(0, 0);
+  ASSERT_TRUE(mis->setTime(0, 0));
+  ASSERT_TRUE(bsdfOnly->setTime(0, 0));
   const FrameBuffers a = mis->render(0, cam, cam), c = bsdfOnly->render(0, cam, cam);
   int blocks = 0;
   double worst = 0.0;
@@ -372,7 +372,7 @@ TEST(Render, SameSeedSameImageWhateverTheThreads) {
   auto render = [&](std::uint64_t seed, int threads) {
     settings.seed = seed;
     auto t = tracerFor(p.scene, settings);
-    t->setTime(0, 0);
+    EXPECT_TRUE(t->setTime(0, 0));
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
     const FrameBuffers f = t->render(3, cam, cam);
     std::vector<float> all;  // every buffer of the contract, one after another
@@ -416,7 +416,7 @@ TEST(Render, PositionBufferFollowsTheSkinnedMesh) {
   const scene::Evaluator evaluator(*s);
   const RenderCamera cam = lookCamera({0.5, 1.0, 4.0}, {0, 0, -1}, 45.0, 48, 64);
   for (double t : {0.0, 1.5, 3.5}) {
-    tracer->setTime(t, t - 1.0 / 24);
+    ASSERT_TRUE(tracer->setTime(t, t - 1.0 / 24));
     const FrameBuffers f = tracer->render(0, cam, cam);
     std::vector<glm::dvec3> world;
     const int meshNode = 0;
@@ -445,7 +445,7 @@ TEST(Render, MotionOfACameraPanIsExact) {
   settings.useEnvironment = false;
   auto tracer = tracerFor(p.scene, settings);
   ASSERT_TRUE(tracer);
-  tracer->setTime(0, 0);
+  ASSERT_TRUE(tracer->setTime(0, 0));
   const int w = 64, h = 36;
   const double yfov = radians(50.0), a = radians(4.0), tanHalf = std::tan(yfov / 2), aspect = double(w) / h;
   const glm::dvec3 eye(0, 2, 1);
@@ -494,7 +494,7 @@ TEST(Render, MotionOfATranslatingObject) {
   ASSERT_TRUE(tracer);
   const int w = 64, h = 64;
   const RenderCamera cam = lookCamera({0, 5, 0}, {0, -1, 0}, 40.0, w, h);
-  tracer->setTime(1.0, 1.0 - 1.0 / 24);
+  ASSERT_TRUE(tracer->setTime(1.0, 1.0 - 1.0 / 24));
   const FrameBuffers f = tracer->render(24, cam, cam);
   const double unitsPerPixel = 2.0 * 4.0 * std::tan(radians(20.0)) / h;
   int checked = 0;

@@ -22,7 +22,7 @@ class EmbreeBackend final : public RenderBackend {
     const int height = tracer_->settings().height;
     for (std::size_t i = 0; i < requests.size(); ++i) {
       const FrameRequest& request = requests[i];
-      tracer_->setTime(request.cameras.time, request.cameras.previousTime);
+      if (auto ok = tracer_->setTime(request.cameras.time, request.cameras.previousTime); !ok) return ok;
       std::atomic<int> rowsDone{0};
       RenderStatistics stats;
       FrameBuffers buffers;

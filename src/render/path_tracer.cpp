@@ -170,9 +170,10 @@ PathTracer::Shading PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& w
 
 SurfaceHit PathTracer::trace(const Ray& ray) const { return rayTracing_->intersect(ray); }
 
-void PathTracer::setTime(double time, double previousTime) {
-  if (!time_ || *time_ != previousTime) rayTracing_->update(previousTime);
-  rayTracing_->update(time);
+Expected<void> PathTracer::setTime(double time, double previousTime) {
+  if (!time_ || *time_ != previousTime)
+    if (auto ok = rayTracing_->update(previousTime); !ok) return ok;
+  if (auto ok = rayTracing_->update(time); !ok) return ok;
   time_ = time;
   // The scene's size for the light choice: from the first frame's geometry.
   if (!sceneRadius_) {
@@ -188,6 +189,7 @@ void PathTracer::setTime(double time, double previousTime) {
   }
   lights_.build(scene_, *rayTracing_, environment_ ? &*environment_ : nullptr, *sceneRadius_,
                 [this](int node, int primitive, unsigned triangle, glm::dvec2 b) { return emission(node, primitive, triangle, b); });
+  return {};
 }
 
 FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& camera, const RenderCamera& previousCamera,

@@ -51,7 +51,7 @@ class PathTracer {
   ~PathTracer();
 
   // Moves the scene to time t; `previousTime` is where motion vectors point back to.
-  void setTime(double time, double previousTime);
+  [[nodiscard]] Expected<void> setTime(double time, double previousTime);
   // Renders the frame at the current time. `frameIndex` seeds the random streams;
   // `rowsDone` (optional) counts finished rows for progress reporting.
   FrameBuffers render(std::uint64_t frameIndex, const RenderCamera& camera, const RenderCamera& previousCamera,

@@ -169,11 +169,13 @@ Expected<std::unique_ptr<RayTracingScene>> RayTracingScene::create(const scene::
   }
   rtcCommitScene(impl->dynamicScene);
   rtcCommitScene(impl->top);
-  if (!impl->error.empty()) return fail(ErrorCode::kExternalTool, "Embree: {}", impl->error);
+  if (const RTCError code = rtcGetDeviceError(impl->device); code != RTC_ERROR_NONE || !impl->error.empty())
+    return fail(ErrorCode::kExternalTool, "Embree: building the scene failed: {}",
+                impl->error.empty() ? fmt::format("error code {}", static_cast<int>(code)) : impl->error);
   return std::unique_ptr<RayTracingScene>(new RayTracingScene(std::move(impl)));
 }
 
-void RayTracingScene::update(double t) {
+Expected<void> RayTracingScene::update(double t) {
   Impl& m = *impl_;
   m.stats.dynamicTriangles = 0;
   m.evaluator.evaluate(t, m.pose);  // all world matrices and visibility once, then look them up
@@ -204,7 +206,15 @@ void RayTracingScene::update(double t) {
   rtcCommitScene(m.dynamicScene);
   rtcCommitGeometry(rtcGetGeometry(m.top, 1));
   rtcCommitScene(m.top);
+  // Embree reports errors through the callback (and its error flag); a failed refit or commit
+  // would otherwise trace against a half-updated BVH.
+  if (const RTCError code = rtcGetDeviceError(m.device); code != RTC_ERROR_NONE || !m.error.empty()) {
+    const std::string message = m.error.empty() ? fmt::format("error code {}", static_cast<int>(code)) : m.error;
+    m.error.clear();
+    return fail(ErrorCode::kExternalTool, "Embree: updating the scene to t = {} s failed: {}", t, message);
+  }
   m.updated = true;
+  return {};
 }
 
 glm::dvec3 RayTracingScene::previousPosition(const SurfaceHit& hit) const {

@@ -53,7 +53,8 @@ class RayTracingScene {
 
   // Refits the dynamic part to time t (node transforms, skinning, morph targets, visibility). The
   // positions of the update before are kept for previousPosition().
-  void update(double t);
+  // Errors from Embree (device errors after the refit and commits) come back as kExternalTool.
+  [[nodiscard]] Expected<void> update(double t);
   // Where the surface point of `hit` was at the previous update: the same barycentric point of the
   // same triangle, moved with its node, skin and morph targets (the hit position itself for static
   // geometry, and for geometry that was hidden then).
