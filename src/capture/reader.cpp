@@ -12,11 +12,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CaptureError {
-  ErrorCode code;
-  std::string message;
-};
-
 // One line split at ':' with typed access; every failure names file:line.
 class Line {
  public:
@@ -31,7 +26,7 @@ class Line {
   }
 
   [[noreturn]] void fail(const std::string& message, ErrorCode code = ErrorCode::kInvalidData) const {
-    throw CaptureError{code, fmt::format("{}:{}: {}", file_, number_, message)};
+    throw Failure{Error{code, fmt::format("{}:{}: {}", file_, number_, message)}};
   }
 
   std::string_view token() const { return fields_[0]; }
@@ -122,13 +117,13 @@ CameraSettings cameraSettings(const Line& l) {
 CapturedModel parseModelMesh(const fs::path& path) {
   const std::string file = path.string();
   LineSource source(path);
-  if (!source.opened()) throw CaptureError{ErrorCode::kIo, file + ": cannot open"};
+  if (!source.opened()) throw Failure{Error{ErrorCode::kIo, file + ": cannot open"}};
   CapturedModel model;
   model.file = path;
   std::string text;
   bool complete = true;
   if (!source.next(text, complete) || text != kModelMeshVersionLine)
-    throw CaptureError{ErrorCode::kParse, fmt::format("{}:1: expected the version line '{}'", file, kModelMeshVersionLine)};
+    throw Failure{Error{ErrorCode::kParse, fmt::format("{}:1: expected the version line '{}'", file, kModelMeshVersionLine)}};
   std::vector<std::size_t> declaredVertices, declaredTriangles;
   std::vector<std::vector<int>> influenceCounts;  // per mesh, per vertex: joints listed by `j`
   std::set<int> bound, inverseBound;
@@ -215,13 +210,13 @@ CapturedModel parseModelMesh(const fs::path& path) {
     }
   }
   const auto where = fmt::format("{}:{}", file, source.number());
-  if (model.path.empty()) throw CaptureError{ErrorCode::kInvalidData, where + ": no 'o' record naming the model"};
-  if (bound != inverseBound) throw CaptureError{ErrorCode::kInvalidData, where + ": every joint needs both a 'b' and an 'x' record"};
+  if (model.path.empty()) throw Failure{Error{ErrorCode::kInvalidData, where + ": no 'o' record naming the model"}};
+  if (bound != inverseBound) throw Failure{Error{ErrorCode::kInvalidData, where + ": every joint needs both a 'b' and an 'x' record"}};
   for (const auto& mesh : model.meshes) {
     const std::size_t n = declaredVertices[static_cast<std::size_t>(mesh.id)];
     auto check = [&](std::size_t count, const char* what, bool optional) {
       if (count != n && !(optional && count == 0))
-        throw CaptureError{ErrorCode::kInvalidData, fmt::format("{}: mesh {} declares {} vertices but has {} {} records", where, mesh.id, n, count, what)};
+        throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} declares {} vertices but has {} {} records", where, mesh.id, n, count, what)}};
     };
     check(mesh.positions.size(), "'p'", false);
     check(mesh.normals.size(), "'n'", true);
@@ -229,15 +224,15 @@ CapturedModel parseModelMesh(const fs::path& path) {
     check(mesh.joints.size(), "'j'", true);
     check(mesh.weights.size(), "'w'", true);
     if (mesh.indices.size() != 3 * declaredTriangles[static_cast<std::size_t>(mesh.id)])
-      throw CaptureError{ErrorCode::kInvalidData, fmt::format("{}: mesh {} declares {} triangles but has {} 'i' records", where, mesh.id,
-                                                              declaredTriangles[static_cast<std::size_t>(mesh.id)], mesh.indices.size() / 3)};
+      throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} declares {} triangles but has {} 'i' records", where, mesh.id,
+                                                              declaredTriangles[static_cast<std::size_t>(mesh.id)], mesh.indices.size() / 3)}};
     for (std::uint32_t index : mesh.indices)
-      if (index >= n) throw CaptureError{ErrorCode::kInvalidData, fmt::format("{}: mesh {} has a triangle using vertex {} of {}", where, mesh.id, index, n)};
+      if (index >= n) throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} has a triangle using vertex {} of {}", where, mesh.id, index, n)}};
     for (std::size_t v = 0; v < mesh.joints.size(); ++v)
       for (int k = 0; k < influenceCounts[static_cast<std::size_t>(mesh.id)][v]; ++k)
         if (mesh.joints[v][k] >= model.joints.size())
-          throw CaptureError{ErrorCode::kInvalidData, fmt::format("{}: mesh {} vertex {} uses joint {} but the model has {} joints", where,
-                                                                  mesh.id, v, mesh.joints[v][k], model.joints.size())};
+          throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} vertex {} uses joint {} but the model has {} joints", where,
+                                                                  mesh.id, v, mesh.joints[v][k], model.joints.size())}};
   }
   return model;
 }
@@ -258,8 +253,8 @@ void CaptureFrame::clear() {
 Expected<CapturedModel> readModelMesh(const fs::path& file) {
   try {
     return parseModelMesh(file);
-  } catch (const CaptureError& e) {
-    return std::unexpected(Error{e.code, e.message});
+  } catch (const Failure& f) {
+    return std::unexpected(f.error);
   }
 }
 
@@ -346,8 +341,8 @@ Expected<std::unique_ptr<CaptureReader>> CaptureReader::open(const fs::path& dir
         l.fail(fmt::format("unknown or misplaced record '{}' before the first frame; expected s, d, k, u, C or f", token), ErrorCode::kParse);
       }
     }
-  } catch (const CaptureError& e) {
-    return std::unexpected(Error{e.code, e.message});
+  } catch (const Failure& f) {
+    return std::unexpected(f.error);
   } catch (const fs::filesystem_error& e) {
     return fail(ErrorCode::kIo, "{}: {}", directory.string(), e.what());
   }
@@ -488,8 +483,8 @@ Expected<bool> CaptureReader::next(CaptureFrame& frame) {
         l.fail(fmt::format("unknown record '{}' in a frame; expected t, p, m, j, l, C or e", token), ErrorCode::kParse);
       }
     }
-  } catch (const CaptureError& e) {
-    return std::unexpected(Error{e.code, e.message});
+  } catch (const Failure& f) {
+    return std::unexpected(f.error);
   }
 }
 

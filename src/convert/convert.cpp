@@ -27,11 +27,6 @@ namespace fs = std::filesystem;
 using json = nlohmann::json;
 using namespace dynbench::capture;
 
-struct ConvertError {
-  ErrorCode code;
-  std::string message;
-};
-
 constexpr int kFloat = 5126, kUnsignedByte = 5121, kUnsignedShort = 5123, kUnsignedInt = 5125;
 constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
 
@@ -40,7 +35,7 @@ class BinaryBuffer {
  public:
   explicit BinaryBuffer(const fs::path& path) : path_(path) {
     fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644);
-    if (fd_ < 0) throw ConvertError{ErrorCode::kIo, fmt::format("{}: cannot create: {}", path.string(), std::strerror(errno))};
+    if (fd_ < 0) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: cannot create: {}", path.string(), std::strerror(errno))}};
   }
   ~BinaryBuffer() {
     if (fd_ >= 0) ::close(fd_);
@@ -60,7 +55,7 @@ class BinaryBuffer {
       const ssize_t n = ::pwrite(fd_, p, bytes, static_cast<off_t>(offset));
       if (n < 0) {
         if (errno == EINTR) continue;
-        throw ConvertError{ErrorCode::kIo, fmt::format("{}: write failed: {}", path_.string(), std::strerror(errno))};
+        throw Failure{Error{ErrorCode::kIo, fmt::format("{}: write failed: {}", path_.string(), std::strerror(errno))}};
       }
       p += n;
       offset += static_cast<std::uint64_t>(n);
@@ -71,7 +66,7 @@ class BinaryBuffer {
   void finish() {
     size_ = (size_ + 3) & ~std::uint64_t{3};
     if (::ftruncate(fd_, static_cast<off_t>(size_)) != 0)
-      throw ConvertError{ErrorCode::kIo, fmt::format("{}: cannot size: {}", path_.string(), std::strerror(errno))};
+      throw Failure{Error{ErrorCode::kIo, fmt::format("{}: cannot size: {}", path_.string(), std::strerror(errno))}};
   }
   std::uint64_t size() const { return size_; }
 
@@ -179,17 +174,17 @@ class Converter {
 
   ConvertReport run() {
     auto opened = CaptureReader::open(options_.capture);
-    if (!opened) throw ConvertError{opened.error().code, opened.error().message};
+    if (!opened) throw Failure{Error{opened.error().code, opened.error().message}};
     reader_ = std::move(*opened);
     const fs::path out = options_.output;
     stem_ = out.stem().string();
     outDir_ = out.has_parent_path() ? out.parent_path() : fs::path(".");
     std::error_code ec;
     fs::create_directories(outDir_, ec);
-    if (ec) throw ConvertError{ErrorCode::kIo, fmt::format("{}: cannot create folder: {}", outDir_.string(), ec.message())};
+    if (ec) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: cannot create folder: {}", outDir_.string(), ec.message())}};
 
     passOne();
-    if (times_.empty()) throw ConvertError{ErrorCode::kInvalidData, fmt::format("{}: the capture has no complete frame", options_.capture.string())};
+    if (times_.empty()) throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: the capture has no complete frame", options_.capture.string())}};
     binPath_ = temporarySibling(outDir_ / (stem_ + ".bin"));
     try {
       {
@@ -288,7 +283,7 @@ class Converter {
     };
     while (true) {
       auto more = reader_->next(frame);
-      if (!more) throw ConvertError{more.error().code, more.error().message};
+      if (!more) throw Failure{Error{more.error().code, more.error().message}};
       if (!*more) break;
       if (frame.cameraSettings && !cameraChanged_) {
         cameraChanged_ = true;
@@ -305,9 +300,9 @@ class Converter {
     // Times must strictly increase for glTF samplers; equal capture times (a paused game) cannot be keyed.
     for (std::size_t k = 1; k < n; ++k)
       if (!(times_[k] > times_[k - 1]))
-        throw ConvertError{ErrorCode::kInvalidData,
+        throw Failure{Error{ErrorCode::kInvalidData,
                            fmt::format("{}: frames {} and {} have the same time {} s (as float); glTF key times must increase",
-                                       options_.capture.string(), k - 1, k, times_[k])};
+                                       options_.capture.string(), k - 1, k, times_[k])}};
   }
 
   // ---- the document --------------------------------------------------------------------------
@@ -369,7 +364,7 @@ class Converter {
       std::error_code ec;
       fs::create_directories(target.parent_path(), ec);
       fs::copy_file(source, target, fs::copy_options::overwrite_existing, ec);
-      if (ec) throw ConvertError{ErrorCode::kIo, fmt::format("{}: cannot copy texture: {}", target.string(), ec.message())};
+      if (ec) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: cannot copy texture: {}", target.string(), ec.message())}};
       report_.written.push_back(target);
       index = addTexture(relative.generic_string(), ext == ".png" ? "image/png" : "image/jpeg");
     }
@@ -429,7 +424,7 @@ class Converter {
         const fs::path target = outDir_ / (stem_ + "_textures") / relative;
         std::error_code ec;
         fs::create_directories(target.parent_path(), ec);
-        if (auto ok = writeImage(target, mr); !ok) throw ConvertError{ok.error().code, ok.error().message};
+        if (auto ok = writeImage(target, mr); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
         report_.written.push_back(target);
         index = addTexture(relative, "image/png");
       }
@@ -723,7 +718,7 @@ class Converter {
 
   void passTwo() {
     auto opened = CaptureReader::open(options_.capture);
-    if (!opened) throw ConvertError{opened.error().code, opened.error().message};
+    if (!opened) throw Failure{Error{opened.error().code, opened.error().message}};
     auto reader = std::move(*opened);
     for (auto& [id, t] : tracks_) {
       t.appeared = t.visible = false;
@@ -750,8 +745,8 @@ class Converter {
     CaptureFrame frame;
     for (std::size_t i = 0; i < times_.size(); ++i) {
       auto more = reader->next(frame);
-      if (!more) throw ConvertError{more.error().code, more.error().message};
-      if (!*more) throw ConvertError{ErrorCode::kIo, fmt::format("{}: the capture changed while it was converted", options_.capture.string())};
+      if (!more) throw Failure{Error{more.error().code, more.error().message}};
+      if (!*more) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: the capture changed while it was converted", options_.capture.string())}};
       // Held values follow this frame's records.
       for (const auto& c : frame.cameras) {
         Track& t = tracks_.at(c.id);
@@ -859,21 +854,21 @@ class Converter {
       std::string ext2 = options_.environment->extension().string();
       std::transform(ext2.begin(), ext2.end(), ext2.begin(), [](unsigned char c) { return std::tolower(c); });
       if (ext2 != ".hdr" && ext2 != ".exr")
-        throw ConvertError{ErrorCode::kUsage, fmt::format("--env {}: expected an .hdr or .exr image", options_.environment->string())};
+        throw Failure{Error{ErrorCode::kUsage, fmt::format("--env {}: expected an .hdr or .exr image", options_.environment->string())}};
       auto header = readImageHeader(*options_.environment);
-      if (!header) throw ConvertError{header.error().code, header.error().message};
+      if (!header) throw Failure{Error{header.error().code, header.error().message}};
       if (header->width != 2 * header->height)
         report_.warnings.push_back(fmt::format("--env {}: {}x{} is not 2:1; is it equirectangular?", options_.environment->string(),
                                                header->width, header->height));
       target = outDir_ / (stem_ + "_environment" + ext2);
       std::error_code ec;
       fs::copy_file(*options_.environment, target, fs::copy_options::overwrite_existing, ec);
-      if (ec) throw ConvertError{ErrorCode::kIo, fmt::format("{}: cannot copy the environment: {}", target.string(), ec.message())};
+      if (ec) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: cannot copy the environment: {}", target.string(), ec.message())}};
       ext["source"] = options_.environment->filename().string();
     } else {
       const SkyImage sky = preethamSky(options_.sky);
       target = outDir_ / (stem_ + "_sky.hdr");
-      if (auto ok = writeImage(target, FloatImage{sky.width, sky.height, 3, sky.rgb, {}}); !ok) throw ConvertError{ok.error().code, ok.error().message};
+      if (auto ok = writeImage(target, FloatImage{sky.width, sky.height, 3, sky.rgb, {}}); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
       ext["source"] = "dynbench Preetham sky";
       ext["sky"] = {{"model", "Preetham 1999 + ESRA sun"}, {"turbidity", options_.sky.turbidity},
                     {"sun_elevation_degrees", options_.sky.sunElevationDegrees}, {"sun_azimuth_degrees", options_.sky.sunAzimuthDegrees},
@@ -905,14 +900,14 @@ class Converter {
     report_.frames = times_.size();
 
     const fs::path readme = outDir_ / (stem_ + ".README.md");
-    if (auto ok = writeFileAtomic(readme, datasetReadme()); !ok) throw ConvertError{ok.error().code, ok.error().message};
+    if (auto ok = writeFileAtomic(readme, datasetReadme()); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
     report_.written.push_back(readme);
     if (!options_.glb) {
       const fs::path bin = outDir_ / (stem_ + ".bin");
       document["buffers"][0]["uri"] = uriPath(stem_ + ".bin");
-      if (auto ok = commitTemporary(binPath_, bin); !ok) throw ConvertError{ok.error().code, ok.error().message};
+      if (auto ok = commitTemporary(binPath_, bin); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
       report_.written.push_back(bin);
-      if (auto ok = writeFileAtomic(options_.output, document.dump()); !ok) throw ConvertError{ok.error().code, ok.error().message};
+      if (auto ok = writeFileAtomic(options_.output, document.dump()); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
     } else {
       writeGlb(document);
     }
@@ -925,7 +920,7 @@ class Converter {
     while (text.size() % 4) text.push_back(' ');
     const std::uint64_t binPadded = (report_.binBytes + 3) & ~std::uint64_t{3};
     const std::uint64_t total = 12 + 8 + text.size() + 8 + binPadded;
-    if (total > 0xFFFFFFFFull) throw ConvertError{ErrorCode::kUnsupported, "the dataset is larger than GLB's 4 GiB limit; write .gltf instead"};
+    if (total > 0xFFFFFFFFull) throw Failure{Error{ErrorCode::kUnsupported, "the dataset is larger than GLB's 4 GiB limit; write .gltf instead"}};
     const fs::path tmp = temporarySibling(options_.output);
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     auto u32 = [&](std::uint64_t v) {
@@ -948,8 +943,8 @@ class Converter {
     out.close();
     std::error_code ec;
     fs::remove(binPath_, ec);
-    if (!out) throw ConvertError{ErrorCode::kIo, fmt::format("{}: write failed", tmp.string())};
-    if (auto ok = commitTemporary(tmp, options_.output); !ok) throw ConvertError{ok.error().code, ok.error().message};
+    if (!out) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: write failed", tmp.string())}};
+    if (auto ok = commitTemporary(tmp, options_.output); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
   }
 
   const ConvertOptions& options_;
@@ -977,8 +972,8 @@ class Converter {
 Expected<ConvertReport> convertCapture(const ConvertOptions& options) {
   try {
     return Converter(options).run();
-  } catch (const ConvertError& e) {
-    return std::unexpected(Error{e.code, e.message});
+  } catch (const Failure& f) {
+    return std::unexpected(f.error);
   }
 }
 

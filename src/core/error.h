@@ -33,4 +33,18 @@ template <typename... Args>
   return std::unexpected(Error{code, fmt::format(format, std::forward<Args>(args)...)});
 }
 
+// Readers and writers whose many nested helpers would each have to pass an Expected up (the glTF
+// reader, the capture reader, convert) may throw the one exception type, Failure, and turn it back
+// into an Expected at their library function's boundary. Nothing else is thrown on purpose, and
+// no exception leaves the library (the CLI's main catches any that does, as an internal error).
+struct Failure {
+  Error error;
+};
+
+template <typename... Args>
+[[noreturn]] void raise(ErrorCode code, fmt::format_string<Args...> format, Args&&... args) {
+  throw Failure{Error{code, fmt::format(format, std::forward<Args>(args)...)}};
+}
+[[noreturn]] inline void raise(Error error) { throw Failure{std::move(error)}; }
+
 }  // namespace dynbench

@@ -4,7 +4,7 @@
 // of the offending value (tinygltf's messages do not carry one); buffer and image URIs must be
 // checked for leaving the dataset's folder before any file is opened (tinygltf resolves them inside
 // its own loader); and stats must never read or decode texture images, only stat their size.
-// JSON parsing itself is nlohmann::json's. Inside this file errors are thrown as GltfError and turned
+// JSON parsing itself is nlohmann::json's. Inside this file errors are thrown as Failure (core/error.h) and turned
 // into an Expected at the public entry point; nothing escapes as an exception.
 #include <algorithm>
 #include <array>
@@ -23,11 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
-
-struct GltfError {
-  ErrorCode code;
-  std::string message;
-};
 
 // Extensions whose meaning dynbench implements or that cannot change what it measures.
 const std::set<std::string, std::less<>> kSupportedExtensions = {
@@ -141,7 +136,7 @@ class GltfReader {
 
   void read() {
     auto bytes = readWholeFile(path_);
-    if (!bytes) throw GltfError{bytes.error().code, bytes.error().message};
+    if (!bytes) throw Failure{Error{bytes.error().code, bytes.error().message}};
     fileBytes_ = std::move(*bytes);
     scene_.source.path = path_;
     addSourceFile(path_, fileBytes_.size());
@@ -173,7 +168,7 @@ class GltfReader {
 
  private:
   [[noreturn]] void fail(ErrorCode code, std::string_view pointer, std::string_view message) const {
-    throw GltfError{code, fmt::format("{}: {}: {}", display_, pointer.empty() ? "/" : pointer, message)};
+    throw Failure{Error{code, fmt::format("{}: {}: {}", display_, pointer.empty() ? "/" : pointer, message)}};
   }
   [[noreturn]] void invalid(std::string_view pointer, std::string_view message) const {
     fail(ErrorCode::kInvalidData, pointer, message);
@@ -241,8 +236,8 @@ class GltfReader {
       }
       std::string what = e.what();
       if (auto pos = what.find("syntax error"); pos != std::string::npos) what = what.substr(pos);
-      throw GltfError{ErrorCode::kParse,
-                      fmt::format("{}: line {}, column {}: invalid JSON: {}", display_, line, column, what)};
+      throw Failure{Error{ErrorCode::kParse,
+                      fmt::format("{}: line {}, column {}: invalid JSON: {}", display_, line, column, what)}};
     }
     if (!root_.is_object()) invalid("", "the top-level JSON value must be an object");
   }
@@ -1158,8 +1153,8 @@ Expected<Scene> loadGltf(const std::filesystem::path& path) {
   Scene scene;
   try {
     GltfReader(path, scene).read();
-  } catch (const GltfError& e) {
-    return std::unexpected(Error{e.code, e.message});
+  } catch (const Failure& f) {
+    return std::unexpected(f.error);
   } catch (const nlohmann::json::exception& e) {
     return fail(ErrorCode::kInvalidData, "{}: {}", path.string(), e.what());
   } catch (const std::bad_alloc&) {
