@@ -9,6 +9,7 @@
 #include "capture_fixture.h"
 #include "convert/convert.h"
 #include "convert/merge_camera.h"
+#include "core/files.h"
 #include "core/image_io.h"
 #include "gltf_builder.h"
 #include "external_tools.h"
@@ -413,6 +414,75 @@ TEST(MergeCamera, CsvPoseLogReplacesTheCameraKeepingRoll) {
   ASSERT_TRUE(original);
   const scene::Evaluator o(*original);
   expectClose(decomposeRigid(o.worldMatrix(camera, static_cast<float>(3 / 60.0))).position, {0, 1.7f, 3}, "original camera");
+}
+
+// The run's poses are world poses: under a parent that moves and turns, merge-camera keys the
+// camera's local channels so that its world pose is the run's at every key.
+TEST(MergeCamera, CameraUnderAMovingParentGetsTheRunsWorldPoses) {
+  const fs::path dir = freshDir("merge_parent");
+  test::GltfBuilder b;
+  const int rig = b.node({{"name", "rig"}});
+  b.channel(rig, "translation", {0, 2}, {0, 0, 0, 10, 1, -4});
+  std::vector<float> turn = test::yawQuat(0), end = test::yawQuat(90);
+  turn.insert(turn.end(), end.begin(), end.end());
+  b.channel(rig, "rotation", {0, 2}, turn);
+  const int camera = b.node({{"name", "eye"}, {"camera", b.perspectiveCamera()}, {"translation", {0, 1.5, 0}}});
+  b.doc["scenes"][0]["nodes"] = nlohmann::json::array({rig});  // the camera is the rig's child, not a root
+  b.doc["nodes"][static_cast<std::size_t>(rig)]["children"] = {camera};
+  const fs::path dataset = b.write(dir, "rigged");
+  const fs::path csv = dir / "run.csv";
+  {
+    std::ofstream out(csv);
+    out << "time,x,y,z,qx,qy,qz,qw\n";
+    for (int k = 0; k < 20; ++k) {
+      const glm::dquat q = quatFromYawPitchRoll(radians(3.0 * k), radians(1.0 * k), 0.0);
+      out << fmt::format("{},{},{},{},{},{},{},{}\n", 0.1 * k, k, 2, -k, q.x, q.y, q.z, q.w);
+    }
+  }
+  MergeCameraOptions options;
+  options.dataset = dataset;
+  options.run = csv;
+  options.output = dir / "merged.gltf";
+  auto report = mergeCamera(options);
+  ASSERT_TRUE(report) << report.error().message;
+  EXPECT_EQ(report->cameraNode, camera);
+  auto merged = scene::loadScene(options.output);
+  ASSERT_TRUE(merged) << merged.error().message;
+  const scene::Evaluator e(*merged);
+  for (int k = 0; k < 20; ++k) {
+    const double t = static_cast<float>(0.1 * k);
+    const RigidPose pose = decomposeRigid(e.worldMatrix(camera, t));
+    expectClose(pose.position, {k, 2, -k}, fmt::format("key {}", k));
+    const auto euler = eulerYawPitchRoll(pose.rotation);
+    EXPECT_NEAR(wrapDegrees(degrees(euler.yaw) - 3.0 * k), 0.0, 1e-3) << k;
+    EXPECT_NEAR(wrapDegrees(degrees(euler.pitch) - 1.0 * k), 0.0, 1e-3) << k;
+  }
+  // The rig itself still moves as before.
+  expectClose(glm::dvec3(e.worldMatrix(rig, 1.0)[3]), {5, 0.5, -2}, "rig at 1 s");
+}
+
+// A dataset whose file name convert had to percent-encode (a space) merges, and the merged
+// dataset's own .bin is referenced by an encoded URI that the validator and the loader accept.
+TEST(MergeCamera, DatasetNamesWithSpaces) {
+  ConvertOptions convertOptions;
+  convertOptions.output = freshDir("merge_space_out") / "my dataset.gltf";
+  const Converted c = convertFixture("merge_space", convertOptions);
+  const fs::path csv = c.dataset.parent_path() / "run.csv";
+  std::ofstream(csv) << "0,0,1,2,0,0,0,1\n1,1,1,2,0,0,0,1\n";
+  MergeCameraOptions options;
+  options.dataset = c.dataset;
+  options.run = csv;
+  options.output = c.dataset.parent_path() / "my dataset vr.gltf";
+  auto report = mergeCamera(options);
+  ASSERT_TRUE(report) << report.error().message;
+  const auto doc = nlohmann::json::parse(*readWholeFile(options.output));
+  EXPECT_EQ(doc["buffers"][0]["uri"], "my%20dataset%20vr.bin");
+  EXPECT_TRUE(fs::exists(c.dataset.parent_path() / "my dataset vr.bin"));
+  int status = -1;
+  const std::string validation = validate(options.output, status);
+  EXPECT_EQ(status, 0) << validation;
+  auto merged = scene::loadScene(options.output);
+  ASSERT_TRUE(merged) << merged.error().message;
 }
 
 TEST(MergeCamera, CameraOnlyCaptureRun) {

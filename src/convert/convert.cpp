@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "capture/reader.h"
+#include "convert/gltf_writer.h"
 #include "core/files.h"
 #include "core/image_io.h"
 #include "core/math.h"
@@ -26,80 +27,6 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 using namespace dynbench::capture;
-
-constexpr int kFloat = 5126, kUnsignedByte = 5121, kUnsignedShort = 5123, kUnsignedInt = 5125;
-constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
-
-// The binary buffer: regions are allocated first, then filled in any order with pwrite.
-class BinaryBuffer {
- public:
-  explicit BinaryBuffer(const fs::path& path) : path_(path) {
-    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644);
-    if (fd_ < 0) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: cannot create: {}", path.string(), std::strerror(errno))}};
-  }
-  ~BinaryBuffer() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  BinaryBuffer(const BinaryBuffer&) = delete;
-  BinaryBuffer& operator=(const BinaryBuffer&) = delete;
-
-  std::uint64_t allocate(std::uint64_t bytes) {
-    size_ = (size_ + 3) & ~std::uint64_t{3};  // every region 4-byte aligned (glTF §3.6.2.4)
-    const std::uint64_t offset = size_;
-    size_ += bytes;
-    return offset;
-  }
-  void write(std::uint64_t offset, const void* data, std::size_t bytes) {
-    const char* p = static_cast<const char*>(data);
-    while (bytes > 0) {
-      const ssize_t n = ::pwrite(fd_, p, bytes, static_cast<off_t>(offset));
-      if (n < 0) {
-        if (errno == EINTR) continue;
-        throw Failure{Error{ErrorCode::kIo, fmt::format("{}: write failed: {}", path_.string(), std::strerror(errno))}};
-      }
-      p += n;
-      offset += static_cast<std::uint64_t>(n);
-      bytes -= static_cast<std::size_t>(n);
-    }
-  }
-  // Pads the file to its allocated (4-byte aligned) size.
-  void finish() {
-    size_ = (size_ + 3) & ~std::uint64_t{3};
-    if (::ftruncate(fd_, static_cast<off_t>(size_)) != 0)
-      throw Failure{Error{ErrorCode::kIo, fmt::format("{}: cannot size: {}", path_.string(), std::strerror(errno))}};
-  }
-  std::uint64_t size() const { return size_; }
-
- private:
-  fs::path path_;
-  int fd_ = -1;
-  std::uint64_t size_ = 0;
-};
-
-// Fills one region front to back through a small buffer, so that a long capture costs a few
-// kilobytes per animated value, not its whole history.
-class RegionWriter {
- public:
-  RegionWriter() = default;
-  RegionWriter(BinaryBuffer* bin, std::uint64_t offset) : bin_(bin), offset_(offset) {}
-  template <typename T>
-  void put(const T& value) {
-    const char* p = reinterpret_cast<const char*>(&value);
-    pending_.insert(pending_.end(), p, p + sizeof(T));
-    if (pending_.size() >= 4096) flush();
-  }
-  void flush() {
-    if (pending_.empty() || !bin_) return;
-    bin_->write(offset_ + written_, pending_.data(), pending_.size());
-    written_ += pending_.size();
-    pending_.clear();
-  }
-
- private:
-  BinaryBuffer* bin_ = nullptr;
-  std::uint64_t offset_ = 0, written_ = 0;
-  std::vector<char> pending_;
-};
 
 enum class Kind { kCamera, kStaticModel, kModel, kLight };
 
@@ -156,16 +83,6 @@ std::vector<float> vec(const glm::dvec3& v) { return {static_cast<float>(v.x), s
 glm::dquat nearest(const glm::dquat& previous, glm::dquat q) {
   if (glm::dot(previous, q) < 0.0) q = -q;
   return q;
-}
-
-// Percent-encodes what may not stand in a URI path (RFC 3986 unreserved characters and '/' stay).
-std::string uriPath(const std::string& path) {
-  std::string out;
-  for (unsigned char c : path) {
-    if (std::isalnum(c) || c == '-' || c == '.' || c == '_' || c == '~' || c == '/') out += static_cast<char>(c);
-    else out += fmt::format("%{:02X}", c);
-  }
-  return out;
 }
 
 class Converter {
@@ -307,33 +224,15 @@ class Converter {
 
   // ---- the document --------------------------------------------------------------------------
 
-  int bufferView(std::uint64_t offset, std::uint64_t length, int target = 0) {
-    json v = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", length}};
-    if (target) v["target"] = target;
-    doc_["bufferViews"].push_back(v);
-    return static_cast<int>(doc_["bufferViews"].size()) - 1;
-  }
-
+  int bufferView(std::uint64_t offset, std::uint64_t length, int target = 0) { return addBufferView(doc_, offset, length, target); }
   int accessor(int view, std::uint64_t byteOffset, int componentType, std::size_t count, const char* type, json min = nullptr,
                json max = nullptr) {
-    json a = {{"bufferView", view}, {"componentType", componentType}, {"count", count}, {"type", type}};
-    if (byteOffset) a["byteOffset"] = byteOffset;
-    if (!min.is_null()) a["min"] = min;
-    if (!max.is_null()) a["max"] = max;
-    doc_["accessors"].push_back(a);
-    return static_cast<int>(doc_["accessors"].size()) - 1;
+    return addAccessor(doc_, view, byteOffset, componentType, count, type, std::move(min), std::move(max));
   }
-
-  // Writes a whole array now (mesh data); returns the accessor.
   template <typename T>
   int dataAccessor(const std::vector<T>& data, int componentType, const char* type, int target, json min = nullptr, json max = nullptr,
                    std::size_t count = 0) {
-    const std::uint64_t bytes = data.size() * sizeof(T);
-    const std::uint64_t offset = bin_->allocate(bytes);
-    bin_->write(offset, data.data(), bytes);
-    const std::string_view kind(type);
-    const std::size_t components = kind == "SCALAR" ? 1 : kind == "VEC2" ? 2 : kind == "VEC3" ? 3 : kind == "VEC4" ? 4 : 16;
-    return accessor(bufferView(offset, bytes, target), 0, componentType, count ? count : data.size() / components, type, min, max);
+    return addDataAccessor(doc_, *bin_, data, componentType, type, target, std::move(min), std::move(max), count);
   }
 
   int addNode(json node, int parent) {
@@ -902,49 +801,9 @@ class Converter {
     const fs::path readme = outDir_ / (stem_ + ".README.md");
     if (auto ok = writeFileAtomic(readme, datasetReadme()); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
     report_.written.push_back(readme);
-    if (!options_.glb) {
-      const fs::path bin = outDir_ / (stem_ + ".bin");
-      document["buffers"][0]["uri"] = uriPath(stem_ + ".bin");
-      if (auto ok = commitTemporary(binPath_, bin); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
-      report_.written.push_back(bin);
-      if (auto ok = writeFileAtomic(options_.output, document.dump()); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
-    } else {
-      writeGlb(document);
-    }
-    report_.written.push_back(options_.output);
-  }
-
-  // GLB: header, JSON chunk, BIN chunk copied from the temporary buffer file (glTF §4.4).
-  void writeGlb(const json& document) {
-    std::string text = document.dump();
-    while (text.size() % 4) text.push_back(' ');
-    const std::uint64_t binPadded = (report_.binBytes + 3) & ~std::uint64_t{3};
-    const std::uint64_t total = 12 + 8 + text.size() + 8 + binPadded;
-    if (total > 0xFFFFFFFFull) throw Failure{Error{ErrorCode::kUnsupported, "the dataset is larger than GLB's 4 GiB limit; write .gltf instead"}};
-    const fs::path tmp = temporarySibling(options_.output);
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    auto u32 = [&](std::uint64_t v) {
-      const auto x = static_cast<std::uint32_t>(v);
-      out.write(reinterpret_cast<const char*>(&x), 4);
-    };
-    out.write("glTF", 4);
-    u32(2);
-    u32(total);
-    u32(text.size());
-    out.write("JSON", 4);
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    u32(binPadded);
-    out.write("BIN\0", 4);
-    {
-      std::ifstream in(binPath_, std::ios::binary);
-      out << in.rdbuf();
-    }
-    for (std::uint64_t k = report_.binBytes; k < binPadded; ++k) out.put('\0');
-    out.close();
-    std::error_code ec;
-    fs::remove(binPath_, ec);
-    if (!out) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: write failed", tmp.string())}};
-    if (auto ok = commitTemporary(tmp, options_.output); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
+    auto written = writeDataset(std::move(document), binPath_, report_.binBytes, options_.output, options_.glb);
+    if (!written) throw Failure{written.error()};
+    report_.written.insert(report_.written.end(), written->begin(), written->end());
   }
 
   const ConvertOptions& options_;

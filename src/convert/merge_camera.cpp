@@ -10,10 +10,12 @@
 #include <nlohmann/json.hpp>
 
 #include "capture/reader.h"
+#include "convert/gltf_writer.h"
 #include "core/files.h"
 #include "core/math.h"
-#include "scene/queries.h"
+#include "scene/evaluate.h"
 #include "scene/load.h"
+#include "scene/queries.h"
 
 namespace dynbench::convert {
 namespace {
@@ -115,7 +117,12 @@ Expected<MergeCameraReport> mergeCamera(const MergeCameraOptions& options) {
       doc["buffers"][0]["uri"].get<std::string>().rfind("data:", 0) == 0)
     return fail(ErrorCode::kUnsupported, "{}: merge-camera needs a dataset with one external .bin buffer (as convert writes)",
                 options.dataset.string());
-  const fs::path bin = datasetDir / doc["buffers"][0]["uri"].get<std::string>();
+  const fs::path bin = datasetDir / scene::percentDecodeUri(doc["buffers"][0]["uri"].get<std::string>());
+
+  // The run's poses are world poses; the channels are the camera node's local ones. Under a parent
+  // the local pose is parent_world(t)^-1 * world, with the parent as animated at that key's time.
+  const int parent = scene->nodes[static_cast<std::size_t>(*node)].parent;
+  const scene::Evaluator evaluator(*scene);
 
   // New keys in dataset time: the run's first key lands on the dataset's start, plus the offset.
   const double start = scene->timeRange().start + options.offsetSeconds - run->front().time;
@@ -127,53 +134,40 @@ Expected<MergeCameraReport> mergeCamera(const MergeCameraOptions& options) {
     if (!times.empty() && !(static_cast<float>(t) > times.back()))
       return fail(ErrorCode::kInvalidData, "{}: two poses {} s apart collapse into one float key time", options.run.string(),
                   key.time - (times.back() - start));
+    glm::dvec3 position = key.position;
     glm::dquat q = key.rotation;
+    if (parent >= 0) {
+      const glm::dmat4 parentWorld = evaluator.worldMatrix(parent, t);
+      const glm::dvec3 scale(glm::length(glm::dvec3(parentWorld[0])), glm::length(glm::dvec3(parentWorld[1])),
+                             glm::length(glm::dvec3(parentWorld[2])));
+      if (glm::any(glm::greaterThan(glm::abs(scale - 1.0), glm::dvec3(1e-6))))
+        return fail(ErrorCode::kUnsupported, "{}: the camera's parent is scaled ({}, {}, {}) at t = {} s; merge-camera writes rigid camera keys",
+                    options.dataset.string(), scale.x, scale.y, scale.z, t);
+      const RigidPose parentPose = decomposeRigid(parentWorld);
+      const glm::dquat inverse = glm::inverse(parentPose.rotation);
+      position = inverse * (position - parentPose.position);
+      q = inverse * q;
+    }
     if (glm::dot(previous, q) < 0) q = -q;  // shortest arc between keys
     previous = q;
     times.push_back(static_cast<float>(t));
-    translations.insert(translations.end(), {float(key.position.x), float(key.position.y), float(key.position.z)});
+    translations.insert(translations.end(), {float(position.x), float(position.y), float(position.z)});
     rotations.insert(rotations.end(), {float(q.x), float(q.y), float(q.z), float(q.w)});
   }
 
-  // The new buffer: the old one, then the camera keys (4-byte aligned).
-  const fs::path outBin = outputDir / (options.output.stem().string() + ".bin");
-  const fs::path tmpBin = temporarySibling(outBin);
+  // The new buffer: a copy of the old one with the camera keys appended (gltf_writer.h).
+  const fs::path tmpBin = temporarySibling(outputDir / (options.output.stem().string() + ".bin"));
   std::error_code ec;
   fs::copy_file(bin, tmpBin, fs::copy_options::overwrite_existing, ec);
   if (ec) return fail(ErrorCode::kIo, "{}: cannot copy to {}: {}", bin.string(), tmpBin.string(), ec.message());
-  std::uint64_t size = fs::file_size(tmpBin);
-  {
-    std::ofstream out(tmpBin, std::ios::binary | std::ios::app);
-    auto append = [&](const std::vector<float>& data) {
-      while (size % 4) {
-        out.put('\0');
-        ++size;
-      }
-      const std::uint64_t offset = size;
-      out.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size() * sizeof(float)));
-      size += data.size() * sizeof(float);
-      doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", data.size() * sizeof(float)}});
-      return doc["bufferViews"].size() - 1;
-    };
-    const auto tv = append(times), pv = append(translations), rv = append(rotations);
-    while (size % 4) {
-      out.put('\0');
-      ++size;
-    }
-    if (!out) {
-      fs::remove(tmpBin, ec);
-      return fail(ErrorCode::kIo, "{}: write failed", tmpBin.string());
-    }
-    auto accessor = [&](std::size_t view, const char* type, json a = json::object()) {
-      a["bufferView"] = view;
-      a["componentType"] = 5126;
-      a["count"] = times.size();
-      a["type"] = type;
-      doc["accessors"].push_back(a);
-      return doc["accessors"].size() - 1;
-    };
-    const auto input = accessor(tv, "SCALAR", {{"min", {times.front()}}, {"max", {times.back()}}});
-    const auto outputs = std::map<std::string, std::size_t>{{"translation", accessor(pv, "VEC3")}, {"rotation", accessor(rv, "VEC4")}};
+  std::uint64_t binBytes = 0;
+  try {
+    BinaryBuffer buffer(tmpBin, BinaryBuffer::Mode::kAppend);
+    const int input = addDataAccessor(doc, buffer, times, kFloat, "SCALAR", 0, json::array({times.front()}), json::array({times.back()}));
+    const std::map<std::string, int> outputs{{"translation", addDataAccessor(doc, buffer, translations, kFloat, "VEC3")},
+                                             {"rotation", addDataAccessor(doc, buffer, rotations, kFloat, "VEC4")}};
+    buffer.finish();
+    binBytes = buffer.size();
     // Repoint the camera's translation and rotation samplers; add channels where there were none.
     if (!doc.contains("animations") || doc["animations"].empty())
       doc["animations"] = {{{"name", "camera"}, {"samplers", json::array()}, {"channels", json::array()}}};
@@ -195,11 +189,12 @@ Expected<MergeCameraReport> mergeCamera(const MergeCameraOptions& options) {
       animation["samplers"].push_back({{"input", input}, {"output", output}, {"interpolation", "LINEAR"}});
       animation["channels"].push_back({{"sampler", animation["samplers"].size() - 1}, {"target", {{"node", *node}, {"path", path}}}});
     }
+  } catch (const Failure& f) {
+    fs::remove(tmpBin, ec);
+    return std::unexpected(f.error);
   }
-  doc["buffers"][0]["byteLength"] = size;
-  doc["buffers"][0]["uri"] = outBin.filename().string();
-  if (auto ok = commitTemporary(tmpBin, outBin); !ok) return std::unexpected(ok.error());
-  if (auto ok = writeFileAtomic(options.output, doc.dump()); !ok) return std::unexpected(ok.error());
+  auto written = writeDataset(std::move(doc), tmpBin, binBytes, options.output, false);
+  if (!written) return std::unexpected(written.error());
   return MergeCameraReport{*node, times.size(), times.front(), times.back()};
 }
 

@@ -1166,4 +1166,6 @@ Expected<Scene> loadGltf(const std::filesystem::path& path) {
   return scene;
 }
 
+std::string percentDecodeUri(std::string_view uri) { return percentDecode(uri); }
+
 }  // namespace dynbench::scene
