@@ -10,6 +10,7 @@
 
 #include "capture/check.h"
 #include "core/files.h"
+#include "core/process.h"
 #include "core/runtime_files.h"
 
 namespace dynbench::capture {
@@ -76,42 +77,40 @@ Expected<Cube2Report> captureCube2(const Cube2Options& o, const Cube2Progress& p
   const std::size_t total = static_cast<std::size_t>(o.seconds * o.fps + 0.5);
   // A stalled game is stopped: at least 2 frames/s of wall time plus a minute for loading.
   const int timeout = 60 + static_cast<int>((o.seconds + o.warmup) * o.fps / 2.0);
-  const std::string env = fmt::format(
-      "DYNBENCH_CAPTURE_DIR={} DYNBENCH_CAPTURE_DATA_ROOT={} DYNBENCH_CAPTURE_FPS={} DYNBENCH_CAPTURE_SEED={} "
-      "DYNBENCH_CAPTURE_WARMUP={} DYNBENCH_CAPTURE_SECONDS={} DYNBENCH_CAPTURE_FOLLOW_AUTO={}",
-      shellQuote(fs::absolute(o.output).string()), shellQuote(fs::absolute(o.data).string()), o.fps, o.seed, o.warmup, o.seconds,
-      o.follow == "auto" ? 1 : 0);
-  const std::string game = fmt::format("{} -q{} -k{} -r -t0 -w{} -h{} {}", shellQuote("./" + client->filename().string()),
-                                       shellQuote(fs::absolute(home).string()), shellQuote(fs::absolute(o.data).string()), o.width, o.height,
-                                       shellQuote("-x" + *script));
+  ProcessOptions game;
+  game.workingDirectory = client->parent_path();  // the client finds its own files relative to it
+  game.environment = {{"DYNBENCH_CAPTURE_DIR", fs::absolute(o.output).string()},
+                      {"DYNBENCH_CAPTURE_DATA_ROOT", fs::absolute(o.data).string()},
+                      {"DYNBENCH_CAPTURE_FPS", fmt::format("{}", o.fps)},
+                      {"DYNBENCH_CAPTURE_SEED", fmt::format("{}", o.seed)},
+                      {"DYNBENCH_CAPTURE_WARMUP", fmt::format("{}", o.warmup)},
+                      {"DYNBENCH_CAPTURE_SECONDS", fmt::format("{}", o.seconds)},
+                      {"DYNBENCH_CAPTURE_FOLLOW_AUTO", o.follow == "auto" ? "1" : "0"}};
+  game.argv = {"timeout", fmt::format("{}", timeout)};
   // xvfb-run -a searches upwards from -n for a free display; two runs starting together from the
   // same number can race for it, so each starts from its own (by process id).
-  const std::string display = o.window ? "" : fmt::format("xvfb-run -a -n {} -s {} ", 100 + ::getpid() % 5000,
-                                                          shellQuote(fmt::format("-screen 0 {}x{}x24", o.width, o.height)));
-  const std::string command = fmt::format("cd {} && {} timeout {} {}{} 2>&1", shellQuote(client->parent_path().string()), env, timeout,
-                                          display, game);
-  const auto started = std::chrono::steady_clock::now();
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return fail(ErrorCode::kExternalTool, "cannot start the Cube 2 client");
-  std::string tail;
-  char line[4096];
+  if (!o.window)
+    game.argv.insert(game.argv.end(), {"xvfb-run", "-a", "-n", fmt::format("{}", 100 + ::getpid() % 5000), "-s",
+                                       fmt::format("-screen 0 {}x{}x24", o.width, o.height)});
+  game.argv.insert(game.argv.end(), {"./" + client->filename().string(), "-q" + fs::absolute(home).string(), "-k" + fs::absolute(o.data).string(),
+                                     "-r", "-t0", fmt::format("-w{}", o.width), fmt::format("-h{}", o.height), "-x" + *script});
   std::size_t frames = 0;
-  while (std::fgets(line, sizeof line, pipe)) {
-    tail += line;
-    if (tail.size() > 3000) tail.erase(0, tail.size() - 3000);
+  game.onLine = [&](std::string_view line) {
     unsigned long long done = 0, all = 0;
-    if (std::sscanf(line, "dynbench-capture: %llu/%llu frames", &done, &all) == 2) {
+    if (std::sscanf(std::string(line).c_str(), "dynbench-capture: %llu/%llu frames", &done, &all) == 2) {
       frames = static_cast<std::size_t>(done);
       if (progress) progress(frames, total);
     }
-  }
-  const int status = ::pclose(pipe);
+    return true;
+  };
+  game.tailBytes = 3000;
+  const auto started = std::chrono::steady_clock::now();
+  auto run = runProcess(game);
   fs::remove_all(home, ec);
-  if (status != 0 || frames < total) {
-    while (!tail.empty() && tail.back() == '\n') tail.pop_back();
+  if (!run) return std::unexpected(run.error());
+  if (!run->succeeded() || frames < total)
     return fail(ErrorCode::kExternalTool, "the Cube 2 client stopped after {} of {} frames (status {}); its last output:\n{}", frames, total,
-                status, tail);
-  }
+                run->exitStatus, run->tail);
   auto summary = checkCapture(o.output);
   if (!summary) return std::unexpected(summary.error());
   // The licences of what the capture holds, which `convert` copies into the dataset's README:

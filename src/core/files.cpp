@@ -83,10 +83,5 @@ std::filesystem::path findOnPath(const std::string& name) {
   return {};
 }
 
-std::string shellQuote(std::string_view s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
 
 }  // namespace dynbench

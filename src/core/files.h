@@ -29,7 +29,5 @@ Expected<void> commitTemporary(const std::filesystem::path& temporary,
 bool isExecutable(const std::filesystem::path& path);
 // `name` looked up in $PATH (as a shell would); empty when it is not there.
 std::filesystem::path findOnPath(const std::string& name);
-// `s` single-quoted for /bin/sh, so that popen() commands survive any file name.
-std::string shellQuote(std::string_view s);
 
 }  // namespace dynbench

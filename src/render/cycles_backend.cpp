@@ -5,11 +5,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <optional>
+#include <string_view>
 
 #include <fmt/format.h>
 
 #include "core/files.h"
 #include "core/math.h"
+#include "core/process.h"
 #include "core/runtime_files.h"
 #include "frames/frame_io.h"
 #include "render/backend.h"
@@ -172,49 +175,40 @@ Expected<void> CyclesBackend::render(const std::vector<FrameRequest>& requests, 
   const fs::path jobFile = work / "job.json";
   if (auto w = writeFileAtomic(jobFile, j.dump(1)); !w) return std::unexpected(w.error());
 
-  const std::string command = fmt::format("{} --background --factory-startup --python {} -- {} 2>&1", shellQuote(blender_.string()),
-                                          shellQuote(script_.string()), shellQuote(jobFile.string()));
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return fail(ErrorCode::kExternalTool, "cannot start Blender ({})", blender_.string());
-  std::string tail, line;
   std::size_t finished = 0;
-  char buffer[4096];
   std::string error;
-  while (std::fgets(buffer, sizeof buffer, pipe)) {
-    line = buffer;
-    tail += line;
-    if (tail.size() > 4000) tail.erase(0, tail.size() - 4000);
-    if (line.rfind("DYNBENCH_ERROR ", 0) == 0) error = line.substr(15);
-    if (line.rfind("DYNBENCH_FRAME_DONE ", 0) == 0) {
-      // Hand the finished frame over right away, so an interrupted run keeps it.
-      const std::size_t k = finished++;
-      const fs::path raw = j["frames"][k]["output"].get<std::string>();
+  std::optional<Error> handOver;  // a finished frame that could not be read or written
+  auto onLine = [&](std::string_view line) {
+    if (line.starts_with("DYNBENCH_ERROR ")) error = line.substr(15);
+    if (!line.starts_with("DYNBENCH_FRAME_DONE ")) return true;
+    // Hand the finished frame over right away, so an interrupted run keeps it.
+    const std::size_t k = finished++;
+    const fs::path raw = j["frames"][k]["output"].get<std::string>();
+    auto frame = [&]() -> Expected<void> {
       auto passes = readImage(raw);
-      if (!passes) {
-        ::pclose(pipe);
-        return std::unexpected(passes.error());
-      }
+      if (!passes) return std::unexpected(passes.error());
       auto image = cyclesPassesToContract(*passes, raw, requests[k].cameras.camera);
-      if (!image) {
-        ::pclose(pipe);
-        return std::unexpected(image.error());
-      }
+      if (!image) return std::unexpected(image.error());
       image->frame = requests[k].frame;
       image->time = requests[k].cameras.time;
-      if (auto w = done(std::move(*image)); !w) {
-        ::pclose(pipe);
-        return w;
-      }
-      fs::remove(raw, ec);
-      if (rows && finished < requests.size()) rows(finished, 0);
+      return done(std::move(*image));
+    }();
+    if (!frame) {
+      handOver = frame.error();
+      return false;  // stop Blender: the job has failed
     }
-  }
-  const int status = ::pclose(pipe);
-  if (status != 0 || finished != requests.size()) {
-    while (!tail.empty() && tail.back() == '\n') tail.pop_back();
+    std::error_code removeError;
+    fs::remove(raw, removeError);
+    if (rows && finished < requests.size()) rows(finished, 0);
+    return true;
+  };
+  auto run = runProcess({.argv = {blender_.string(), "--background", "--factory-startup", "--python", script_.string(), "--", jobFile.string()},
+                         .onLine = onLine});
+  if (!run) return std::unexpected(run.error());
+  if (handOver) return std::unexpected(*handOver);
+  if (!run->succeeded() || finished != requests.size())
     return fail(ErrorCode::kExternalTool, "Blender (Cycles) failed after {} of {} frames{}; its last output:\n{}", finished, requests.size(),
-                error.empty() ? "" : ": " + error, tail);
-  }
+                error.empty() ? "" : ": " + error, run->tail);
   fs::remove_all(work, ec);
   return {};
 }

@@ -1,16 +1,10 @@
 #include "report/plots.h"
 
-#include <cerrno>
-#include <cstring>
 #include <fstream>
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
 
 #include "core/files.h"
+#include "core/process.h"
 #include "report/stats_output.h"
-
-extern char** environ;
 
 namespace dynbench::report {
 namespace {
@@ -27,26 +21,12 @@ std::string quoted(const std::string& s) {
   return out + "'";
 }
 
-Expected<void> runGnuplot(const fs::path& script, const fs::path& log) {
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  std::string program = "gnuplot", scriptArg = script.string();
-  char* argv[] = {program.data(), scriptArg.data(), nullptr};
-  pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0)
-    return fail(ErrorCode::kExternalTool, "cannot run gnuplot ({}); install Debian's gnuplot-nox (scripts/setup.sh does)",
-                std::strerror(rc));
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    auto text = readWholeFile(log);
-    return fail(ErrorCode::kExternalTool, "gnuplot failed on {}: {}", script.string(), text ? *text : std::string("(no output)"));
-  }
+Expected<void> runGnuplot(const fs::path& script) {
+  auto run = runProcess({.argv = {"gnuplot", script.string()}});
+  if (!run)
+    return fail(ErrorCode::kExternalTool, "{}; install Debian's gnuplot-nox (scripts/setup.sh does)", run.error().message);
+  if (!run->succeeded())
+    return fail(ErrorCode::kExternalTool, "gnuplot failed on {}: {}", script.string(), run->tail.empty() ? "(no output)" : run->tail);
   return {};
 }
 
@@ -80,18 +60,16 @@ Expected<std::vector<fs::path>> writeLineFigures(const fs::path& dir, const std:
     }
   }
   const fs::path scriptPath = temporarySibling(dir / (stem + "_plots.gp"));
-  const fs::path logPath = temporarySibling(dir / (stem + "_plots.log"));
   auto cleanup = [&] {
     fs::remove(data, ec);
     fs::remove(scriptPath, ec);
-    fs::remove(logPath, ec);
     for (const auto& [tmp, target] : moves) fs::remove(tmp, ec);
   };
   if (auto ok = writeFileAtomic(scriptPath, script); !ok) {
     cleanup();
     return std::unexpected(ok.error());
   }
-  if (auto ok = runGnuplot(scriptPath, logPath); !ok) {
+  if (auto ok = runGnuplot(scriptPath); !ok) {
     cleanup();
     return std::unexpected(ok.error());
   }
