@@ -1,17 +1,12 @@
 // `dynbench discard FRAMES_DIR`: reprojection discard percentages (thesis §3.2.2, Table 6.7).
-#include <fstream>
 #include <optional>
 
-#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include "cli/commands.h"
-#include "core/files.h"
-#include "core/image_io.h"
 #include "core/progress.h"
 #include "discard/discard.h"
-#include "report/plots.h"
-#include "report/tables.h"
+#include "pipeline/stages.h"
 
 namespace dynbench::cli {
 namespace {
@@ -24,44 +19,16 @@ struct DiscardCli {
 };
 
 Expected<void> runDiscard(const DiscardCli& cli) {
-  const auto& t = cli.thresholds;
-  for (const auto& [name, value] : {std::pair{"--threshold-position", t.position}, {"--threshold-normal", t.normal},
-                                    {"--threshold-direct", t.direct}, {"--threshold-indirect", t.indirect}})
-    if (!(value >= 0)) return fail(ErrorCode::kUsage, "{} must be a non-negative number (got {})", name, value);
-  discard::MaskSink masks;
-  if (!cli.masks.empty()) {
-    masks = [&](const discard::FeatureFrame& frame, const discard::DiscardResult& r) -> Expected<void> {
-      FloatImage image{frame.width, frame.height, 3, discard::maskImage(frame, r.mask), {}};
-      return writeImage(fs::path(cli.masks) / fmt::format("discard_{:05d}.png", frame.frame), image);
-    };
-  }
   std::optional<Progress> progress;
-  discard::DiscardProgress report = [&](std::size_t done, std::size_t total) {
-    if (!progress) progress.emplace("discard", total, "frames");
-    progress->update(done);
-  };
-  auto run = discard::discardFolder(cli.frames, t, masks, report);
+  auto outcome = pipeline::runDiscard({cli.frames, cli.thresholds, cli.json, cli.csv, cli.masks, cli.plots},
+                                      [&](std::size_t done, std::size_t total) {
+                                        if (!progress) progress.emplace("discard", total, "frames");
+                                        progress->update(done);
+                                      });
   progress.reset();
-  if (!run) return std::unexpected(run.error());
-  for (const auto& w : run->warnings) spdlog::warn("{}: {}", cli.frames, w);
-
-  const std::string name = fs::path(cli.frames).filename().string().empty() ? cli.frames : fs::path(cli.frames).filename().string();
-  fmt::print("{}", report::markdownTable(report::discardTable(
-                       {{name, run->mean}}, fmt::format("{} frame pairs, {}x{}", run->frames.size(), run->width, run->height))));
-
-  if (!cli.json.empty())
-    if (auto ok = writeFileAtomic(cli.json, discard::discardJson(*run, cli.frames)); !ok) return ok;
-  if (!cli.csv.empty()) {
-    std::string csv = "frame,time,frustum,world_position,shading_normal,direct_radiance,indirect_radiance\n";
-    for (const auto& f : run->frames)
-      csv += fmt::format("{},{},{},{},{},{},{}\n", f.frame, f.time, f.frustum, f.position, f.normal, f.direct, f.indirect);
-    if (auto ok = writeFileAtomic(cli.csv, csv); !ok) return ok;
-  }
-  if (!cli.plots.empty()) {
-    const std::string name = fs::path(cli.frames).filename().string();
-    auto written = report::writeDiscardPlot(run->frames, name, cli.plots, name.empty() ? "frames" : name);
-    if (!written) return std::unexpected(written.error());
-  }
+  if (!outcome) return std::unexpected(outcome.error());
+  for (const auto& w : outcome->run.warnings) spdlog::warn("{}: {}", cli.frames, w);
+  fmt::print("{}", outcome->markdown);
   return {};
 }
 

@@ -10,7 +10,7 @@
 #include "core/progress.h"
 #include "render/backend.h"
 #include "render/render_job.h"
-#include "scene/load.h"
+#include "pipeline/stages.h"
 
 namespace dynbench::cli {
 namespace {
@@ -49,11 +49,6 @@ Expected<void> runRender(const RenderCli& cli) {
     job.frames = *range;
   }
 
-  auto scene = scene::loadScene(cli.dataset);
-  if (!scene) return std::unexpected(scene.error());
-  if (cli.animation && !scene::keepOnlyAnimation(*scene, *cli.animation))
-    return fail(ErrorCode::kUsage, "{}: --animation '{}' names no animation", cli.dataset, *cli.animation);
-
   // Progress on a terminal only: rows (of all frames) done, frames done, samples per second.
   std::optional<Progress> progress;
   render::RenderProgress report;
@@ -67,10 +62,11 @@ Expected<void> runRender(const RenderCli& cli) {
       progress->update(rows, fmt::format("{}/{} frames, {:.2f} M samples/s", frames, framesTotal, samplesPerSecond / 1e6));
     };
   }
-  auto summary = render::renderDataset(*scene, job, report);
+  std::vector<std::string> sceneWarnings;
+  auto summary = pipeline::runRender({job}, report, &sceneWarnings);
   progress.reset();
   if (!summary) return std::unexpected(summary.error());
-  for (const auto& w : scene->warnings) spdlog::warn("{}", w);
+  for (const auto& w : sceneWarnings) spdlog::warn("{}", w);
   for (const auto& w : summary->warnings) spdlog::warn("{}", w);
   fmt::print("{}: {} frame(s) rendered, {} already complete (skipped), {:.1f} s", cli.output, summary->rendered.size(),
              summary->skipped.size(), summary->seconds);

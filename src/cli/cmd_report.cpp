@@ -1,6 +1,6 @@
 // `dynbench report RUN... -o report.html`: datasets side by side (Tables 6.1-6.7, figures).
 #include "cli/commands.h"
-#include "report/html_report.h"
+#include "pipeline/stages.h"
 
 namespace dynbench::cli {
 namespace {
@@ -17,9 +17,7 @@ Expected<void> runReport(const ReportCli& cli) {
   options.output = cli.output;
   options.title = cli.title;
   options.thumbnails = cli.thumbnails;
-  if (options.output.extension() != ".html")
-    return fail(ErrorCode::kUsage, "-o {}: the report is an .html file (its Markdown twin is written beside it)", cli.output);
-  auto files = report::writeReport(options);
+  auto files = pipeline::runReport(options);
   if (!files) return std::unexpected(files.error());
   fmt::print("{}\n{}\n", files->html.string(), files->markdown.string());
   return {};

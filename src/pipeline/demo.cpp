@@ -8,19 +8,15 @@
 #include "convert/convert.h"
 #include "convert/merge_camera.h"
 #include "core/files.h"
-#include "core/image_io.h"
 #include "core/math.h"
-#include "discard/discard.h"
-#include "metrics/camera_motion.h"
-#include "metrics/properties.h"
-#include "render/render_job.h"
-#include "report/html_report.h"
-#include "report/stats_output.h"
+#include "pipeline/stages.h"
 #include "scene/evaluate.h"
 #include "scene/load.h"
 #include "scene/queries.h"
 
 namespace dynbench::demo {
+
+using namespace dynbench::pipeline;
 namespace {
 
 namespace fs = std::filesystem;
@@ -38,44 +34,39 @@ std::string captureKey(const DemoOptions& o) {
 
 // stats, render, discard for one dataset into RUN.
 Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, const DemoOptions& o, const DemoLog& log) {
-  auto scene = scene::loadScene(dataset);
-  if (!scene) return std::unexpected(scene.error());
-  report::StatsRow row;
-  row.name = dataset.filename().string();
-  row.path = dataset.string();
-  row.properties = metrics::measureProperties(*scene, o.fps);
-  auto motion = metrics::measureCameraMotion(*scene, o.fps, std::nullopt);
-  if (!motion) return std::unexpected(motion.error());
-  row.motion = std::move(*motion);
-  if (auto ok = writeFileAtomic(run / "stats.json", report::statsJson({row}, o.fps)); !ok) return ok;
-  if (auto ok = writeFileAtomic(run / (dataset.stem().string() + "_camera.csv"), report::cameraSeriesCsv(row.motion)); !ok) return ok;
+  StatsStage stats;
+  stats.inputs = {dataset};
+  stats.fps = o.fps;
+  stats.json = run / "stats.json";
+  stats.seriesDir = run;
+  if (auto measured = runStats(stats); !measured) return std::unexpected(measured.error());
 
-  render::RenderJob job;
-  job.dataset = dataset;
-  job.output = run / "frames";
-  job.fps = o.fps;
-  job.settings.width = o.width;
-  job.settings.height = o.height;
-  job.settings.samplesPerPixel = o.samplesPerPixel;
-  job.settings.bounces = o.bounces;
-  job.settings.seed = o.seed;
-  auto rendered = render::renderDataset(*scene, job);
+  RenderStage render;
+  render.job.dataset = dataset;
+  render.job.output = run / "frames";
+  render.job.fps = o.fps;
+  render.job.settings.width = o.width;
+  render.job.settings.height = o.height;
+  render.job.settings.samplesPerPixel = o.samplesPerPixel;
+  render.job.settings.bounces = o.bounces;
+  render.job.settings.seed = o.seed;
+  auto rendered = runRender(render);
   if (!rendered) return std::unexpected(rendered.error());
   log(fmt::format("  rendered {} frames ({} already there) in {:.0f} s", rendered->rendered.size(), rendered->skipped.size(), rendered->seconds));
 
-  discard::Thresholds thresholds;
-  thresholds.relativePosition = true;
-  thresholds.position = 0.01;  // 1% of the scene's size
-  thresholds.noiseAware = true;
-  const fs::path masks = run / "masks";
-  auto discarded = discard::discardFolder(job.output, thresholds, [&](const discard::FeatureFrame& f, const discard::DiscardResult& r) {
-    FloatImage image{f.width, f.height, 3, discard::maskImage(f, r.mask), {}};
-    return writeImage(masks / fmt::format("discard_{:05d}.png", f.frame), image);
-  });
+  DiscardStage discard;
+  discard.frames = render.job.output;
+  discard.thresholds.relativePosition = true;
+  discard.thresholds.position = 0.01;  // 1% of the scene's size
+  discard.thresholds.noiseAware = true;
+  discard.json = run / "discard.json";
+  discard.csv = run / "discard.csv";
+  discard.masks = run / "masks";
+  auto discarded = runDiscard(discard);
   if (!discarded) return std::unexpected(discarded.error());
-  if (auto ok = writeFileAtomic(run / "discard.json", discard::discardJson(*discarded, job.output.string())); !ok) return ok;
+  const auto& mean = discarded->run.mean;
   log(fmt::format("  discard: frustum {:.2f} %, world position {:.2f} %, shading normal {:.2f} %, direct {:.2f} %, indirect {:.2f} %",
-                  discarded->mean.frustum, discarded->mean.position, discarded->mean.normal, discarded->mean.direct, discarded->mean.indirect));
+                  mean.frustum, mean.position, mean.normal, mean.direct, mean.indirect));
   return {};
 }
 
@@ -198,7 +189,7 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
   r.runs = runs;
   r.output = o.output / "report.html";
   r.title = fmt::format("dynbench demo: {} with {} bots, first-person bot vs fly-through", o.map, o.bots);
-  auto files = report::writeReport(r);
+  auto files = runReport(r);
   if (!files) return std::unexpected(files.error());
   return files->html;
 }
