@@ -1,0 +1,173 @@
+#include "convert/converter.h"
+
+namespace dynbench::convert::detail {
+
+int Converter::image(const std::string& texture) {
+  if (texture.empty()) return -1;
+  if (auto it = imageByTexture_.find(texture); it != imageByTexture_.end()) return it->second;
+  int index = -1;
+  std::string ext = fs::path(texture).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext != ".png" && ext != ".jpg" && ext != ".jpeg") {
+    report_.warnings.push_back(fmt::format("texture '{}' is neither PNG nor JPEG (glTF's image formats); left out", texture));
+  } else if (const fs::path source = textureSource(texture); !source.empty()) {
+    const fs::path relative = fs::path(texture).lexically_normal();
+    const fs::path target = outDir_ / (stem_ + "_textures") / relative;
+    std::error_code ec;
+    fs::create_directories(target.parent_path(), ec);
+    fs::copy_file(source, target, fs::copy_options::overwrite_existing, ec);
+    if (ec) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: cannot copy texture: {}", target.string(), ec.message())}};
+    report_.written.push_back(target);
+    index = addTexture(relative.generic_string(), ext == ".png" ? "image/png" : "image/jpeg");
+  }
+  imageByTexture_[texture] = index;
+  return index;
+}
+
+// A texture's file under the data root, or empty (with a warning) when it cannot be used.
+fs::path Converter::textureSource(const std::string& texture) {
+  const fs::path relative = fs::path(texture).lexically_normal();
+  std::string ext = relative.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  fs::path root = options_.dataRoot ? *options_.dataRoot : fs::path(reader_->settings().dataRoot);
+  if (root.is_relative()) root = options_.capture / root;
+  std::error_code ec;
+  if (relative.is_absolute() || relative.empty() || *relative.begin() == "..") {
+    report_.warnings.push_back(fmt::format("texture '{}' is not a path inside the data root; left out", texture));
+    return {};
+  }
+  if (!fs::is_regular_file(root / relative, ec)) {
+    report_.warnings.push_back(fmt::format("texture '{}' not found at {}; left out", texture, (root / relative).string()));
+    return {};
+  }
+  return root / relative;
+}
+
+int Converter::addTexture(const std::string& relativeUri, const std::string& mime) {
+  doc_["images"].push_back({{"uri", uriPath(stem_ + "_textures/" + relativeUri)}, {"mimeType", mime}});
+  doc_["textures"].push_back({{"source", doc_["images"].size() - 1}, {"sampler", 0}});
+  ++report_.textures;
+  return static_cast<int>(doc_["textures"].size()) - 1;
+}
+
+// The mask map turned into a glTF metallic-roughness texture (docs/dataset.md): Cube 2 masks hold
+// specular intensity in R and the environment-map (chrome) mask in B, so roughness (G) = 1 - 0.8 R
+// and metallic (B) = B. Returns -1 when the mask cannot be read.
+int Converter::metallicRoughnessFromMask(const std::string& mask) {
+  if (mask.empty()) return -1;
+  if (auto it = maskTextures_.find(mask); it != maskTextures_.end()) return it->second;
+  int index = -1;
+  if (const fs::path source = textureSource(mask); !source.empty()) {
+    auto image = readImage(source);
+    if (!image) {
+      report_.warnings.push_back(fmt::format("mask map '{}': {}; left out", mask, image.error().message));
+    } else {
+      FloatImage mr{image->width, image->height, 3, {}, {}};
+      mr.pixels.resize(static_cast<std::size_t>(image->width) * image->height * 3);
+      for (std::size_t p = 0; p < mr.pixels.size() / 3; ++p) {
+        const float* in = &image->pixels[p * static_cast<std::size_t>(image->channels)];
+        const float specular = in[0];
+        const float chrome = image->channels >= 3 ? in[2] : 0.0f;
+        mr.pixels[p * 3 + 0] = 1.0f;                    // R: occlusion, unused
+        mr.pixels[p * 3 + 1] = 1.0f - 0.8f * specular;  // G: roughness
+        mr.pixels[p * 3 + 2] = chrome;                  // B: metallic
+      }
+      const std::string relative = (fs::path(mask).parent_path() / (fs::path(mask).stem().string() + "_metallic_roughness.png")).generic_string();
+      const fs::path target = outDir_ / (stem_ + "_textures") / relative;
+      std::error_code ec;
+      fs::create_directories(target.parent_path(), ec);
+      if (auto ok = writeImage(target, mr); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
+      report_.written.push_back(target);
+      index = addTexture(relative, "image/png");
+    }
+  }
+  maskTextures_[mask] = index;
+  return index;
+}
+
+// Material per (texture, mask) pair (docs/dataset.md): base colour from the texture map;
+// metallic and roughness from the mask map, or dielectric with roughness 0.8 without one.
+int Converter::material(const CapturedMesh& mesh) {
+  const auto key = std::make_pair(mesh.texture, mesh.maskTexture);
+  if (auto it = materialByMaps_.find(key); it != materialByMaps_.end()) return it->second;
+  json m = {{"name", mesh.texture.empty() ? "untextured" : fs::path(mesh.texture).stem().string()},
+            {"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.8}}}};
+  if (int t = image(mesh.texture); t >= 0) m["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", t}};
+  if (int t = metallicRoughnessFromMask(mesh.maskTexture); t >= 0) {
+    m["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", t}};
+    m["pbrMetallicRoughness"]["metallicFactor"] = 1.0;
+    m["pbrMetallicRoughness"]["roughnessFactor"] = 1.0;
+    m["extras"] = {{"dynbench_mask_map", mesh.maskTexture}};
+  }
+  doc_["materials"].push_back(m);
+  const int index = static_cast<int>(doc_["materials"].size()) - 1;
+  materialByMaps_[key] = index;
+  return index;
+}
+
+void Converter::buildMeshes() {
+  for (const auto& model : reader_->models()) {
+    json primitives = json::array();
+    for (const auto& mesh : model.meshes) {
+      if (mesh.indices.empty()) continue;
+      glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+      std::vector<float> positions;
+      for (const auto& p : mesh.positions) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+        positions.insert(positions.end(), {p.x, p.y, p.z});
+      }
+      json attributes = {{"POSITION", dataAccessor(positions, kFloat, "VEC3", kArrayBuffer, std::vector<float>{lo.x, lo.y, lo.z},
+                                                   std::vector<float>{hi.x, hi.y, hi.z})}};
+      if (!mesh.normals.empty()) {
+        std::vector<float> normals;
+        for (auto n : mesh.normals) {
+          const float len = glm::length(n);
+          n = len > 0 ? n / len : glm::vec3(0, 1, 0);  // glTF requires unit normals
+          normals.insert(normals.end(), {n.x, n.y, n.z});
+        }
+        attributes["NORMAL"] = dataAccessor(normals, kFloat, "VEC3", kArrayBuffer);
+      }
+      if (!mesh.uvs.empty()) {
+        std::vector<float> uvs;
+        for (const auto& t : mesh.uvs) uvs.insert(uvs.end(), {t.x, t.y});
+        attributes["TEXCOORD_0"] = dataAccessor(uvs, kFloat, "VEC2", kArrayBuffer);
+      }
+      if (!model.joints.empty() && !mesh.joints.empty()) {
+        std::vector<std::uint16_t> joints;
+        std::vector<float> weights;
+        for (std::size_t v = 0; v < mesh.joints.size(); ++v) {
+          const glm::vec4 w = mesh.weights[v];
+          const float sum = w.x + w.y + w.z + w.w;
+          for (int k = 0; k < 4; ++k) {
+            joints.push_back(w[k] > 0 ? mesh.joints[v][k] : 0);
+            weights.push_back(sum > 0 ? w[k] / sum : (k == 0 ? 1.0f : 0.0f));  // glTF: weights sum to 1
+          }
+        }
+        attributes["JOINTS_0"] = dataAccessor(joints, kUnsignedShort, "VEC4", kArrayBuffer);
+        attributes["WEIGHTS_0"] = dataAccessor(weights, kFloat, "VEC4", kArrayBuffer);
+      }
+      primitives.push_back({{"attributes", attributes},
+                            {"indices", dataAccessor(mesh.indices, kUnsignedInt, "SCALAR", kElementArrayBuffer)},
+                            {"material", material(mesh)}});
+    }
+    if (primitives.empty()) {
+      meshOfModel_.push_back(-1);
+      continue;
+    }
+    doc_["meshes"].push_back({{"name", model.path}, {"primitives", primitives}});
+    meshOfModel_.push_back(static_cast<int>(doc_["meshes"].size()) - 1);
+    ++report_.meshes;
+    // Inverse bind matrices, shared by every instance of the model.
+    if (!model.joints.empty()) {
+      std::vector<float> matrices;
+      for (const auto& j : model.joints) {
+        const glm::dmat4 m = matrixOf(j.inverseBindPose);
+        for (int c = 0; c < 4; ++c)
+          for (int r = 0; r < 4; ++r) matrices.push_back(static_cast<float>(m[c][r]));
+      }
+      ibmOfModel_[static_cast<int>(meshOfModel_.size()) - 1] = dataAccessor(matrices, kFloat, "MAT4", 0);
+    }
+  }
+}
+}  // namespace dynbench::convert::detail
