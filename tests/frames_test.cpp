@@ -1,8 +1,6 @@
 // The feature-buffer contract module: a frame written with every buffer reads back bit for bit, a
 // frame with only some buffers (as Cycles writes) reads back with the others empty, and the
 // writer refuses frames that break the contract.
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 
@@ -12,18 +10,13 @@
 #include "core/image_io.h"
 #include "frames/frame_io.h"
 #include "frames/preview.h"
+#include "gltf_builder.h"
 
 namespace dynbench::frames {
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("dynbench_frames_" + std::to_string(::getpid())) / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+using test::freshDir;
 
 FeatureFrame patterned(int width, int height) {
   FeatureFrame f;
@@ -45,7 +38,7 @@ FeatureFrame patterned(int width, int height) {
 }
 
 TEST(Frames, EveryBufferRoundTripsExactly) {
-  const fs::path dir = scratch("round_trip");
+  const fs::path dir = freshDir("frames_round_trip");
   const FeatureFrame written = patterned(5, 3);
   ASSERT_TRUE(writeFrame(dir, written, {{"engine", "test"}}));
   EXPECT_TRUE(frameComplete(dir, 7, {{"engine", "test"}}));
@@ -77,7 +70,7 @@ TEST(Frames, EveryBufferRoundTripsExactly) {
 }
 
 TEST(Frames, OptionalBuffersMayBeAbsentButRequiredOnesMayNot) {
-  const fs::path dir = scratch("subset");
+  const fs::path dir = freshDir("frames_subset");
   FeatureFrame f = patterned(4, 2);
   f.id.clear();
   f.motion.clear();
