@@ -24,12 +24,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 fs::path yawScene(const fs::path& dir) {
   test::GltfBuilder b;
@@ -111,7 +105,7 @@ TEST(Cli, StatsWritesTablesJsonCsvSeriesAndPlots) {
   EXPECT_NE(r.out.find("7.500"), std::string::npos);
   EXPECT_NE(r.out.find("2.000"), std::string::npos);
 
-  const auto json = nlohmann::json::parse(slurp(dir / "s.json"));
+  const auto json = nlohmann::json::parse(test::slurp(dir / "s.json"));
   const auto& d = json["datasets"][0];
   EXPECT_EQ(d["properties"]["animation_frames"], 49);
   EXPECT_TRUE(d["properties"]["animated_camera"].get<bool>());
@@ -120,7 +114,7 @@ TEST(Cli, StatsWritesTablesJsonCsvSeriesAndPlots) {
   EXPECT_NEAR(d["camera_motion"]["position"]["mean"].get<double>(), 2.0, 1e-4);
   EXPECT_EQ(d["camera_motion"]["camera"], "eye");
 
-  std::istringstream csv(slurp(dir / "s.csv"));
+  std::istringstream csv(test::slurp(dir / "s.csv"));
   std::string header, row, extra;
   std::getline(csv, header);
   std::getline(csv, row);
@@ -140,11 +134,11 @@ TEST(Cli, StatsWritesTablesJsonCsvSeriesAndPlots) {
   EXPECT_NEAR(std::stod(column("yaw_mean_deg")), 7.5, 1e-4);
   EXPECT_EQ(column("animation_frames"), "49");
 
-  const std::string series = slurp(dir / "series/yaw.gltf_camera.csv");
+  const std::string series = test::slurp(dir / "series/yaw.gltf_camera.csv");
   EXPECT_EQ(std::count(series.begin(), series.end(), '\n'), 50);  // header + 49 frames
 
   for (const char* figure : {"rotation_per_axis", "rotation_geodesic"}) {
-    const std::string png = slurp(dir / "plots" / fmt::format("yaw.gltf_{}.png", figure));
+    const std::string png = test::slurp(dir / "plots" / fmt::format("yaw.gltf_{}.png", figure));
     ASSERT_GT(png.size(), 1000u) << figure;
     EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
     // IHDR: big-endian width and height at bytes 16-23; the plots are 1200 x 450.
@@ -155,7 +149,7 @@ TEST(Cli, StatsWritesTablesJsonCsvSeriesAndPlots) {
     EXPECT_EQ(png.substr(12, 4), "IHDR");
     EXPECT_EQ(be32(16), 1200);
     EXPECT_EQ(be32(20), 450);
-    const std::string svg = slurp(dir / "plots" / fmt::format("yaw.gltf_{}.svg", figure));
+    const std::string svg = test::slurp(dir / "plots" / fmt::format("yaw.gltf_{}.svg", figure));
     EXPECT_NE(svg.find("<svg"), std::string::npos);
     EXPECT_NE(svg.find("</svg>"), std::string::npos);
   }
@@ -166,7 +160,7 @@ TEST(Cli, StatsWritesTablesJsonCsvSeriesAndPlots) {
   fs::copy_file(scene, dir / "yaw_scene.gltf");
   const auto named = dynbench(fmt::format("stats {} --plots {}", (dir / "yaw_scene.gltf").string(), (dir / "plots2").string()), dir);
   ASSERT_EQ(named.status, 0) << named.err;
-  const std::string svg = slurp(dir / "plots2" / "yaw_scene.gltf_rotation_geodesic.svg");
+  const std::string svg = test::slurp(dir / "plots2" / "yaw_scene.gltf_rotation_geodesic.svg");
   EXPECT_NE(svg.find("yaw_scene.gltf: geodesic change"), std::string::npos) << svg.substr(0, 3000);
 }
 
@@ -205,7 +199,7 @@ TEST(Cli, SeveralDatasetsOneRowEach) {
                                       yawScene(dir).string(), (dir / "m.json").string()),
                           dir);
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto json = nlohmann::json::parse(slurp(dir / "m.json"));
+  const auto json = nlohmann::json::parse(test::slurp(dir / "m.json"));
   ASSERT_EQ(json["datasets"].size(), 2u);
   EXPECT_EQ(json["datasets"][0]["properties"]["armatures"], 1);
   EXPECT_TRUE(json["datasets"][0]["camera_motion"]["camera"].is_null());

@@ -475,7 +475,7 @@ TEST(MergeCamera, DatasetNamesWithSpaces) {
   options.output = c.dataset.parent_path() / "my dataset vr.gltf";
   auto report = mergeCamera(options);
   ASSERT_TRUE(report) << report.error().message;
-  const auto doc = nlohmann::json::parse(*readWholeFile(options.output));
+  const auto doc = nlohmann::json::parse(test::slurp(options.output));
   EXPECT_EQ(doc["buffers"][0]["uri"], "my%20dataset%20vr.bin");
   EXPECT_TRUE(fs::exists(c.dataset.parent_path() / "my dataset vr.bin"));
   int status = -1;

@@ -53,14 +53,14 @@ TEST(Cube2, SeededMatchIsDeterministicAndConverts) {
   EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
 
   // The dataset README lists the licences of the Cube 2 assets (cube2-data's copyright file).
-  const std::string readme = *readWholeFile(dir / "ds" / "colos.README.md");
+  const std::string readme = test::slurp(dir / "ds" / "colos.README.md");
   EXPECT_NE(readme.find("cube2-data"), std::string::npos);
   EXPECT_NE(readme.find("License: CC-BY-3.0"), std::string::npos);
   EXPECT_NE(readme.find("zlib"), std::string::npos);
 
   r = dynbench(fmt::format("stats {} --fps 60 --json {}", (dir / "ds" / "colos.gltf").string(), (dir / "stats.json").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto j = nlohmann::json::parse(*readWholeFile(dir / "stats.json"))["datasets"][0];
+  const auto j = nlohmann::json::parse(test::slurp(dir / "stats.json"))["datasets"][0];
   EXPECT_TRUE(j["properties"]["animated_camera"].get<bool>());
   EXPECT_GE(j["properties"]["static_objects"].get<int>(), 1);        // the map
   EXPECT_GT(j["properties"]["faces"].get<int>(), 5000);              // colos has ~7,800 triangles
@@ -124,7 +124,7 @@ TEST(Cube2, SecondMapConvertsAndValidates) {
   EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
   r = dynbench(fmt::format("stats {} --fps 60 --json {}", (dir / "ds" / "cyber1.gltf").string(), (dir / "stats.json").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto j = nlohmann::json::parse(*readWholeFile(dir / "stats.json"))["datasets"][0];
+  const auto j = nlohmann::json::parse(test::slurp(dir / "stats.json"))["datasets"][0];
   EXPECT_TRUE(j["properties"]["animated_camera"].get<bool>());
   EXPECT_GT(j["properties"]["faces"].get<int>(), 5000);
   EXPECT_GE(j["properties"]["armatures"].get<int>(), 3);  // the followed bot's three opponents and team mate

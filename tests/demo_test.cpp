@@ -27,7 +27,7 @@ TEST(Demo, FlythroughPassesThroughTheKeysAndTurnsSlowly) {
   b.channel(cam, "translation", {0, 1, 2, 3, 4}, {0, 0, 0, 10, 0, 0, 10, 0, -10, 20, 0, -10, 20, 0, -20});
   const fs::path dataset = b.write(dir, "zigzag");
   ASSERT_TRUE(demo::writeFlythroughCsv(dataset, dir / "fly.csv", 5, 60.0));
-  const std::string csv = *readWholeFile(dir / "fly.csv");
+  const std::string csv = test::slurp(dir / "fly.csv");
   std::vector<std::array<double, 8>> rows;
   std::size_t start = csv.find('\n') + 1;
   for (std::size_t end; (end = csv.find('\n', start)) != std::string::npos; start = end + 1) {
@@ -64,7 +64,7 @@ TEST(Demo, WholeChainOnAShortMatch) {
   const auto r = dynbench(fmt::format("demo -o {} --seconds 3 --bots 4 --res 64x36 --spp 1 --bounces 1", (dir / "demo").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("report: "), std::string::npos) << r.out;
-  const std::string md = *readWholeFile(dir / "demo" / "report.md");
+  const std::string md = test::slurp(dir / "demo" / "report.md");
   EXPECT_NE(md.find("| colos_bot "), std::string::npos);
   EXPECT_NE(md.find("| colos_flythrough "), std::string::npos);
   // Table 6.5: the fly-through turns no faster than 30 deg/s, i.e. 1.25 deg per frame at 24 fps.
@@ -79,17 +79,17 @@ TEST(Demo, WholeChainOnAShortMatch) {
 
   // A rerun with the same options reuses the capture; with another seed it captures again (it
   // used to measure the old match under the new options' name).
-  const std::string capture = *readWholeFile(dir / "demo" / "capture" / "Capture.txt");
+  const std::string capture = test::slurp(dir / "demo" / "capture" / "Capture.txt");
   const std::string args = fmt::format("demo -o {} --seconds 3 --bots 4 --res 64x36 --spp 1 --bounces 1", (dir / "demo").string());
   auto again = dynbench(args, dir);
   ASSERT_EQ(again.status, 0) << again.err << again.out;
   EXPECT_NE(again.out.find("exists, reused"), std::string::npos) << again.out;
-  EXPECT_EQ(*readWholeFile(dir / "demo" / "capture" / "Capture.txt"), capture);
+  EXPECT_EQ(test::slurp(dir / "demo" / "capture" / "Capture.txt"), capture);
   again = dynbench(args + " --seed 2", dir);
   ASSERT_EQ(again.status, 0) << again.err << again.out;
   EXPECT_NE(again.out.find("was made with other options, capturing again"), std::string::npos) << again.out;
-  EXPECT_NE(*readWholeFile(dir / "demo" / "capture" / "Capture.txt"), capture);
-  EXPECT_NE(readWholeFile(dir / "demo" / "capture" / "dynbench-demo-capture.json")->find("\"seed\": 2"), std::string::npos);
+  EXPECT_NE(test::slurp(dir / "demo" / "capture" / "Capture.txt"), capture);
+  EXPECT_NE(test::slurp(dir / "demo" / "capture" / "dynbench-demo-capture.json").find("\"seed\": 2"), std::string::npos);
   EXPECT_NE(again.out.find("convert: capture ->"), std::string::npos) << again.out;  // the dataset follows the new capture
 }
 

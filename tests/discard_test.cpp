@@ -253,7 +253,7 @@ TEST(DiscardCli, TableJsonCsvAndMasks) {
                           dir);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("| frustum % |"), std::string::npos) << r.out;
-  const auto j = nlohmann::json::parse(*readWholeFile(dir / "d.json"));
+  const auto j = nlohmann::json::parse(test::slurp(dir / "d.json"));
   ASSERT_EQ(j["frames"].size(), 3u);
   // A 2-degree yaw per frame over a 50-degree-high, 48x27 image, the camera at the origin: the
   // frustum share is the pixels whose centre ray, turned by 2 degrees about +Y, lands outside the
@@ -277,12 +277,12 @@ TEST(DiscardCli, TableJsonCsvAndMasks) {
   EXPECT_NEAR(j["frames"][2]["frustum"].get<double>(), expected, 1e-9);
   EXPECT_NEAR(j["mean"]["frustum"].get<double>(), expected, 1e-9);
   EXPECT_EQ(j["mean"]["world_position"].get<double>(), 0.0);
-  const auto csv = *readWholeFile(dir / "d.csv");
+  const auto csv = test::slurp(dir / "d.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);
   const auto png = readImageHeader(dir / "plots" / "frames_discard.png");
   ASSERT_TRUE(png) << png.error().message;
   EXPECT_EQ(png->width, 1200);
-  const std::string svg = *readWholeFile(dir / "plots" / "frames_discard.svg");
+  const std::string svg = test::slurp(dir / "plots" / "frames_discard.svg");
   EXPECT_NE(svg.find("</svg>"), std::string::npos);
   EXPECT_NE(svg.find("shading normal"), std::string::npos);  // the legend names the features
   auto mask = readImageHeader(dir / "masks" / "discard_00003.png");

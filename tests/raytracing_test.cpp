@@ -57,7 +57,7 @@ TEST(RayTracing, GroundHitsEqualTheAnalyticIntersection) {
   lens.yfov = radians(50.0);
   lens.znear = 0.1;
   const RenderCamera cam(world, lens, 64, 48);
-  int groundHits = 0;
+  int groundHits = 0, crateHits = 0;
   for (int py = 0; py < 48; py += 3)
     for (int px = 0; px < 64; px += 3) {
       const Ray ray = cam.ray(px + 0.5, py + 0.5);
@@ -66,10 +66,21 @@ TEST(RayTracing, GroundHitsEqualTheAnalyticIntersection) {
         EXPECT_FALSE(hit.hit);
         continue;
       }
+      // The crate's top (y = 1, |x|, |z| <= 0.5) is in front of the ground where the ray crosses it.
+      const double tTop = (1.0 - ray.origin.y) / ray.direction.y;
+      const glm::dvec3 top = ray.origin + tTop * ray.direction;
+      const double edge = std::max(std::abs(top.x), std::abs(top.z));
+      if (std::abs(edge - 0.5) < 1e-3) continue;  // grazing the crate's edge: either answer is right
+      if (edge < 0.5) {
+        ASSERT_TRUE(hit.hit) << px << "," << py;
+        ++crateHits;
+        EXPECT_EQ(hit.node, 1) << px << "," << py;
+        EXPECT_LT(glm::length(hit.position - top), 1e-4 * std::max(1.0, tTop)) << px << "," << py;
+        continue;
+      }
       const double t = -ray.origin.y / ray.direction.y;  // the plane y = 0
       const glm::dvec3 expected = ray.origin + t * ray.direction;
       if (std::abs(expected.x) > 9.9 || std::abs(expected.z) > 9.9) continue;  // near the quad's edge
-      if (hit.node == 1) continue;                                              // the crate in front
       ASSERT_TRUE(hit.hit) << px << "," << py;
       ++groundHits;
       EXPECT_EQ(hit.node, 0);
@@ -79,6 +90,7 @@ TEST(RayTracing, GroundHitsEqualTheAnalyticIntersection) {
       EXPECT_NEAR(std::abs(hit.geometricNormal.y), 1.0, 1e-9);
     }
   EXPECT_GT(groundHits, 100);
+  EXPECT_GT(crateHits, 0);  // every sampled ray was classified and checked above; the crate was among them
   EXPECT_TRUE((*rt)->occluded({0, 5, 0}, {0, -1, 0}, 10.0));
   EXPECT_FALSE((*rt)->occluded({0, 5, 0}, {0, 1, 0}, 10.0));
   EXPECT_FALSE((*rt)->occluded({0, 5, 0}, {0, -1, 0}, 2.0));  // stops short of the crate top (y = 1)

@@ -153,7 +153,12 @@ TEST(RenderCli, TheDatasetEnvironmentLightsTheBackground) {
   ASSERT_EQ(r.status, 0) << r.err;
   image = readImage(dir / "dark" / "frame_00000.exr");
   ASSERT_TRUE(image);
-  EXPECT_EQ(image->pixels[channel("direct.B")], 0.0f);
+  ASSERT_EQ(image->pixels.size(), 32u * static_cast<std::size_t>(image->channels));
+  for (std::size_t p = 0; p < 32; ++p) {  // the whole image: nothing hit, nothing lit
+    const float* px = &image->pixels[p * static_cast<std::size_t>(image->channels)];
+    for (const char* c : {"direct.R", "direct.G", "direct.B", "indirect.R", "indirect.G", "indirect.B", "hit", "P.X", "P.Y", "P.Z"})
+      EXPECT_EQ(px[channel(c)], 0.0f) << c << " at pixel " << p;
+  }
 
   // The environment image missing: the error names the file and the JSON pointer.
   fs::remove(dir / "sky.hdr");

@@ -27,10 +27,6 @@ void makeRun(const fs::path& run, const std::string& frames) {
   }
 }
 
-std::string slurp(const fs::path& p) {
-  auto text = readWholeFile(p);
-  return text ? *text : std::string();
-}
 
 std::size_t count(const std::string& text, const std::string& what) {
   std::size_t n = 0;
@@ -46,13 +42,13 @@ TEST(Report, TablesAndImagesInTheBrowser) {
                                       (dir / "out" / "report.html").string()),
                           dir);
   ASSERT_EQ(r.status, 0) << r.err;
-  const std::string md = *readWholeFile(dir / "out" / "report.md");
+  const std::string md = test::slurp(dir / "out" / "report.md");
   for (int t = 1; t <= 7; ++t) EXPECT_NE(md.find(fmt::format("Table 6.{}.", t)), std::string::npos) << t;
   EXPECT_EQ(count(md, "| slow "), 7u);  // one row per table
   EXPECT_EQ(count(md, "| fast "), 7u);
   // Per run: A.1, A.2, the discard series, 3 thumbnails, 3 masks.
   EXPECT_EQ(count(md, "!["), 18u);
-  const std::string html = *readWholeFile(dir / "out" / "report.html");
+  const std::string html = test::slurp(dir / "out" / "report.html");
   EXPECT_EQ(html.find("http://"), std::string::npos);  // self-contained: nothing to fetch
   EXPECT_EQ(html.find("src=\"report_files"), std::string::npos);
 
@@ -80,7 +76,7 @@ TEST(Report, BadRunsFailClearly) {
   // A real run, then one malformed value at a time: the error names the file and the JSON
   // pointer, the status is 5, and no report is written (it used to print "-" and exit 0).
   makeRun(dir / "good", "0:1");
-  const std::string stats = slurp(dir / "good" / "stats.json"), discard = slurp(dir / "good" / "discard.json");
+  const std::string stats = test::slurp(dir / "good" / "stats.json"), discard = test::slurp(dir / "good" / "discard.json");
   struct Case {
     std::string file, from, to, message;
   };

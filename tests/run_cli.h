@@ -9,7 +9,24 @@
 #include <sstream>
 #include <string>
 
+#include <gtest/gtest.h>
+
 namespace dynbench {
+
+namespace test {
+// A whole file's text; a missing or unreadable file is a test failure (and "" is returned), so a
+// test never dereferences an empty result.
+inline std::string slurp(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    ADD_FAILURE() << path << ": cannot read";
+    return {};
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+}  // namespace test
 
 // Runs a shell command; returns its exit status (-1 if it did not exit) and appends its stdout.
 inline int runShell(const std::string& command, std::string& out) {
