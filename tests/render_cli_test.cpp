@@ -11,6 +11,7 @@
 #include "core/files.h"
 #include "core/image_io.h"
 #include "gltf_builder.h"
+#include "render/backend.h"
 #include "run_cli.h"
 
 namespace dynbench {
@@ -189,6 +190,25 @@ TEST(RenderCli, BadOptionsFailClearly) {
   const auto r = dynbench(fmt::format("render {} -o {}", (dir / "missing.gltf").string(), (dir / "out").string()), dir);
   EXPECT_EQ(r.status, 3);
   EXPECT_NE(r.err.find("missing.gltf"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace dynbench
+
+namespace dynbench {
+namespace {
+
+// Backends are found by name; an unknown one is a usage error listing the names.
+TEST(RenderBackends, FoundByNameAndListedWhenNot) {
+  ASSERT_GE(render::renderBackends().size(), 2u);
+  EXPECT_STREQ(render::renderBackends().front().name, "embree");  // the default first
+  auto cycles = render::findBackend("cycles");
+  ASSERT_TRUE(cycles);
+  EXPECT_STREQ((*cycles)->name, "cycles");
+  auto none = render::findBackend("optix");
+  ASSERT_FALSE(none);
+  EXPECT_EQ(none.error().code, ErrorCode::kUsage);
+  EXPECT_EQ(none.error().message, "--engine 'optix': expected one of embree, cycles");
 }
 
 }  // namespace
