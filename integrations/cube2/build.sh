@@ -6,7 +6,8 @@
 #   bash integrations/cube2/build.sh [BUILD_DIR=build/cube2] [DYNBENCH_BUILD=build/release]
 # Prints the client's path. Needs scripts/setup.sh run first (the source tarball and libsdl2-dev,
 # libsdl2-image-dev, libsdl2-mixer-dev, libenet-dev, zlib1g-dev, libgl-dev) and dynbench built
-# (libdynbench_capture.a); running it needs cube2-data and xvfb.
+# (libdynbench_capture_engine.a: the SDK as engines link it, without sanitizers); running it needs
+# cube2-data and xvfb.
 set -euo pipefail
 
 build_dir=${1:-build/cube2}
@@ -41,15 +42,19 @@ for f in dynbench_capture.h dynbench_capture.cpp dynbench_models.h; do
     rm -f "$src"/engine/{main,dynlight,rendermodel,dynbench_capture}.o
   fi
 done
-for lib in libdynbench_capture.a libdynbench_core.a; do
+for lib in libdynbench_capture_engine.a; do
   [[ -f "$dynbench_build/$lib" ]] || { echo "cube2: $dynbench_build/$lib missing: build dynbench first (cmake --build build/release)" >&2; exit 1; }
 done
+# The game's Makefile does not know the SDK library either: relink when it is newer than the client.
+if [[ -f "$src/sauer_client" && "$dynbench_build/libdynbench_capture_engine.a" -nt "$src/sauer_client" ]]; then
+  rm -f "$src/sauer_client"
+fi
 # The tarball ships without the bundled enet: an empty enet/ with a no-op Makefile satisfies the
 # game's Makefile, and -lenet then finds Debian's libenet.
 mkdir -p "$src/enet/include"
 printf 'all:\n\t@true\n' > "$src/enet/Makefile"
 make -C "$src" -j"$(nproc)" client \
   DYNBENCH_INCLUDES="-I$repo/include" \
-  DYNBENCH_LIBS="$dynbench_build/libdynbench_capture.a $dynbench_build/libdynbench_core.a -lfmt" \
+  DYNBENCH_LIBS="$dynbench_build/libdynbench_capture_engine.a -lfmt" \
   >"$build_dir/build.log" 2>&1 || { tail -20 "$build_dir/build.log" >&2; exit 1; }
 echo "$src/sauer_client"
