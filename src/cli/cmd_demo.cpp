@@ -31,7 +31,8 @@ void addDemoCommand(CLI::App& app, CommandRun& run) {
   auto o = std::make_shared<DemoCli>();
   auto* cmd = app.add_subcommand("demo", "The whole chain on a seeded Cube 2 bot match: capture, convert, stats, render, discard, report");
   cmd->footer("Also makes a smooth fly-through over the same match as a second dataset, so the report shows the contrast.\n"
-              "A rerun reuses the capture and the frames already rendered. Example: dynbench demo -o demo --seconds 20");
+              "A rerun reuses the capture when --map, --bots, --seconds and --seed are the same, and the frames already rendered.\n"
+              "Example: dynbench demo -o demo --seconds 20");
   cmd->add_option("-o,--output", o->options.output, "Output folder");
   cmd->add_option("--map", o->options.map, "Map");
   cmd->add_option("--bots", o->options.bots, "Bots")->check(between(capture::kBotsRange.first, capture::kBotsRange.second));

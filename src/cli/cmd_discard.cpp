@@ -53,7 +53,9 @@ void addDiscardCommand(CLI::App& app, CommandRun& run) {
       ->check(nonNegative());
   cmd->add_flag("--absolute-radiance", o->thresholds.absoluteRadiance, "Radiance thresholds in radiance units, not relative");
   cmd->add_flag("--noise-aware", o->thresholds.noiseAware,
-                "Discard radiance only when the change exceeds 3 standard deviations of the pixels' noise (needs *.var channels)");
+                fmt::format("Discard radiance only when the change exceeds {} standard deviations of the pixels' noise (needs *.var "
+                            "channels)",
+                            discard::Thresholds{}.noiseSigmas));
   cmd->add_option("--json", o->json, "Per-frame and mean percentages as JSON");
   cmd->add_option("--csv", o->csv, "Per-frame percentages as CSV");
   cmd->add_option("--plots", o->plots, "Write NAME_discard.png and .svg: per-frame discard percentages (gnuplot)");
