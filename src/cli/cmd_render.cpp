@@ -1,15 +1,12 @@
 // `dynbench render DATASET -o DIR`: path-traced feature buffers for every frame
 // (docs/feature-buffers.md), with dynbench's Embree path tracer or Blender Cycles.
-#include <mutex>
 #include <optional>
-#include <thread>
 
 #include <spdlog/spdlog.h>
 
 #include "cli/commands.h"
 #include "core/progress.h"
 #include "render/backend.h"
-#include "render/render_job.h"
 #include "pipeline/stages.h"
 
 namespace dynbench::cli {
@@ -19,17 +16,14 @@ namespace {
 // prints them from there.
 struct RenderCli {
   render::RenderJob job;
-  std::string dataset, output, frames;
+  std::string frames;
   std::string resolution = fmt::format("{}x{}", render::RenderSettings{}.width, render::RenderSettings{}.height);
-  std::optional<std::string> animation, envConstant;
+  std::optional<std::string> envConstant;
   bool noEnvironment = false;
 };
 
 Expected<void> runRender(const RenderCli& cli) {
   render::RenderJob job = cli.job;
-  job.dataset = cli.dataset;
-  job.output = cli.output;
-  job.animation = cli.animation;
   auto res = parseResolution(cli.resolution);
   if (!res) return std::unexpected(res.error());
   job.settings.width = res->first;
@@ -68,7 +62,7 @@ Expected<void> runRender(const RenderCli& cli) {
   if (!summary) return std::unexpected(summary.error());
   for (const auto& w : sceneWarnings) spdlog::warn("{}", w);
   for (const auto& w : summary->warnings) spdlog::warn("{}", w);
-  fmt::print("{}: {} frame(s) rendered, {} already complete (skipped), {:.1f} s", cli.output, summary->rendered.size(),
+  fmt::print("{}: {} frame(s) rendered, {} already complete (skipped), {:.1f} s", job.output.string(), summary->rendered.size(),
              summary->skipped.size(), summary->seconds);
   if (summary->cameraSamples > 0 && summary->seconds > 0)
     fmt::print(", {:.2f} M samples/s, {:.2f} M rays/s", summary->cameraSamples / summary->seconds / 1e6, summary->rays / summary->seconds / 1e6);
@@ -93,8 +87,8 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
   cmd->footer("Writes DIR/frame_NNNNN.exr and DIR/frame_NNNNN.json per frame (docs/feature-buffers.md). Frames already\n"
               "complete with the same settings are skipped, so an interrupted render resumes.\n"
               "Example: dynbench render dataset.gltf -o frames --frames 0:47 --spp 64");
-  cmd->add_option("DATASET", o->dataset, "Animated dataset (glTF, GLB, FBX, DAE, ...)")->required();
-  cmd->add_option("-o,--output", o->output, "Output folder")->required();
+  cmd->add_option("DATASET", o->job.dataset, "Animated dataset (glTF, GLB, FBX, DAE, ...)")->required();
+  cmd->add_option("-o,--output", o->job.output, "Output folder")->required();
   cmd->add_option("--res", o->resolution, "Resolution WIDTHxHEIGHT (the thesis used 1920x1080)");
   cmd->add_option("--spp", o->job.settings.samplesPerPixel, "Samples per pixel (the thesis used 1024)")->check(positive());
   cmd->add_option("--bounces", o->job.settings.bounces, "Bounces after the first hit, as Cycles counts them (the thesis used 12)")
@@ -102,7 +96,7 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--fps", o->job.fps, "Frames per second: frame i is at t = start + i / fps")->check(positive());
   cmd->add_option("--frames", o->frames, "Frames A:B[:STEP] (inclusive), A: or A (empty: every frame)");
   cmd->add_option("--camera", o->job.camera, "Camera node: index or name (default: the first animated camera)");
-  cmd->add_option("--animation", o->animation, "Play only this animation (index or name)");
+  cmd->add_option("--animation", o->job.animation, "Play only this animation (index or name)");
   cmd->add_option("--seed", o->job.settings.seed, "Random seed; the same seed and options give the same images");
   std::vector<std::string> engines;
   std::string engineHelp = "Renderer:";

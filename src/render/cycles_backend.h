@@ -10,8 +10,6 @@
 #include <filesystem>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "core/error.h"
 #include "core/image_io.h"
 #include "frames/feature_frame.h"
