@@ -1,12 +1,15 @@
 // `--engine cycles` against dynbench's own path tracer on one frame: the position and normal
 // buffers must agree. Needs Blender (Debian's `blender`); the test says so and skips without it.
 #include <cmath>
+#include <fstream>
 
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
 
+#include "convert/sky.h"
 #include "core/image_io.h"
+#include "core/math.h"
 #include "gltf_builder.h"
 #include "render/cycles_backend.h"
 #include "external_tools.h"
@@ -24,7 +27,10 @@ fs::path floorAndSphere(const fs::path& dir) {
   b.doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorFactor", {0.6, 0.6, 0.6, 1}}, {"metallicFactor", 0.0}}}}});
   std::vector<float> p{-5, 0, -5, -5, 0, 5, 5, 0, 5, 5, 0, -5}, n{0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
   std::vector<std::uint32_t> idx{0, 1, 2, 0, 2, 3};
-  json floor = {{"attributes", {{"POSITION", b.accessor(p, "VEC3")}, {"NORMAL", b.accessor(n, "VEC3")}}}, {"indices", b.indices(idx)}, {"material", 0}};
+  const std::vector<float> uv{0, 0, 0, 5, 5, 5, 5, 0};  // five texture repeats across the floor
+  json floor = {{"attributes", {{"POSITION", b.accessor(p, "VEC3")}, {"NORMAL", b.accessor(n, "VEC3")}, {"TEXCOORD_0", b.accessor(uv, "VEC2")}}},
+                {"indices", b.indices(idx)},
+                {"material", 0}};
   p.clear();
   n.clear();
   idx.clear();
@@ -123,6 +129,105 @@ TEST(Cycles, PositionAndNormalAgreeWithDynbench) {
   EXPECT_GE(agree, static_cast<int>(0.99 * (w * h - edges))) << "hit disagreements " << hitMismatch << ", pixels on geometry " << both;
   std::printf("P and N agree on %d of %d pixels off silhouettes (%d silhouette pixels, %d hit/miss disagreements)\n", agree,
               w * h - edges, edges, hitMismatch);
+}
+
+// The radiance test's scene: floorAndSphere's geometry with a checker-textured floor, a rough
+// red sphere, and one kind of light at a time, so a disagreement names its source.
+enum class LightKind { kSky, kPoint, kSpot, kDirectional };
+
+fs::path litScene(const fs::path& dir, LightKind kind) {
+  const fs::path base = floorAndSphere(dir);
+  auto doc = json::parse(test::slurp(base));
+  // A checker texture (8 x 8 texels, sRGB PNG) on the floor.
+  FloatImage checker{8, 8, 3, {}, {}};
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x)
+      for (int c = 0; c < 3; ++c) checker.pixels.push_back((x + y) % 2 ? 0.9f : (c == 2 ? 0.6f : 0.2f));
+  EXPECT_TRUE(writeImage(dir / "checker.png", checker));
+  doc["images"] = json::array({{{"uri", "checker.png"}}});
+  doc["samplers"] = json::array({{{"magFilter", 9728}, {"minFilter", 9728}}});  // nearest: both engines look up the same texel
+  doc["textures"] = json::array({{{"source", 0}, {"sampler", 0}}});
+  doc["materials"] = json::array({{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}, {"metallicFactor", 0.0}, {"roughnessFactor", 1.0}}}},
+                                  {{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.3, 0.2, 1}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.5}}}}});
+  doc["meshes"][1]["primitives"][0]["material"] = 1;
+  std::string name;
+  json light;
+  json node = {{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}};
+  const double c45 = std::cos(M_PI / 4), s45 = std::sin(M_PI / 4);
+  switch (kind) {
+    case LightKind::kSky: {
+      const auto sky = convert::preethamSky({3.0, 35.0, 60.0, 256});
+      EXPECT_TRUE(writeImage(dir / "sky.hdr", FloatImage{sky.width, sky.height, 3, sky.rgb, {}}));
+      doc["extensions"]["DYNBENCH_environment"] = {{"uri", "sky.hdr"}};
+      doc["extensionsUsed"].push_back("DYNBENCH_environment");
+      name = "sky";
+      break;
+    }
+    case LightKind::kPoint:
+      light = {{"type", "point"}, {"color", {1.0, 0.9, 0.8}}, {"intensity", 40.0}};
+      node["translation"] = {1.5, 2.5, 1.0};
+      name = "point";
+      break;
+    case LightKind::kSpot:
+      light = {{"type", "spot"}, {"intensity", 80.0}, {"spot", {{"innerConeAngle", 0.3}, {"outerConeAngle", 0.6}}}};
+      node["translation"] = {-0.5, 4.0, 0.5};
+      node["rotation"] = {-s45, 0, 0, c45};  // local -Z turned to -Y: straight down
+      name = "spot";
+      break;
+    case LightKind::kDirectional:
+      light = {{"type", "directional"}, {"color", {0.9, 0.95, 1.0}}, {"intensity", 5.0}};
+      node["rotation"] = {-0.3535534, 0.3535534, 0.1464466, 0.8535534};  // down and to the side
+      name = "directional";
+      break;
+  }
+  if (kind != LightKind::kSky) {
+    doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({light});
+    doc["extensionsUsed"].push_back("KHR_lights_punctual");
+    doc["nodes"].push_back(node);
+    doc["scenes"][0]["nodes"].push_back(doc["nodes"].size() - 1);
+  }
+  const fs::path out = dir / (name + ".gltf");
+  std::ofstream(out) << doc.dump();
+  return out;
+}
+
+struct MeanRadiance {
+  double direct = 0, indirect = 0;
+};
+
+MeanRadiance meanRadiance(const fs::path& exr) {
+  auto image = readImage(exr);
+  EXPECT_TRUE(image) << exr;
+  MeanRadiance m;
+  if (!image) return m;
+  const auto d = channels(*image, {"direct.R", "direct.G", "direct.B"}), i = channels(*image, {"indirect.R", "indirect.G", "indirect.B"});
+  const std::size_t n = d.size() / 3;
+  for (std::size_t k = 0; k < n; ++k) {
+    m.direct += luminance(glm::dvec3(d[3 * k], d[3 * k + 1], d[3 * k + 2])) / static_cast<double>(n);
+    m.indirect += luminance(glm::dvec3(i[3 * k], i[3 * k + 1], i[3 * k + 2])) / static_cast<double>(n);
+  }
+  return m;
+}
+
+TEST(Cycles, RadianceAgreesWithDynbenchForEachKindOfLight) {
+  DYNBENCH_NEEDS(test::missingBlender());
+  const auto dir = test::freshDir("cycles_radiance");
+  for (const auto kind : {LightKind::kSky, LightKind::kPoint, LightKind::kSpot, LightKind::kDirectional}) {
+    const fs::path scene = litScene(dir, kind);
+    const std::string name = scene.stem().string();
+    MeanRadiance m[2];
+    for (int e = 0; e < 2; ++e) {
+      const std::string engine = e ? "cycles" : "embree";
+      const auto out = dir / (name + "_" + engine);
+      const auto r = dynbench(fmt::format("render {} -o {} --engine {} --res 64x48 --spp {} --bounces 2", scene.string(), out.string(), engine,
+                                          e ? 256 : 64),
+                              dir);
+      ASSERT_EQ(r.status, 0) << engine << ": " << r.err;
+      m[e] = meanRadiance(out / "frame_00000.exr");
+    }
+    std::printf("%-12s direct dynbench %.5g cycles %.5g (ratio %.4f); indirect dynbench %.5g cycles %.5g (ratio %.4f)\n", name.c_str(),
+                m[0].direct, m[1].direct, m[1].direct / m[0].direct, m[0].indirect, m[1].indirect, m[1].indirect / m[0].indirect);
+  }
 }
 
 TEST(Cycles, MissingBlenderIsAClearError) {

@@ -11,6 +11,9 @@
 #include "frames/frame_io.h"
 #include "frames/preview.h"
 #include "gltf_builder.h"
+#include "run_cli.h"
+
+#include <fstream>
 
 namespace dynbench::frames {
 namespace {
@@ -66,7 +69,38 @@ TEST(Frames, EveryBufferRoundTripsExactly) {
   std::sort(names.begin(), names.end());
   std::sort(expected.begin(), expected.end());
   EXPECT_EQ(names, expected);
-  EXPECT_EQ(contractChannelNames().size(), 22u);
+  EXPECT_EQ(contractChannelNames().size(), 23u);
+  EXPECT_FALSE(read->sampling);  // none written
+}
+
+TEST(Frames, TheSamplingSummaryRoundTrips) {
+  const fs::path dir = freshDir("frames_sampling");
+  FeatureFrame written = patterned(4, 2);
+  written.sampling = frames::SamplingSummary{true, 0.25, 1.5, 0.75, 16, 4096, 123.5, 3, 0.01, 2.5};
+  ASSERT_TRUE(writeFrame(dir, written, {{"engine", "test"}}));
+  auto entries = listFrames(dir);
+  ASSERT_TRUE(entries);
+  auto read = readFrame((*entries)[0]);
+  ASSERT_TRUE(read) << read.error().message;
+  ASSERT_TRUE(read->sampling);
+  const auto& s = *read->sampling;
+  EXPECT_TRUE(s.adaptive);
+  EXPECT_EQ(s.tolerance, 0.25);
+  EXPECT_EQ(s.directTarget, 1.5);
+  EXPECT_EQ(s.indirectTarget, 0.75);
+  EXPECT_EQ(s.minSamples, 16);
+  EXPECT_EQ(s.maxSamples, 4096);
+  EXPECT_EQ(s.meanSamples, 123.5);
+  EXPECT_EQ(s.cappedPixels, 3);
+  EXPECT_EQ(s.lightCutoff, 0.01);
+  EXPECT_EQ(s.droppedIrradianceBound, 2.5);
+  // A malformed value is named by its JSON pointer.
+  auto j = nlohmann::json::parse(test::slurp(frameSidecarPath(dir, 7)));
+  j["sampling"]["mean_spp"] = "many";
+  std::ofstream(frameSidecarPath(dir, 7)) << j.dump();
+  auto bad = readFrame((*entries)[0]);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("/sampling/mean_spp: expected a number"), std::string::npos) << bad.error().message;
 }
 
 TEST(Frames, OptionalBuffersMayBeAbsentButRequiredOnesMayNot) {

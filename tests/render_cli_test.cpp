@@ -49,7 +49,7 @@ TEST(RenderCli, WritesTheContractAndResumes) {
     const std::vector<std::string> expected{"P.X",    "P.Y",    "P.Z",      "N.X",        "N.Y",          "N.Z",
                                             "direct.R", "direct.G", "direct.B", "indirect.R", "indirect.G",   "indirect.B",
                                             "albedo.R", "albedo.G", "albedo.B", "Z",          "id",           "motion.X",
-                                            "motion.Y", "direct.var", "indirect.var", "hit"};
+                                            "motion.Y", "direct.var", "indirect.var", "hit", "spp"};
     // EXR stores channels sorted by name; compare as sets.
     auto names = image->channelNames;
     auto sorted = expected;

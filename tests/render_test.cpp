@@ -153,74 +153,155 @@ PlaneScene pointLightOverPlane() {
   return p;
 }
 
-TEST(Render, PointLightOverDiffusePlaneGivesTheAnalyticRadiance) {
+TEST(Render, PointLightOverDiffusePlaneGivesTheAnalyticRadianceWithoutNoise) {
   // L = (albedo / pi) I cos(theta) / d^2 = (albedo / pi) I h / d^3 at a point of the plane y = 0.
+  // Punctual light is summed, not sampled, and radiance is taken at the pixel centre's hit: one
+  // sample gives the exact answer, with zero variance.
   const PlaneScene p = pointLightOverPlane();
-  RenderSettings settings;
-  settings.samplesPerPixel = 8;
-  settings.useEnvironment = false;
-  auto tracer = tracerFor(p.scene, settings);
-  ASSERT_TRUE(tracer);
-  ASSERT_TRUE(tracer->setTime(0.0, 0.0));
-  const int w = 80, h = 60;
-  const RenderCamera cam = lookCamera({0, 4, 0}, {0, -1, 0}, 60.0, w, h);
-  const FrameBuffers f = tracer->render(0, cam, cam);
-  auto analytic = [&](double px, double py) {
-    const Ray r = cam.ray(px, py);
-    const glm::dvec3 x = r.origin + r.direction * (-r.origin.y / r.direction.y);
-    const double d = glm::length(p.light - x);
-    return p.albedo / kPi * p.intensity * p.light.y / (d * d * d);
-  };
-  int checked = 0;
-  for (int py = 2; py < h; py += 7)
-    for (int px = 3; px < w; px += 9) {
-      const std::size_t i = static_cast<std::size_t>(py * w + px);
-      if (f.hit[i] == 0.0f) continue;
-      // The pixel averages jittered samples over its footprint: the answer lies between the
-      // analytic values at the footprint's corners (the function is smooth at pixel scale).
-      const double c[4] = {analytic(px, py), analytic(px + 1, py), analytic(px, py + 1), analytic(px + 1, py + 1)};
-      const double lo = *std::min_element(c, c + 4), hi = *std::max_element(c, c + 4);
-      const double value = f.direct[3 * i];
-      EXPECT_GE(value, lo * (1 - 1e-4)) << px << "," << py;
-      EXPECT_LE(value, hi * (1 + 1e-4)) << px << "," << py;
-      EXPECT_EQ(rgb(f.indirect, i), glm::dvec3(0.0));  // a plane cannot light itself
-      EXPECT_FLOAT_EQ(f.directVariance[i] >= 0 ? 1.0f : 0.0f, 1.0f);
-      ++checked;
-    }
-  EXPECT_GT(checked, 40);
+  for (const int spp : {1, 4}) {
+    RenderSettings settings;
+    settings.samplesPerPixel = spp;
+    settings.useEnvironment = false;
+    auto tracer = tracerFor(p.scene, settings);
+    ASSERT_TRUE(tracer);
+    ASSERT_TRUE(tracer->setTime(0.0, 0.0));
+    const int w = 80, h = 60;
+    const RenderCamera cam = lookCamera({0, 4, 0}, {0, -1, 0}, 60.0, w, h);
+    const FrameBuffers f = tracer->render(0, cam, cam);
+    int checked = 0;
+    for (int py = 0; py < h; ++py)
+      for (int px = 0; px < w; ++px) {
+        const std::size_t i = static_cast<std::size_t>(py * w + px);
+        if (f.hit[i] == 0.0f) continue;
+        const Ray r = cam.ray(px + 0.5, py + 0.5);
+        const glm::dvec3 x = r.origin + r.direction * (-r.origin.y / r.direction.y);
+        const double d = glm::length(p.light - x);
+        const double analytic = p.albedo / kPi * p.intensity * p.light.y / (d * d * d);
+        ASSERT_NEAR(f.direct[3 * i], analytic, 2e-6 * analytic) << px << "," << py;
+        EXPECT_EQ(rgb(f.indirect, i), glm::dvec3(0.0));  // a plane cannot light itself
+        EXPECT_EQ(f.directVariance[i], 0.0f);
+        EXPECT_EQ(f.spp[i], static_cast<float>(spp));
+        ++checked;
+      }
+    EXPECT_GT(checked, 3000);
+  }
 }
 
-TEST(Render, ManyPunctualLightsAreChosenWithoutBias) {
-  // Ten lights of a tenth of the intensity at the same place: more than LightSet samples one by
-  // one, so one is chosen at random per shading point. The image is the single light's, within noise.
+TEST(Render, ThousandLightsOfWhichTenReachGiveTheImageOfTheTen) {
+  // Ten point lights with a range over the plane, and 990 whose range ends before the plane: the
+  // light hierarchy must find the ten (and only those) and the image must be the ten's alone.
   const PlaneScene one = pointLightOverPlane();
-  test::GltfBuilder b;
-  const int grey = addMaterial(b, glm::dvec3(one.albedo), 0.0, 1.0, true);
-  b.node({{"name", "plane"}, {"mesh", addPlane(b, 3.0, 0.0, grey)}});
-  static_assert(LightSet::kEveryPunctualLimit < 10);
-  for (int k = 0; k < 10; ++k) {
-    b.doc["extensions"]["KHR_lights_punctual"]["lights"].push_back({{"type", "point"}, {"intensity", one.intensity / 10}});
-    b.node({{"translation", {one.light.x, one.light.y, one.light.z}}, {"extensions", {{"KHR_lights_punctual", {{"light", k}}}}}});
-  }
-  b.doc["extensionsUsed"] = {"KHR_lights_punctual", "KHR_materials_specular"};
-  const scene::Scene ten = load(b, "ten_lights");
+  auto build = [&](int outOfReach) {
+    test::GltfBuilder b;
+    const int grey = addMaterial(b, glm::dvec3(one.albedo), 0.0, 1.0, true);
+    b.node({{"name", "plane"}, {"mesh", addPlane(b, 3.0, 0.0, grey)}});
+    auto& lights = b.doc["extensions"]["KHR_lights_punctual"]["lights"];
+    int index = 0;
+    for (int k = 0; k < 10; ++k) {
+      lights.push_back({{"type", "point"}, {"intensity", one.intensity / 10}, {"range", 50.0}});
+      b.node({{"translation", {-1.0 + 0.2 * k, one.light.y, 0.3 * (k % 3)}}, {"extensions", {{"KHR_lights_punctual", {{"light", index++}}}}}});
+    }
+    for (int k = 0; k < outOfReach; ++k) {
+      lights.push_back({{"type", "point"}, {"intensity", 1000.0}, {"range", 0.5}});
+      b.node({{"translation", {-2.5 + 0.005 * k, 1.0 + 0.001 * k, 0.2}}, {"extensions", {{"KHR_lights_punctual", {{"light", index++}}}}}});
+    }
+    b.doc["extensionsUsed"] = {"KHR_lights_punctual", "KHR_materials_specular"};
+    return load(b, outOfReach ? "thousand_lights" : "ten_lights");
+  };
+  const scene::Scene ten = build(0), thousand = build(990);
   RenderSettings settings;
-  settings.samplesPerPixel = 4;
+  settings.samplesPerPixel = 1;
   settings.useEnvironment = false;
-  auto a = tracerFor(one.scene, settings), c = tracerFor(ten, settings);
+  auto a = tracerFor(ten, settings), c = tracerFor(thousand, settings);
   ASSERT_TRUE(a && c);
   ASSERT_TRUE(a->setTime(0, 0));
   ASSERT_TRUE(c->setTime(0, 0));
   const RenderCamera cam = lookCamera({0, 4, 0}, {0, -1, 0}, 60.0, 40, 30);
-  const FrameBuffers fa = a->render(0, cam, cam), fc = c->render(0, cam, cam);
-  double sumA = 0, sumC = 0, var = 0;
+  RenderStatistics statsTen, statsThousand;
+  const FrameBuffers fa = a->render(0, cam, cam, nullptr, &statsTen), fc = c->render(0, cam, cam, nullptr, &statsThousand);
+  int lit = 0;
   for (std::size_t i = 0; i < fa.hit.size(); ++i) {
-    sumA += luminance(rgb(fa.direct, i));
-    sumC += luminance(rgb(fc.direct, i));
-    var += fc.directVariance[i] + fa.directVariance[i];
+    ASSERT_EQ(fa.hit[i], fc.hit[i]);
+    for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(fc.direct[3 * i + ch], fa.direct[3 * i + ch], 1e-6 * fa.direct[3 * i + ch] + 1e-12);
+    lit += fa.direct[3 * i] > 0;
   }
-  EXPECT_NEAR(sumC, sumA, 5 * std::sqrt(var));
-  EXPECT_GT(var, 0.0);  // the choice is random: there is noise to bound
+  EXPECT_GT(lit, 1000);
+  EXPECT_EQ(statsThousand.punctualInFrame, 1000u);
+  // The cost follows the lights in reach: exactly the ten at every shading point of the plane.
+  ASSERT_GT(statsThousand.shadingPoints, 0u);
+  EXPECT_EQ(statsThousand.punctualEvaluated, 10 * statsThousand.shadingPoints);
+}
+
+TEST(Render, ALightSwitchedOffByNodeVisibilityContributesNothing) {
+  const PlaneScene on = pointLightOverPlane();
+  test::GltfBuilder b;
+  const int grey = addMaterial(b, glm::dvec3(on.albedo), 0.0, 1.0, true);
+  b.node({{"name", "plane"}, {"mesh", addPlane(b, 3.0, 0.0, grey)}});
+  b.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"type", "point"}, {"intensity", on.intensity}}});
+  b.doc["extensionsUsed"] = {"KHR_lights_punctual", "KHR_materials_specular", "KHR_node_visibility"};
+  b.node({{"translation", {on.light.x, on.light.y, on.light.z}},
+          {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}, {"KHR_node_visibility", {{"visible", false}}}}}});
+  const scene::Scene off = load(b, "light_off");
+  RenderSettings settings;
+  settings.samplesPerPixel = 2;
+  settings.useEnvironment = false;
+  auto lit = tracerFor(on.scene, settings), dark = tracerFor(off, settings);
+  ASSERT_TRUE(lit && dark);
+  ASSERT_TRUE(lit->setTime(0, 0));
+  ASSERT_TRUE(dark->setTime(0, 0));
+  const RenderCamera cam = lookCamera({0, 4, 0}, {0, -1, 0}, 60.0, 40, 30);
+  const FrameBuffers fl = lit->render(0, cam, cam), fd = dark->render(0, cam, cam);
+  double litSum = 0;
+  for (std::size_t i = 0; i < fd.hit.size(); ++i) {
+    EXPECT_EQ(fd.direct[3 * i], 0.0f);
+    EXPECT_EQ(fd.indirect[3 * i], 0.0f);
+    litSum += fl.direct[3 * i];
+  }
+  EXPECT_GT(litSum, 0.0);  // the same light, visible, does light the plane
+}
+
+TEST(Render, LightCutOffDropsNoMoreThanItsBound) {
+  // 200 unranged lights spread far over the plane, one bright one near it; an environment sets the
+  // automatic cut-off. The cut image differs from the exact one (cut-off 0) by at most the
+  // documented bound (albedo / pi x dropped irradiance), and some lights are in fact cut.
+  test::GltfBuilder b;
+  const double albedo = 0.5;
+  const int grey = addMaterial(b, glm::dvec3(albedo), 0.0, 1.0, true);
+  b.node({{"name", "plane"}, {"mesh", addPlane(b, 3.0, 0.0, grey)}});
+  auto& lights = b.doc["extensions"]["KHR_lights_punctual"]["lights"];
+  lights.push_back({{"type", "point"}, {"intensity", 50.0}});
+  b.node({{"translation", {0.0, 1.0, 0.0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  for (int k = 1; k <= 200; ++k) {
+    lights.push_back({{"type", "point"}, {"intensity", 2.0}});
+    b.node({{"translation", {std::cos(k) * 60.0, 5.0 + k * 0.2, std::sin(k) * 60.0}}, {"extensions", {{"KHR_lights_punctual", {{"light", k}}}}}});
+  }
+  b.doc["extensionsUsed"] = {"KHR_lights_punctual", "KHR_materials_specular"};
+  const scene::Scene s = load(b, "cutoff");
+  RenderSettings exact, cut;
+  exact.samplesPerPixel = cut.samplesPerPixel = 1;
+  exact.bounces = cut.bounces = 0;
+  exact.useEnvironment = cut.useEnvironment = false;
+  exact.lightCutoff = 0.0;
+  cut.lightCutoff = 1e-3;  // lux: lights beyond sqrt(2 / 1e-3) = 44.7 units are skipped
+  auto te = tracerFor(s, exact), tc = tracerFor(s, cut);
+  ASSERT_TRUE(te && tc);
+  ASSERT_TRUE(te->setTime(0, 0));
+  ASSERT_TRUE(tc->setTime(0, 0));
+  const RenderCamera cam = lookCamera({0, 4, 0}, {0, -1, 0}, 60.0, 40, 30);
+  RenderStatistics se, sc;
+  const FrameBuffers fe = te->render(0, cam, cam, nullptr, &se), fc = tc->render(0, cam, cam, nullptr, &sc);
+  ASSERT_TRUE(fc.sampling);
+  const double bound = albedo / kPi * fc.sampling->droppedIrradianceBound;
+  EXPECT_NEAR(fc.sampling->droppedIrradianceBound, 201 * 1e-3, 1e-12);
+  double largest = 0;
+  for (std::size_t i = 0; i < fe.hit.size(); ++i) {
+    const double dropped = fe.direct[3 * i] - fc.direct[3 * i];
+    EXPECT_GE(dropped, -1e-6 * fe.direct[3 * i]);
+    EXPECT_LE(dropped, bound);
+    largest = std::max(largest, dropped);
+  }
+  EXPECT_GT(largest, 0.0);                                     // something was cut
+  EXPECT_LT(sc.punctualEvaluated, se.punctualEvaluated / 2);  // and that saved work
 }
 
 TEST(Render, SpotLightConeAndRangeWindow) {

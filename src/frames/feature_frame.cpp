@@ -26,6 +26,7 @@ const std::vector<BufferSpec>& contractBuffers() {
       {"direct.var", {"direct.var"}, &FeatureFrame::directVariance, false},
       {"indirect.var", {"indirect.var"}, &FeatureFrame::indirectVariance, false},
       {"hit", {"hit"}, &FeatureFrame::hit, true},
+      {"spp", {"spp"}, &FeatureFrame::spp, false},
   };
   return buffers;
 }

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,18 @@ struct FrameCamera {
   int width = 0, height = 0;       // pixels
 };
 
+// How a frame's radiance was sampled (the sidecar's `sampling` object; docs/feature-buffers.md).
+struct SamplingSummary {
+  bool adaptive = false;              // render --converge
+  double tolerance = 0.0;             // --tolerance: a fraction of the discard threshold
+  double directTarget = 0.0, indirectTarget = 0.0;  // standard-error targets (luminance, cd/m2)
+  int minSamples = 0, maxSamples = 0;  // samples per pixel, smallest and largest in the frame
+  double meanSamples = 0.0;
+  long cappedPixels = 0;               // pixels that reached --max-spp before their target
+  double lightCutoff = 0.0;            // irradiance cut-off of lights without a range (0: none)
+  double droppedIrradianceBound = 0.0;  // the most irradiance the cut-off drops at any point
+};
+
 // One frame's buffers: row 0 at the top, channels of a buffer interleaved per pixel. A buffer the
 // renderer did not produce is empty (Cycles writes no id, motion or variance).
 struct FeatureFrame {
@@ -34,6 +47,8 @@ struct FeatureFrame {
   std::vector<float> depth, id, hit;                              // 1 per pixel
   std::vector<float> motion;                                      // 2 per pixel
   std::vector<float> directVariance, indirectVariance;            // 1 per pixel
+  std::vector<float> spp;                                         // 1 per pixel: samples taken
+  std::optional<SamplingSummary> sampling;                        // the sidecar's `sampling`
 
   std::size_t pixelCount() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(height); }
   bool hasVariance() const { return !directVariance.empty() && !indirectVariance.empty(); }
@@ -50,7 +65,7 @@ struct BufferSpec {
 };
 
 // The contract's buffers in the order dynbench writes them (P N direct indirect albedo Z id
-// motion direct.var indirect.var hit).
+// motion direct.var indirect.var hit spp).
 const std::vector<BufferSpec>& contractBuffers();
 // Every channel name of the contract, in that order.
 std::vector<std::string> contractChannelNames();

@@ -76,6 +76,49 @@ json sidecarJson(long frame, double time, const FrameCamera& camera, const json&
   return j;
 }
 
+json samplingJson(const SamplingSummary& s) {
+  return {{"adaptive", s.adaptive},
+          {"tolerance", s.tolerance},
+          {"direct_target", s.directTarget},
+          {"indirect_target", s.indirectTarget},
+          {"min_spp", s.minSamples},
+          {"max_spp", s.maxSamples},
+          {"mean_spp", s.meanSamples},
+          {"capped_pixels", s.cappedPixels},
+          {"light_cutoff", s.lightCutoff},
+          {"dropped_irradiance_bound", s.droppedIrradianceBound}};
+}
+
+namespace {
+
+Expected<SamplingSummary> readSampling(const json& j, const fs::path& path) {
+  SamplingSummary s;
+  const json& o = j["sampling"];
+  if (!o.is_object()) return fail(ErrorCode::kInvalidData, "{}: /sampling: expected an object", path.string());
+  if (o.contains("adaptive")) {
+    if (!o["adaptive"].is_boolean()) return fail(ErrorCode::kInvalidData, "{}: /sampling/adaptive: expected true or false", path.string());
+    s.adaptive = o["adaptive"].get<bool>();
+  }
+  for (auto [key, target] : {std::pair{"tolerance", &s.tolerance}, {"direct_target", &s.directTarget}, {"indirect_target", &s.indirectTarget},
+                             {"mean_spp", &s.meanSamples}, {"light_cutoff", &s.lightCutoff},
+                             {"dropped_irradiance_bound", &s.droppedIrradianceBound}}) {
+    auto v = numberAt(j, path, std::string("/sampling/") + key, 0.0);
+    if (!v) return std::unexpected(v.error());
+    *target = *v;
+  }
+  for (auto [key, target] : {std::pair{"min_spp", &s.minSamples}, {"max_spp", &s.maxSamples}}) {
+    auto v = numberAt(j, path, std::string("/sampling/") + key, 0.0);
+    if (!v) return std::unexpected(v.error());
+    *target = static_cast<int>(*v);
+  }
+  auto capped = numberAt(j, path, "/sampling/capped_pixels", 0.0);
+  if (!capped) return std::unexpected(capped.error());
+  s.cappedPixels = static_cast<long>(*capped);
+  return s;
+}
+
+}  // namespace
+
 Expected<Sidecar> readSidecar(const fs::path& path) {
   auto text = readWholeFile(path);
   if (!text) return std::unexpected(text.error());
@@ -122,6 +165,11 @@ Expected<Sidecar> readSidecar(const fs::path& path) {
     *target = *v;
   }
   if (j.contains("render")) s.render = j["render"];
+  if (j.contains("sampling")) {
+    auto sampling = readSampling(j, path);
+    if (!sampling) return std::unexpected(sampling.error());
+    s.sampling = *sampling;
+  }
   return s;
 }
 
@@ -160,6 +208,7 @@ Expected<FeatureFrame> readFrame(const FrameEntry& entry, const ReadOptions& opt
   f.frame = entry.frame;
   f.time = sidecar->time;
   f.camera = sidecar->camera;
+  f.sampling = sidecar->sampling;
 
   auto image = readImage(entry.image);
   if (!image) return std::unexpected(image.error());
@@ -222,7 +271,9 @@ Expected<void> writeFrame(const fs::path& dir, const FeatureFrame& frame, const 
       for (std::size_t c = 0; c < widths[b]; ++c) *out++ = (*present[b])[i * widths[b] + c];
   if (auto w = writeImage(frameImagePath(dir, frame.frame), image); !w) return w;
   // The sidecar last: its presence marks the frame complete.
-  return writeFileAtomic(frameSidecarPath(dir, frame.frame), sidecarJson(frame.frame, frame.time, frame.camera, render).dump(2) + "\n");
+  json sidecar = sidecarJson(frame.frame, frame.time, frame.camera, render);
+  if (frame.sampling) sidecar["sampling"] = samplingJson(*frame.sampling);
+  return writeFileAtomic(frameSidecarPath(dir, frame.frame), sidecar.dump(2) + "\n");
 }
 
 bool frameComplete(const fs::path& dir, long frame, const json& render) {

@@ -22,12 +22,14 @@ nlohmann::json matrixJson(const glm::dmat4& m);
 // The sidecar: format and version, frame, time, resolution, camera, conventions, and `render`,
 // the engine and settings that made the frame (compared when resuming).
 nlohmann::json sidecarJson(long frame, double time, const FrameCamera& camera, const nlohmann::json& render);
+nlohmann::json samplingJson(const SamplingSummary& sampling);
 
 struct Sidecar {
   long frame = 0;
   double time = 0.0;
   FrameCamera camera;
   nlohmann::json render;  // null when absent (another renderer's frames)
+  std::optional<SamplingSummary> sampling;
 };
 // Reads and checks a sidecar: /format must be "dynbench-frame" and /version one this build reads;
 // errors name the file and the JSON pointer.

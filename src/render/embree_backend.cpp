@@ -43,6 +43,9 @@ class EmbreeBackend final : public RenderBackend {
       }
       statistics_.cameraSamples += stats.cameraSamples;
       statistics_.rays += stats.rays;
+      statistics_.shadingPoints += stats.shadingPoints;
+      statistics_.punctualEvaluated += stats.punctualEvaluated;
+      statistics_.punctualInFrame += stats.punctualInFrame;
       buffers.frame = request.frame;
       buffers.time = request.cameras.time;
       buffers.camera = request.cameras.camera.frameCamera();

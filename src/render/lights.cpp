@@ -93,15 +93,15 @@ double EnvironmentLight::pdf(const glm::dvec3& direction) const {
   return sinTheta > 0 ? distribution_.density(uv) / (2.0 * kPi * kPi * sinTheta) : 0.0;
 }
 
-void LightSet::build(const scene::Scene& scene, const RayTracingScene& rayTracing, const EnvironmentLight* environment,
-                     double sceneRadius, EmissionFunction emission) {
+Expected<void> LightSet::build(const scene::Scene& scene, const RayTracingScene& rayTracing, const EnvironmentLight* environment,
+                               double sceneRadius, EmissionFunction emission, std::optional<double> cutoff) {
   punctual_.clear();
+  everywhere_.clear();
+  sphereLight_.clear();
   triangles_.clear();
   environment_ = environment;
   emission_ = std::move(emission);
-  std::vector<double> weights;
   const auto& pose = rayTracing.pose();
-  const double disc = kPi * sceneRadius * sceneRadius;  // area a distant light's power crosses
   for (std::size_t n = 0; n < scene.nodes.size() && n < pose.world.size(); ++n) {
     const int li = scene.nodes[n].light;
     if (li < 0 || !pose.visible[n]) continue;
@@ -117,20 +117,42 @@ void LightSet::build(const scene::Scene& scene, const RayTracingScene& rayTracin
       p.cosOuter = std::cos(static_cast<double>(l.outerConeAngle));
       p.cosInner = std::cos(static_cast<double>(l.innerConeAngle));
     }
-    double power = luminance(p.intensity);
-    if (l.type == scene::Light::Type::kPoint) power *= 4.0 * kPi;
-    else if (l.type == scene::Light::Type::kSpot) power *= 2.0 * kPi * (1.0 - p.cosOuter);
-    else power *= disc;
-    if (power <= 0) continue;
+    if (!(std::max({p.intensity.x, p.intensity.y, p.intensity.z}) > 0)) continue;
     punctual_.push_back(p);
-    weights.push_back(power);
   }
-  punctualInChoice_ = punctual_.size() > kEveryPunctualLimit;
-  if (!punctualInChoice_) weights.clear();
-  double environmentPower = 0.0;
-  if (environment_) environmentPower = environment_->meanLuminance() * kPi * disc;
-  weights.push_back(environmentPower);
 
+  // Spheres of influence: KHR's range (the window is 0 beyond it: exact), else the distance where
+  // the brightest channel's I / d^2 falls to the cut-off.
+  std::size_t unranged = 0;
+  for (const auto& p : punctual_)
+    if (p.type != scene::Light::Type::kDirectional && !(p.range > 0)) ++unranged;
+  const double environmentIrradiance = environment_ ? kPi * environment_->meanLuminance() : 0.0;
+  cutoff_ = cutoff ? std::max(0.0, *cutoff) : unranged > 0 ? kAutoCutoffShare * environmentIrradiance / static_cast<double>(unranged) : 0.0;
+  culledByCutoff_ = 0;
+  std::vector<glm::dvec4> spheres;
+  for (std::size_t i = 0; i < punctual_.size(); ++i) {
+    const Punctual& p = punctual_[i];
+    double radius = std::numeric_limits<double>::infinity();
+    if (p.type != scene::Light::Type::kDirectional) {
+      if (p.range > 0) {
+        radius = p.range;
+      } else if (cutoff_ > 0) {
+        radius = std::sqrt(std::max({p.intensity.x, p.intensity.y, p.intensity.z}) / cutoff_);
+        ++culledByCutoff_;
+      }
+    }
+    if (std::isfinite(radius)) {
+      spheres.emplace_back(p.position, radius);
+      sphereLight_.push_back(static_cast<std::uint32_t>(i));
+    } else {
+      everywhere_.push_back(static_cast<std::uint32_t>(i));
+    }
+  }
+  if (auto ok = spheres_.build(spheres); !ok) return ok;
+
+  std::vector<double> weights;
+  const double disc = kPi * sceneRadius * sceneRadius;  // area a distant light's power crosses
+  weights.push_back(environment_ ? environment_->meanLuminance() * kPi * disc : 0.0);
   std::vector<double> triangleWeights;
   if (emission_) {
     rayTracing.forEachPrimitive([&](const PrimitiveView& v) {
@@ -156,11 +178,17 @@ void LightSet::build(const scene::Scene& scene, const RayTracingScene& rayTracin
   if (choice_.empty()) {
     choice_ = Distribution1D();
     environmentChoice_ = emissiveChoice_ = 0.0;
-    return;
+    return {};
   }
-  const std::size_t p = punctualInChoice_ ? punctual_.size() : 0;
-  environmentChoice_ = choice_.probability(p);
-  emissiveChoice_ = choice_.probability(p + 1);
+  environmentChoice_ = choice_.probability(0);
+  emissiveChoice_ = choice_.probability(1);
+  return {};
+}
+
+void LightSet::punctualInReach(const glm::dvec3& point, std::vector<std::uint32_t>& reach) const {
+  spheres_.query(point, reach);
+  for (auto& k : reach) k = sphereLight_[k];
+  reach.insert(reach.end(), everywhere_.begin(), everywhere_.end());
 }
 
 std::optional<LightSample> LightSet::samplePunctual(std::size_t light, const glm::dvec3& point) const {
@@ -200,13 +228,7 @@ std::optional<LightSample> LightSet::sample(const glm::dvec3& point, double uCho
   double choiceProbability = 0.0;
   const std::size_t pick = choice_.sampleDiscrete(uChoice, &choiceProbability);
   LightSample s;
-  const std::size_t punctualChoices = punctualInChoice_ ? punctual_.size() : 0;
-  if (pick < punctualChoices) {
-    auto light = samplePunctual(pick, point);
-    if (light) light->pdf = choiceProbability;
-    return light;
-  }
-  if (pick == punctualChoices) {
+  if (pick == 0) {
     double pdf = 0.0;
     s.direction = environment_->sample(u, &pdf);
     if (!(pdf > 0)) return std::nullopt;

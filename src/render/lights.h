@@ -54,24 +54,39 @@ struct LightSample {
 // Emission of an emissive surface at a point of a triangle (the integrator evaluates the material).
 using EmissionFunction = std::function<glm::dvec3(int node, int primitive, unsigned triangle, glm::dvec2 barycentric)>;
 
+// The relative error the automatic light cut-off admits: lights without a `range` are skipped where
+// their irradiance is below epsilon = kAutoCutoffShare x E_env / N, with E_env = pi x the environment's
+// mean radiance (what a surface open to a uniform sky of that mean receives) and N the frame's
+// punctual lights without a range; all of them together then drop less than kAutoCutoffShare x E_env
+// at any point. docs/feature-buffers.md states the rule.
+inline constexpr double kAutoCutoffShare = 1e-3;
+
 class LightSet {
  public:
   // Gathers the frame's lights: punctual lights at their nodes' world transforms (from the
   // ray-tracing scene's pose; hidden nodes are off), every visible emissive triangle, and the
-  // environment. `sceneRadius` sizes the power estimate of directional and environment light.
-  void build(const scene::Scene& scene, const RayTracingScene& rayTracing, const EnvironmentLight* environment,
-             double sceneRadius, EmissionFunction emission);
+  // environment. `sceneRadius` sizes the power estimate of environment light. `cutoff`: the
+  // irradiance below which a point or spot light without a range is skipped (nullopt: automatic,
+  // kAutoCutoffShare; 0: never).
+  [[nodiscard]] Expected<void> build(const scene::Scene& scene, const RayTracingScene& rayTracing, const EnvironmentLight* environment,
+                                     double sceneRadius, EmissionFunction emission, std::optional<double> cutoff = std::nullopt);
 
-  // With a few punctual lights (up to kEveryPunctualLimit) every one of them is sampled at each
-  // shading point (a shadow ray each, no noise from choosing); with more, they join the random
-  // choice below. Cube 2 maps have hundreds of lights; small test scenes have one or two.
-  static constexpr std::size_t kEveryPunctualLimit = 8;
-  std::size_t everyPunctualCount() const { return punctualInChoice_ ? 0 : punctual_.size(); }
+  // Punctual lights are delta lights: their direct light at a point is a sum over the lights, not
+  // an integral, so the integrator evaluates every light that can reach the point (a shadow ray
+  // each) and none adds noise. `reach` receives the indices of those lights: directional lights,
+  // lights whose sphere of influence (KHR `range`, or the cut-off radius) contains the point (found
+  // through a BVH over the spheres), and lights with neither.
+  void punctualInReach(const glm::dvec3& point, std::vector<std::uint32_t>& reach) const;
   std::optional<LightSample> samplePunctual(std::size_t light, const glm::dvec3& point) const;
+  std::size_t punctualCount() const { return punctual_.size(); }
+  // The cut-off in use (0: none) and the most irradiance it can drop at any point (N x epsilon,
+  // per colour channel).
+  double cutoffIrradiance() const { return cutoff_; }
+  double droppedIrradianceBound() const { return cutoff_ * static_cast<double>(culledByCutoff_); }
 
   bool empty() const { return choice_.empty(); }
-  // One light picked by estimated power (the environment, the emissive triangles and, when there
-  // are many, the punctual lights), then a point on it (next event estimation).
+  // The environment or an emissive triangle, picked by estimated power, then a point on it (next
+  // event estimation; Monte Carlo, weighted against BSDF sampling by the integrator).
   std::optional<LightSample> sample(const glm::dvec3& point, double uChoice, glm::dvec2 u) const;
   // Densities of the other strategy for MIS, when a BSDF-sampled ray reaches the environment or
   // an emissive triangle (whose emissive factor luminance is `emissiveLuminance`).
@@ -93,14 +108,16 @@ class LightSet {
     unsigned index;
   };
   std::vector<Punctual> punctual_;
+  std::vector<std::uint32_t> everywhere_;    // punctual lights with no sphere of influence
+  std::vector<std::uint32_t> sphereLight_;   // sphere k of the index -> punctual light
+  SphereIndex spheres_;
+  double cutoff_ = 0.0;
+  std::size_t culledByCutoff_ = 0;  // lights given a cut-off radius
   std::vector<Triangle> triangles_;
   Distribution1D triangleChoice_;
   const EnvironmentLight* environment_ = nullptr;
   EmissionFunction emission_;
-  // Choice among: punctual lights [0, P) when punctualInChoice_ (else P = 0), the environment (P),
-  // the emissive triangles (P + 1).
-  Distribution1D choice_;
-  bool punctualInChoice_ = false;
+  Distribution1D choice_;  // the environment (0) or the emissive triangles (1)
   double environmentChoice_ = 0.0, emissiveChoice_ = 0.0;
 };
 

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "core/math.h"
@@ -187,151 +188,279 @@ Expected<void> PathTracer::setTime(double time, double previousTime) {
     });
     if (lo.x <= hi.x) sceneRadius_ = std::max(1e-3, 0.5 * glm::length(hi - lo));
   }
-  lights_.build(scene_, *rayTracing_, environment_ ? &*environment_ : nullptr, *sceneRadius_,
-                [this](int node, int primitive, unsigned triangle, glm::dvec2 b) { return emission(node, primitive, triangle, b); });
-  return {};
+  return lights_.build(scene_, *rayTracing_, environment_ ? &*environment_ : nullptr, *sceneRadius_,
+                       [this](int node, int primitive, unsigned triangle, glm::dvec2 b) { return emission(node, primitive, triangle, b); },
+                       settings_.lightCutoff);
 }
+
+struct PathTracer::PathSample {
+  glm::dvec3 direct{0.0}, indirect{0.0};
+};
+
+// Per-thread working memory of the path loop, so the per-ray path does not allocate.
+struct PathTracer::PathScratch {
+  std::vector<std::uint32_t> reach;  // punctual lights in reach of a shading point
+  std::uint64_t rays = 0, shadingPoints = 0, punctualEvaluated = 0;
+};
+
+PathTracer::PathSample PathTracer::tracePath(const Ray& cameraRay, const SurfaceHit& firstHit, const Shading& firstShading, Random& rng,
+                                             PathScratch& scratch) const {
+  PathSample out;
+  Ray ray = cameraRay;
+  glm::dvec3 throughput(1.0);
+  double previousBsdfPdf = 0.0;  // solid-angle pdf of the BSDF sample that made `ray`
+  bool previousDelta = true;     // camera rays: nothing else could have found the emitter
+  for (int depth = 0;; ++depth) {
+    SurfaceHit traced;
+    if (depth > 0) {
+      traced = trace(ray);
+      ++scratch.rays;
+    }
+    const SurfaceHit& hit = depth == 0 ? firstHit : traced;
+    // Radiance found by this ray is direct when it reaches the camera from the first surface
+    // (depth 1) or is seen by the camera itself (depth 0).
+    glm::dvec3& bucket = depth <= 1 ? out.direct : out.indirect;
+    if (!hit.hit) {
+      if (environment_) {
+        const glm::dvec3 le = environment_->radiance(ray.direction);
+        const double w =
+            previousDelta || !settings_.nextEventEstimation ? 1.0 : powerHeuristic(previousBsdfPdf, lights_.pdfEnvironment(ray.direction));
+        bucket += throughput * le * w;
+      }
+      break;
+    }
+    const glm::dvec3 wo = -ray.direction;
+    const Shading s = depth == 0 ? firstShading : shade(hit, wo);
+    if (s.material.emission != glm::dvec3(0.0)) {
+      double w = 1.0;
+      if (!previousDelta && settings_.nextEventEstimation) {
+        const double cosLight = std::abs(glm::dot(hit.geometricNormal, ray.direction));
+        w = powerHeuristic(previousBsdfPdf, lights_.pdfEmissive(s.emissiveWeight, hit.distance, cosLight));
+      }
+      bucket += throughput * s.material.emission * w;
+    }
+    if (depth > settings_.bounces) break;
+    const Frame frame(s.shadingNormal);
+    const Bsdf bsdf(s.material, frame, s.geometricNormal);
+    const glm::dvec3 origin = offsetOrigin(hit.position, s.geometricNormal);
+    glm::dvec3& nextBucket = depth == 0 ? out.direct : out.indirect;  // light reaching this hit
+
+    if (settings_.nextEventEstimation) {
+      // Adds one light's contribution; Monte Carlo samples are weighted against BSDF sampling
+      // (Veach's MIS), delta lights count fully (no other strategy can find them).
+      auto addLight = [&](const std::optional<LightSample>& ls) {
+        if (!ls || !(ls->pdf > 0)) return;
+        const glm::dvec3 f = bsdf.eval(wo, ls->direction);
+        if (f == glm::dvec3(0.0)) return;
+        const double cosine = std::abs(glm::dot(s.shadingNormal, ls->direction));
+        const double tMax = std::isinf(ls->distance) ? 1e30 : ls->distance * (1.0 - 1e-4) - 3e-5;
+        ++scratch.rays;
+        if (rayTracing_->occluded(origin, ls->direction, tMax)) return;
+        const double w = ls->delta ? 1.0 : powerHeuristic(ls->pdf, bsdf.pdf(wo, ls->direction));
+        nextBucket += throughput * f * ls->radiance * (cosine * w / ls->pdf);
+      };
+      // Every punctual light in reach: a sum, no noise (LightSet::punctualInReach).
+      lights_.punctualInReach(hit.position, scratch.reach);
+      ++scratch.shadingPoints;
+      scratch.punctualEvaluated += scratch.reach.size();
+      for (const std::uint32_t l : scratch.reach) addLight(lights_.samplePunctual(l, hit.position));
+      // The environment or an emissive triangle: one Monte Carlo sample. Drawn whether or not
+      // there is anything to choose, so the random stream stays aligned.
+      const double uChoice = rng.uniform();
+      const glm::dvec2 uLight = rng.uniform2();
+      if (!lights_.empty()) addLight(lights_.sample(hit.position, uChoice, uLight));
+    }
+
+    const double uLobe = rng.uniform();
+    const auto bs = bsdf.sample(wo, rng.uniform2(), uLobe);
+    if (!bs) break;
+    throughput *= bs->value * (std::abs(glm::dot(s.shadingNormal, bs->direction)) / bs->pdf);
+    if (depth >= 3) {  // Russian roulette keeps long paths cheap without bias
+      const double survive = std::min(0.95, std::max({throughput.x, throughput.y, throughput.z}));
+      if (rng.uniform() >= survive) break;
+      throughput /= survive;
+    }
+    if (!finite(throughput) || throughput == glm::dvec3(0.0)) break;
+    previousBsdfPdf = bs->pdf;
+    previousDelta = false;
+    ray.origin = origin;
+    ray.direction = bs->direction;
+  }
+  if (!finite(out.direct)) out.direct = glm::dvec3(0.0);
+  if (!finite(out.indirect)) out.indirect = glm::dvec3(0.0);
+  return out;
+}
+
+namespace {
+
+// Running sums of one pixel's samples.
+struct PixelSums {
+  glm::dvec3 direct{0.0}, indirect{0.0};
+  double directSq = 0.0, indirectSq = 0.0;  // of luminance
+  int samples = 0;
+
+  void add(const glm::dvec3& d, const glm::dvec3& i) {
+    direct += d;
+    indirect += i;
+    directSq += luminance(d) * luminance(d);
+    indirectSq += luminance(i) * luminance(i);
+    ++samples;
+  }
+  // Variance of the pixel's mean luminance: the sample variance (n - 1 denominator) over n.
+  double varianceOfMean(double sum, double sumSq) const {
+    const double n = samples;
+    if (n < 2) return 0.0;
+    const double mean = sum / n;
+    return std::max(0.0, (sumSq - n * mean * mean) / (n - 1.0)) / n;
+  }
+  double directVariance() const { return varianceOfMean(luminance(direct), directSq); }
+  double indirectVariance() const { return varianceOfMean(luminance(indirect), indirectSq); }
+};
+
+// The next sample count of an adaptive pixel: the count its present standard error predicts for
+// the target (SE falls as 1/sqrt(n)), 10 % over, at least one more round of `round` samples and at
+// most four times as many, capped.
+int nextSampleCount(int n, double ratioSquared, int round, int cap) {
+  const double predicted = std::ceil(1.1 * n * ratioSquared);
+  const double next = std::clamp(predicted, static_cast<double>(n + round), 4.0 * n);
+  return static_cast<int>(std::min<double>(cap, next));
+}
+
+}  // namespace
 
 FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& camera, const RenderCamera& previousCamera,
                                 std::atomic<int>* rowsDone, RenderStatistics* statistics) const {
   FrameBuffers out;
   out.resize(camera.width(), camera.height());
   std::fill(out.id.begin(), out.id.end(), -1.0f);  // the contract's "no instance"
-  const int width = camera.width(), height = camera.height(), spp = settings_.samplesPerPixel;
+  const int width = camera.width(), height = camera.height(), firstRound = settings_.samplesPerPixel;
+  const std::size_t pixels = out.pixelCount();
   const glm::dvec3 forward = -glm::dvec3(camera.world()[2]);
-  std::atomic<std::uint64_t> rays{0};
+  std::vector<PixelSums> sums(pixels);
+  std::vector<SurfaceHit> firstHits(pixels);
+  tbb::enumerable_thread_specific<PathScratch> scratches;
 
+  auto samplePixel = [&](std::size_t pixel, int upTo, PathScratch& scratch) {
+    const int px = static_cast<int>(pixel % static_cast<std::size_t>(width)), py = static_cast<int>(pixel / static_cast<std::size_t>(width));
+    const Ray ray = camera.ray(px + 0.5, py + 0.5);
+    const SurfaceHit& hit = firstHits[pixel];
+    PixelSums& sum = sums[pixel];
+    if (!hit.hit) {
+      // The camera sees the environment: a single lookup, no noise.
+      const glm::dvec3 le = environment_ ? environment_->radiance(ray.direction) : glm::dvec3(0.0);
+      while (sum.samples < upTo) sum.add(le, glm::dvec3(0.0));
+      return;
+    }
+    const Shading shading = shade(hit, -ray.direction);
+    for (int sample = sum.samples; sample < upTo; ++sample) {
+      Random rng(settings_.seed, frameIndex, pixel, static_cast<std::uint64_t>(sample));
+      const PathSample ps = tracePath(ray, hit, shading, rng, scratch);
+      sum.add(ps.direct, ps.indirect);
+    }
+  };
+
+  // First round: the geometry buffers from the ray through each pixel centre (so that P, N, Z,
+  // id and motion describe one surface point; a blend of two surfaces across an edge is on
+  // neither), then samplesPerPixel paths from that same hit.
   tbb::parallel_for(tbb::blocked_range<int>(0, height, 1), [&](const tbb::blocked_range<int>& rows) {
-    std::uint64_t localRays = 0;
+    PathScratch& scratch = scratches.local();
     for (int py = rows.begin(); py < rows.end(); ++py) {
       for (int px = 0; px < width; ++px) {
         const std::size_t pixel = static_cast<std::size_t>(py) * static_cast<std::size_t>(width) + static_cast<std::size_t>(px);
-
-        // Geometry buffers: the ray through the pixel centre, so that P, N, Z, id and motion
-        // describe one surface point (a blend of two surfaces across an edge is on neither).
-        {
-          const Ray ray = camera.ray(px + 0.5, py + 0.5);
-          const SurfaceHit hit = trace(ray);
-          ++localRays;
-          if (hit.hit) {
-            const Shading s = shade(hit, -ray.direction);
-            put3(out.position, pixel, hit.position);
-            put3(out.normal, pixel, s.shadingNormal);
-            out.depth[pixel] = static_cast<float>(glm::dot(hit.position - camera.position(), forward));
-            out.id[pixel] = static_cast<float>(hit.node);
-            out.hit[pixel] = 1.0f;
-            const PixelProjection previous = previousCamera.project(rayTracing_->previousPosition(hit));
-            // Behind the previous camera there is no pixel to point to: a vector far off screen.
-            const glm::dvec2 target = previous.inFront ? previous.pixel : glm::dvec2(-1e9);
-            out.motion[2 * pixel] = static_cast<float>(target.x - (px + 0.5));
-            out.motion[2 * pixel + 1] = static_cast<float>(target.y - (py + 0.5));
-          }
+        const Ray ray = camera.ray(px + 0.5, py + 0.5);
+        const SurfaceHit hit = trace(ray);
+        ++scratch.rays;
+        firstHits[pixel] = hit;
+        if (hit.hit) {
+          const Shading s = shade(hit, -ray.direction);
+          put3(out.position, pixel, hit.position);
+          put3(out.normal, pixel, s.shadingNormal);
+          put3(out.albedo, pixel, s.material.baseColor);
+          out.depth[pixel] = static_cast<float>(glm::dot(hit.position - camera.position(), forward));
+          out.id[pixel] = static_cast<float>(hit.node);
+          out.hit[pixel] = 1.0f;
+          const PixelProjection previous = previousCamera.project(rayTracing_->previousPosition(hit));
+          // Behind the previous camera there is no pixel to point to: a vector far off screen.
+          const glm::dvec2 target = previous.inFront ? previous.pixel : glm::dvec2(-1e9);
+          out.motion[2 * pixel] = static_cast<float>(target.x - (px + 0.5));
+          out.motion[2 * pixel + 1] = static_cast<float>(target.y - (py + 0.5));
         }
-
-        glm::dvec3 directSum(0.0), indirectSum(0.0), albedoSum(0.0);
-        double directSq = 0.0, indirectSq = 0.0;
-        for (int sample = 0; sample < spp; ++sample) {
-          Random rng(settings_.seed, frameIndex, pixel, static_cast<std::uint64_t>(sample));
-          const glm::dvec2 jitter = rng.uniform2();
-          Ray ray = camera.ray(px + jitter.x, py + jitter.y);
-          glm::dvec3 throughput(1.0), direct(0.0), indirect(0.0);
-          double previousBsdfPdf = 0.0;  // solid-angle pdf of the BSDF sample that made `ray`
-          bool previousDelta = true;     // camera rays: nothing else could have found the emitter
-          for (int depth = 0;; ++depth) {
-            const SurfaceHit hit = trace(ray);
-            ++localRays;
-            // Radiance found by this ray is direct when it reaches the camera from the first
-            // surface (depth 1) or is seen by the camera itself (depth 0).
-            glm::dvec3& bucket = depth <= 1 ? direct : indirect;
-            if (!hit.hit) {
-              if (environment_) {
-                const glm::dvec3 le = environment_->radiance(ray.direction);
-                const double w = previousDelta || !settings_.nextEventEstimation
-                                     ? 1.0
-                                     : powerHeuristic(previousBsdfPdf, lights_.pdfEnvironment(ray.direction));
-                bucket += throughput * le * w;
-              }
-              break;
-            }
-            const glm::dvec3 wo = -ray.direction;
-            const Shading s = shade(hit, wo);
-            if (depth == 0) albedoSum += s.material.baseColor;
-            if (s.material.emission != glm::dvec3(0.0)) {
-              double w = 1.0;
-              if (!previousDelta && settings_.nextEventEstimation) {
-                const double cosLight = std::abs(glm::dot(hit.geometricNormal, ray.direction));
-                w = powerHeuristic(previousBsdfPdf, lights_.pdfEmissive(s.emissiveWeight, hit.distance, cosLight));
-              }
-              bucket += throughput * s.material.emission * w;
-            }
-            if (depth > settings_.bounces) break;
-            const Frame frame(s.shadingNormal);
-            const Bsdf bsdf(s.material, frame, s.geometricNormal);
-            const glm::dvec3 origin = offsetOrigin(hit.position, s.geometricNormal);
-            glm::dvec3& nextBucket = depth == 0 ? direct : indirect;  // light reaching this hit
-
-            if (settings_.nextEventEstimation) {
-              // Adds one light sample's contribution, weighted against BSDF sampling (Veach's MIS).
-              auto addLight = [&](const std::optional<LightSample>& ls) {
-                if (!ls || !(ls->pdf > 0)) return;
-                const glm::dvec3 f = bsdf.eval(wo, ls->direction);
-                if (f == glm::dvec3(0.0)) return;
-                const double cosine = std::abs(glm::dot(s.shadingNormal, ls->direction));
-                const double tMax = std::isinf(ls->distance) ? 1e30 : ls->distance * (1.0 - 1e-4) - 3e-5;
-                ++localRays;
-                if (rayTracing_->occluded(origin, ls->direction, tMax)) return;
-                const double w = ls->delta ? 1.0 : powerHeuristic(ls->pdf, bsdf.pdf(wo, ls->direction));
-                nextBucket += throughput * f * ls->radiance * (cosine * w / ls->pdf);
-              };
-              for (std::size_t l = 0; l < lights_.everyPunctualCount(); ++l) addLight(lights_.samplePunctual(l, hit.position));
-              // Drawn whether or not there is anything to choose, so the random stream stays aligned.
-              const double uChoice = rng.uniform();
-              const glm::dvec2 uLight = rng.uniform2();
-              if (!lights_.empty()) addLight(lights_.sample(hit.position, uChoice, uLight));
-            }
-
-            const double uLobe = rng.uniform();
-            const auto bs = bsdf.sample(wo, rng.uniform2(), uLobe);
-            if (!bs) break;
-            throughput *= bs->value * (std::abs(glm::dot(s.shadingNormal, bs->direction)) / bs->pdf);
-            if (depth >= 3) {  // Russian roulette keeps long paths cheap without bias
-              const double survive = std::min(0.95, std::max({throughput.x, throughput.y, throughput.z}));
-              if (rng.uniform() >= survive) break;
-              throughput /= survive;
-            }
-            if (!finite(throughput) || throughput == glm::dvec3(0.0)) break;
-            previousBsdfPdf = bs->pdf;
-            previousDelta = false;
-            ray.origin = origin;
-            ray.direction = bs->direction;
-          }
-          if (!finite(direct)) direct = glm::dvec3(0.0);
-          if (!finite(indirect)) indirect = glm::dvec3(0.0);
-          directSum += direct;
-          indirectSum += indirect;
-          directSq += luminance(direct) * luminance(direct);
-          indirectSq += luminance(indirect) * luminance(indirect);
-        }
-        const double n = spp;
-        put3(out.direct, pixel, directSum / n);
-        put3(out.indirect, pixel, indirectSum / n);
-        put3(out.albedo, pixel, albedoSum / n);
-        // Variance of the pixel's mean luminance: the sample variance (n - 1 denominator) over n.
-        auto varianceOfMean = [n](double sum, double sumSq) {
-          if (n < 2) return 0.0;
-          const double mean = sum / n;
-          return std::max(0.0, (sumSq - n * mean * mean) / (n - 1.0)) / n;
-        };
-        out.directVariance[pixel] = static_cast<float>(varianceOfMean(luminance(directSum), directSq));
-        out.indirectVariance[pixel] = static_cast<float>(varianceOfMean(luminance(indirectSum), indirectSq));
+        samplePixel(pixel, firstRound, scratch);
       }
-      if (rowsDone) rowsDone->fetch_add(1, std::memory_order_relaxed);
+      if (rowsDone && !settings_.converge) rowsDone->fetch_add(1, std::memory_order_relaxed);
     }
-    rays.fetch_add(localRays, std::memory_order_relaxed);
   });
+
+  frames::SamplingSummary summary;
+  summary.lightCutoff = lights_.cutoffIrradiance();
+  summary.droppedIrradianceBound = lights_.droppedIrradianceBound();
+  if (settings_.converge) {
+    // The targets: tolerance x the discard threshold of each buffer, which is a fraction of the
+    // frame's mean luminance (discard's default relative thresholds), estimated from the first
+    // round. A pixel converges when both standard errors are at or below their targets.
+    double meanDirect = 0.0, meanIndirect = 0.0;
+    for (const auto& p : sums) {
+      meanDirect += luminance(p.direct) / p.samples;
+      meanIndirect += luminance(p.indirect) / p.samples;
+    }
+    meanDirect /= static_cast<double>(pixels);
+    meanIndirect /= static_cast<double>(pixels);
+    summary.adaptive = true;
+    summary.tolerance = settings_.tolerance;
+    summary.directTarget = settings_.tolerance * settings_.directThresholdFraction * meanDirect;
+    summary.indirectTarget = settings_.tolerance * settings_.indirectThresholdFraction * meanIndirect;
+    const double directTargetSq = summary.directTarget * summary.directTarget;
+    const double indirectTargetSq = summary.indirectTarget * summary.indirectTarget;
+    const int cap = std::max(firstRound, settings_.maxSamplesPerPixel);
+    // Rows again, each pixel sampled in rounds until it converges; its random streams are its
+    // sample indices, so the result does not depend on the thread schedule.
+    tbb::parallel_for(tbb::blocked_range<int>(0, height, 1), [&](const tbb::blocked_range<int>& rows) {
+      PathScratch& scratch = scratches.local();
+      for (int py = rows.begin(); py < rows.end(); ++py) {
+        for (int px = 0; px < width; ++px) {
+          const std::size_t pixel = static_cast<std::size_t>(py) * static_cast<std::size_t>(width) + static_cast<std::size_t>(px);
+          PixelSums& sum = sums[pixel];
+          while (sum.samples < cap) {
+            auto ratio = [](double variance, double targetSq) {
+              if (variance <= 0) return 0.0;
+              return targetSq > 0 ? variance / targetSq : std::numeric_limits<double>::infinity();
+            };
+            const double r = std::max(ratio(sum.directVariance(), directTargetSq), ratio(sum.indirectVariance(), indirectTargetSq));
+            if (r <= 1.0) break;
+            samplePixel(pixel, nextSampleCount(sum.samples, r, firstRound, cap), scratch);
+          }
+        }
+        if (rowsDone) rowsDone->fetch_add(1, std::memory_order_relaxed);
+      }
+    });
+    for (const auto& p : sums)
+      if (p.samples >= cap && (p.directVariance() > directTargetSq || p.indirectVariance() > indirectTargetSq)) ++summary.cappedPixels;
+  }
+
+  std::uint64_t totalSamples = 0;
+  summary.minSamples = std::numeric_limits<int>::max();
+  for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
+    const PixelSums& p = sums[pixel];
+    const double n = p.samples;
+    put3(out.direct, pixel, p.direct / n);
+    put3(out.indirect, pixel, p.indirect / n);
+    out.directVariance[pixel] = static_cast<float>(p.directVariance());
+    out.indirectVariance[pixel] = static_cast<float>(p.indirectVariance());
+    out.spp[pixel] = static_cast<float>(p.samples);
+    totalSamples += static_cast<std::uint64_t>(p.samples);
+    summary.minSamples = std::min(summary.minSamples, p.samples);
+    summary.maxSamples = std::max(summary.maxSamples, p.samples);
+  }
+  summary.meanSamples = pixels ? static_cast<double>(totalSamples) / static_cast<double>(pixels) : 0.0;
+  out.sampling = summary;
   if (statistics) {
-    statistics->cameraSamples += static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height) * static_cast<std::uint64_t>(spp);
-    statistics->rays += rays.load();
+    statistics->cameraSamples += totalSamples;
+    for (const auto& scratch : scratches) {
+      statistics->rays += scratch.rays;
+      statistics->shadingPoints += scratch.shadingPoints;
+      statistics->punctualEvaluated += scratch.punctualEvaluated;
+    }
+    statistics->punctualInFrame += lights_.punctualCount();
   }
   return out;
 }

@@ -7,6 +7,12 @@
 // first hit straight from a light source or the environment; indirect = light that arrives after
 // one or more further bounces. `bounces` counts those further bounces, as Cycles' "max bounces"
 // does: 0 renders direct light only.
+//
+// Every buffer of a pixel describes one surface point: the hit of the ray through the pixel
+// centre. Radiance is estimated there (paths start at that hit), not over the pixel's footprint,
+// so the discard compares radiance at the same points as world position and normal. Punctual
+// lights are summed at every path vertex (LightSet::punctualInReach), so a scene lit only by them
+// has noise-free direct light at 1 spp.
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -35,6 +41,17 @@ struct RenderSettings {
   // false: BSDF sampling alone, no light sampling (an independent estimator for tests; punctual
   // lights are then invisible, as no BSDF sample can hit a point).
   bool nextEventEstimation = true;
+  // Irradiance below which a point or spot light without a range is skipped (LightSet::build):
+  // nullopt automatic, 0 never.
+  std::optional<double> lightCutoff;
+  // Adaptive sampling (`render --converge`): after samplesPerPixel samples, each pixel takes more
+  // in rounds until the standard error of its direct and of its indirect luminance is at most
+  // tolerance x the discard threshold (thresholdFraction x the frame's mean luminance of that
+  // buffer, discard's default relative thresholds), or maxSamplesPerPixel is reached.
+  bool converge = false;
+  double tolerance = 0.25;
+  int maxSamplesPerPixel = 4096;
+  double directThresholdFraction = 0.1, indirectThresholdFraction = 0.1;
 };
 
 // One frame's buffers: the feature-buffer contract's frame (frames/feature_frame.h).
@@ -42,6 +59,9 @@ using FrameBuffers = frames::FeatureFrame;
 
 struct RenderStatistics {
   std::uint64_t cameraSamples = 0, rays = 0;
+  std::uint64_t shadingPoints = 0;         // path vertices where direct light was gathered
+  std::uint64_t punctualEvaluated = 0;     // punctual lights evaluated at them (in reach)
+  std::uint64_t punctualInFrame = 0;       // what evaluating every light would have cost
 };
 
 class PathTracer {
@@ -69,6 +89,12 @@ class PathTracer {
   bool alphaOpaque(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
   const scene::Material* materialOf(int node, int primitive) const;
   SurfaceHit trace(const Ray& ray) const;
+  struct PathSample;
+  struct PathScratch;
+  // One path from the camera through the pixel centre, starting at its first hit (already traced
+  // and shaded): its direct and indirect radiance.
+  PathSample tracePath(const Ray& cameraRay, const SurfaceHit& firstHit, const Shading& firstShading, Random& rng,
+                       PathScratch& scratch) const;
 
   const scene::Scene& scene_;
   RenderSettings settings_;

@@ -1,5 +1,7 @@
 #include "render/raytracing_scene.h"
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include <embree3/rtcore.h>
@@ -298,5 +300,90 @@ bool RayTracingScene::occluded(const glm::dvec3& origin, const glm::dvec3& direc
 }
 
 RayTracingStats RayTracingScene::stats() const { return impl_->stats; }
+
+struct SphereIndex::Impl {
+  std::string error;
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+namespace {
+
+// Float boxes that contain the double spheres: grown by a relative margin so rounding cannot cut
+// off a point the exact test accepts.
+void sphereBounds(const RTCBoundsFunctionArguments* args) {
+  const auto& s = (*static_cast<const std::vector<glm::dvec4>*>(args->geometryUserPtr))[args->primID];
+  const double r = s.w * (1.0 + 1e-5) + 1e-6 * std::max({1.0, std::abs(s.x), std::abs(s.y), std::abs(s.z)});
+  args->bounds_o->lower_x = static_cast<float>(s.x - r);
+  args->bounds_o->lower_y = static_cast<float>(s.y - r);
+  args->bounds_o->lower_z = static_cast<float>(s.z - r);
+  args->bounds_o->upper_x = static_cast<float>(s.x + r);
+  args->bounds_o->upper_y = static_cast<float>(s.y + r);
+  args->bounds_o->upper_z = static_cast<float>(s.z + r);
+}
+
+struct SphereQuery {
+  const std::vector<glm::dvec4>* spheres;
+  glm::dvec3 point;
+  std::vector<std::uint32_t>* found;
+};
+
+bool sphereQueryVisit(RTCPointQueryFunctionArguments* args) {
+  auto* q = static_cast<SphereQuery*>(args->userPtr);
+  const glm::dvec4& s = (*q->spheres)[args->primID];
+  const glm::dvec3 d = q->point - glm::dvec3(s);
+  if (glm::dot(d, d) < s.w * s.w) q->found->push_back(args->primID);
+  return false;  // the query radius stays 0
+}
+
+}  // namespace
+
+SphereIndex::SphereIndex() : impl_(std::make_unique<Impl>()) {}
+SphereIndex::~SphereIndex() = default;
+
+Expected<void> SphereIndex::build(const std::vector<glm::dvec4>& spheres) {
+  for (std::size_t i = 0; i < spheres.size(); ++i)
+    if (!(spheres[i].w > 0) || !std::isfinite(spheres[i].w))
+      return fail(ErrorCode::kInternal, "sphere index: sphere {} has radius {}; expected a finite positive radius", i, spheres[i].w);
+  spheres_ = spheres;
+  if (!impl_->device) {
+    impl_->device = rtcNewDevice(nullptr);
+    if (!impl_->device) return fail(ErrorCode::kExternalTool, "Embree: cannot create a device (error {})", static_cast<int>(rtcGetDeviceError(nullptr)));
+    rtcSetDeviceErrorFunction(impl_->device, onEmbreeError, &impl_->error);
+  }
+  if (impl_->scene) rtcReleaseScene(impl_->scene);
+  impl_->scene = nullptr;
+  if (spheres_.empty()) return {};
+  impl_->scene = rtcNewScene(impl_->device);
+  RTCGeometry geometry = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(geometry, static_cast<unsigned>(spheres_.size()));
+  rtcSetGeometryUserData(geometry, &spheres_);
+  rtcSetGeometryBoundsFunction(geometry, sphereBounds, nullptr);
+  rtcCommitGeometry(geometry);
+  rtcAttachGeometry(impl_->scene, geometry);
+  rtcReleaseGeometry(geometry);
+  rtcCommitScene(impl_->scene);
+  if (!impl_->error.empty()) return fail(ErrorCode::kExternalTool, "Embree: building the light hierarchy failed: {}", impl_->error);
+  return {};
+}
+
+void SphereIndex::query(const glm::dvec3& p, std::vector<std::uint32_t>& found) const {
+  found.clear();
+  if (!impl_->scene) return;
+  RTCPointQuery query;
+  query.x = static_cast<float>(p.x);
+  query.y = static_cast<float>(p.y);
+  query.z = static_cast<float>(p.z);
+  query.radius = 0.0f;
+  query.time = 0.0f;
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  SphereQuery q{&spheres_, p, &found};
+  rtcPointQuery(impl_->scene, &query, &context, sphereQueryVisit, &q);
+}
 
 }  // namespace dynbench::render

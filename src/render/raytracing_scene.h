@@ -75,4 +75,28 @@ class RayTracingScene {
   std::unique_ptr<Impl> impl_;
 };
 
+// A bounding volume hierarchy over spheres (Embree's BVH over user primitives, searched with
+// rtcPointQuery): which spheres contain a point. The lights' spheres of influence use it so that
+// the cost of direct light follows the lights that can reach a point, not every light of the frame.
+class SphereIndex {
+ public:
+  SphereIndex();
+  ~SphereIndex();
+  SphereIndex(const SphereIndex&) = delete;
+  SphereIndex& operator=(const SphereIndex&) = delete;
+
+  // Rebuilds the hierarchy over these spheres (xyz centre, w radius > 0 and finite).
+  [[nodiscard]] Expected<void> build(const std::vector<glm::dvec4>& spheres);
+  // Appends to `found` (cleared first) the index of every sphere containing p, exactly
+  // (|p - centre| < radius; the hierarchy's float boxes only prune).
+  void query(const glm::dvec3& p, std::vector<std::uint32_t>& found) const;
+  std::size_t size() const { return spheres_.size(); }
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+  std::vector<glm::dvec4> spheres_;
+};
+
 }  // namespace dynbench::render

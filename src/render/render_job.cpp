@@ -91,7 +91,13 @@ nlohmann::json renderRecord(const RenderJob& job) {
                       {"seed", s.seed},
                       {"width", s.width},
                       {"height", s.height},
-                      {"environment", s.constantEnvironment ? "constant" : (s.useEnvironment ? "dataset" : "none")}};
+                      {"environment", s.constantEnvironment ? "constant" : (s.useEnvironment ? "dataset" : "none")},
+                      // Radiance at the pixel centre's hit, punctual lights summed (docs/feature-buffers.md):
+                      // frames of the earlier footprint-sampled integrator are not reused.
+                      {"radiance_at", "pixel_centre"}};
+  if (s.converge) r["converge"] = {{"tolerance", s.tolerance}, {"max_spp", s.maxSamplesPerPixel},
+                                   {"direct_threshold", s.directThresholdFraction}, {"indirect_threshold", s.indirectThresholdFraction}};
+  if (s.lightCutoff) r["light_cutoff"] = *s.lightCutoff;
   // The dataset file's size and modification time: frames of an older version of a dataset at the
   // same path are not complete for the new one.
   std::error_code ec;
