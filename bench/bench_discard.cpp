@@ -78,7 +78,6 @@ int main(int argc, char** argv) {
   const int frames = argc > 1 ? std::max(2, std::atoi(argv[1])) : 8;
   const auto a = frame(0), b = frame(1);
   discard::Thresholds t;
-  t.noiseAware = true;
   const auto absolute = discard::absoluteThresholds(t, b, discard::sceneSize(a));
   constexpr int kRepeats = 10;
   auto start = Clock::now();

@@ -225,8 +225,22 @@ TEST(Cycles, RadianceAgreesWithDynbenchForEachKindOfLight) {
       ASSERT_EQ(r.status, 0) << engine << ": " << r.err;
       m[e] = meanRadiance(out / "frame_00000.exr");
     }
+    const double directRatio = m[1].direct / m[0].direct, indirectRatio = m[1].indirect / m[0].indirect;
     std::printf("%-12s direct dynbench %.5g cycles %.5g (ratio %.4f); indirect dynbench %.5g cycles %.5g (ratio %.4f)\n", name.c_str(),
-                m[0].direct, m[1].direct, m[1].direct / m[0].direct, m[0].indirect, m[1].indirect, m[1].indirect / m[0].indirect);
+                m[0].direct, m[1].direct, directRatio, m[0].indirect, m[1].indirect, indirectRatio);
+    // The remaining differences, pinned (docs/feature-buffers.md, "Agreement with Cycles"): Blender
+    // imports glTF materials as its Principled BSDF, whose Disney diffuse adds retro-reflection at
+    // roughness 1 and whose specular layer does not take its energy from the diffuse one (glTF's
+    // Appendix B does), so Cycles is 5-20 % brighter on this rough textured floor; Blender's spot
+    // cone is a smoothstep over `spot_blend` where KHR_lights_punctual's is a squared linear ramp
+    // between the cones, which lights more of the cone's edge (+30-70 % here). Light units, the
+    // environment's mapping and bounce counting agree: the ratios do not depend on the kind of light
+    // beyond that. A change in either renderer that moves a ratio out of its band fails here.
+    const bool spot = kind == LightKind::kSpot;
+    EXPECT_GT(directRatio, spot ? 1.3 : 1.0) << name;
+    EXPECT_LT(directRatio, spot ? 1.7 : 1.2) << name;
+    EXPECT_GT(indirectRatio, 1.0) << name;
+    EXPECT_LT(indirectRatio, spot ? 1.6 : 1.35) << name;
   }
 }
 

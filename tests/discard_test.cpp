@@ -168,13 +168,70 @@ TEST(Discard, NoiseAloneIsNotChangeWhenNoiseAware) {
     std::fill(f->indirectVariance.begin(), f->indirectVariance.end(), 0.0025f);
   }
   Thresholds t = absolute(0.1, 0.1, 0.02, 0.02);
+  t.radianceTest = discard::Thresholds::RadianceTest::kPlain;
   const auto plain = discardFrame(b, a, t);
-  t.noiseAware = true;
+  t.radianceTest = discard::Thresholds::RadianceTest::kNoiseAware;
   const auto aware = discardFrame(b, a, t);
   EXPECT_GT(plain.percentages.direct, 60.0);  // |N(0, 0.0707^2)| * sqrt(3) > 0.02: about 83%
   EXPECT_GT(plain.percentages.indirect, 60.0);
   EXPECT_LT(aware.percentages.direct, 1.0);
   EXPECT_LT(aware.percentages.indirect, 1.0);
+}
+
+TEST(Discard, ExpectedTestCountsEachPixelWithTheProbabilityOfARealChange) {
+  // Noise-free values, but variance channels saying each frame's pixel has luminance variance
+  // sigma^2 / 6, so the difference's luminance has sigma^2 / 3: on the thresholds' RGB scale (a
+  // grey change, x sqrt(3)) sigma. The grey change delta has that scale's size d = sqrt(3) delta =
+  // tau + sigma: each pixel counts P(|N(d, sigma^2)| > tau) = Phi(1) + Phi(-(2 tau + sigma) /
+  // sigma) = Phi(1) + Phi(-5), and the 95 % interval is 1.96 sqrt(N p (1 - p)) / N.
+  const int w = 50, h = 40;
+  const auto cam = camera(0.0, w, h, 50.0);
+  const double tau = 0.1, sigma = 0.05, delta = (tau + sigma) / std::sqrt(3.0);
+  auto grey = [](double value) {
+    return [value](const render::Ray& ray, int x, int y) {
+      Surface s = farSphere(ray, x, y);
+      s.direct = glm::dvec3(value);
+      s.indirect = glm::dvec3(0.5);
+      return s;
+    };
+  };
+  FeatureFrame before = makeFrame(0, cam, grey(1.0)), now = makeFrame(1, cam, grey(1.0 + delta));
+  for (auto* f : {&before, &now}) std::fill(f->directVariance.begin(), f->directVariance.end(), static_cast<float>(sigma * sigma / 6));
+  std::size_t hits = 0;
+  for (float v : now.hit) hits += v > 0;
+  ASSERT_EQ(hits, static_cast<std::size_t>(w * h));  // the far sphere fills the image
+  const auto r = discardFrame(now, before, absolute(1.0, 1.0, tau, tau));
+  const double p = 0.8413447460685429 + 2.866515718791939e-7;
+  const double n = w * h;
+  EXPECT_NEAR(r.percentages.direct, 100.0 * p, 1e-4);  // float variance channels: about 1e-7 relative
+  ASSERT_TRUE(r.percentages.directInterval);
+  const double half = 1.959963984540054 * std::sqrt(n * p * (1 - p)) / n * 100.0;
+  EXPECT_NEAR(r.percentages.directInterval->low, 100.0 * p - half, 1e-3);
+  EXPECT_NEAR(r.percentages.directInterval->high, 100.0 * p + half, 1e-3);
+  // Indirect did not change and has no noise: exactly 0, an interval of width 0.
+  EXPECT_EQ(r.percentages.indirect, 0.0);
+  EXPECT_EQ(r.percentages.indirectInterval->halfWidth(), 0.0);
+  // The mask shows the likelier outcome: every pixel (p > 0.5).
+  std::size_t masked = 0;
+  for (auto bits : r.mask) masked += (bits & kDirect) != 0;
+  EXPECT_EQ(masked, hits);
+  // As the noise vanishes the expected test becomes the plain one (for a grey change): every pixel.
+  for (auto* f : {&before, &now}) std::fill(f->directVariance.begin(), f->directVariance.end(), 0.0f);
+  EXPECT_EQ(discardFrame(now, before, absolute(1.0, 1.0, tau, tau)).percentages.direct, 100.0);
+  // A change of hue at constant luminance is no change to the expected test; the plain test's RGB
+  // distance sees it.
+  auto hue = [](bool red) {
+    return [red](const render::Ray& ray, int x, int y) {
+      Surface s = farSphere(ray, x, y);
+      s.direct = red ? glm::dvec3(1.0 / 0.2126, 0, 0) : glm::dvec3(0, 1.0 / 0.7152, 0);
+      return s;
+    };
+  };
+  const FeatureFrame red = makeFrame(0, cam, hue(true)), green = makeFrame(1, cam, hue(false));
+  Thresholds t = absolute(1.0, 1.0, tau, tau);
+  EXPECT_NEAR(discardFrame(green, red, t).percentages.direct, 0.0, 1e-9);
+  t.radianceTest = Thresholds::RadianceTest::kPlain;
+  EXPECT_EQ(discardFrame(green, red, t).percentages.direct, 100.0);
 }
 
 TEST(Discard, ALightSwitchedOffDiscardsTheLitArea) {
@@ -226,19 +283,25 @@ TEST(Discard, ReprojectionRoundTripsThroughThePixelDirection) {
 }
 
 // A frames folder written to the contract (through the renderer's own sidecar writer).
-void writeFrames(const fs::path& dir, int count, int w, int h) {
+void writeFrames(const fs::path& dir, int count, int w, int h, bool variance = true) {
   for (int k = 0; k < count; ++k) {
     const auto cam = camera(2.0 * k, w, h, 50.0);
     const FeatureFrame f = makeFrame(k, cam, farSphere);
     FloatImage image;
     image.width = w;
     image.height = h;
-    image.channelNames = {"P.X", "P.Y", "P.Z", "N.X", "N.Y", "N.Z", "direct.R", "direct.G", "direct.B", "indirect.R", "indirect.G", "indirect.B", "hit"};
+    image.channelNames = {"P.X",        "P.Y",        "P.Z",        "N.X", "N.Y",        "N.Z",         "direct.R", "direct.G",
+                          "direct.B",   "indirect.R", "indirect.G", "indirect.B", "hit", "direct.var", "indirect.var"};
+    if (!variance) image.channelNames.resize(image.channelNames.size() - 2);
     image.channels = static_cast<int>(image.channelNames.size());
     for (std::size_t i = 0; i < f.hit.size(); ++i) {
       for (const auto* b : {&f.position, &f.normal, &f.direct, &f.indirect})
         for (int c = 0; c < 3; ++c) image.pixels.push_back((*b)[3 * i + c]);
       image.pixels.push_back(f.hit[i]);
+      // Noise of a few percent of the radiance, so the expected test has intervals to print.
+      if (!variance) continue;
+      image.pixels.push_back(static_cast<float>(1e-3 * (1 + i % 7)));
+      image.pixels.push_back(static_cast<float>(1e-4 * (1 + i % 5)));
     }
     ASSERT_TRUE(writeImage(frames::frameImagePath(dir, k), image));
     ASSERT_TRUE(writeFileAtomic(frames::frameSidecarPath(dir, k), frames::sidecarJson(k, k / 24.0, cam.frameCamera(), {}).dump()));
@@ -255,6 +318,23 @@ TEST(DiscardCli, TableJsonCsvAndMasks) {
   EXPECT_NE(r.out.find("| frustum % |"), std::string::npos) << r.out;
   const auto j = nlohmann::json::parse(test::slurp(dir / "d.json"));
   ASSERT_EQ(j["frames"].size(), 3u);
+  // The expected test's 95 % intervals, for the mean and per frame, bracket their estimates; the
+  // mean's half width is the frames' in quadrature over their count.
+  EXPECT_EQ(j["thresholds"]["radiance_test"], "expected");
+  double sumSq = 0;
+  for (const auto& f : j["frames"]) {
+    for (const char* column : {"direct_radiance", "indirect_radiance"}) {
+      const auto& in = f["interval"][column];
+      ASSERT_EQ(in.size(), 2u);
+      EXPECT_LE(in[0].get<double>(), f[column].get<double>());
+      EXPECT_GE(in[1].get<double>(), f[column].get<double>());
+    }
+    sumSq += std::pow(0.5 * (f["interval"]["direct_radiance"][1].get<double>() - f["interval"]["direct_radiance"][0].get<double>()), 2);
+  }
+  const auto& meanDirect = j["mean"]["interval"]["direct_radiance"];
+  EXPECT_NEAR(0.5 * (meanDirect[1].get<double>() - meanDirect[0].get<double>()), std::sqrt(sumSq) / 3, 1e-9);
+  EXPECT_GT(meanDirect[1].get<double>(), meanDirect[0].get<double>());  // these frames are noisy: a real interval
+  EXPECT_NE(r.out.find(" ± "), std::string::npos) << r.out;
   // A 2-degree yaw per frame over a 50-degree-high, 48x27 image, the camera at the origin: the
   // frustum share is the pixels whose centre ray, turned by 2 degrees about +Y, lands outside the
   // span of the image's pixel centres (Eq. 3.3: NDC beyond 1 - 1/width or 1 - 1/height), worked out
@@ -313,7 +393,13 @@ TEST(DiscardCli, BadFramesFoldersFailClearly) {
   EXPECT_EQ(r.status, 5) << r.err;
   EXPECT_NE(r.err.find("lacks the channel(s) N.X, N.Y, N.Z"), std::string::npos) << r.err;
 
-  r = dynbench(fmt::format("discard {} --noise-aware", (dir / "g2").string()), dir);
+  writeFrames(dir / "novar", 2, 16, 9, false);
+  // Frames without variances (Cycles'): the expected test runs, says what it assumed.
+  r = dynbench(fmt::format("discard {}", (dir / "novar").string()), dir);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE((r.out + r.err).find("no direct.var / indirect.var channels"), std::string::npos) << r.out << r.err;
+  EXPECT_NE(r.out.find("0.000 ± 0.000"), std::string::npos) << r.out;
+  r = dynbench(fmt::format("discard {} --noise-aware", (dir / "novar").string()), dir);
   EXPECT_EQ(r.status, 5) << r.err;
   EXPECT_NE(r.err.find("direct.var"), std::string::npos) << r.err;
 

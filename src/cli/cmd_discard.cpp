@@ -39,7 +39,7 @@ void addDiscardCommand(CLI::App& app, CommandRun& run) {
   auto* cmd = app.add_subcommand("discard", "Reprojection discard percentages of a frames folder (thesis Table 6.7)");
   cmd->footer("FRAMES_DIR holds frame_NNNNN.exr + frame_NNNNN.json per frame (docs/feature-buffers.md), e.g. from\n"
               "`dynbench render`. Definitions and defaults: docs/metrics.md.\n"
-              "Example: dynbench discard frames/run1 --relative-position --noise-aware --json discard.json --masks masks/");
+              "Example: dynbench discard frames/run1 --relative-position --json discard.json --masks masks/");
   cmd->add_option("FRAMES_DIR", o->frames, "Folder of feature-buffer frames")->required();
   cmd->add_option("--threshold-position", o->thresholds.position, "World-position distance, scene units (a fraction of the scene's size with --relative-position)")
       ->check(nonNegative());
@@ -52,10 +52,17 @@ void addDiscardCommand(CLI::App& app, CommandRun& run) {
                   "Indirect radiance distance, a fraction of the frame's mean luminance")
       ->check(nonNegative());
   cmd->add_flag("--absolute-radiance", o->thresholds.absoluteRadiance, "Radiance thresholds in radiance units, not relative");
-  cmd->add_flag("--noise-aware", o->thresholds.noiseAware,
-                fmt::format("Discard radiance only when the change exceeds {} standard deviations of the pixels' noise (needs *.var "
-                            "channels)",
-                            discard::Thresholds{}.noiseSigmas));
+  using Test = discard::Thresholds::RadianceTest;
+  cmd->add_option("--radiance-test", o->thresholds.radianceTest,
+                  "expected (default): each pixel counts with the probability that its radiance truly changed, given its noise "
+                  "(*.var channels), with 95% intervals; noise-aware: the change must also exceed 3 standard deviations of the "
+                  "noise; plain: the thesis's test on the rendered values")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, Test>{{"expected", Test::kExpected}, {"noise-aware", Test::kNoiseAware},
+                                                                      {"plain", Test::kPlain}}));
+  cmd->add_flag_callback("--noise-aware", [o] { o->thresholds.radianceTest = Test::kNoiseAware; },
+                         fmt::format("Same as --radiance-test noise-aware: radiance discards only when the change exceeds {} standard "
+                                     "deviations of the pixels' noise (needs *.var channels)",
+                                     discard::Thresholds{}.noiseSigmas));
   cmd->add_option("--json", o->json, "Per-frame and mean percentages as JSON");
   cmd->add_option("--csv", o->csv, "Per-frame percentages as CSV");
   cmd->add_option("--plots", o->plots, "Write NAME_discard.png and .svg: per-frame discard percentages (gnuplot)");

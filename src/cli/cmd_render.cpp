@@ -53,7 +53,9 @@ Expected<void> runRender(const RenderCli& cli) {
       if (!progress) progress.emplace("render", rowsTotal, "rows");
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
       const double samplesPerSecond = seconds > 0 ? rows * samplesPerRow / seconds : 0.0;
-      progress->update(rows, fmt::format("{}/{} frames, {:.2f} M samples/s", frames, framesTotal, samplesPerSecond / 1e6));
+      // Adaptive sampling has no fixed samples per row: frames only.
+      progress->update(rows, job.settings.converge ? fmt::format("{}/{} frames", frames, framesTotal)
+                                                   : fmt::format("{}/{} frames, {:.2f} M samples/s", frames, framesTotal, samplesPerSecond / 1e6));
     };
   }
   std::vector<std::string> sceneWarnings;
@@ -66,6 +68,9 @@ Expected<void> runRender(const RenderCli& cli) {
              summary->skipped.size(), summary->seconds);
   if (summary->cameraSamples > 0 && summary->seconds > 0)
     fmt::print(", {:.2f} M samples/s, {:.2f} M rays/s", summary->cameraSamples / summary->seconds / 1e6, summary->rays / summary->seconds / 1e6);
+  if (summary->pixels > 0)
+    fmt::print(", {:.1f} spp on average", static_cast<double>(summary->cameraSamples) / static_cast<double>(summary->pixels));
+  if (job.settings.converge) fmt::print(", {} pixel(s) reached --max-spp before the tolerance", summary->cappedPixels);
   fmt::print("\n");
   return {};
 }
@@ -109,6 +114,16 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--blender", o->job.blender, "Blender executable for --engine cycles");
   cmd->add_option("--env-constant", o->envConstant, "Light with a constant environment of radiance L or R,G,B instead of the dataset's");
   cmd->add_flag("--no-environment", o->noEnvironment, "No image-based light (black background)");
+  cmd->add_flag("--converge", o->job.settings.converge,
+                "Adaptive sampling: after --spp samples, sample each pixel in rounds until the standard error of its direct and of its "
+                "indirect luminance is at most --tolerance x discard's radiance threshold (docs/feature-buffers.md), or --max-spp");
+  cmd->add_option("--tolerance", o->job.settings.tolerance, "With --converge: the standard error target as a fraction of discard's threshold")
+      ->check(CLI::Range(1e-4, 10.0));
+  cmd->add_option("--max-spp", o->job.settings.maxSamplesPerPixel, "With --converge: samples per pixel at most")->check(positive());
+  cmd->add_option("--light-cutoff", o->job.settings.lightCutoff,
+                  "Irradiance below which a point or spot light without a range is skipped (0: never; default: automatic, at most "
+                  "0.1% of the environment's mean irradiance dropped in all; docs/feature-buffers.md)")
+      ->check(nonNegative());
   cmd->callback([o, &run] { run = [o] { return runRender(*o); }; });
 }
 

@@ -103,13 +103,46 @@ Thresholds absoluteThresholds(const Thresholds& t, const FeatureFrame& current, 
   return a;
 }
 
+const char* radianceTestName(Thresholds::RadianceTest test) {
+  switch (test) {
+    case Thresholds::RadianceTest::kExpected: return "expected";
+    case Thresholds::RadianceTest::kNoiseAware: return "noise-aware";
+    case Thresholds::RadianceTest::kPlain: return "plain";
+  }
+  return "?";
+}
+
+namespace {
+
+constexpr double kZ95 = 1.959963984540054;  // the standard normal's 97.5th percentile
+
+double standardNormalCdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
+
+// The probability that a change whose estimate is d (>= 0) with standard deviation sigma truly
+// exceeds the threshold tau in size: P(|X| > tau), X ~ N(d, sigma^2), the normal approximation of
+// the difference of two pixel means. sigma = 0 is the plain test.
+double exceedanceProbability(double d, double sigma, double tau) {
+  if (!(sigma > 0)) return d > tau ? 1.0 : 0.0;
+  return standardNormalCdf((d - tau) / sigma) + standardNormalCdf((-d - tau) / sigma);
+}
+
+// Per-thread sums of one frame: counts of the deterministic columns and, for the radiance
+// columns, the sum of p (expected count) and of p (1 - p) (its variance, independent pixels).
+struct FrameSums {
+  std::array<double, 5> count{};
+  double directVariance = 0.0, indirectVariance = 0.0;
+};
+
+}  // namespace
+
 DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& previous, const Thresholds& t) {
+  using Test = Thresholds::RadianceTest;
   DiscardResult result;
   const int w = current.width, h = current.height;
   const auto n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
   result.mask.assign(n, 0);
-  std::size_t counts[5] = {0, 0, 0, 0, 0};
-  const bool noise = t.noiseAware && current.hasVariance() && previous.hasVariance();
+  const bool variance = current.hasVariance() && previous.hasVariance();
+  const Test test = t.radianceTest;
   // Eq. (3.3) on the thesis's pixel-index coordinates (pixel i at x = i): outside [0, w - 1].
   // A pixel that reprojects onto an edge pixel's centre stays inside despite rounding: buffers store
   // float positions, about 1e-7 relative, i.e. up to a few 1e-6 px; the slack is 1e-3 px.
@@ -119,10 +152,11 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
     return x < -kEdge || x > previous.width - 1 + kEdge || y < -kEdge || y > previous.height - 1 + kEdge;
   };
   const glm::dmat4 inverseCurrent = glm::inverse(current.camera.projection * current.camera.view);
-  // Rows in parallel (TBB); each row's counts are summed at the end, so the result is exact.
-  std::vector<std::array<std::size_t, 5>> rowCounts(static_cast<std::size_t>(h), std::array<std::size_t, 5>{});
+  // Rows in parallel (TBB); each row's sums are added in row order at the end, so the result does
+  // not depend on the schedule.
+  std::vector<FrameSums> rowSums(static_cast<std::size_t>(h));
   tbb::parallel_for(0, h, [&](int py) {
-    auto& rowCount = rowCounts[static_cast<std::size_t>(py)];
+    FrameSums& row = rowSums[static_cast<std::size_t>(py)];
     for (int px = 0; px < w; ++px) {
       const std::size_t i = static_cast<std::size_t>(py) * static_cast<std::size_t>(w) + static_cast<std::size_t>(px);
       unsigned char bits = 0;
@@ -143,31 +177,66 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
           // Position and normal history of a surface cannot come from the background.
           if (historyMissesGeometry || glm::length(p - sample3(previous.position, taps)) > t.position) bits |= kPosition;
           if (historyMissesGeometry || glm::length(at3(current.normal, i) - sample3(previous.normal, taps)) > t.normal) bits |= kNormal;
-          auto radianceChanged = [&](const std::vector<float>& now, const std::vector<float>& before, double threshold,
-                                     const std::vector<float>& varNow, const std::vector<float>& varBefore) {
+          // The probability (0 or 1 for the deterministic tests) that the radiance changed.
+          auto radianceChange = [&](const std::vector<float>& now, const std::vector<float>& before, double threshold,
+                                    const std::vector<float>& varNow, const std::vector<float>& varBefore) {
             const glm::dvec3 a = at3(now, i), b = sample3(before, taps);
-            if (!(glm::length(a - b) > threshold)) return false;
-            if (!noise) return true;
-            // Variance of the bilinear sample: sum of w_k^2 var_k (independent pixels).
-            double var = varNow[i];
-            for (int k = 0; k < 4; ++k) var += taps.weight[k] * taps.weight[k] * varBefore[taps.index[k]];
-            return std::abs(luminance(a) - luminance(b)) > t.noiseSigmas * std::sqrt(var);
+            const double d = glm::length(a - b);
+            // Variance of the difference: the pixel's plus the bilinear sample's, sum of w_k^2 var_k
+            // (independent pixels).
+            double var = 0.0;
+            if (variance && test != Test::kPlain) {
+              var = varNow[i];
+              for (int k = 0; k < 4; ++k) var += taps.weight[k] * taps.weight[k] * varBefore[taps.index[k]];
+            }
+            switch (test) {
+              case Test::kPlain: return d > threshold ? 1.0 : 0.0;
+              case Test::kNoiseAware:
+                return d > threshold && std::abs(luminance(a) - luminance(b)) > t.noiseSigmas * std::sqrt(var) ? 1.0 : 0.0;
+              case Test::kExpected: break;
+            }
+            // The expected test compares luminance, the quantity whose variance the renderer
+            // records: its difference is an unbiased estimate, where the RGB distance of two noisy
+            // pixels is biased up by their noise. On the thresholds' scale it is the RGB distance
+            // of a grey change of that luminance, sqrt(3) |dY| (noise scaled alike), so both tests
+            // agree on grey changes without noise.
+            constexpr double kGrey = 1.7320508075688772;  // sqrt(3)
+            return exceedanceProbability(kGrey * std::abs(luminance(a) - luminance(b)), kGrey * std::sqrt(var), threshold);
           };
-          if (radianceChanged(current.direct, previous.direct, t.direct, current.directVariance, previous.directVariance)) bits |= kDirect;
-          if (radianceChanged(current.indirect, previous.indirect, t.indirect, current.indirectVariance, previous.indirectVariance))
-            bits |= kIndirect;
+          const double pd = radianceChange(current.direct, previous.direct, t.direct, current.directVariance, previous.directVariance);
+          const double pi = radianceChange(current.indirect, previous.indirect, t.indirect, current.indirectVariance, previous.indirectVariance);
+          row.count[3] += pd;
+          row.count[4] += pi;
+          row.directVariance += pd * (1.0 - pd);
+          row.indirectVariance += pi * (1.0 - pi);
+          if (pd > 0.5) bits |= kDirect;  // the mask shows the more likely outcome
+          if (pi > 0.5) bits |= kIndirect;
         }
       }
       result.mask[i] = bits;
-      for (int b = 0; b < 5; ++b)
-        if (bits & (1u << b)) ++rowCount[static_cast<std::size_t>(b)];
+      for (int b = 0; b < 3; ++b)
+        if (bits & (1u << b)) row.count[static_cast<std::size_t>(b)] += 1.0;
     }
   });
-  for (const auto& row : rowCounts)
-    for (int b = 0; b < 5; ++b) counts[b] += row[static_cast<std::size_t>(b)];
+  FrameSums total;
+  for (const auto& row : rowSums) {
+    for (std::size_t b = 0; b < 5; ++b) total.count[b] += row.count[b];
+    total.directVariance += row.directVariance;
+    total.indirectVariance += row.indirectVariance;
+  }
   const double scale = 100.0 / static_cast<double>(n);  // Eq. (3.4), as a percentage
-  result.percentages = {current.frame, current.time, counts[0] * scale, counts[1] * scale, counts[2] * scale, counts[3] * scale,
-                        counts[4] * scale};
+  auto& p = result.percentages;
+  p = {current.frame, current.time, total.count[0] * scale, total.count[1] * scale, total.count[2] * scale, total.count[3] * scale,
+       total.count[4] * scale, std::nullopt, std::nullopt};
+  if (test == Test::kExpected) {
+    // 95 %: the expected count +- 1.96 standard deviations of a sum of independent Bernoulli(p).
+    auto interval = [&](double percent, double countVariance) {
+      const double half = kZ95 * std::sqrt(countVariance) * scale;
+      return Interval{std::max(0.0, percent - half), std::min(100.0, percent + half)};
+    };
+    p.directInterval = interval(p.direct, total.directVariance);
+    p.indirectInterval = interval(p.indirect, total.indirectVariance);
+  }
   return result;
 }
 
@@ -182,6 +251,7 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
   if (entries->size() < 2) return fail(ErrorCode::kInvalidData, "{}: needs at least two frames (found {})", dir.string(), entries->size());
   DiscardRun run;
   run.thresholds = thresholds;
+  bool warnedNoVariance = false;
   std::optional<FeatureFrame> previous;
   for (std::size_t k = 0; k < entries->size(); ++k) {
     auto frame = frames::readFrame((*entries)[k]);
@@ -197,8 +267,14 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
       return fail(ErrorCode::kInvalidData, "{}: is {}x{}, but the frames before it are {}x{}", (*entries)[k].image.string(), frame->width,
                   frame->height, run.width, run.height);
     }
-    if (thresholds.noiseAware && !frame->hasVariance())
+    if (thresholds.radianceTest == Thresholds::RadianceTest::kNoiseAware && !frame->hasVariance())
       return fail(ErrorCode::kInvalidData, "{}: --noise-aware needs the direct.var and indirect.var channels", (*entries)[k].image.string());
+    if (thresholds.radianceTest == Thresholds::RadianceTest::kExpected && !frame->hasVariance() && !warnedNoVariance) {
+      run.warnings.push_back(fmt::format("{}: no direct.var / indirect.var channels: the radiance columns treat the frames as noise-free "
+                                         "(their intervals are 0 wide); render with dynbench for variances",
+                                         (*entries)[k].image.string()));
+      warnedNoVariance = true;
+    }
     if (previous) {
       if (previous->frame + 1 != frame->frame) {
         run.warnings.push_back(fmt::format("frames {} and {} are not consecutive: pair skipped", previous->frame, frame->frame));
@@ -223,6 +299,17 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
   }
   const double n = static_cast<double>(run.frames.size());  // Eq. (3.5)
   for (double* v : {&run.mean.frustum, &run.mean.position, &run.mean.normal, &run.mean.direct, &run.mean.indirect}) *v /= n;
+  if (thresholds.radianceTest == Thresholds::RadianceTest::kExpected) {
+    // The mean of independent frame estimates: half-widths add in quadrature, over n.
+    auto meanInterval = [&](double mean, std::optional<Interval> FramePercentages::*member) {
+      double sumSq = 0.0;
+      for (const auto& f : run.frames) sumSq += std::pow((f.*member)->halfWidth(), 2);
+      const double half = std::sqrt(sumSq) / n;
+      return Interval{std::max(0.0, mean - half), std::min(100.0, mean + half)};
+    };
+    run.mean.directInterval = meanInterval(run.mean.direct, &FramePercentages::directInterval);
+    run.mean.indirectInterval = meanInterval(run.mean.indirect, &FramePercentages::indirectInterval);
+  }
   return run;
 }
 
@@ -246,8 +333,12 @@ std::vector<float> maskImage(const FeatureFrame& frame, const std::vector<unsign
 namespace {
 
 nlohmann::json percentagesJson(const FramePercentages& p) {
-  return {{"frustum", p.frustum}, {"world_position", p.position}, {"shading_normal", p.normal}, {"direct_radiance", p.direct},
-          {"indirect_radiance", p.indirect}};
+  nlohmann::json j = {{"frustum", p.frustum}, {"world_position", p.position}, {"shading_normal", p.normal}, {"direct_radiance", p.direct},
+                      {"indirect_radiance", p.indirect}};
+  if (p.directInterval && p.indirectInterval)
+    j["interval"] = {{"direct_radiance", {p.directInterval->low, p.directInterval->high}},
+                     {"indirect_radiance", {p.indirectInterval->low, p.indirectInterval->high}}};
+  return j;
 }
 
 }  // namespace
@@ -261,7 +352,7 @@ std::string discardJson(const DiscardRun& run, const std::string& framesDir) {
   j["scene_size"] = run.sceneSize;
   j["thresholds"] = {{"position", t.position},       {"relative_position", t.relativePosition}, {"normal", t.normal},
                      {"direct", t.direct},           {"indirect", t.indirect},                 {"absolute_radiance", t.absoluteRadiance},
-                     {"noise_aware", t.noiseAware}, {"noise_sigmas", t.noiseSigmas}};
+                     {"radiance_test", radianceTestName(t.radianceTest)}, {"noise_sigmas", t.noiseSigmas}};
   j["mean"] = percentagesJson(run.mean);
   j["frames"] = nlohmann::json::array();
   for (const auto& f : run.frames) {
@@ -283,6 +374,17 @@ Expected<FramePercentages> readPercentages(const JsonFields& f, const std::strin
     auto v = f.number(base + "/" + key);
     if (!v) return std::unexpected(v.error());
     *target = *v;
+  }
+  // Intervals: optional (files of the other radiance tests and of earlier versions have none).
+  if (f.has(base + "/interval")) {
+    for (auto [key, target] : {std::pair{"direct_radiance", &p.directInterval}, {"indirect_radiance", &p.indirectInterval}}) {
+      const std::string pointer = base + "/interval/" + key;
+      auto low = f.number(pointer + "/0");
+      if (!low) return std::unexpected(low.error());
+      auto high = f.number(pointer + "/1");
+      if (!high) return std::unexpected(high.error());
+      *target = Interval{*low, *high};
+    }
   }
   return p;
 }

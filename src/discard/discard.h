@@ -31,10 +31,23 @@ struct Thresholds {
   // absoluteRadiance takes it in radiance units, as the thesis's functions literally do.
   double direct = 0.1, indirect = 0.1;
   bool absoluteRadiance = false;
-  // noiseAware: a radiance difference also has to exceed noiseSigmas standard deviations of the
-  // two pixels' Monte Carlo noise (their variance channels), so noise alone is not change.
-  bool noiseAware = false;
+  // How a radiance difference becomes a discard (docs/metrics.md, "Radiance discard"):
+  //  kExpected (default): each pixel counts with the probability that its true change exceeds the
+  //    threshold, given its Monte Carlo noise (the variance channels) under the normal
+  //    approximation; the column is the expected percentage, with a 95 % interval.
+  //  kNoiseAware: the difference must also exceed noiseSigmas standard deviations of the noise.
+  //  kPlain: the thesis's test on the rendered values (noise counts as change).
+  enum class RadianceTest { kExpected, kNoiseAware, kPlain };
+  RadianceTest radianceTest = RadianceTest::kExpected;
   double noiseSigmas = 3.0;
+};
+
+const char* radianceTestName(Thresholds::RadianceTest test);  // "expected", "noise-aware", "plain"
+
+// A 95 % interval of a percentage.
+struct Interval {
+  double low = 0.0, high = 0.0;
+  double halfWidth() const { return 0.5 * (high - low); }
 };
 
 // Why a pixel was discarded, per feature (a pixel may be discarded for several features).
@@ -50,6 +63,8 @@ struct FramePercentages {
   long frame = 0;       // the current frame i (compared with i - 1)
   double time = 0.0;
   double frustum = 0, position = 0, normal = 0, direct = 0, indirect = 0;  // percent of w x h
+  // The radiance columns' 95 % intervals (the kExpected test; absent otherwise).
+  std::optional<Interval> directInterval, indirectInterval;
 };
 
 struct DiscardResult {

@@ -58,7 +58,6 @@ Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, cons
   discard.frames = render.job.output;
   discard.thresholds.relativePosition = true;
   discard.thresholds.position = 0.01;  // 1% of the scene's size
-  discard.thresholds.noiseAware = true;
   discard.json = run / "discard.json";
   discard.csv = run / "discard.csv";
   discard.masks = run / "masks";

@@ -119,9 +119,14 @@ Expected<DiscardOutcome> runDiscard(const DiscardStage& stage, const discard::Di
   if (!stage.json.empty())
     if (auto ok = writeFileAtomic(stage.json, discard::discardJson(*run, stage.frames.string())); !ok) return std::unexpected(ok.error());
   if (!stage.csv.empty()) {
-    std::string csv = "frame,time,frustum,world_position,shading_normal,direct_radiance,indirect_radiance\n";
+    std::string csv =
+        "frame,time,frustum,world_position,shading_normal,direct_radiance,indirect_radiance,direct_low,direct_high,indirect_low,indirect_high\n";
+    // Interval columns are empty for the tests that give none.
+    auto bound = [](const std::optional<discard::Interval>& i, bool high) { return i ? fmt::format("{}", high ? i->high : i->low) : std::string(); };
     for (const auto& f : run->frames)
-      csv += fmt::format("{},{},{},{},{},{},{}\n", f.frame, f.time, f.frustum, f.position, f.normal, f.direct, f.indirect);
+      csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", f.frame, f.time, f.frustum, f.position, f.normal, f.direct, f.indirect,
+                         bound(f.directInterval, false), bound(f.directInterval, true), bound(f.indirectInterval, false),
+                         bound(f.indirectInterval, true));
     if (auto ok = writeFileAtomic(stage.csv, csv); !ok) return std::unexpected(ok.error());
   }
   if (!stage.plots.empty())

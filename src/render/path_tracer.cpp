@@ -407,8 +407,11 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
     meanIndirect /= static_cast<double>(pixels);
     summary.adaptive = true;
     summary.tolerance = settings_.tolerance;
-    summary.directTarget = settings_.tolerance * settings_.directThresholdFraction * meanDirect;
-    summary.indirectTarget = settings_.tolerance * settings_.indirectThresholdFraction * meanIndirect;
+    // Discard's expected test measures a luminance change on the thresholds' RGB scale, x sqrt(3)
+    // (a grey change): the luminance standard error's target is the threshold's share over sqrt(3).
+    constexpr double kGrey = 1.7320508075688772;
+    summary.directTarget = settings_.tolerance * settings_.directThresholdFraction * meanDirect / kGrey;
+    summary.indirectTarget = settings_.tolerance * settings_.indirectThresholdFraction * meanIndirect / kGrey;
     const double directTargetSq = summary.directTarget * summary.directTarget;
     const double indirectTargetSq = summary.indirectTarget * summary.indirectTarget;
     const int cap = std::max(firstRound, settings_.maxSamplesPerPixel);

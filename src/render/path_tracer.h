@@ -47,7 +47,8 @@ struct RenderSettings {
   // Adaptive sampling (`render --converge`): after samplesPerPixel samples, each pixel takes more
   // in rounds until the standard error of its direct and of its indirect luminance is at most
   // tolerance x the discard threshold (thresholdFraction x the frame's mean luminance of that
-  // buffer, discard's default relative thresholds), or maxSamplesPerPixel is reached.
+  // buffer, discard's default relative thresholds) / sqrt(3) (the expected test's grey scale,
+  // discard.h), or maxSamplesPerPixel is reached.
   bool converge = false;
   double tolerance = 0.25;
   int maxSamplesPerPixel = 4096;

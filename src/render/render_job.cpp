@@ -148,6 +148,10 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
   const FrameSink write = [&](frames::FeatureFrame&& frame) -> Expected<void> {
     if (auto ok = frames::writeFrame(job.output, frame, record); !ok) return ok;
     summary.rendered.push_back(frame.frame);
+    if (frame.sampling) {
+      summary.cappedPixels += frame.sampling->cappedPixels;
+      summary.pixels += frame.pixelCount();
+    }
     const std::size_t done = summary.rendered.size();
     if (progress) progress(done * height, rowsTotal, done, requests.size());
     return {};
@@ -155,6 +159,7 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
   if (auto ok = (*renderer)->render(requests, write, rows); !ok) return std::unexpected(ok.error());
   summary.cameraSamples = (*renderer)->statistics().cameraSamples;
   summary.rays = (*renderer)->statistics().rays;
+  summary.light = (*renderer)->statistics();
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return summary;
 }

@@ -43,6 +43,9 @@ struct RenderSummary {
   std::vector<long> rendered, skipped;
   double seconds = 0.0;
   std::uint64_t cameraSamples = 0, rays = 0;
+  std::uint64_t pixels = 0;      // of the frames rendered (with a sampling summary)
+  long cappedPixels = 0;         // --converge: pixels that reached --max-spp before their target
+  RenderStatistics light;        // the backend's counters (shading points, lights evaluated)
   std::vector<std::string> warnings;
 };
 

@@ -83,13 +83,24 @@ std::vector<Table> statsTables(const std::vector<StatsRow>& rows) {
   return out;
 }
 
+namespace {
+
+// "mean ± half width" of a 95 % interval (intervals can be asymmetric where they meet 0 or 100:
+// the larger side is printed).
+std::string withInterval(double mean, const std::optional<discard::Interval>& interval) {
+  if (!interval) return fixed3(mean);
+  return fmt::format("{} ± {}", fixed3(mean), fixed3(std::max(mean - interval->low, interval->high - mean)));
+}
+
+}  // namespace
+
 Table discardTable(const std::vector<DiscardRow>& rows, const std::string& detail) {
   Table t{"Table 6.7. Discarded pixels, % of the image, mean over the frame pairs" + (detail.empty() ? "" : " (" + detail + ")") + ".",
           {"dataset", "frustum %", "world position %", "shading normal %", "direct radiance %", "indirect radiance %"},
           {}};
   for (const auto& r : rows)
-    t.rows.push_back({r.name, fixed3(r.mean.frustum), fixed3(r.mean.position), fixed3(r.mean.normal), fixed3(r.mean.direct),
-                      fixed3(r.mean.indirect)});
+    t.rows.push_back({r.name, fixed3(r.mean.frustum), fixed3(r.mean.position), fixed3(r.mean.normal),
+                      withInterval(r.mean.direct, r.mean.directInterval), withInterval(r.mean.indirect, r.mean.indirectInterval)});
   return t;
 }
 
