@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <fmt/format.h>
 
@@ -61,7 +62,7 @@ TEST(Demo, FlythroughPassesThroughTheKeysAndTurnsSlowly) {
 TEST(Demo, WholeChainOnAShortMatch) {
   DYNBENCH_NEEDS(test::missingCube2());
   const fs::path dir = test::freshDir("demo_chain");
-  const auto r = dynbench(fmt::format("demo -o {} --seconds 3 --bots 4 --res 64x36 --spp 1 --bounces 1", (dir / "demo").string()), dir);
+  const auto r = dynbench(fmt::format("demo -o {} --seconds 3 --bots 4 --res 32x18 --spp 1 --max-spp 32 --render-frames 12 --bounces 1", (dir / "demo").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("report: "), std::string::npos) << r.out;
   const std::string md = test::slurp(dir / "demo" / "report.md");
@@ -76,11 +77,56 @@ TEST(Demo, WholeChainOnAShortMatch) {
   EXPECT_LE(max, 1.25 + 1e-3);
   EXPECT_TRUE(fs::exists(dir / "demo" / "report.html"));
   EXPECT_TRUE(fs::exists(dir / "demo" / "runs" / "colos_bot" / "discard.json"));
+  // The demo renders a converged window and Table 6.7 prints the radiance columns' intervals.
+  EXPECT_NE(md.find(" ± "), std::string::npos) << md;
+  const auto discardJson = nlohmann::json::parse(test::slurp(dir / "demo" / "runs" / "colos_bot" / "discard.json"));
+  EXPECT_EQ(discardJson["frames"].size(), 11u);
+  EXPECT_EQ(discardJson["mean"]["interval"]["direct_radiance"].size(), 2u);
+
+  // Convergence (the issue's acceptance, at a size the suite affords): the seeded segment (colos,
+  // 4 bots, 3 s, seed 1), frames 40-47, rendered to convergence with two seeds gives direct and
+  // indirect discard means within 0.5 percentage points of each other, each inside the other's
+  // interval; the same with half the tolerance.
+  const fs::path dataset = dir / "demo" / "datasets" / "colos_bot.gltf";
+  for (const double tolerance : {0.5, 0.25}) {
+    nlohmann::json discarded[2];
+    for (int seed = 1; seed <= 2; ++seed) {
+      const fs::path frames = dir / fmt::format("converged_{}_{}", tolerance, seed);
+      const auto rendered = dynbench(fmt::format("render {} -o {} --res 32x18 --frames 40:47 --bounces 2 --converge --tolerance {} "
+                                                 "--max-spp 4096 --seed {}",
+                                                 dataset.string(), frames.string(), tolerance, seed),
+                                     dir);
+      ASSERT_EQ(rendered.status, 0) << rendered.err;
+      const auto d = dynbench(fmt::format("discard {} --relative-position --json {}", frames.string(), (frames / "d.json").string()), dir);
+      ASSERT_EQ(d.status, 0) << d.err;
+      discarded[seed - 1] = nlohmann::json::parse(test::slurp(frames / "d.json"));
+    }
+    for (const char* column : {"direct_radiance", "indirect_radiance"}) {
+      const double a = discarded[0]["mean"][column], b = discarded[1]["mean"][column];
+      const auto& ia = discarded[0]["mean"]["interval"][column];
+      const auto& ib = discarded[1]["mean"]["interval"][column];
+      std::printf("tolerance %.2f %s: seed 1 %.3f [%.3f, %.3f], seed 2 %.3f [%.3f, %.3f]\n", tolerance, column, a, ia[0].get<double>(),
+                  ia[1].get<double>(), b, ib[0].get<double>(), ib[1].get<double>());
+      if (std::string(column) == "indirect_radiance") {
+        // Not met yet for indirect light (issue 13 stays open): its threshold is a tenth of the
+        // frame's small mean indirect luminance, rare bright paths make the pixels' variance
+        // estimates too low, and the seeds differ by up to about 1 point, beyond the intervals.
+        // Pinned at the present agreement so that a regression shows.
+        EXPECT_NEAR(a, b, 1.5) << column << " at tolerance " << tolerance;
+        continue;
+      }
+      EXPECT_NEAR(a, b, 0.5) << column << " at tolerance " << tolerance;
+      EXPECT_GE(a, ib[0].get<double>()) << column;
+      EXPECT_LE(a, ib[1].get<double>()) << column;
+      EXPECT_GE(b, ia[0].get<double>()) << column;
+      EXPECT_LE(b, ia[1].get<double>()) << column;
+    }
+  }
 
   // A rerun with the same options reuses the capture; with another seed it captures again (it
   // used to measure the old match under the new options' name).
   const std::string capture = test::slurp(dir / "demo" / "capture" / "Capture.txt");
-  const std::string args = fmt::format("demo -o {} --seconds 3 --bots 4 --res 64x36 --spp 1 --bounces 1", (dir / "demo").string());
+  const std::string args = fmt::format("demo -o {} --seconds 3 --bots 4 --res 32x18 --spp 1 --max-spp 32 --render-frames 12 --bounces 1", (dir / "demo").string());
   auto again = dynbench(args, dir);
   ASSERT_EQ(again.status, 0) << again.err << again.out;
   EXPECT_NE(again.out.find("exists, reused"), std::string::npos) << again.out;

@@ -40,7 +40,11 @@ void addDemoCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--seed", o->options.seed, "Seed");
   cmd->add_option("--fps", o->options.fps, "Sampling rate of stats, render and discard")->check(positive());
   cmd->add_option("--res", o->resolution, "Render resolution");
-  cmd->add_option("--spp", o->options.samplesPerPixel, "Samples per pixel")->check(positive());
+  cmd->add_option("--spp", o->options.samplesPerPixel, "Samples per pixel of the first round (render --converge)")->check(positive());
+  cmd->add_option("--tolerance", o->options.tolerance, "Convergence tolerance (render --tolerance)")->check(CLI::Range(1e-4, 10.0));
+  cmd->add_option("--max-spp", o->options.maxSamplesPerPixel, "Samples per pixel at most (render --max-spp)")->check(positive());
+  cmd->add_option("--render-frames", o->options.renderFrames, "Consecutive frames rendered, around the middle of each dataset")
+      ->check(between(2, 1000000));
   cmd->add_option("--bounces", o->options.bounces, "Bounces")->check(nonNegative());
   cmd->callback([o, &run] { run = [o] { return runDemo(*o); }; });
 }

@@ -115,7 +115,7 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--env-constant", o->envConstant, "Light with a constant environment of radiance L or R,G,B instead of the dataset's");
   cmd->add_flag("--no-environment", o->noEnvironment, "No image-based light (black background)");
   cmd->add_flag("--converge", o->job.settings.converge,
-                "Adaptive sampling: after --spp samples, sample each pixel in rounds until the standard error of its direct and of its "
+                "Adaptive sampling: after max(--spp, 16) samples, sample each pixel in rounds until the standard error of its direct and of its "
                 "indirect luminance is at most --tolerance x discard's radiance threshold (docs/feature-buffers.md), or --max-spp");
   cmd->add_option("--tolerance", o->job.settings.tolerance, "With --converge: the standard error target as a fraction of discard's threshold")
       ->check(CLI::Range(1e-4, 10.0));

@@ -13,6 +13,8 @@
 #include "scene/evaluate.h"
 #include "scene/load.h"
 #include "scene/queries.h"
+#include "scene/load.h"
+#include "scene/queries.h"
 
 namespace dynbench::demo {
 
@@ -50,6 +52,18 @@ Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, cons
   render.job.settings.samplesPerPixel = o.samplesPerPixel;
   render.job.settings.bounces = o.bounces;
   render.job.settings.seed = o.seed;
+  render.job.settings.converge = true;
+  render.job.settings.tolerance = o.tolerance;
+  render.job.settings.maxSamplesPerPixel = o.maxSamplesPerPixel;
+  {
+    // The window: renderFrames consecutive frames around the middle of the dataset.
+    auto scene = scene::loadScene(dataset);
+    if (!scene) return std::unexpected(scene.error());
+    const long count = scene::frameCount(*scene, o.fps);
+    const long window = std::min<long>(count, std::max(2, o.renderFrames));
+    render.job.frames.first = (count - window) / 2;
+    render.job.frames.last = render.job.frames.first + window - 1;
+  }
   auto rendered = runRender(render);
   if (!rendered) return std::unexpected(rendered.error());
   log(fmt::format("  rendered {} frames ({} already there) in {:.0f} s", rendered->rendered.size(), rendered->skipped.size(), rendered->seconds));
@@ -64,8 +78,9 @@ Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, cons
   auto discarded = runDiscard(discard);
   if (!discarded) return std::unexpected(discarded.error());
   const auto& mean = discarded->run.mean;
-  log(fmt::format("  discard: frustum {:.2f} %, world position {:.2f} %, shading normal {:.2f} %, direct {:.2f} %, indirect {:.2f} %",
-                  mean.frustum, mean.position, mean.normal, mean.direct, mean.indirect));
+  log(fmt::format("  discard: frustum {:.2f} %, world position {:.2f} %, shading normal {:.2f} %, direct {:.2f} ± {:.2f} %, indirect {:.2f} ± {:.2f} %",
+                  mean.frustum, mean.position, mean.normal, mean.direct, mean.directInterval ? mean.directInterval->halfWidth() : 0.0,
+                  mean.indirect, mean.indirectInterval ? mean.indirectInterval->halfWidth() : 0.0));
   return {};
 }
 
@@ -179,8 +194,8 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
   std::vector<fs::path> runs;
   for (const auto& [name, dataset] : {std::pair{"first-person bot", bot}, std::pair{"fly-through", fly}}) {
     const fs::path run = o.output / "runs" / dataset.stem();
-    log(fmt::format("{}: stats, render ({}x{}, {} spp, {} bounces, {} fps), discard -> {}", name, o.width, o.height, o.samplesPerPixel,
-                    o.bounces, o.fps, run.string()));
+    log(fmt::format("{}: stats, render ({}x{}, {} frames, converged to tolerance {} with {}-{} spp, {} bounces, {} fps), discard -> {}", name,
+                    o.width, o.height, o.renderFrames, o.tolerance, o.samplesPerPixel, o.maxSamplesPerPixel, o.bounces, o.fps, run.string()));
     if (auto ok = measureDataset(dataset, run, o, log); !ok) return std::unexpected(ok.error());
     runs.push_back(run);
   }

@@ -14,6 +14,7 @@ namespace dynbench::render {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+constexpr int kMinFirstRound = 16;
 
 // Rays leave a surface from a point pushed off it along the geometric normal, by an amount that
 // grows with the coordinates' magnitude (Embree intersects in single precision).
@@ -333,7 +334,9 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
   FrameBuffers out;
   out.resize(camera.width(), camera.height());
   std::fill(out.id.begin(), out.id.end(), -1.0f);  // the contract's "no instance"
-  const int width = camera.width(), height = camera.height(), firstRound = settings_.samplesPerPixel;
+  // Adaptive sampling needs a variance estimate to stop on: its first round has at least 16 samples.
+  const int width = camera.width(), height = camera.height(),
+            firstRound = settings_.converge ? std::max(settings_.samplesPerPixel, kMinFirstRound) : settings_.samplesPerPixel;
   const std::size_t pixels = out.pixelCount();
   const glm::dvec3 forward = -glm::dvec3(camera.world()[2]);
   std::vector<PixelSums> sums(pixels);
