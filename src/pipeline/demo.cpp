@@ -13,8 +13,6 @@
 #include "scene/evaluate.h"
 #include "scene/load.h"
 #include "scene/queries.h"
-#include "scene/load.h"
-#include "scene/queries.h"
 
 namespace dynbench::demo {
 
@@ -41,7 +39,8 @@ Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, cons
   stats.fps = o.fps;
   stats.json = run / "stats.json";
   stats.seriesDir = run;
-  if (auto measured = runStats(stats); !measured) return std::unexpected(measured.error());
+  auto measured = runStats(stats);
+  if (!measured) return std::unexpected(measured.error());
 
   RenderStage render;
   render.job.dataset = dataset;
@@ -56,10 +55,9 @@ Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, cons
   render.job.settings.tolerance = o.tolerance;
   render.job.settings.maxSamplesPerPixel = o.maxSamplesPerPixel;
   {
-    // The window: renderFrames consecutive frames around the middle of the dataset.
-    auto scene = scene::loadScene(dataset);
-    if (!scene) return std::unexpected(scene.error());
-    const long count = scene::frameCount(*scene, o.fps);
+    // The window: renderFrames consecutive frames around the middle of the dataset (its frame
+    // count at o.fps, as stats just measured it).
+    const long count = static_cast<long>(measured->rows.front().properties.animationFrames);
     const long window = std::min<long>(count, std::max(2, o.renderFrames));
     render.job.frames.first = (count - window) / 2;
     render.job.frames.last = render.job.frames.first + window - 1;
