@@ -1,13 +1,19 @@
 // Engine agreement (run by hand; not part of the test suite):
-//   build/release/bench/bench_agreement FRAMES_A FRAMES_B
+//   build/release/bench/bench_agreement FRAMES_A FRAMES_B [--png DIR]
 // For every frame the two folders share, prints the mean luminance (cd/m2, Rec. 709 weights) of
-// direct, indirect and their sum in each, and B / A. Used to compare `--engine embree` with
+// direct, indirect and their sum in each, and B / A. --png writes DIR/frame_NNNNN.png per frame:
+// A's direct, B's direct, A's indirect, B's indirect side by side, each pair at the exposure that
+// maps A's mean to middle grey (Reinhard's c / (1 + c), gamma 1/2.2), to see where they differ. Used to compare `--engine embree` with
 // `--engine cycles` renders of the same frames (docs/feature-buffers.md, "Agreement with Cycles").
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
+#include <string>
 
 #include <fmt/format.h>
 
+#include "core/image_io.h"
 #include "core/math.h"
 #include "frames/frame_io.h"
 
@@ -31,13 +37,26 @@ Means meansOf(const frames::FeatureFrame& f) {
   return m;
 }
 
+// Pastes `buffer` (3 floats per pixel) tone-mapped at `exposure` into panel `panel` of a strip.
+void paste(FloatImage& strip, int panel, const frames::FeatureFrame& f, const std::vector<float>& buffer, double exposure) {
+  for (int y = 0; y < f.height; ++y)
+    for (int x = 0; x < f.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const double v = exposure * buffer[3 * (static_cast<std::size_t>(y) * f.width + x) + c];
+        strip.pixels[3 * (static_cast<std::size_t>(y) * strip.width + panel * f.width + x) + c] =
+            static_cast<float>(std::pow(v / (1.0 + v), 1.0 / 2.2));
+      }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    std::fprintf(stderr, "usage: bench_agreement FRAMES_A FRAMES_B\n");
+  if (argc != 3 && !(argc == 5 && std::string(argv[3]) == "--png")) {
+    std::fprintf(stderr, "usage: bench_agreement FRAMES_A FRAMES_B [--png DIR]\n");
     return 2;
   }
+  const std::filesystem::path pngDir = argc == 5 ? argv[4] : "";
+  if (!pngDir.empty()) std::filesystem::create_directories(pngDir);
   auto a = frames::listFrames(argv[1]), b = frames::listFrames(argv[2]);
   if (!a || !b) {
     std::fprintf(stderr, "%s\n", (!a ? a.error() : b.error()).message.c_str());
@@ -59,6 +78,18 @@ int main(int argc, char** argv) {
     fmt::print("{:>6} {:>12.2f} {:>12.2f} {:>12.2f} {:>12.2f} {:>12.2f} {:>12.2f} {:>8.4f} {:>8.4f} {:>8.4f}\n", ea.frame, ma.direct, ma.indirect,
                ma.direct + ma.indirect, mb.direct, mb.indirect, mb.direct + mb.indirect, mb.direct / ma.direct, mb.indirect / ma.indirect,
                (mb.direct + mb.indirect) / (ma.direct + ma.indirect));
+    if (!pngDir.empty() && fa->width == fb->width && fa->height == fb->height) {
+      FloatImage strip{4 * fa->width, fa->height, 3, std::vector<float>(static_cast<std::size_t>(12) * fa->pixelCount()), {}};
+      const double directExposure = 0.18 / std::max(1e-12, ma.direct), indirectExposure = 0.18 / std::max(1e-12, ma.indirect);
+      paste(strip, 0, *fa, fa->direct, directExposure);
+      paste(strip, 1, *fb, fb->direct, directExposure);
+      paste(strip, 2, *fa, fa->indirect, indirectExposure);
+      paste(strip, 3, *fb, fb->indirect, indirectExposure);
+      if (auto w = writeImage(pngDir / fmt::format("frame_{:05d}.png", ea.frame), strip); !w) {
+        std::fprintf(stderr, "%s\n", w.error().message.c_str());
+        return 1;
+      }
+    }
   }
   return 0;
 }

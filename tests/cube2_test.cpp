@@ -103,6 +103,29 @@ TEST(Cube2, SeededMatchIsDeterministicAndConverts) {
   EXPECT_LT(median, 1e-3);
   EXPECT_LT(p99, 0.15);
   EXPECT_LT(worst, 0.5);
+  // The map's vertex normals are its surfaces' normals: the engine stores them as signed bytes and
+  // gives lightmapped faces a placeholder (0, 0, 1); both once made floors lean 45 degrees. The
+  // engine smooths normals across faces that meet at small angles, so a corner's normal may lean
+  // from its triangle's face normal (front side, counter-clockwise as glTF winds), but by less than
+  // 25 degrees nearly everywhere; and floors face up.
+  const auto mapNode = std::find_if(dataset->nodes.begin(), dataset->nodes.end(), [](const auto& n) { return n.name == "map colos"; });
+  ASSERT_NE(mapNode, dataset->nodes.end());
+  std::size_t corners = 0, alongFace = 0, upward = 0;
+  for (const auto& prim : dataset->meshes[static_cast<std::size_t>(mapNode->mesh)].primitives) {
+    ASSERT_EQ(prim.normals.size(), prim.positions.size());
+    for (std::size_t t = 0; t < prim.triangleCount(); ++t) {
+      const std::uint32_t* idx = &prim.indices[3 * t];
+      const glm::dvec3 a(prim.positions[idx[0]]), b(prim.positions[idx[1]]), c(prim.positions[idx[2]]);
+      const glm::dvec3 cross = glm::cross(b - a, c - a);
+      if (glm::length(cross) < 1e-9) continue;
+      const glm::dvec3 face = glm::normalize(cross);
+      upward += face.y > 0.99 ? 1 : 0;
+      for (int k = 0; k < 3; ++k, ++corners) alongFace += glm::dot(glm::dvec3(prim.normals[idx[k]]), face) > 0.9 ? 1 : 0;
+    }
+  }
+  std::printf("map normals: %zu of %zu corners within 25 degrees of their face normal; %zu upward triangles\n", alongFace, corners, upward);
+  EXPECT_GT(static_cast<double>(alongFace), 0.99 * static_cast<double>(corners));
+  EXPECT_GT(upward, 500u);
   // A bot's first-person view turns far faster than a slow fly-through: over 15 degrees per second
   // on average (0.25 per frame at 60 fps), three times a slow 5 degrees-per-second pan.
   EXPECT_GT(j["camera_motion"]["rotation_degrees"]["mean"].get<double>() * 60.0, 15.0);

@@ -28,8 +28,13 @@ glm::dvec3 catmullRom(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dve
 }
 
 // What makes a capture: the match options. Compared as text with the record beside a capture.
+// Raised whenever the Cube 2 adapter changes what it records (2: the map's normals decoded as the
+// signed bytes they are), so that captures an older adapter made are not reused.
+constexpr int kCaptureAdapterVersion = 2;
+
 std::string captureKey(const DemoOptions& o) {
-  return fmt::format("{{\"map\": \"{}\", \"bots\": {}, \"seconds\": {}, \"seed\": {}}}\n", o.map, o.bots, o.seconds, o.seed);
+  return fmt::format("{{\"map\": \"{}\", \"bots\": {}, \"seconds\": {}, \"seed\": {}, \"adapter\": {}}}\n", o.map, o.bots, o.seconds,
+                     o.seed, kCaptureAdapterVersion);
 }
 
 // stats, render, discard for one dataset into RUN.

@@ -168,6 +168,7 @@ Expected<void> CyclesBackend::render(const std::vector<FrameRequest>& requests, 
                                  {"intensity", l.intensity},
                                  {"inner_cone", l.innerConeAngle},
                                  {"outer_cone", l.outerConeAngle},
+                                 {"range", l.range},
                                  {"visible", pose.visible[n] != 0}});
     }
     j["frames"].push_back(frame);

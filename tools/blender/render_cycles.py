@@ -34,6 +34,107 @@ try:
 except Exception as error:
     fail("the glTF importer failed: " + str(error))
 
+def node_math(tree, operation, *inputs, clamp=False):
+    """A Math node of `tree` computing `operation` of inputs that are numbers or sockets."""
+    node = tree.nodes.new("ShaderNodeMath")
+    node.operation = operation
+    node.use_clamp = clamp
+    for i, value in enumerate(inputs):
+        if isinstance(value, (int, float)):
+            node.inputs[i].default_value = value
+        else:
+            tree.links.new(value, node.inputs[i])
+    return node.outputs[0]
+
+
+def gltf_brdf(material):
+    """Rebuilds the importer's Principled BSDF as glTF 2.0's Appendix B BRDF, the BRDF dynbench
+    renders (src/render/bsdf.h), from Cycles closures:
+      dielectric = 0.96 Lambert(baseColor) + GGX with Fresnel(f0 = 0.04) on v.h
+      metal      = GGX with Fresnel(f0 = baseColor) on v.h
+      mix by metallic, plus emission, alpha as the importer wired it.
+    Blender 3.4's Principled BSDF alone is not that BRDF: its Disney diffuse adds retro-reflection
+    and its diffuse is not reduced by the specular layer. Its specular lobe is (a GGX with a
+    per-microfacet Fresnel), so it is used with a black base colour for the dielectric's specular
+    layer and with metallic 1 for the metal. glTF's diffuse weight is 1 - F(v.h), which depends on
+    the light direction; Cycles has no such closure, so it is fixed at 1 - f0 = 0.96, its value
+    when v and l are not far apart (docs/feature-buffers.md, "Agreement with Cycles", gives the
+    difference this leaves)."""
+    if not material or not material.use_nodes:
+        return
+    tree = material.node_tree
+    nodes, links = tree.nodes, tree.links
+    for principled in [n for n in nodes if n.type == "BSDF_PRINCIPLED"]:
+        outputs = [link.to_socket for link in principled.outputs["BSDF"].links]
+        if not outputs:
+            continue
+
+        def feed(socket, name):
+            # The Principled input's texture wiring or constant, carried over (an unlinked normal
+            # is the shading normal on both).
+            source = principled.inputs[name]
+            if source.is_linked:
+                links.new(source.links[0].from_socket, socket)
+            elif name != "Normal":
+                socket.default_value = source.default_value
+
+        def specular_lobe(metallic):
+            lobe = nodes.new("ShaderNodeBsdfPrincipled")
+            lobe.distribution = "GGX"
+            lobe.inputs["Metallic"].default_value = metallic
+            lobe.inputs["Specular"].default_value = 0.5  # f0 = 0.08 x 0.5 = 0.04
+            lobe.inputs["Specular Tint"].default_value = 0.0
+            if metallic > 0:
+                feed(lobe.inputs["Base Color"], "Base Color")
+            else:
+                lobe.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+            feed(lobe.inputs["Roughness"], "Roughness")
+            feed(lobe.inputs["Normal"], "Normal")
+            return lobe.outputs["BSDF"]
+
+        weight = nodes.new("ShaderNodeMixRGB")
+        weight.blend_type = "MULTIPLY"
+        weight.inputs["Fac"].default_value = 1.0
+        feed(weight.inputs["Color1"], "Base Color")
+        weight.inputs["Color2"].default_value = (0.96, 0.96, 0.96, 1.0)
+        diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+        diffuse.inputs["Roughness"].default_value = 0.0  # Lambert
+        links.new(weight.outputs["Color"], diffuse.inputs["Color"])
+        feed(diffuse.inputs["Normal"], "Normal")
+        dielectric = nodes.new("ShaderNodeAddShader")
+        links.new(diffuse.outputs["BSDF"], dielectric.inputs[0])
+        links.new(specular_lobe(0.0), dielectric.inputs[1])
+        surface = nodes.new("ShaderNodeMixShader")
+        feed(surface.inputs["Fac"], "Metallic")
+        links.new(dielectric.outputs["Shader"], surface.inputs[1])
+        links.new(specular_lobe(1.0), surface.inputs[2])
+        shader = surface.outputs["Shader"]
+
+        emission = nodes.new("ShaderNodeEmission")
+        feed(emission.inputs["Color"], "Emission")
+        feed(emission.inputs["Strength"], "Emission Strength")
+        add = nodes.new("ShaderNodeAddShader")
+        links.new(shader, add.inputs[0])
+        links.new(emission.outputs["Emission"], add.inputs[1])
+        shader = add.outputs["Shader"]
+
+        alpha = principled.inputs["Alpha"]
+        if alpha.is_linked or alpha.default_value < 1.0:
+            transparent = nodes.new("ShaderNodeBsdfTransparent")
+            cutout = nodes.new("ShaderNodeMixShader")
+            feed(cutout.inputs["Fac"], "Alpha")
+            links.new(transparent.outputs["BSDF"], cutout.inputs[1])
+            links.new(shader, cutout.inputs[2])
+            shader = cutout.outputs["Shader"]
+        for socket in outputs:
+            links.new(shader, socket)
+        nodes.remove(principled)
+
+
+for material in bpy.data.materials:
+    gltf_brdf(material)
+
+
 # glTF is +Y up, Blender +Z up; the importer maps (x, y, z) to (x, -z, y).
 Y_UP_TO_Z_UP = Matrix(((1, 0, 0, 0), (0, 0, -1, 0), (0, 1, 0, 0), (0, 0, 0, 1)))
 
@@ -65,6 +166,42 @@ for i, light in enumerate(job["frames"][0]["lights"] if job["frames"] else []):
     obj = bpy.data.objects.new(data.name, data)
     scene.collection.objects.link(obj)
     lights.append(obj)
+
+def light_shader(data, light):
+    """The parts of a KHR_lights_punctual light Blender lacks, as the light's emission strength
+    (the factor dynbench's src/render/lights.cpp applies beside I / d^2):
+    - range: the recommended window clamp(1 - (d / range)^4, 0, 1), d the distance to the lit point
+      (Light Path's Ray Length in a light shader); Blender's lights have no range and would light
+      everything beyond it;
+    - spot: the squared linear ramp clamp((cos a - cos outer) / (cos inner - cos outer), 0, 1)^2,
+      cos a = -z of the emission direction in the light's frame (Texture Coordinate's Normal);
+      Blender's own cone edge (spot_blend) is a smoothstep and is switched off. Blender 3.4's spot
+      also scales by cos a (measured: tests/cycles_test.cpp), divided out here."""
+    data.use_nodes = True
+    tree = data.node_tree
+    nodes, links = tree.nodes, tree.links
+    for node in [n for n in nodes if n.type not in ("EMISSION", "OUTPUT_LIGHT")]:
+        nodes.remove(node)
+    emission = next(n for n in nodes if n.type == "EMISSION")
+
+    strength = 1.0
+    if light["type"] != "directional" and light.get("range", 0.0) > 0.0:
+        distance = nodes.new("ShaderNodeLightPath").outputs["Ray Length"]
+        r4 = node_math(tree, "POWER", node_math(tree, "DIVIDE", distance, light["range"]), 4.0)
+        strength = node_math(tree, "SUBTRACT", 1.0, r4, clamp=True)
+    if light["type"] == "spot":
+        z = nodes.new("ShaderNodeSeparateXYZ")
+        links.new(nodes.new("ShaderNodeTexCoord").outputs["Normal"], z.inputs["Vector"])
+        cos_outer, cos_inner = math.cos(light["outer_cone"]), math.cos(light["inner_cone"])
+        scale = 1.0 / max(1e-3, cos_inner - cos_outer)
+        ramp = node_math(tree, "MULTIPLY_ADD", z.outputs["Z"], -scale, -cos_outer * scale, clamp=True)
+        factor = node_math(tree, "DIVIDE", node_math(tree, "POWER", ramp, 2.0), node_math(tree, "MULTIPLY", z.outputs["Z"], -1.0))
+        strength = factor if isinstance(strength, float) else node_math(tree, "MULTIPLY", strength, factor)
+    if isinstance(strength, float):
+        emission.inputs["Strength"].default_value = strength
+    else:
+        links.new(strength, emission.inputs["Strength"])
+
 
 world = bpy.data.worlds.new("dynbench_world")
 scene.world = world
@@ -158,7 +295,11 @@ for frame in job["frames"]:
             obj.data.energy = light["intensity"] * 4.0 * math.pi
         if obj.data.type == "SPOT":
             obj.data.spot_size = 2.0 * light["outer_cone"]
-            obj.data.spot_blend = 1.0 - light["inner_cone"] / light["outer_cone"] if light["outer_cone"] > 0 else 0.0
+            # Blender's own cone edge is a smoothstep over `spot_blend`; KHR_lights_punctual's is a
+            # squared linear ramp in cos(angle) between the cones. So Blender's edge is switched
+            # off and the light's emission node computes glTF's ramp (spot_ramp below).
+            obj.data.spot_blend = 0.0
+        light_shader(obj.data, light)
         obj.hide_render = not light["visible"]
     render.filepath = frame["output"]
     bpy.ops.render.render(write_still=True)

@@ -105,31 +105,61 @@ void exportMap(const char *map) {
     ushort *edata = nullptr;
     vertex *vdata = nullptr;
     if (!readva(&va, edata, vdata)) continue;
-    // Per vertex array and slot, each engine vertex becomes one mesh vertex.
-    int *remap = new int[va.verts];
+    // The vertex buffer holds each normal as signed bytes: genverts (engine/octarender.cpp) flips
+    // the sign bit of the engine's bvec (x * 255/2 + 127.5). Surfaces the engine lights only from
+    // lightmaps get the placeholder (0, 0, 1) there, whatever their orientation (gencubeverts);
+    // those take their triangle's face normal, which for the map's flat cube faces is the normal.
+    const bvec placeholder(128, 128, 255);
+    // Per vertex array and slot, each engine vertex becomes one mesh vertex per distinct normal.
+    vector<int> *remap = new vector<int>[va.verts];
     ushort *idx = edata;
     loopj(va.texs) {
       elementset &es = va.eslist[j];
       MapMesh &mesh = meshFor(es.texture);
-      loopk(va.verts) remap[k] = -1;
-      loopk(es.length[1]) {
-        const int n = idx[k] - va.voffset;
-        if (remap[n] < 0) {
+      loopk(va.verts) remap[k].setsize(0);
+      for (int k = 0; k + 2 < es.length[1]; k += 3) {
+        float corner[3][3];
+        loopl(3) toCapture(vdata[idx[k + l] - va.voffset].pos, corner[l]);
+        // Engine order winds clockwise seen from the front in capture space: the front normal is
+        // (c - a) x (b - a).
+        vec e1(corner[2][0] - corner[0][0], corner[2][1] - corner[0][1], corner[2][2] - corner[0][2]);
+        vec e2(corner[1][0] - corner[0][0], corner[1][1] - corner[0][1], corner[1][2] - corner[0][2]);
+        vec face;
+        face.cross(e1, e2);
+        const float area = face.magnitude();
+        face = area > 0 ? face.div(area) : vec(0, 1, 0);
+        loopl(3) {
+          const int n = idx[k + l] - va.voffset;
           const vertex &v = vdata[n];
-          remap[n] = mesh.positions.length() / 3;
-          float p[3], nrm[3];
-          toCapture(v.pos, p);
-          const vec cubeNormal(v.norm.x * (2.0f / 255.0f) - 1.0f, v.norm.y * (2.0f / 255.0f) - 1.0f, v.norm.z * (2.0f / 255.0f) - 1.0f);
-          toCapture(cubeNormal, nrm);
-          const float length = sqrtf(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
-          loopl(3) {
-            mesh.positions.add(p[l]);
-            mesh.normals.add(length > 0 ? nrm[l] / length : (l == 1 ? 1.0f : 0.0f));
+          bvec stored(v.norm.x, v.norm.y, v.norm.z);
+          stored.flip();
+          float engineNormal[3];
+          toCapture(stored.tonormal(), engineNormal);
+          vec normal(engineNormal[0], engineNormal[1], engineNormal[2]);
+          const float length = normal.magnitude();
+          const bool usable = stored != placeholder && length > 0 && normal.dot(face) > 0;
+          normal = usable ? normal.div(length) : face;
+          int index = -1;
+          for (int m = 0; m < remap[n].length(); m++) {
+            const int candidate = remap[n][m];
+            const vec existing(mesh.normals[3 * candidate], mesh.normals[3 * candidate + 1], mesh.normals[3 * candidate + 2]);
+            if (existing.dot(normal) > 0.9999f) {
+              index = candidate;
+              break;
+            }
           }
-          mesh.uvs.add(v.tc.x);
-          mesh.uvs.add(v.tc.y);
+          if (index < 0) {
+            index = mesh.positions.length() / 3;
+            remap[n].add(index);
+            for (int c = 0; c < 3; c++) {
+              mesh.positions.add(corner[l][c]);
+              mesh.normals.add(normal[c]);
+            }
+            mesh.uvs.add(v.tc.x);
+            mesh.uvs.add(v.tc.y);
+          }
+          mesh.indices.add(uint(index));
         }
-        mesh.indices.add(uint(remap[n]));
       }
       idx += es.length[1];
     }
