@@ -94,9 +94,9 @@ int main(int argc, char** argv) {
   }
   const double agreeDirect = std::abs(a[0].direct - a[1].direct), agreeIndirect = std::abs(a[0].indirect - a[1].indirect);
   const double adaptiveSeconds = a[0].seconds + a[1].seconds;
-  fmt::print("converge (tolerance {}, max {} spp): {:.1f} s for two seeds, {:.0f} spp on average; seeds differ by {:.3f} (direct) and "
-             "{:.3f} (indirect) points\n",
-             tolerance, maxSpp, adaptiveSeconds, a[0].meanSpp, agreeDirect, agreeIndirect);
+  fmt::print("converge (tolerance {}, max {} spp): {:.1f} s for two seeds, {:.0f} spp on average; direct {:.3f} / {:.3f}, indirect "
+             "{:.3f} / {:.3f}; seeds differ by {:.3f} (direct) and {:.3f} (indirect) points\n",
+             tolerance, maxSpp, adaptiveSeconds, a[0].meanSpp, a[0].direct, a[1].direct, a[0].indirect, a[1].indirect, agreeDirect, agreeIndirect);
 
   double fixedSeconds = 0;
   int reached = 0, firstAgreement = 0;

@@ -107,14 +107,6 @@ TEST(Demo, WholeChainOnAShortMatch) {
       const auto& ib = discarded[1]["mean"]["interval"][column];
       std::printf("tolerance %.2f %s: seed 1 %.3f [%.3f, %.3f], seed 2 %.3f [%.3f, %.3f]\n", tolerance, column, a, ia[0].get<double>(),
                   ia[1].get<double>(), b, ib[0].get<double>(), ib[1].get<double>());
-      if (std::string(column) == "indirect_radiance") {
-        // Not met yet for indirect light (issue 13 stays open): its threshold is a tenth of the
-        // frame's small mean indirect luminance, rare bright paths make the pixels' variance
-        // estimates too low, and the seeds differ by up to about 1 point, beyond the intervals.
-        // Pinned at the present agreement so that a regression shows.
-        EXPECT_NEAR(a, b, 1.5) << column << " at tolerance " << tolerance;
-        continue;
-      }
       EXPECT_NEAR(a, b, 0.5) << column << " at tolerance " << tolerance;
       EXPECT_GE(a, ib[0].get<double>()) << column;
       EXPECT_LE(a, ib[1].get<double>()) << column;
