@@ -155,18 +155,6 @@ scene.collection.objects.link(camera)
 scene.camera = camera
 camera_data.sensor_fit = "VERTICAL"
 
-lights = []
-for i, light in enumerate(job["frames"][0]["lights"] if job["frames"] else []):
-    kind = {"point": "POINT", "spot": "SPOT", "directional": "SUN"}[light["type"]]
-    data = bpy.data.lights.new("dynbench_light_%d" % i, kind)
-    if kind in {"POINT", "SPOT"}:
-        data.shadow_soft_size = 0.0  # a point, as KHR_lights_punctual says
-    else:
-        data.angle = 0.0
-    obj = bpy.data.objects.new(data.name, data)
-    scene.collection.objects.link(obj)
-    lights.append(obj)
-
 def light_shader(data, light):
     """The parts of a KHR_lights_punctual light Blender lacks, as the light's emission strength
     (the factor dynbench's src/render/lights.cpp applies beside I / d^2):
@@ -177,15 +165,16 @@ def light_shader(data, light):
       cos a = -z of the emission direction in the light's frame (Texture Coordinate's Normal);
       Blender's own cone edge (spot_blend) is a smoothstep and is switched off. Blender 3.4's spot
       also scales by cos a (measured: tests/cycles_test.cpp), divided out here."""
+    ranged = light["type"] != "directional" and light.get("range", 0.0) > 0.0
+    if not ranged and light["type"] != "spot":
+        return
     data.use_nodes = True
     tree = data.node_tree
     nodes, links = tree.nodes, tree.links
-    for node in [n for n in nodes if n.type not in ("EMISSION", "OUTPUT_LIGHT")]:
-        nodes.remove(node)
     emission = next(n for n in nodes if n.type == "EMISSION")
 
-    strength = 1.0
-    if light["type"] != "directional" and light.get("range", 0.0) > 0.0:
+    strength = None
+    if ranged:
         distance = nodes.new("ShaderNodeLightPath").outputs["Ray Length"]
         r4 = node_math(tree, "POWER", node_math(tree, "DIVIDE", distance, light["range"]), 4.0)
         strength = node_math(tree, "SUBTRACT", 1.0, r4, clamp=True)
@@ -196,12 +185,26 @@ def light_shader(data, light):
         scale = 1.0 / max(1e-3, cos_inner - cos_outer)
         ramp = node_math(tree, "MULTIPLY_ADD", z.outputs["Z"], -scale, -cos_outer * scale, clamp=True)
         factor = node_math(tree, "DIVIDE", node_math(tree, "POWER", ramp, 2.0), node_math(tree, "MULTIPLY", z.outputs["Z"], -1.0))
-        strength = factor if isinstance(strength, float) else node_math(tree, "MULTIPLY", strength, factor)
-    if isinstance(strength, float):
-        emission.inputs["Strength"].default_value = strength
-    else:
-        links.new(strength, emission.inputs["Strength"])
+        strength = factor if strength is None else node_math(tree, "MULTIPLY", strength, factor)
+    links.new(strength, emission.inputs["Strength"])
 
+
+lights = []
+for i, light in enumerate(job["frames"][0]["lights"] if job["frames"] else []):
+    kind = {"point": "POINT", "spot": "SPOT", "directional": "SUN"}[light["type"]]
+    data = bpy.data.lights.new("dynbench_light_%d" % i, kind)
+    if kind in {"POINT", "SPOT"}:
+        data.shadow_soft_size = 0.0  # a point, as KHR_lights_punctual says
+    else:
+        data.angle = 0.0
+    # A light's kind, range and cones are its definition's: the same in every frame.
+    if kind == "SPOT":
+        data.spot_size = 2.0 * light["outer_cone"]
+        data.spot_blend = 0.0  # KHR's ramp is the light shader's (light_shader)
+    light_shader(data, light)
+    obj = bpy.data.objects.new(data.name, data)
+    scene.collection.objects.link(obj)
+    lights.append(obj)
 
 world = bpy.data.worlds.new("dynbench_world")
 scene.world = world
@@ -293,13 +296,6 @@ for frame in job["frames"]:
             obj.data.energy = light["intensity"]
         else:
             obj.data.energy = light["intensity"] * 4.0 * math.pi
-        if obj.data.type == "SPOT":
-            obj.data.spot_size = 2.0 * light["outer_cone"]
-            # Blender's own cone edge is a smoothstep over `spot_blend`; KHR_lights_punctual's is a
-            # squared linear ramp in cos(angle) between the cones. So Blender's edge is switched
-            # off and the light's emission node computes glTF's ramp (spot_ramp below).
-            obj.data.spot_blend = 0.0
-        light_shader(obj.data, light)
         obj.hide_render = not light["visible"]
     render.filepath = frame["output"]
     bpy.ops.render.render(write_still=True)
