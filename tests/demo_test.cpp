@@ -3,6 +3,8 @@
 #include <cmath>
 
 #include <gtest/gtest.h>
+
+#include "frames/feature_frame.h"
 #include <nlohmann/json.hpp>
 
 #include <fmt/format.h>
@@ -112,6 +114,35 @@ TEST(Demo, WholeChainOnAShortMatch) {
       EXPECT_LE(a, ib[1].get<double>()) << column;
       EXPECT_GE(b, ia[0].get<double>()) << column;
       EXPECT_LE(b, ia[1].get<double>()) << column;
+    }
+  }
+
+  // Frames a disk can hold (docs/feature-buffers.md, "Precision on disk"): the same render stored
+  // at the contract's precision and at 32 bits gives the same discard means within 0.01
+  // percentage points, in at most 40 bytes per pixel.
+  {
+    nlohmann::json discarded[2];
+    double bytesPerPixel[2] = {0, 0};
+    for (int full = 0; full < 2; ++full) {
+      const fs::path frames = dir / (full ? "storage_float32" : "storage_contract");
+      const auto rendered = dynbench(fmt::format("render {} -o {} --res 96x54 --frames 40:47 --bounces 2 --spp 8{}", dataset.string(),
+                                                 frames.string(), full ? " --float32" : ""),
+                                     dir);
+      ASSERT_EQ(rendered.status, 0) << rendered.err;
+      std::uintmax_t bytes = 0;
+      for (long f = 40; f <= 47; ++f) bytes += fs::file_size(frames::frameImagePath(frames, f));
+      bytesPerPixel[full] = static_cast<double>(bytes) / (8.0 * 96 * 54);
+      const auto d = dynbench(fmt::format("discard {} --relative-position --json {}", frames.string(), (frames / "d.json").string()), dir);
+      ASSERT_EQ(d.status, 0) << d.err;
+      discarded[full] = nlohmann::json::parse(test::slurp(frames / "d.json"));
+    }
+    std::printf("bytes per pixel: %.2f at the contract's precision, %.2f at 32 bits\n", bytesPerPixel[0], bytesPerPixel[1]);
+    EXPECT_LE(bytesPerPixel[0], 40.0);
+    EXPECT_LT(bytesPerPixel[0], 0.75 * bytesPerPixel[1]);
+    for (const auto& [column, value] : discarded[1]["mean"].items()) {
+      if (!value.is_number()) continue;
+      std::printf("%s: %.4f (contract) vs %.4f (32-bit)\n", column.c_str(), discarded[0]["mean"][column].get<double>(), value.get<double>());
+      EXPECT_NEAR(discarded[0]["mean"][column].get<double>(), value.get<double>(), 0.01) << column;
     }
   }
 

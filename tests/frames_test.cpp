@@ -73,6 +73,69 @@ TEST(Frames, EveryBufferRoundTripsExactly) {
   EXPECT_FALSE(read->sampling);  // none written
 }
 
+// Precision on disk (docs/feature-buffers.md): each buffer as its Storage says, half only where
+// the frame's values allow it, 32-bit everywhere with --float32.
+TEST(Frames, EachBufferIsStoredAtTheContractsPrecision) {
+  const fs::path dir = freshDir("frames_precision");
+  FeatureFrame f = patterned(4, 2);
+  for (std::size_t i = 0; i < f.pixelCount(); ++i) {
+    const float k = static_cast<float>(i);
+    for (int c = 0; c < 3; ++c) {
+      f.position[3 * i + c] = 1234.567f + 0.001f * k + c;  // not exact in half
+      f.normal[3 * i + c] = 0.1234567f * (c + 1) - 0.01f * k;
+      f.direct[3 * i + c] = 12.34567f + k;
+      f.indirect[3 * i + c] = 0.0123457f * (k + 1);
+    }
+    f.motion[2 * i] = 3.14159f * k;
+    f.motion[2 * i + 1] = -1.5f;
+    f.id[i] = static_cast<float>(i % 3);
+  }
+  auto channelFormat = [](const FloatImage& image, const std::string& name) {
+    const auto at = std::find(image.channelNames.begin(), image.channelNames.end(), name) - image.channelNames.begin();
+    return image.formats.at(static_cast<std::size_t>(at));
+  };
+  auto roundTrip = [&](const FeatureFrame& frame, const WriteOptions& options) {
+    EXPECT_TRUE(writeFrame(dir, frame, {{"engine", "test"}}, options));
+    auto image = readImage(frameImagePath(dir, frame.frame));
+    EXPECT_TRUE(image);
+    auto read = readFrame({frame.frame, frameImagePath(dir, frame.frame), frameSidecarPath(dir, frame.frame)});
+    EXPECT_TRUE(read);
+    return std::pair{*image, *read};
+  };
+  {
+    const auto [image, read] = roundTrip(f, {});
+    EXPECT_EQ(channelFormat(image, "P.X"), SampleFormat::kFloat32);
+    EXPECT_EQ(read.position, f.position);  // positions exactly
+    for (const char* name : {"N.X", "direct.R", "indirect.B", "albedo.G", "direct.var", "motion.X", "hit", "id", "spp"})
+      EXPECT_EQ(channelFormat(image, name), SampleFormat::kFloat16) << name;
+    for (const char* name : {"Z"}) EXPECT_EQ(channelFormat(image, name), SampleFormat::kFloat32) << name;
+    EXPECT_NE(read.normal, f.normal);  // rounded, within half's relative error
+    for (std::size_t i = 0; i < f.normal.size(); ++i) EXPECT_NEAR(read.normal[i], f.normal[i], std::abs(f.normal[i]) * 0x1p-11);
+    for (std::size_t i = 0; i < f.direct.size(); ++i) EXPECT_NEAR(read.direct[i], f.direct[i], f.direct[i] * 0x1p-11);
+    for (std::size_t i = 0; i < f.motion.size(); ++i) EXPECT_NEAR(read.motion[i], f.motion[i], 1.0 / 64);  // within 256 px: 1/64 px here
+    EXPECT_EQ(read.id, f.id);  // small integers: exact
+  }
+  {
+    // Values half cannot hold keep 32 bits, buffer by buffer: radiance over 65504, a vector longer
+    // than 256 pixels (or "behind the camera"), a node id with no exact half.
+    FeatureFrame g = f;
+    g.direct[4] = 70000.0f;
+    g.motion[1] = -1e9f;
+    g.id[2] = 2049.0f;
+    const auto [image, read] = roundTrip(g, {});
+    for (const char* name : {"direct.R", "motion.Y", "id"}) EXPECT_EQ(channelFormat(image, name), SampleFormat::kFloat32) << name;
+    EXPECT_EQ(channelFormat(image, "indirect.R"), SampleFormat::kFloat16);
+    EXPECT_EQ(read.direct, g.direct);
+    EXPECT_EQ(read.motion, g.motion);
+    EXPECT_EQ(read.id, g.id);
+  }
+  {
+    const auto [image, read] = roundTrip(f, {.float32 = true});
+    for (const auto format : image.formats) EXPECT_EQ(format, SampleFormat::kFloat32);
+    for (const auto& spec : contractBuffers()) EXPECT_EQ(read.*spec.member, f.*spec.member) << spec.name;
+  }
+}
+
 TEST(Frames, TheSamplingSummaryRoundTrips) {
   const fs::path dir = freshDir("frames_sampling");
   FeatureFrame written = patterned(4, 2);

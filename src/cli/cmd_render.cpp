@@ -120,6 +120,8 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--tolerance", o->job.settings.tolerance, "With --converge: the standard error target as a fraction of discard's threshold")
       ->check(CLI::Range(1e-4, 10.0));
   cmd->add_option("--max-spp", o->job.settings.maxSamplesPerPixel, "With --converge: samples per pixel at most")->check(positive());
+  cmd->add_flag("--float32", o->job.float32,
+                "Store every channel as 32-bit float (default: half where docs/feature-buffers.md allows it, about half the disk)");
   cmd->add_option("--light-cutoff", o->job.settings.lightCutoff,
                   "Irradiance below which a point or spot light without a range is skipped (0: never; default: automatic, at most "
                   "0.1% of the environment's mean irradiance dropped in all; docs/feature-buffers.md)")

@@ -49,7 +49,7 @@ json Converter::environment() {
   } else {
     const SkyImage sky = preethamSky(options_.sky);
     target = outDir_ / (stem_ + "_sky.hdr");
-    if (auto ok = writeImage(target, FloatImage{sky.width, sky.height, 3, sky.rgb, {}}); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
+    if (auto ok = writeImage(target, FloatImage{sky.width, sky.height, 3, sky.rgb, {}, {}, {}}); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
     ext["source"] = "dynbench Preetham sky";
     ext["sky"] = {{"model", "Preetham 1999 + ESRA sun"}, {"turbidity", options_.sky.turbidity},
                   {"sun_elevation_degrees", options_.sky.sunElevationDegrees}, {"sun_azimuth_degrees", options_.sky.sunAzimuthDegrees},

@@ -62,7 +62,7 @@ int Converter::metallicRoughnessFromMask(const std::string& mask) {
     if (!image) {
       report_.warnings.push_back(fmt::format("mask map '{}': {}; left out", mask, image.error().message));
     } else {
-      FloatImage mr{image->width, image->height, 3, {}, {}};
+      FloatImage mr{image->width, image->height, 3, {}, {}, {}, {}};
       mr.pixels.resize(static_cast<std::size_t>(image->width) * image->height * 3);
       for (std::size_t p = 0; p < mr.pixels.size() / 3; ++p) {
         const float* in = &image->pixels[p * static_cast<std::size_t>(image->channels)];

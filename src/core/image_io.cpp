@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 #include <mutex>
+#include <string_view>
 
 #include "core/files.h"
 #include "core/runtime_files.h"
@@ -14,8 +15,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-using WriteFn = int (*)(const char*, const char*, int, int, int, const float*, const char* const*, char*, std::size_t);
-using ReadFn = int (*)(const char*, int*, int*, int*, float**, char*, std::size_t, char*, std::size_t);
+using WriteFn = int (*)(const char*, const char*, int, int, int, const float*, const char* const*, const char*, const char*, char*,
+                        std::size_t);
+using ReadFn = int (*)(const char*, int*, int*, int*, float**, char*, std::size_t, char*, std::size_t, char*, std::size_t);
 using FreeFn = void (*)(float*);
 
 struct Module {
@@ -40,8 +42,8 @@ const Module& module() {
         tried += fmt::format("\n  {}: {}", c.string(), ::dlerror());
         continue;
       }
-      m.write = reinterpret_cast<WriteFn>(::dlsym(handle, "dynbench_image_write"));
-      m.read = reinterpret_cast<ReadFn>(::dlsym(handle, "dynbench_image_read"));
+      m.write = reinterpret_cast<WriteFn>(::dlsym(handle, "dynbench_image_write_v2"));
+      m.read = reinterpret_cast<ReadFn>(::dlsym(handle, "dynbench_image_read_v2"));
       m.free = reinterpret_cast<FreeFn>(::dlsym(handle, "dynbench_image_free"));
       if (m.write && m.read && m.free) return;
       tried += fmt::format("\n  {}: not a dynbench image module", c.string());
@@ -62,10 +64,15 @@ Expected<void> writeImage(const fs::path& path, const FloatImage& image) {
   char error[1024] = "";
   if (!image.channelNames.empty() && image.channelNames.size() != static_cast<std::size_t>(image.channels))
     return fail(ErrorCode::kInvalidData, "{}: {} channel names for {} channels", path.string(), image.channelNames.size(), image.channels);
+  if (!image.formats.empty() && image.formats.size() != static_cast<std::size_t>(image.channels))
+    return fail(ErrorCode::kInvalidData, "{}: {} channel formats for {} channels", path.string(), image.formats.size(), image.channels);
   std::vector<const char*> names;
   for (const auto& n : image.channelNames) names.push_back(n.c_str());
+  std::string formats;
+  for (const SampleFormat f : image.formats) formats += static_cast<char>(f);
   if (m.write(path.c_str(), tmp.c_str(), image.width, image.height, image.channels, image.pixels.data(),
-              names.empty() ? nullptr : names.data(), error, sizeof error) != 0) {
+              names.empty() ? nullptr : names.data(), formats.empty() ? nullptr : formats.c_str(),
+              image.compression.empty() ? nullptr : image.compression.c_str(), error, sizeof error) != 0) {
     fs::remove(tmp, ec);
     return fail(ErrorCode::kIo, "{}: cannot write: {}", path.string(), error);
   }
@@ -80,10 +87,12 @@ Expected<FloatImage> read(const fs::path& path, bool pixelsToo) {
   FloatImage image;
   float* pixels = nullptr;
   char error[1024] = "";
-  std::string names(4096, '\0');
+  std::string names(4096, '\0'), formats(1024, '\0');
   if (m.read(path.c_str(), &image.width, &image.height, &image.channels, pixelsToo ? &pixels : nullptr, names.data(), names.size(),
-             error, sizeof error) != 0)
+             formats.data(), formats.size(), error, sizeof error) != 0)
     return fail(ErrorCode::kParse, "{}: {}", path.string(), error);
+  for (const char f : std::string_view(formats.c_str()))
+    image.formats.push_back(f == 'h' ? SampleFormat::kFloat16 : SampleFormat::kFloat32);
   for (std::size_t start = 0, end; (end = names.find('\n', start)) != std::string::npos; start = end + 1)
     image.channelNames.push_back(names.substr(start, end - start));
   if (pixels) {

@@ -9,10 +9,19 @@
 
 namespace dynbench {
 
+// How a channel is stored in the file (OpenEXR's pixel types); pixels are floats in memory either way.
+enum class SampleFormat : char { kFloat32 = 'f', kFloat16 = 'h' };
+
 struct FloatImage {
   int width = 0, height = 0, channels = 0;
   std::vector<float> pixels;  // row-major, top row first, channels interleaved
   std::vector<std::string> channelNames;  // empty: the format's defaults (R, G, B, A)
+  // Per channel, for EXR files: 32- or 16-bit float on disk. Empty: 32-bit float. Read back as the
+  // file stores them (kFloat16 for half channels, kFloat32 for any other type). PNG and JPEG are 8-bit
+  // whatever this says.
+  std::vector<SampleFormat> formats;
+  // EXR compression ("zip", "piz", "zips", "none", ...); empty: OpenImageIO's default (zip).
+  std::string compression;
 };
 
 // Writes to a temporary name and renames, as every output. The format follows the extension

@@ -24,8 +24,11 @@ void setError(char* error, std::size_t size, const std::string& message) {
 extern "C" {
 
 // Writes `temporary` with the writer chosen by `path`'s extension; 8-bit formats get 8-bit pixels.
-int dynbench_image_write(const char* path, const char* temporary, int width, int height, int channels, const float* pixels,
-                         const char* const* channelNames, char* error, std::size_t errorSize) {
+// `formats` (optional): one character per channel, 'h' half or 'f' float (EXR); `compression`
+// (optional): the EXR compression name.
+int dynbench_image_write_v2(const char* path, const char* temporary, int width, int height, int channels, const float* pixels,
+                            const char* const* channelNames, const char* formats, const char* compression, char* error,
+                            std::size_t errorSize) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   const bool eightBit = ext == ".png" || ext == ".jpg" || ext == ".jpeg";
@@ -39,6 +42,10 @@ int dynbench_image_write(const char* path, const char* temporary, int width, int
     spec.channelnames.assign(channelNames, channelNames + channels);
     spec.alpha_channel = -1;  // feature buffers have no alpha; keep every channel as it is
   }
+  if (formats && !eightBit) {
+    for (int c = 0; c < channels; ++c) spec.channelformats.push_back(formats[c] == 'h' ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
+  }
+  if (compression) spec.attribute("compression", compression);
   if (!out->open(temporary, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, pixels) || !out->close()) {
     setError(error, errorSize, out->geterror());
     return 1;
@@ -48,8 +55,9 @@ int dynbench_image_write(const char* path, const char* temporary, int width, int
 
 // Reads the header (pixels == NULL) or the whole image as floats (*pixels malloc'd; free with
 // dynbench_image_free).
-int dynbench_image_read(const char* path, int* width, int* height, int* channels, float** pixels, char* names,
-                        std::size_t namesSize, char* error, std::size_t errorSize) {
+// `formats` receives one character per channel: 'h' for half, 'f' for any other type.
+int dynbench_image_read_v2(const char* path, int* width, int* height, int* channels, float** pixels, char* names, std::size_t namesSize,
+                           char* formats, std::size_t formatsSize, char* error, std::size_t errorSize) {
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     setError(error, errorSize, "not a readable image: " + OIIO::geterror());
@@ -63,6 +71,11 @@ int dynbench_image_read(const char* path, int* width, int* height, int* channels
     std::string joined;
     for (const auto& n : spec.channelnames) joined += n + "\n";
     setError(names, namesSize, joined);
+  }
+  if (formats && formatsSize) {
+    std::string types;
+    for (int c = 0; c < spec.nchannels; ++c) types += spec.channelformat(c) == OIIO::TypeDesc::HALF ? 'h' : 'f';
+    setError(formats, formatsSize, types);
   }
   if (!pixels) return 0;
   const std::size_t count = static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels;

@@ -14,19 +14,24 @@ void FeatureFrame::resize(int w, int h) {
 }
 
 const std::vector<BufferSpec>& contractBuffers() {
+  // Precision per buffer: what discard and evaluation need (docs/feature-buffers.md). Positions
+  // keep 32 bits: a world coordinate of 1000 in half is off by 0.25. Motion is half only in a frame
+  // whose vectors are all within 256 pixels (off by at most 1/16 pixel, as RG16F motion buffers of
+  // game engines); a frame with a longer vector, or -1e9 ("behind the previous camera"), keeps 32 bits.
+  using enum Storage;
   static const std::vector<BufferSpec> buffers{
-      {"P", {"P.X", "P.Y", "P.Z"}, &FeatureFrame::position, true},
-      {"N", {"N.X", "N.Y", "N.Z"}, &FeatureFrame::normal, true},
-      {"direct", {"direct.R", "direct.G", "direct.B"}, &FeatureFrame::direct, true},
-      {"indirect", {"indirect.R", "indirect.G", "indirect.B"}, &FeatureFrame::indirect, true},
-      {"albedo", {"albedo.R", "albedo.G", "albedo.B"}, &FeatureFrame::albedo, false},
-      {"Z", {"Z"}, &FeatureFrame::depth, false},
-      {"id", {"id"}, &FeatureFrame::id, false},
-      {"motion", {"motion.X", "motion.Y"}, &FeatureFrame::motion, false},
-      {"direct.var", {"direct.var"}, &FeatureFrame::directVariance, false},
-      {"indirect.var", {"indirect.var"}, &FeatureFrame::indirectVariance, false},
-      {"hit", {"hit"}, &FeatureFrame::hit, true},
-      {"spp", {"spp"}, &FeatureFrame::spp, false},
+      {"P", {"P.X", "P.Y", "P.Z"}, &FeatureFrame::position, true, kFloat32},
+      {"N", {"N.X", "N.Y", "N.Z"}, &FeatureFrame::normal, true, kFloat16},
+      {"direct", {"direct.R", "direct.G", "direct.B"}, &FeatureFrame::direct, true, kFloat16},
+      {"indirect", {"indirect.R", "indirect.G", "indirect.B"}, &FeatureFrame::indirect, true, kFloat16},
+      {"albedo", {"albedo.R", "albedo.G", "albedo.B"}, &FeatureFrame::albedo, false, kFloat16},
+      {"Z", {"Z"}, &FeatureFrame::depth, false, kFloat32},
+      {"id", {"id"}, &FeatureFrame::id, false, kFloat16WhenExact},
+      {"motion", {"motion.X", "motion.Y"}, &FeatureFrame::motion, false, kFloat16, 256.0f},
+      {"direct.var", {"direct.var"}, &FeatureFrame::directVariance, false, kFloat16},
+      {"indirect.var", {"indirect.var"}, &FeatureFrame::indirectVariance, false, kFloat16},
+      {"hit", {"hit"}, &FeatureFrame::hit, true, kFloat16WhenExact},
+      {"spp", {"spp"}, &FeatureFrame::spp, false, kFloat16WhenExact},
   };
   return buffers;
 }

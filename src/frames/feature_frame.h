@@ -56,12 +56,25 @@ struct FeatureFrame {
   void resize(int width, int height);
 };
 
+// How a buffer is stored on disk (docs/feature-buffers.md, "Precision on disk"). Readers need not
+// know: EXR channels carry their type and every reader gets floats.
+enum class Storage {
+  kFloat32,          // always 32-bit (world position, depth, motion)
+  kFloat16,          // 16-bit half: relative error <= 2^-11; 32-bit in a frame where a finite value
+                     // exceeds the buffer's halfLimit, so nothing overflows and the absolute error
+                     // stays <= halfLimit x 2^-12
+  kFloat16WhenExact  // 16-bit when every value of the frame is exact in half (0/1 flags, small
+                     // integers such as node ids below 2048), else 32-bit: lossless either way
+};
+
 // A buffer of the contract: its EXR channel names and where it lives in FeatureFrame.
 struct BufferSpec {
   const char* name;                 // "direct"
   std::vector<std::string> channels;  // {"direct.R", "direct.G", "direct.B"}
   std::vector<float> FeatureFrame::*member;
   bool required;                    // every frames folder has it
+  Storage storage;
+  float halfLimit = 65504.0f;       // kFloat16: the largest magnitude stored as half (65504: half's largest)
 };
 
 // The contract's buffers in the order dynbench writes them (P N direct indirect albedo Z id

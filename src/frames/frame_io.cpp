@@ -4,6 +4,8 @@
 #include <map>
 #include <regex>
 
+#include <glm/gtc/packing.hpp>
+
 #include <fmt/format.h>
 
 #include "core/files.h"
@@ -243,8 +245,25 @@ Expected<FeatureFrame> readFrame(const FrameEntry& entry, const ReadOptions& opt
   return f;
 }
 
-Expected<void> writeFrame(const fs::path& dir, const FeatureFrame& frame, const json& render) {
+bool storedAsHalf(const BufferSpec& spec, const std::vector<float>& values) {
+  constexpr float kHalfMax = 65504.0f;  // the largest finite half
+  const float limit = std::min(spec.halfLimit, kHalfMax);
+  switch (spec.storage) {
+    case Storage::kFloat32:
+      return false;
+    case Storage::kFloat16:
+      return std::all_of(values.begin(), values.end(), [limit](float v) { return !std::isfinite(v) || std::abs(v) <= limit; });
+    case Storage::kFloat16WhenExact:
+      return std::all_of(values.begin(), values.end(), [](float v) { return glm::unpackHalf1x16(glm::packHalf1x16(v)) == v; });
+  }
+  return false;
+}
+
+Expected<void> writeFrame(const fs::path& dir, const FeatureFrame& frame, const json& render, const WriteOptions& options) {
   FloatImage image;
+  // ZIP (zlib over 16 scanlines, with OpenEXR's predictor): lossless, and the smallest of
+  // OpenEXR's lossless codecs on these buffers (docs/feature-buffers.md has the measurements).
+  image.compression = "zip";
   image.width = frame.width;
   image.height = frame.height;
   std::vector<const std::vector<float>*> present;
@@ -260,6 +279,8 @@ Expected<void> writeFrame(const fs::path& dir, const FeatureFrame& frame, const 
       return fail(ErrorCode::kInvalidData, "frame {}: the {} buffer has {} values, expected {}", frame.frame, spec.name, buffer.size(),
                   pixels * spec.channels.size());
     image.channelNames.insert(image.channelNames.end(), spec.channels.begin(), spec.channels.end());
+    const bool half = !options.float32 && storedAsHalf(spec, buffer);
+    image.formats.insert(image.formats.end(), spec.channels.size(), half ? SampleFormat::kFloat16 : SampleFormat::kFloat32);
     present.push_back(&buffer);
     widths.push_back(spec.channels.size());
   }

@@ -50,9 +50,18 @@ struct ReadOptions {
 // when absent), the camera from the sidecar. Errors name the file and what is missing.
 Expected<FeatureFrame> readFrame(const FrameEntry& entry, const ReadOptions& options = {});
 
-// Writes frame_NNNNN.exr (every non-empty buffer, contract order) and then its sidecar, each
-// through a temporary name, so an interrupted write never leaves a frame that looks complete.
-Expected<void> writeFrame(const std::filesystem::path& dir, const FeatureFrame& frame, const nlohmann::json& render);
+// Whether writeFrame stores a buffer of these values as half (Storage's rules).
+bool storedAsHalf(const BufferSpec& spec, const std::vector<float>& values);
+
+struct WriteOptions {
+  // Every channel as 32-bit float, whatever the contract's storage says (render --float32).
+  bool float32 = false;
+};
+// Writes frame_NNNNN.exr (every non-empty buffer, contract order, each stored as its BufferSpec
+// says, ZIP-compressed) and then its sidecar, each through a temporary name, so an interrupted
+// write never leaves a frame that looks complete.
+Expected<void> writeFrame(const std::filesystem::path& dir, const FeatureFrame& frame, const nlohmann::json& render,
+                          const WriteOptions& options = {});
 
 // True when frame `frame` of `dir` exists and its sidecar records exactly `render`.
 bool frameComplete(const std::filesystem::path& dir, long frame, const nlohmann::json& render);

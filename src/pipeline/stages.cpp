@@ -108,7 +108,7 @@ Expected<DiscardOutcome> runDiscard(const DiscardStage& stage, const discard::Di
   if (!stage.masks.empty())
     masks = [&](const discard::FeatureFrame& frame, const discard::DiscardResult& r) -> Expected<void> {
       return writeImage(stage.masks / fmt::format("discard_{:05d}.png", frame.frame),
-                        FloatImage{frame.width, frame.height, 3, discard::maskImage(frame, r.mask), {}});
+                        FloatImage{frame.width, frame.height, 3, discard::maskImage(frame, r.mask), {}, {}, {}});
     };
   auto run = discard::discardFolder(stage.frames, t, masks, progress);
   if (!run) return std::unexpected(run.error());

@@ -55,16 +55,32 @@ EnvironmentLight EnvironmentLight::constant(const glm::dvec3& radiance) {
   return env;
 }
 
-glm::dvec3 EnvironmentLight::radiance(const glm::dvec3& direction) const {
-  const glm::dvec2 uv = equirectCoordinates(direction);
+std::size_t EnvironmentLight::pixelAt(glm::dvec2 uv) const {
   const int x = std::clamp(static_cast<int>(uv.x * width_), 0, width_ - 1);
   const int y = std::clamp(static_cast<int>(uv.y * height_), 0, height_ - 1);
-  return glm::dvec3(pixels_[static_cast<std::size_t>(y) * width_ + x]);
+  return static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x);
+}
+
+glm::dvec3 EnvironmentLight::radiance(const glm::dvec3& direction) const {
+  return glm::dvec3(pixels_[pixelAt(equirectCoordinates(direction))]);
+}
+
+glm::dvec3 EnvironmentLight::radiance(const glm::dvec3& direction, double* pdf) const {
+  const glm::dvec2 uv = equirectCoordinates(direction);
+  if (distribution_.empty()) {
+    *pdf = 0.0;
+  } else if (height_ == 1) {
+    *pdf = 1.0 / (4.0 * kPi);
+  } else {
+    const double sinTheta = std::sin(kPi * uv.y);
+    *pdf = sinTheta > 0 ? distribution_.density(uv) / (2.0 * kPi * kPi * sinTheta) : 0.0;
+  }
+  return glm::dvec3(pixels_[pixelAt(uv)]);
 }
 
 // A density over the image square becomes a solid-angle density through the equirectangular
 // Jacobian: dω = 2π² sin θ du dv.
-glm::dvec3 EnvironmentLight::sample(glm::dvec2 u, double* pdf) const {
+glm::dvec3 EnvironmentLight::sample(glm::dvec2 u, double* pdf, glm::dvec3* radiance) const {
   double density = 0.0;
   if (distribution_.empty()) {  // a black environment: nothing to sample
     *pdf = 0.0;
@@ -76,21 +92,22 @@ glm::dvec3 EnvironmentLight::sample(glm::dvec2 u, double* pdf) const {
     // the density stays bounded at the poles.
     const double z = 1.0 - 2.0 * u.y, r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = 2.0 * kPi * u.x;
     *pdf = 1.0 / (4.0 * kPi);
-    return {r * std::cos(phi), z, r * std::sin(phi)};
+    const glm::dvec3 d(r * std::cos(phi), z, r * std::sin(phi));
+    if (radiance) *radiance = this->radiance(d);
+    return d;
   }
   uv = distribution_.sample(u, &density);
   const glm::dvec3 d = equirectDirection(uv.x, uv.y);
   const double sinTheta = std::sin(kPi * uv.y);
   *pdf = sinTheta > 0 ? density / (2.0 * kPi * kPi * sinTheta) : 0.0;
+  if (radiance) *radiance = glm::dvec3(pixels_[pixelAt(uv)]);
   return d;
 }
 
 double EnvironmentLight::pdf(const glm::dvec3& direction) const {
-  if (distribution_.empty()) return 0.0;
-  if (height_ == 1) return 1.0 / (4.0 * kPi);
-  const glm::dvec2 uv = equirectCoordinates(direction);
-  const double sinTheta = std::sin(kPi * uv.y);
-  return sinTheta > 0 ? distribution_.density(uv) / (2.0 * kPi * kPi * sinTheta) : 0.0;
+  double p = 0.0;
+  radiance(direction, &p);
+  return p;
 }
 
 Expected<void> LightSet::build(const scene::Scene& scene, const RayTracingScene& rayTracing, const EnvironmentLight* environment,
@@ -230,10 +247,9 @@ std::optional<LightSample> LightSet::sample(const glm::dvec3& point, double uCho
   LightSample s;
   if (pick == 0) {
     double pdf = 0.0;
-    s.direction = environment_->sample(u, &pdf);
+    s.direction = environment_->sample(u, &pdf, &s.radiance);
     if (!(pdf > 0)) return std::nullopt;
     s.distance = std::numeric_limits<double>::infinity();
-    s.radiance = environment_->radiance(s.direction);
     s.pdf = choiceProbability * pdf;
     return s;
   }
@@ -255,6 +271,15 @@ std::optional<LightSample> LightSet::sample(const glm::dvec3& point, double uCho
   s.radiance = emission_(tri.node, tri.primitive, tri.index, b);
   s.pdf = choiceProbability * triangleProbability * d2 / (area * cosLight);
   return s;
+}
+
+glm::dvec3 LightSet::environmentRadiance(const glm::dvec3& direction, double* pdf) const {
+  *pdf = 0.0;
+  if (!environment_) return glm::dvec3(0.0);
+  double p = 0.0;
+  const glm::dvec3 le = environment_->radiance(direction, &p);
+  if (environmentChoice_ > 0) *pdf = environmentChoice_ * p;
+  return le;
 }
 
 double LightSet::pdfEnvironment(const glm::dvec3& direction) const {

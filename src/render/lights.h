@@ -30,8 +30,11 @@ class EnvironmentLight {
   static EnvironmentLight constant(const glm::dvec3& radiance);
 
   glm::dvec3 radiance(const glm::dvec3& direction) const;
-  // A direction towards the environment with its solid-angle density.
-  glm::dvec3 sample(glm::dvec2 u, double* pdf) const;
+  // Radiance and solid-angle density in one lookup (a path that escapes needs both).
+  glm::dvec3 radiance(const glm::dvec3& direction, double* pdf) const;
+  // A direction towards the environment with its solid-angle density and, when asked, the
+  // radiance from it (the sampled pixel's, without mapping the direction back).
+  glm::dvec3 sample(glm::dvec2 u, double* pdf, glm::dvec3* radiance = nullptr) const;
   double pdf(const glm::dvec3& direction) const;
   // Mean radiance over the sphere (luminance), for choosing between lights.
   double meanLuminance() const { return meanLuminance_; }
@@ -41,6 +44,8 @@ class EnvironmentLight {
   std::vector<glm::vec3> pixels_;  // radiance, intensity applied
   Distribution2D distribution_;
   double meanLuminance_ = 0.0;
+
+  std::size_t pixelAt(glm::dvec2 uv) const;
 };
 
 struct LightSample {
@@ -91,6 +96,8 @@ class LightSet {
   // Densities of the other strategy for MIS, when a BSDF-sampled ray reaches the environment or
   // an emissive triangle (whose emissive factor luminance is `emissiveLuminance`).
   double pdfEnvironment(const glm::dvec3& direction) const;
+  // The environment's radiance in `direction` and, in *pdf, pdfEnvironment(direction): one lookup.
+  glm::dvec3 environmentRadiance(const glm::dvec3& direction, double* pdf) const;
   double pdfEmissive(double emissiveLuminance, double distance, double cosAtLight) const;
   // Luminance of an emissive factor as used for the triangle choice.
   static double emissiveWeight(const glm::dvec3& emissiveFactor) { return luminance(emissiveFactor); }

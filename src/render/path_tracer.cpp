@@ -223,9 +223,9 @@ PathTracer::PathSample PathTracer::tracePath(const Ray& cameraRay, const Surface
     glm::dvec3& bucket = depth <= 1 ? out.direct : out.indirect;
     if (!hit.hit) {
       if (environment_) {
-        const glm::dvec3 le = environment_->radiance(ray.direction);
-        const double w =
-            previousDelta || !settings_.nextEventEstimation ? 1.0 : powerHeuristic(previousBsdfPdf, lights_.pdfEnvironment(ray.direction));
+        double pdfLight = 0.0;
+        const glm::dvec3 le = lights_.environmentRadiance(ray.direction, &pdfLight);
+        const double w = previousDelta || !settings_.nextEventEstimation ? 1.0 : powerHeuristic(previousBsdfPdf, pdfLight);
         bucket += throughput * le * w;
       }
       break;

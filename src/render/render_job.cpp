@@ -98,6 +98,8 @@ nlohmann::json renderRecord(const RenderJob& job) {
   if (s.converge) r["converge"] = {{"tolerance", s.tolerance}, {"max_spp", s.maxSamplesPerPixel},
                                    {"direct_threshold", s.directThresholdFraction}, {"indirect_threshold", s.indirectThresholdFraction}};
   if (s.lightCutoff) r["light_cutoff"] = *s.lightCutoff;
+  // --float32 is recorded, so such a job does not take half-stored frames as complete.
+  if (job.float32) r["storage"] = "float32";
   // The dataset file's size and modification time: frames of an older version of a dataset at the
   // same path are not complete for the new one.
   std::error_code ec;
@@ -146,7 +148,7 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
   RowProgress rows;
   if (progress) rows = [&](std::size_t i, int done) { progress(i * height + static_cast<std::size_t>(done), rowsTotal, i, requests.size()); };
   const FrameSink write = [&](frames::FeatureFrame&& frame) -> Expected<void> {
-    if (auto ok = frames::writeFrame(job.output, frame, record); !ok) return ok;
+    if (auto ok = frames::writeFrame(job.output, frame, record, {.float32 = job.float32}); !ok) return ok;
     summary.rendered.push_back(frame.frame);
     if (frame.sampling) {
       summary.cappedPixels += frame.sampling->cappedPixels;

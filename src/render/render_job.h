@@ -36,6 +36,7 @@ struct RenderJob {
   // scene::keepOnlyAnimation; recorded so that frames of another animation are not reused.
   std::optional<std::string> animation;
   int threads = 0;  // 0: all cores
+  bool float32 = false;  // store every channel as 32-bit float (frames::WriteOptions)
   std::string blender = "blender";  // the Blender executable for --engine cycles
 };
 

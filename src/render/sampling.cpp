@@ -5,24 +5,63 @@
 namespace dynbench::render {
 
 Distribution1D::Distribution1D(std::span<const double> weights) : weights_(weights.begin(), weights.end()) {
-  cdf_.resize(weights_.size() + 1, 0.0);
-  for (std::size_t i = 0; i < weights_.size(); ++i) {
-    weights_[i] = std::isfinite(weights_[i]) ? std::max(0.0, weights_[i]) : 0.0;
-    cdf_[i + 1] = cdf_[i] + weights_[i];
+  total_ = 0.0;
+  for (auto& w : weights_) {
+    w = std::isfinite(w) ? std::max(0.0, w) : 0.0;
+    total_ += w;
   }
-  total_ = cdf_.back();
+  const std::size_t n = weights_.size();
+  if (n == 0 || !(total_ > 0.0)) return;
+  // Vose's construction: slots under their share (< 1 in units of total / n) are topped up by
+  // slots over it, one donor per slot.
+  alias_.resize(n);
+  std::vector<double> scaled(n);
+  std::vector<std::uint32_t> small, large;
+  for (std::size_t i = 0; i < n; ++i) {
+    scaled[i] = weights_[i] * static_cast<double>(n) / total_;
+    (scaled[i] < 1.0 ? small : large).push_back(static_cast<std::uint32_t>(i));
+  }
+  while (!small.empty() && !large.empty()) {
+    const std::uint32_t s = small.back(), l = large.back();
+    small.pop_back();
+    alias_[s].keep = scaled[s];
+    alias_[s].alias = l;
+    scaled[l] -= 1.0 - scaled[s];
+    if (scaled[l] < 1.0) {
+      large.pop_back();
+      small.push_back(l);
+    }
+  }
+  // What is left is a full slot up to rounding; a bin of weight 0 never is, but stays unpickable.
+  for (const auto& rest : {small, large})
+    for (const std::uint32_t i : rest) {
+      alias_[i].keep = weights_[i] > 0 ? 1.0 : 0.0;
+      alias_[i].alias = i;
+    }
+  std::uint32_t positive = 0;
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (weights_[i] > 0) positive = i;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    Slot& slot = alias_[i];
+    if (slot.keep < 1.0 && weights_[slot.alias] <= 0) slot.alias = positive;
+    slot.probabilitySelf = probability(i);
+    slot.probabilityAlias = probability(slot.alias);
+  }
 }
 
 std::size_t Distribution1D::sampleDiscrete(double u, double* probability, double* remapped) const {
-  const double target = u * total_;
-  // The last bin whose cdf start is <= target and whose weight is positive.
-  auto it = std::upper_bound(cdf_.begin(), cdf_.end(), target);
-  std::size_t bin = static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - cdf_.begin()) - 1));
-  bin = std::min(bin, weights_.size() - 1);
-  while (weights_[bin] <= 0.0 && bin > 0) --bin;  // u == 1 - epsilon landing past the end
-  if (probability) *probability = weights_[bin] / total_;
-  if (remapped) *remapped = weights_[bin] > 0 ? std::clamp((target - cdf_[bin]) / weights_[bin], 0.0, 0x1.fffffffffffffp-1) : 0.0;
-  return bin;
+  const double n = static_cast<double>(alias_.size());
+  const double x = std::clamp(u, 0.0, 1.0) * n;
+  const std::size_t i = std::min(static_cast<std::size_t>(x), alias_.size() - 1);
+  const double f = std::min(x - static_cast<double>(i), 1.0);
+  const Slot& slot = alias_[i];
+  const bool keep = f < slot.keep;
+  if (probability) *probability = keep ? slot.probabilitySelf : slot.probabilityAlias;
+  if (remapped) {
+    const double r = keep ? f / slot.keep : (f - slot.keep) / (1.0 - slot.keep);
+    *remapped = std::clamp(r, 0.0, 0x1.fffffffffffffp-1);
+  }
+  return keep ? i : slot.alias;
 }
 
 Distribution2D::Distribution2D(std::span<const double> weights, int width, int height) : width_(width), height_(height) {

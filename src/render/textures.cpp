@@ -34,16 +34,23 @@ Texture toTexture(const FloatImage& image, bool srgb) {
 
 }  // namespace
 
+// In float: texels are float, and a float uv resolves 1/1000 of a texel on a 16k-texel repeat.
 glm::dvec4 Texture::sample(glm::dvec2 uv) const {
-  const double x = uv.x * width - 0.5, y = uv.y * height - 0.5;
-  const double fx = std::floor(x), fy = std::floor(y);
-  const double tx = x - fx, ty = y - fy;
-  auto wrap = [](long long i, int n) { return static_cast<std::size_t>(((i % n) + n) % n); };
-  const auto x0 = wrap(static_cast<long long>(fx), width), x1 = wrap(static_cast<long long>(fx) + 1, width);
-  const auto y0 = wrap(static_cast<long long>(fy), height), y1 = wrap(static_cast<long long>(fy) + 1, height);
+  const float x = static_cast<float>(uv.x) * static_cast<float>(width) - 0.5f;
+  const float y = static_cast<float>(uv.y) * static_cast<float>(height) - 0.5f;
+  const float fx = std::floor(x), fy = std::floor(y);
+  const float tx = x - fx, ty = y - fy;
+  // Repeat: one remainder per axis (uv far outside [0, 1] stays exact as long as it fits a long).
+  auto wrap = [](float f, int n) {
+    long i = static_cast<long>(f) % n;
+    return static_cast<std::size_t>(i < 0 ? i + n : i);
+  };
+  const std::size_t x0 = wrap(fx, width), y0 = wrap(fy, height);
+  const std::size_t x1 = x0 + 1 == static_cast<std::size_t>(width) ? 0 : x0 + 1;
+  const std::size_t y1 = y0 + 1 == static_cast<std::size_t>(height) ? 0 : y0 + 1;
   const auto w = static_cast<std::size_t>(width);
-  const glm::dvec4 a(texels[y0 * w + x0]), b(texels[y0 * w + x1]), c(texels[y1 * w + x0]), d(texels[y1 * w + x1]);
-  return (1 - ty) * ((1 - tx) * a + tx * b) + ty * ((1 - tx) * c + tx * d);
+  const glm::vec4 &a = texels[y0 * w + x0], &b = texels[y0 * w + x1], &c = texels[y1 * w + x0], &d = texels[y1 * w + x1];
+  return glm::dvec4((1 - ty) * ((1 - tx) * a + tx * b) + ty * ((1 - tx) * c + tx * d));
 }
 
 Expected<TextureSet> TextureSet::load(const scene::Scene& scene, std::vector<std::string>& warnings) {

@@ -147,7 +147,7 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
       if (!frame) return std::unexpected(frame.error());
       auto rgb = frames::previewImage(*frame);
       const fs::path png = files.assets / fmt::format("{}_frame_{:05d}.png", stem, entry.frame);
-      if (auto ok = writeImage(png, FloatImage{frame->width, frame->height, 3, std::move(rgb), {}}); !ok) return std::unexpected(ok.error());
+      if (auto ok = writeImage(png, FloatImage{frame->width, frame->height, 3, std::move(rgb), {}, {}, {}}); !ok) return std::unexpected(ok.error());
       list.push_back({fmt::format("Frame {} (direct + indirect, tone-mapped)", entry.frame), png});
       if (t == 0 && r.frames.size() == 1) break;
     }
