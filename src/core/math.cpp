@@ -89,7 +89,8 @@ glm::dvec3 equirectDirection(double u, double v) {
 
 glm::dvec2 equirectCoordinates(const glm::dvec3& d) {
   const double phi = std::atan2(d.x, -d.z);
-  const double theta = std::acos(std::clamp(d.y, -1.0, 1.0));
+  // atan2 rather than acos(d.y): acos loses half the digits near the poles.
+  const double theta = std::atan2(std::sqrt(d.x * d.x + d.z * d.z), d.y);
   return {phi / (2.0 * kPi) + 0.5, theta / kPi};
 }
 

@@ -13,7 +13,8 @@ float srgbToLinear(float c) {  // IEC 61966-2-1
   return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
-Texture toTexture(const FloatImage& image, bool srgb) {
+// The texel values of `image` as floats, sRGB-decoded when `srgb` (alpha stays linear).
+Texture floatTexture(const FloatImage& image, bool srgb) {
   Texture t;
   t.width = image.width;
   t.height = image.height;
@@ -28,6 +29,47 @@ Texture toTexture(const FloatImage& image, bool srgb) {
     if (srgb)
       for (int k = 0; k < 3; ++k) v[k] = srgbToLinear(v[k]);
     t.texels[i] = v;
+  }
+  return t;
+}
+
+// The same texture as 8-bit codes when every value of the image is one of 256 levels k / 255 (an
+// 8-bit PNG or JPEG): each code decodes to exactly the float floatTexture would have stored.
+// Otherwise (16-bit or HDR images) the float texture.
+Texture toTexture(const FloatImage& image, bool srgb) {
+  std::array<float, 256> level{};
+  std::array<bool, 256> seen{};
+  auto codeOf = [&](float v, std::uint8_t& code) {
+    const float scaled = v * 255.0f;
+    if (!(scaled >= -0.25f && scaled <= 255.25f)) return false;
+    code = static_cast<std::uint8_t>(std::lround(scaled));
+    if (std::abs(scaled - code) > 1e-3f) return false;
+    if (!seen[code]) {
+      seen[code] = true;
+      level[code] = v;
+    }
+    return level[code] == v;  // one float per code, or the decode would not be exact
+  };
+  Texture t;
+  t.width = image.width;
+  t.height = image.height;
+  t.codes.resize(static_cast<std::size_t>(image.width) * image.height);
+  const int c = image.channels;
+  // A missing alpha is 1.0f in the float path: code 255 must decode to exactly that.
+  std::uint8_t opaque = 0;
+  bool exact = codeOf(1.0f, opaque);
+  for (std::size_t i = 0; exact && i < t.codes.size(); ++i) {
+    const float* p = &image.pixels[i * static_cast<std::size_t>(c)];
+    auto& code = t.codes[i];
+    if (c == 1) exact = codeOf(p[0], code[0]) && (code[1] = code[2] = code[0], code[3] = opaque, true);
+    else if (c == 2) exact = codeOf(p[0], code[0]) && codeOf(p[1], code[3]) && (code[1] = code[2] = code[0], true);
+    else exact = codeOf(p[0], code[0]) && codeOf(p[1], code[1]) && codeOf(p[2], code[2]) && (c < 4 ? (code[3] = opaque, true) : codeOf(p[3], code[3]));
+  }
+  if (!exact) return floatTexture(image, srgb);
+  for (int k = 0; k < 256; ++k) {
+    const float v = seen[static_cast<std::size_t>(k)] ? level[static_cast<std::size_t>(k)] : static_cast<float>(k) / 255.0f;
+    t.decodeAlpha[static_cast<std::size_t>(k)] = v;
+    t.decodeColour[static_cast<std::size_t>(k)] = srgb ? srgbToLinear(v) : v;
   }
   return t;
 }
@@ -49,7 +91,13 @@ glm::dvec4 Texture::sample(glm::dvec2 uv) const {
   const std::size_t x1 = x0 + 1 == static_cast<std::size_t>(width) ? 0 : x0 + 1;
   const std::size_t y1 = y0 + 1 == static_cast<std::size_t>(height) ? 0 : y0 + 1;
   const auto w = static_cast<std::size_t>(width);
-  const glm::vec4 &a = texels[y0 * w + x0], &b = texels[y0 * w + x1], &c = texels[y1 * w + x0], &d = texels[y1 * w + x1];
+  const std::size_t i00 = y0 * w + x0, i01 = y0 * w + x1, i10 = y1 * w + x0, i11 = y1 * w + x1;
+  auto texel = [&](std::size_t i) {
+    if (codes.empty()) return texels[i];
+    const auto& k = codes[i];
+    return glm::vec4(decodeColour[k[0]], decodeColour[k[1]], decodeColour[k[2]], decodeAlpha[k[3]]);
+  };
+  const glm::vec4 a = texel(i00), b = texel(i01), c = texel(i10), d = texel(i11);
   return glm::dvec4((1 - ty) * ((1 - tx) * a + tx * b) + ty * ((1 - tx) * c + tx * d));
 }
 
@@ -88,7 +136,7 @@ Expected<TextureSet> TextureSet::load(const scene::Scene& scene, std::vector<std
 const Texture* TextureSet::find(int image, bool srgb) const {
   if (image < 0 || static_cast<std::size_t>(image) >= linear_.size()) return nullptr;
   const Texture& t = (srgb ? linear_ : raw_)[static_cast<std::size_t>(image)];
-  return t.texels.empty() ? nullptr : &t;
+  return t.texels.empty() && t.codes.empty() ? nullptr : &t;
 }
 
 glm::dvec4 TextureSet::sample(const scene::TextureRef& ref, bool srgb, glm::dvec2 uv, glm::dvec4 fallback) const {

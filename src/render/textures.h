@@ -2,6 +2,8 @@
 // The textures a scene's materials use, decoded once (through core/image_io, i.e. OpenImageIO)
 // and shared by every frame and thread. Colour slots (base colour, emissive) are sRGB-decoded at
 // load; data slots (metallic-roughness, normal) keep their values (glTF 2.0 §3.9).
+#include <array>
+#include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -13,7 +15,13 @@ namespace dynbench::render {
 
 struct Texture {
   int width = 0, height = 0;
-  std::vector<glm::vec4> texels;  // row-major, top row first (glTF's uv (0, 0) is the top left)
+  // Row-major, top row first (glTF's uv (0, 0) is the top left); one of the two is filled. An
+  // 8-bit image keeps its 8-bit codes, decoded through `decode` (the exact floats the 32-bit path
+  // would hold): four bytes a texel instead of sixteen, which is what a texture lookup waits for
+  // (the path tracer's largest cost in `perf` before this).
+  std::vector<glm::vec4> texels;
+  std::vector<std::array<std::uint8_t, 4>> codes;
+  std::array<float, 256> decodeColour{}, decodeAlpha{};  // code -> value (sRGB-decoded for colour slots)
   // Bilinear filtering between the four nearest texel centres, repeating at the edges (glTF's
   // default sampler; dynbench does not read sampler objects).
   glm::dvec4 sample(glm::dvec2 uv) const;
