@@ -5,8 +5,8 @@
 // uniformly random directions).
 #include <chrono>
 #include <cstdio>
-#include <random>
 
+#include "raw_rays.h"
 #include "render/camera.h"
 #include "render/raytracing_scene.h"
 #include "scene/queries.h"
@@ -63,30 +63,8 @@ int main(int argc, char** argv) {
     world = evaluator.worldMatrix(*node, t);
   }
   const render::RenderCamera camera(world, lens, 640, 360);
-  std::size_t hits = 0;
-  start = Clock::now();
-  for (int repeat = 0; repeat < 4; ++repeat)
-    for (int y = 0; y < 360; ++y)
-      for (int x = 0; x < 640; ++x) hits += (*rt)->intersect(camera.ray(x + 0.5, y + 0.5)).hit;
-  const double primary = std::chrono::duration<double>(Clock::now() - start).count();
-  std::printf("primary rays:  %.2f Mrays/s (one thread, %.0f %% hit)\n", 4 * 640 * 360 / primary / 1e6, 100.0 * hits / (4 * 640 * 360));
-
-  // Incoherent rays: origins around the camera (within 20 units), random directions.
-  std::mt19937 random(1);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  constexpr int kRays = 1'000'000;
-  std::vector<render::Ray> rays(kRays);
-  for (auto& r : rays) {
-    r.origin = camera.position() + 20.0 * glm::dvec3(u(random), u(random), u(random));
-    glm::dvec3 d;
-    do d = {u(random), u(random), u(random)};
-    while (glm::length(d) > 1.0 || glm::length(d) < 1e-3);
-    r.direction = glm::normalize(d);
-  }
-  hits = 0;
-  start = Clock::now();
-  for (const auto& r : rays) hits += (*rt)->intersect(r).hit;
-  const double incoherent = std::chrono::duration<double>(Clock::now() - start).count();
-  std::printf("random rays:   %.2f Mrays/s (one thread, %.0f %% hit)\n", kRays / incoherent / 1e6, 100.0 * hits / kRays);
+  const auto raw = bench::measureRawRays(**rt, camera);
+  std::printf("primary rays:  %.2f Mrays/s (one thread, %.0f %% hit)\n", raw.primaryRaysPerSecond / 1e6, 100.0 * raw.primaryHitShare);
+  std::printf("random rays:   %.2f Mrays/s (one thread, %.0f %% hit)\n", raw.randomRaysPerSecond / 1e6, 100.0 * raw.randomHitShare);
   return 0;
 }

@@ -1,10 +1,15 @@
 // Render benchmark (run by hand; not part of the test suite):
-//   build/release/bench/bench_render [DATASET] [--frames A:B] [--res WxH] [--spp N] [--bounces N]
-// Renders the same frames with --engine embree and --engine cycles (Blender), each twice with two
-// seeds, and prints wall times, their ratio, each engine's noise (the variance of one render,
-// estimated as mean((Y1 - Y2)^2) / 2 over pixels, Y = luminance of direct + indirect) and the
-// time-to-equal-noise ratio (time x variance is constant as samples grow). Then runs
-// bench_raytrace on the same dataset: Embree's raw ray throughput, the ceiling.
+//   build/release/bench/bench_render [DATASET] [--frames A:B] [--res WxH] [--spp N] [--bounces N] [--no-cycles]
+// For the same dataset and frames, in one run:
+//  1. the path tracer's rays per second on one thread and on two, and the 2-thread speedup (over
+//     the frames, and over the whole job with loading);
+//  2. Embree's raw ray throughput on the same scene and camera (bench/raw_rays.h: primary rays
+//     through the render camera, random incoherent rays around it), and the path tracer's share;
+//  3. bytes per pixel of the frames on disk;
+//  4. unless --no-cycles, Cycles (Blender) against the path tracer: each renders twice with two
+//     seeds; wall times, their ratio, each engine's noise (the variance of one render, estimated
+//     as mean((Y1 - Y2)^2) / 2 over pixels, Y = luminance of direct + indirect) and the
+//     time-to-equal-noise ratio (time x variance is constant as samples grow).
 // Without DATASET it builds a test arena: a floor, walls and 40 pillars (static), 12 moving
 // spheres of mixed materials, 6 point lights and the Preetham sky, seen by a fast-turning camera.
 #include <chrono>
@@ -17,10 +22,13 @@
 #include "convert/sky.h"
 #include "core/image_io.h"
 #include "core/math.h"
+#include "raw_rays.h"
 #include "gltf_builder.h"
 #include "frames/frame_io.h"
 #include "render/render_job.h"
+#include "scene/evaluate.h"
 #include "scene/load.h"
+#include "scene/queries.h"
 
 namespace fs = std::filesystem;
 using namespace dynbench;
@@ -146,12 +154,14 @@ std::vector<double> radiance(const fs::path& dir, const std::vector<long>& frame
 int main(int argc, char** argv) {
   std::string dataset, frames = "0:3", res = "480x270";
   int spp = 16, bounces = 4;
+  bool cycles = true;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--frames" && i + 1 < argc) frames = argv[++i];
     else if (a == "--res" && i + 1 < argc) res = argv[++i];
     else if (a == "--spp" && i + 1 < argc) spp = std::atoi(argv[++i]);
     else if (a == "--bounces" && i + 1 < argc) bounces = std::atoi(argv[++i]);
+    else if (a == "--no-cycles") cycles = false;
     else dataset = a;
   }
   const fs::path work = fs::temp_directory_path() / "dynbench_bench_render";
@@ -169,30 +179,96 @@ int main(int argc, char** argv) {
   job.settings.height = h;
   job.settings.samplesPerPixel = spp;
   job.settings.bounces = bounces;
-  job.frames = *render::parseFrameRange(frames);
+  auto range = render::parseFrameRange(frames);
+  if (!range) {
+    std::fprintf(stderr, "%s\n", range.error().message.c_str());
+    return 1;
+  }
+  job.frames = *range;
   auto list = render::jobFrames(*scene, job);
   if (!list) {
     std::fprintf(stderr, "%s\n", list.error().message.c_str());
     return 1;
   }
   std::printf("%s: frames %s (%zu), %dx%d, %d spp, %d bounces\n", dataset.c_str(), frames.c_str(), list->size(), w, h, spp, bounces);
+  auto run = [&](const std::string& engine, int threads, std::uint64_t seed, const fs::path& out) {
+    job.engine = engine;
+    job.threads = threads;
+    job.settings.seed = seed;
+    job.output = out;
+    fs::remove_all(out);
+    auto summary = render::renderDataset(*scene, job);
+    if (!summary) {
+      std::fprintf(stderr, "%s: %s\n", engine.c_str(), summary.error().message.c_str());
+      std::exit(1);
+    }
+    return *summary;
+  };
+
+  // A warm-up render (one frame, one sample), so neither measurement below pays for cold caches
+  // and first-time library loading.
+  {
+    const auto saved = job.frames;
+    const int savedSpp = job.settings.samplesPerPixel;
+    job.frames = {list->front(), list->front(), 1};
+    job.settings.samplesPerPixel = 1;
+    run("embree", 0, 1, work / "warm_up");
+    job.frames = saved;
+    job.settings.samplesPerPixel = savedSpp;
+  }
+
+  // 1. The path tracer on one thread and on two.
+  double framesSeconds[2] = {0, 0}, jobSeconds[2] = {0, 0}, raysPerSecond[2] = {0, 0};
+  for (int t = 1; t <= 2; ++t) {
+    const auto s = run("embree", t, 1, work / fmt::format("embree_{}thread", t));
+    framesSeconds[t - 1] = s.seconds - s.loadSeconds;
+    jobSeconds[t - 1] = s.seconds;
+    raysPerSecond[t - 1] = static_cast<double>(s.rays) / framesSeconds[t - 1];
+    std::printf("path tracer, %d thread(s): %.2f M rays/s (%.2f M rays/s per thread) over %.2f s of frames; whole job %.2f s "
+                "(loading %.2f s)\n",
+                t, raysPerSecond[t - 1] / 1e6, raysPerSecond[t - 1] / t / 1e6, framesSeconds[t - 1], s.seconds, s.loadSeconds);
+  }
+  std::printf("2-thread speedup: %.2fx over the frames, %.2fx over the whole job\n", framesSeconds[0] / framesSeconds[1],
+              jobSeconds[0] / jobSeconds[1]);
+
+  // 2. Embree's ceiling on the same scene (the first frame's time) and camera.
+  {
+    auto rt = render::RayTracingScene::create(*scene);
+    auto node = scene::selectCameraNode(*scene, job.camera);
+    if (!rt || !node) {
+      std::fprintf(stderr, "cannot build the ray-tracing scene or find the camera\n");
+      return 1;
+    }
+    const scene::Evaluator evaluator(*scene);
+    auto cameras = render::frameCameras(evaluator, *node, job, list->front());
+    if (!cameras || !(*rt)->update(cameras->time)) {
+      std::fprintf(stderr, "cannot place the scene at the first frame\n");
+      return 1;
+    }
+    const auto raw = bench::measureRawRays(**rt, cameras->camera);
+    std::printf("Embree raw, one thread: primary %.2f M rays/s (%.0f %% hit), random %.2f M rays/s (%.0f %% hit)\n",
+                raw.primaryRaysPerSecond / 1e6, 100 * raw.primaryHitShare, raw.randomRaysPerSecond / 1e6, 100 * raw.randomHitShare);
+    std::printf("path tracer (one thread) / Embree raw: %.0f %% of random-ray, %.0f %% of primary-ray throughput\n",
+                100 * raysPerSecond[0] / raw.randomRaysPerSecond, 100 * raysPerSecond[0] / raw.primaryRaysPerSecond);
+  }
+
+  // 3. Bytes per pixel on disk.
+  {
+    std::uintmax_t bytes = 0;
+    for (long f : *list) bytes += fs::file_size(frames::frameImagePath(work / "embree_1thread", f));
+    std::printf("frames on disk: %.2f bytes per pixel\n", static_cast<double>(bytes) / (static_cast<double>(list->size()) * w * h));
+  }
+  if (!cycles) return 0;
+
+  // 4. Cycles at equal noise.
   double seconds[2] = {0, 0}, variance[2] = {0, 0};
   const char* names[2] = {"embree", "cycles"};
   for (int e = 0; e < 2; ++e) {
-    job.engine = e == 0 ? "embree" : "cycles";
     std::vector<double> y[2];
-    for (int run = 0; run < 2; ++run) {
-      job.settings.seed = static_cast<std::uint64_t>(run + 1);
-      job.output = work / fmt::format("{}_{}", names[e], run);
-      fs::remove_all(job.output);
-      const auto start = std::chrono::steady_clock::now();
-      auto summary = render::renderDataset(*scene, job);
-      if (!summary) {
-        std::fprintf(stderr, "%s: %s\n", names[e], summary.error().message.c_str());
-        return 1;
-      }
-      seconds[e] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / 2;
-      y[run] = radiance(job.output, *list);
+    for (int r = 0; r < 2; ++r) {
+      const auto s = run(names[e], 0, static_cast<std::uint64_t>(r + 1), work / fmt::format("{}_{}", names[e], r));
+      seconds[e] += s.seconds / 2;
+      y[r] = radiance(job.output, *list);
     }
     double sum = 0, mean = 0;
     for (std::size_t i = 0; i < y[0].size(); ++i) {
@@ -205,7 +281,5 @@ int main(int argc, char** argv) {
   }
   std::printf("cycles / embree time: %.2fx; time to equal noise (time x variance): %.2fx\n", seconds[1] / seconds[0],
               seconds[1] * variance[1] / (seconds[0] * variance[0]));
-  std::fflush(stdout);
-  const fs::path raytrace = fs::path(argv[0]).parent_path() / "bench_raytrace";
-  return std::system(fmt::format("'{}' '{}'", raytrace.string(), dataset).c_str()) == 0 ? 0 : 1;
+  return 0;
 }

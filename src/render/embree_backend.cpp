@@ -4,8 +4,6 @@
 #include <optional>
 #include <thread>
 
-#include <tbb/global_control.h>
-
 #include "render/backend.h"
 #include "render/path_tracer.h"
 
@@ -14,11 +12,9 @@ namespace {
 
 class EmbreeBackend final : public RenderBackend {
  public:
-  EmbreeBackend(std::unique_ptr<PathTracer> tracer, int threads) : tracer_(std::move(tracer)), threads_(threads) {}
+  explicit EmbreeBackend(std::unique_ptr<PathTracer> tracer) : tracer_(std::move(tracer)) {}
 
   Expected<void> render(const std::vector<FrameRequest>& requests, const FrameSink& done, const RowProgress& rows) override {
-    std::optional<tbb::global_control> limit;
-    if (threads_ > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads_));
     const int height = tracer_->settings().height;
     for (std::size_t i = 0; i < requests.size(); ++i) {
       const FrameRequest& request = requests[i];
@@ -58,7 +54,6 @@ class EmbreeBackend final : public RenderBackend {
 
  private:
   std::unique_ptr<PathTracer> tracer_;
-  int threads_;
   RenderStatistics statistics_;
 };
 
@@ -67,7 +62,7 @@ class EmbreeBackend final : public RenderBackend {
 Expected<std::unique_ptr<RenderBackend>> createEmbreeBackend(const BackendContext& context) {
   auto tracer = PathTracer::create(context.scene, context.job.settings, context.warnings);
   if (!tracer) return std::unexpected(tracer.error());
-  return std::make_unique<EmbreeBackend>(std::move(*tracer), context.job.threads);
+  return std::make_unique<EmbreeBackend>(std::move(*tracer));
 }
 
 }  // namespace dynbench::render

@@ -31,7 +31,7 @@ Expected<EnvironmentLight> EnvironmentLight::load(const scene::Environment& envi
       glm::vec3 value(p[0], p[1], p[2]);
       for (int c = 0; c < 3; ++c)
         if (!std::isfinite(value[c]) || value[c] < 0) value[c] = 0;  // NaN/negative texels emit nothing
-      env.pixels_[i] = value * environment.intensity;
+      env.pixels_[i] = glm::vec4(value * environment.intensity, 0.0f);
       const double y709 = luminance(glm::dvec3(env.pixels_[i]));
       weights[i] = y709 * pixelSolidAngle;
       total += y709 * pixelSolidAngle;
@@ -40,6 +40,11 @@ Expected<EnvironmentLight> EnvironmentLight::load(const scene::Environment& envi
   }
   env.meanLuminance_ = solidAngle > 0 ? total / solidAngle : 0.0;
   env.distribution_ = Distribution2D(weights, env.width_, env.height_);
+  if (!env.distribution_.empty())
+    for (int y = 0; y < env.height_; ++y)
+      for (int x = 0; x < env.width_; ++x)
+        env.pixels_[static_cast<std::size_t>(y) * env.width_ + x].w =
+            static_cast<float>(env.distribution_.density({(x + 0.5) / env.width_, (y + 0.5) / env.height_}));
   return env;
 }
 
@@ -47,7 +52,7 @@ EnvironmentLight EnvironmentLight::constant(const glm::dvec3& radiance) {
   EnvironmentLight env;
   env.width_ = 2;  // two columns so the mapping has a seam like any other image
   env.height_ = 1;
-  env.pixels_.assign(2, glm::vec3(radiance));
+  env.pixels_.assign(2, glm::vec4(glm::vec3(radiance), 0.0f));  // density unused: sampled as a sphere
   // Weight by solid angle only: with one row this samples the sphere uniformly.
   const std::vector<double> weights{1.0, 1.0};
   env.distribution_ = Distribution2D(weights, 2, 1);
@@ -65,28 +70,27 @@ glm::dvec3 EnvironmentLight::radiance(const glm::dvec3& direction) const {
   return glm::dvec3(pixels_[pixelAt(equirectCoordinates(direction))]);
 }
 
-glm::dvec3 EnvironmentLight::radiance(const glm::dvec3& direction, double* pdf) const {
-  const glm::dvec2 uv = equirectCoordinates(direction);
-  if (distribution_.empty()) {
-    *pdf = 0.0;
-  } else if (height_ == 1) {
-    *pdf = 1.0 / (4.0 * kPi);
-  } else {
-    const double sinTheta = std::sin(kPi * uv.y);
-    *pdf = sinTheta > 0 ? distribution_.density(uv) / (2.0 * kPi * kPi * sinTheta) : 0.0;
-  }
-  return glm::dvec3(pixels_[pixelAt(uv)]);
-}
-
 // A density over the image square becomes a solid-angle density through the equirectangular
 // Jacobian: dω = 2π² sin θ du dv.
+double EnvironmentLight::solidAnglePdf(double density, double v) const {
+  const double sinTheta = std::sin(kPi * v);
+  return sinTheta > 0 ? density / (2.0 * kPi * kPi * sinTheta) : 0.0;
+}
+
+glm::dvec3 EnvironmentLight::radiance(const glm::dvec3& direction, double* pdf) const {
+  const glm::dvec2 uv = equirectCoordinates(direction);
+  const glm::vec4& pixel = pixels_[pixelAt(uv)];
+  if (distribution_.empty()) *pdf = 0.0;
+  else if (height_ == 1) *pdf = 1.0 / (4.0 * kPi);
+  else *pdf = solidAnglePdf(pixel.w, uv.y);
+  return glm::dvec3(pixel);
+}
+
 glm::dvec3 EnvironmentLight::sample(glm::dvec2 u, double* pdf, glm::dvec3* radiance) const {
-  double density = 0.0;
   if (distribution_.empty()) {  // a black environment: nothing to sample
     *pdf = 0.0;
     return {0, 1, 0};
   }
-  glm::dvec2 uv;
   if (height_ == 1) {
     // A single row (constant environment): sample the sphere uniformly instead of in (u, v), so
     // the density stays bounded at the poles.
@@ -96,12 +100,12 @@ glm::dvec3 EnvironmentLight::sample(glm::dvec2 u, double* pdf, glm::dvec3* radia
     if (radiance) *radiance = this->radiance(d);
     return d;
   }
-  uv = distribution_.sample(u, &density);
-  const glm::dvec3 d = equirectDirection(uv.x, uv.y);
-  const double sinTheta = std::sin(kPi * uv.y);
-  *pdf = sinTheta > 0 ? density / (2.0 * kPi * kPi * sinTheta) : 0.0;
-  if (radiance) *radiance = glm::dvec3(pixels_[pixelAt(uv)]);
-  return d;
+  std::size_t cell = 0;
+  const glm::dvec2 uv = distribution_.sampleCell(u, &cell);
+  const glm::vec4& pixel = pixels_[cell];
+  *pdf = solidAnglePdf(pixel.w, uv.y);
+  if (radiance) *radiance = glm::dvec3(pixel);
+  return equirectDirection(uv.x, uv.y);
 }
 
 double EnvironmentLight::pdf(const glm::dvec3& direction) const {

@@ -41,11 +41,15 @@ class EnvironmentLight {
 
  private:
   int width_ = 0, height_ = 0;
-  std::vector<glm::vec3> pixels_;  // radiance, intensity applied
+  // Per pixel: radiance (intensity applied) and, in w, the pixel's density over the image square
+  // (Distribution2D's), so a lookup and its pdf touch one cache line.
+  std::vector<glm::vec4> pixels_;
   Distribution2D distribution_;
   double meanLuminance_ = 0.0;
 
   std::size_t pixelAt(glm::dvec2 uv) const;
+  // Solid-angle density at image point uv of a pixel whose square density is `density`.
+  double solidAnglePdf(double density, double v) const;
 };
 
 struct LightSample {

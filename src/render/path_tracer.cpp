@@ -418,27 +418,29 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
     const double directTargetSq = summary.directTarget * summary.directTarget;
     const double indirectTargetSq = summary.indirectTarget * summary.indirectTarget;
     const int cap = std::max(firstRound, settings_.maxSamplesPerPixel);
-    // Rows again, each pixel sampled in rounds until it converges; its random streams are its
-    // sample indices, so the result does not depend on the thread schedule.
-    tbb::parallel_for(tbb::blocked_range<int>(0, height, 1), [&](const tbb::blocked_range<int>& rows) {
+    // Each pixel sampled in rounds until it converges; its random streams are its sample indices,
+    // so the result does not depend on the thread schedule. Scheduled in runs of 8 pixels, not
+    // rows: a row of capped pixels costs seconds, and a core would wait for it at the frame's end.
+    std::atomic<std::size_t> pixelsDone{0};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pixels, 8), [&](const tbb::blocked_range<std::size_t>& run) {
       PathScratch& scratch = scratches.local();
-      for (int py = rows.begin(); py < rows.end(); ++py) {
-        for (int px = 0; px < width; ++px) {
-          const std::size_t pixel = static_cast<std::size_t>(py) * static_cast<std::size_t>(width) + static_cast<std::size_t>(px);
-          PixelSums& sum = sums[pixel];
-          while (sum.samples < cap) {
-            auto ratio = [](double variance, double targetSq) {
-              if (variance <= 0) return 0.0;
-              return targetSq > 0 ? variance / targetSq : std::numeric_limits<double>::infinity();
-            };
-            const double r = std::max(ratio(sum.directVariance(), directTargetSq), ratio(sum.indirectVariance(), indirectTargetSq));
-            if (r <= 1.0) break;
-            samplePixel(pixel, nextSampleCount(sum.samples, r, firstRound, cap), scratch);
-          }
+      for (std::size_t pixel = run.begin(); pixel < run.end(); ++pixel) {
+        PixelSums& sum = sums[pixel];
+        while (sum.samples < cap) {
+          auto ratio = [](double variance, double targetSq) {
+            if (variance <= 0) return 0.0;
+            return targetSq > 0 ? variance / targetSq : std::numeric_limits<double>::infinity();
+          };
+          const double r = std::max(ratio(sum.directVariance(), directTargetSq), ratio(sum.indirectVariance(), indirectTargetSq));
+          if (r <= 1.0) break;
+          samplePixel(pixel, nextSampleCount(sum.samples, r, firstRound, cap), scratch);
         }
-        if (rowsDone) rowsDone->fetch_add(1, std::memory_order_relaxed);
       }
+      const std::size_t done = pixelsDone.fetch_add(run.size(), std::memory_order_relaxed) + run.size();
+      // Whole rows' worth, for progress; the last run's store below makes it `height` exactly.
+      if (rowsDone) rowsDone->store(std::min(height - 1, static_cast<int>(done / static_cast<std::size_t>(width))), std::memory_order_relaxed);
     });
+    if (rowsDone) rowsDone->store(height, std::memory_order_relaxed);
     for (const auto& p : sums)
       if (p.samples >= cap && (p.directVariance() > directTargetSq || p.indirectVariance() > indirectTargetSq)) ++summary.cappedPixels;
   }

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <thread>
 
+#include <tbb/global_control.h>
+
 #include "core/files.h"
 #include "render/backend.h"
 #include "scene/queries.h"
@@ -139,8 +141,12 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
     requests.push_back({f, std::move(*cameras)});
   }
   const auto started = std::chrono::steady_clock::now();
+  // --threads holds for the whole job: loading (textures decode in parallel) and rendering.
+  std::optional<tbb::global_control> limit;
+  if (job.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(job.threads));
   auto renderer = (*backend)->create({scene, job, *cameraNode, summary.warnings});
   if (!renderer) return std::unexpected(renderer.error());
+  summary.loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 
   // Around every backend alike: frames written through the contract module, progress in rows.
   const std::size_t height = static_cast<std::size_t>(job.settings.height);

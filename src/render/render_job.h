@@ -42,7 +42,8 @@ struct RenderJob {
 
 struct RenderSummary {
   std::vector<long> rendered, skipped;
-  double seconds = 0.0;
+  double seconds = 0.0;      // the whole job: loading the renderer (textures, BVH) and its frames
+  double loadSeconds = 0.0;  // of which creating the renderer
   std::uint64_t cameraSamples = 0, rays = 0;
   std::uint64_t pixels = 0;      // of the frames rendered (with a sampling summary)
   long cappedPixels = 0;         // --converge: pixels that reached --max-spp before their target

@@ -41,12 +41,8 @@ Distribution1D::Distribution1D(std::span<const double> weights) : weights_(weigh
   std::uint32_t positive = 0;
   for (std::uint32_t i = 0; i < n; ++i)
     if (weights_[i] > 0) positive = i;
-  for (std::uint32_t i = 0; i < n; ++i) {
-    Slot& slot = alias_[i];
+  for (auto& slot : alias_)
     if (slot.keep < 1.0 && weights_[slot.alias] <= 0) slot.alias = positive;
-    slot.probabilitySelf = probability(i);
-    slot.probabilityAlias = probability(slot.alias);
-  }
 }
 
 std::size_t Distribution1D::sampleDiscrete(double u, double* probability, double* remapped) const {
@@ -56,7 +52,7 @@ std::size_t Distribution1D::sampleDiscrete(double u, double* probability, double
   const double f = std::min(x - static_cast<double>(i), 1.0);
   const Slot& slot = alias_[i];
   const bool keep = f < slot.keep;
-  if (probability) *probability = keep ? slot.probabilitySelf : slot.probabilityAlias;
+  if (probability) *probability = this->probability(keep ? i : slot.alias);
   if (remapped) {
     const double r = keep ? f / slot.keep : (f - slot.keep) / (1.0 - slot.keep);
     *remapped = std::clamp(r, 0.0, 0x1.fffffffffffffp-1);
@@ -81,6 +77,14 @@ glm::dvec2 Distribution2D::sample(glm::dvec2 u, double* density) const {
   const std::size_t row = rows_.sampleDiscrete(u.y, &pRow, &v);
   const std::size_t column = columns_[row].sampleDiscrete(u.x, &pColumn, &w);
   if (density) *density = pRow * pColumn * width_ * height_;
+  return {(static_cast<double>(column) + w) / width_, (static_cast<double>(row) + v) / height_};
+}
+
+glm::dvec2 Distribution2D::sampleCell(glm::dvec2 u, std::size_t* cell) const {
+  double v = 0, w = 0;
+  const std::size_t row = rows_.sampleDiscrete(u.y, nullptr, &v);
+  const std::size_t column = columns_[row].sampleDiscrete(u.x, nullptr, &w);
+  *cell = row * static_cast<std::size_t>(width_) + column;
   return {(static_cast<double>(column) + w) / width_, (static_cast<double>(row) + v) / height_};
 }
 

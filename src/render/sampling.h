@@ -94,11 +94,9 @@ class Distribution1D {
   double probability(std::size_t bin) const { return total_ > 0 ? weights_[bin] / total_ : 0.0; }
 
  private:
-  // Slot i of the table: bin i with probability `keep` (of the slot's 1/n), else bin `alias`; the
-  // two bins' probabilities ride along so a sample touches one cache line.
+  // Slot i of the table: bin i with probability `keep` (of the slot's 1/n), else bin `alias`.
   struct Slot {
     double keep = 1.0;
-    double probabilitySelf = 0.0, probabilityAlias = 0.0;
     std::uint32_t alias = 0;
   };
   std::vector<double> weights_;
@@ -115,6 +113,8 @@ class Distribution2D {
   bool empty() const { return rows_.empty(); }
   // A continuous point in [0, 1)^2 with its density with respect to area in [0, 1)^2.
   glm::dvec2 sample(glm::dvec2 u, double* density) const;
+  // The same point, and the index (row x width + column) of its cell instead of the density.
+  glm::dvec2 sampleCell(glm::dvec2 u, std::size_t* cell) const;
   double density(glm::dvec2 point) const;
 
  private:

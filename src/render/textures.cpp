@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <tbb/parallel_for.h>
 
 #include "core/image_io.h"
 
@@ -113,23 +114,28 @@ Expected<TextureSet> TextureSet::load(const scene::Scene& scene, std::vector<std
     for (const auto* ref : {&m.metallicRoughnessTexture, &m.normalTexture})
       if (ref->image >= 0) wantRaw[static_cast<std::size_t>(ref->image)] = 1;
   }
-  for (std::size_t i = 0; i < scene.images.size(); ++i) {
-    if (!wantLinear[i] && !wantRaw[i]) continue;
+  // Decoded in parallel: a dataset's textures are the serial part of a render's start (0.7 s of
+  // 0.8 s for one frame of the colos segment before this).
+  std::vector<std::string> problems(scene.images.size());
+  tbb::parallel_for(std::size_t{0}, scene.images.size(), [&](std::size_t i) {
+    if (!wantLinear[i] && !wantRaw[i]) return;
     const auto& image = scene.images[i];
     if (image.embedded || image.file.empty()) {
-      warnings.push_back(fmt::format("image {} ('{}') is embedded in the file; render reads only external image files, "
-                                     "so its material slots use their factors alone", i, image.name));
-      continue;
+      problems[i] = fmt::format("image {} ('{}') is embedded in the file; render reads only external image files, "
+                                "so its material slots use their factors alone", i, image.name);
+      return;
     }
     auto decoded = readImage(image.file);
     if (!decoded) {
-      warnings.push_back(fmt::format("image {}: {}; its material slots use their factors alone", i, decoded.error().message));
-      continue;
+      problems[i] = fmt::format("image {}: {}; its material slots use their factors alone", i, decoded.error().message);
+      return;
     }
-    if (decoded->width <= 0 || decoded->height <= 0 || decoded->channels <= 0) continue;
+    if (decoded->width <= 0 || decoded->height <= 0 || decoded->channels <= 0) return;
     if (wantLinear[i]) set.linear_[i] = toTexture(*decoded, true);
     if (wantRaw[i]) set.raw_[i] = toTexture(*decoded, false);
-  }
+  });
+  for (auto& p : problems)
+    if (!p.empty()) warnings.push_back(std::move(p));
   return set;
 }
 
