@@ -3,6 +3,7 @@
 // Rewrites every frame of a rendered folder with OpenEXR's lossless codecs, at 32-bit float and at
 // the contract's precision (frames::Storage), and prints bytes per pixel; then each buffer alone
 // (contract precision, ZIP), so docs/feature-buffers.md can say where the bytes go.
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -63,8 +64,10 @@ int main(int argc, char** argv) {
     all.push_back(std::move(*f));
   }
   const fs::path tmp = fs::temp_directory_path() / "dynbench_bench_storage.exr";
+  double writeSeconds = 0;  // of the last call
   auto bytes = [&](bool float32, const std::string& codec, const char* only) {
     std::uintmax_t total = 0;
+    const auto start = std::chrono::steady_clock::now();
     for (const auto& f : all) {
       if (auto ok = writeImage(tmp, toImage(f, float32, codec, only)); !ok) {
         std::fprintf(stderr, "%s\n", ok.error().message.c_str());
@@ -72,12 +75,16 @@ int main(int argc, char** argv) {
       }
       total += fs::file_size(tmp);
     }
+    writeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return static_cast<double>(total) / static_cast<double>(pixels);
   };
   std::printf("%s: %zu frames, %dx%d\n", argv[1], all.size(), all[0].width, all[0].height);
-  std::printf("%-8s %14s %14s   (bytes per pixel; contract = half where frames::Storage allows)\n", "codec", "float32", "contract");
-  for (const char* codec : {"none", "rle", "zips", "zip", "zip:9", "piz", "b44"})
-    std::printf("%-8s %14.2f %14.2f\n", codec, bytes(true, codec, nullptr), bytes(false, codec, nullptr));
+  std::printf("%-8s %14s %14s %16s   (bytes per pixel; contract = half where frames::Storage allows)\n", "codec", "float32", "contract",
+              "contract write");
+  for (const char* codec : {"none", "rle", "zips", "zip", "zip:9", "piz", "b44"}) {
+    const double full = bytes(true, codec, nullptr), contract = bytes(false, codec, nullptr);
+    std::printf("%-8s %14.2f %14.2f %11.1f ms/frame\n", codec, full, contract, 1e3 * writeSeconds / static_cast<double>(all.size()));
+  }
   std::printf("\nper buffer, contract precision, zip:\n");
   for (const auto& spec : frames::contractBuffers())
     if (!(all[0].*spec.member).empty()) std::printf("  %-13s %6.2f B/px\n", spec.name, bytes(false, "zip", spec.name));
