@@ -3,6 +3,7 @@
 // Rewrites every frame of a rendered folder with OpenEXR's lossless codecs, at 32-bit float and at
 // the contract's precision (frames::Storage), and prints bytes per pixel; then each buffer alone
 // (contract precision, ZIP), so docs/feature-buffers.md can say where the bytes go.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -17,27 +18,22 @@ using namespace dynbench;
 
 namespace {
 
-// The frame as one EXR image: every buffer, or only `only` when given.
-FloatImage toImage(const frames::FeatureFrame& f, bool float32, const std::string& compression, const char* only = nullptr) {
-  FloatImage image;
-  image.width = f.width;
-  image.height = f.height;
-  image.compression = compression;
-  std::vector<const frames::BufferSpec*> specs;
-  for (const auto& spec : frames::contractBuffers())
-    if (!(f.*spec.member).empty() && (!only || std::string(only) == spec.name)) specs.push_back(&spec);
-  for (const auto* spec : specs) {
-    image.channelNames.insert(image.channelNames.end(), spec->channels.begin(), spec->channels.end());
-    const bool half = !float32 && frames::storedAsHalf(*spec, f.*spec->member);
-    image.formats.insert(image.formats.end(), spec->channels.size(), half ? SampleFormat::kFloat16 : SampleFormat::kFloat32);
+// The channels of `image` named in `names`, formats kept.
+FloatImage selectChannels(const FloatImage& image, const std::vector<std::string>& names) {
+  FloatImage out;
+  out.width = image.width;
+  out.height = image.height;
+  std::vector<std::size_t> at;
+  for (const auto& n : names) {
+    at.push_back(static_cast<std::size_t>(std::find(image.channelNames.begin(), image.channelNames.end(), n) - image.channelNames.begin()));
+    out.channelNames.push_back(n);
+    out.formats.push_back(image.formats[at.back()]);
   }
-  image.channels = static_cast<int>(image.channelNames.size());
-  const std::size_t pixels = f.pixelCount();
-  image.pixels.reserve(pixels * image.channelNames.size());
+  out.channels = static_cast<int>(at.size());
+  const std::size_t pixels = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
   for (std::size_t i = 0; i < pixels; ++i)
-    for (const auto* spec : specs)
-      for (std::size_t c = 0; c < spec->channels.size(); ++c) image.pixels.push_back((f.*spec->member)[i * spec->channels.size() + c]);
-  return image;
+    for (const std::size_t c : at) out.pixels.push_back(image.pixels[i * static_cast<std::size_t>(image.channels) + c]);
+  return out;
 }
 
 }  // namespace
@@ -65,11 +61,19 @@ int main(int argc, char** argv) {
   }
   const fs::path tmp = fs::temp_directory_path() / "dynbench_bench_storage.exr";
   double writeSeconds = 0;  // of the last call
-  auto bytes = [&](bool float32, const std::string& codec, const char* only) {
+  auto bytes = [&](bool float32, const std::string& codec, const frames::BufferSpec* only) {
     std::uintmax_t total = 0;
     const auto start = std::chrono::steady_clock::now();
     for (const auto& f : all) {
-      if (auto ok = writeImage(tmp, toImage(f, float32, codec, only)); !ok) {
+      // The image writeFrame would write (frames::frameImage), with another codec.
+      auto image = frames::frameImage(f, {.float32 = float32});
+      if (!image) {
+        std::fprintf(stderr, "%s\n", image.error().message.c_str());
+        std::exit(1);
+      }
+      if (only) *image = selectChannels(*image, only->channels);
+      image->compression = codec;
+      if (auto ok = writeImage(tmp, *image); !ok) {
         std::fprintf(stderr, "%s\n", ok.error().message.c_str());
         std::exit(1);
       }
@@ -87,7 +91,7 @@ int main(int argc, char** argv) {
   }
   std::printf("\nper buffer, contract precision, zip:\n");
   for (const auto& spec : frames::contractBuffers())
-    if (!(all[0].*spec.member).empty()) std::printf("  %-13s %6.2f B/px\n", spec.name, bytes(false, "zip", spec.name));
+    if (!(all[0].*spec.member).empty()) std::printf("  %-13s %6.2f B/px\n", spec.name, bytes(false, "zip", &spec));
   fs::remove(tmp);
   return 0;
 }

@@ -245,6 +245,9 @@ Expected<FeatureFrame> readFrame(const FrameEntry& entry, const ReadOptions& opt
   return f;
 }
 
+namespace {
+
+// Whether a buffer of these values is stored as half (Storage's rules).
 bool storedAsHalf(const BufferSpec& spec, const std::vector<float>& values) {
   constexpr float kHalfMax = 65504.0f;  // the largest finite half
   const float limit = std::min(spec.halfLimit, kHalfMax);
@@ -259,7 +262,9 @@ bool storedAsHalf(const BufferSpec& spec, const std::vector<float>& values) {
   return false;
 }
 
-Expected<void> writeFrame(const fs::path& dir, const FeatureFrame& frame, const json& render, const WriteOptions& options) {
+}  // namespace
+
+Expected<FloatImage> frameImage(const FeatureFrame& frame, const WriteOptions& options) {
   FloatImage image;
   // ZIP (zlib over 16 scanlines, with OpenEXR's predictor): lossless, and the smallest of
   // OpenEXR's lossless codecs on these buffers (docs/feature-buffers.md has the measurements).
@@ -290,7 +295,13 @@ Expected<void> writeFrame(const fs::path& dir, const FeatureFrame& frame, const 
   for (std::size_t i = 0; i < pixels; ++i)
     for (std::size_t b = 0; b < present.size(); ++b)
       for (std::size_t c = 0; c < widths[b]; ++c) *out++ = (*present[b])[i * widths[b] + c];
-  if (auto w = writeImage(frameImagePath(dir, frame.frame), image); !w) return w;
+  return image;
+}
+
+Expected<void> writeFrame(const fs::path& dir, const FeatureFrame& frame, const json& render, const WriteOptions& options) {
+  auto image = frameImage(frame, options);
+  if (!image) return std::unexpected(image.error());
+  if (auto w = writeImage(frameImagePath(dir, frame.frame), *image); !w) return w;
   // The sidecar last: its presence marks the frame complete.
   json sidecar = sidecarJson(frame.frame, frame.time, frame.camera, render);
   if (frame.sampling) sidecar["sampling"] = samplingJson(*frame.sampling);

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/image_io.h"
 #include "frames/feature_frame.h"
 
 namespace dynbench::frames {
@@ -50,13 +51,14 @@ struct ReadOptions {
 // when absent), the camera from the sidecar. Errors name the file and what is missing.
 Expected<FeatureFrame> readFrame(const FrameEntry& entry, const ReadOptions& options = {});
 
-// Whether writeFrame stores a buffer of these values as half (Storage's rules).
-bool storedAsHalf(const BufferSpec& spec, const std::vector<float>& values);
-
 struct WriteOptions {
   // Every channel as 32-bit float, whatever the contract's storage says (render --float32).
   bool float32 = false;
 };
+// The frame's EXR image as writeFrame writes it: every non-empty buffer in contract order, each
+// channel's format as its BufferSpec's Storage gives it for these values, ZIP compression.
+// Errors name a missing required buffer or a buffer of the wrong size.
+Expected<FloatImage> frameImage(const FeatureFrame& frame, const WriteOptions& options = {});
 // Writes frame_NNNNN.exr (every non-empty buffer, contract order, each stored as its BufferSpec
 // says, ZIP-compressed) and then its sidecar, each through a temporary name, so an interrupted
 // write never leaves a frame that looks complete.

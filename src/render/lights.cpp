@@ -286,11 +286,6 @@ glm::dvec3 LightSet::environmentRadiance(const glm::dvec3& direction, double* pd
   return le;
 }
 
-double LightSet::pdfEnvironment(const glm::dvec3& direction) const {
-  if (!environment_ || environmentChoice_ <= 0) return 0.0;
-  return environmentChoice_ * environment_->pdf(direction);
-}
-
 // Choice of the triangle ∝ area x weight, then uniform on it: the area cancels, leaving
 // P(emissive) x weight / total x d^2 / cos.
 double LightSet::pdfEmissive(double emissiveLuminance, double distance, double cosAtLight) const {

@@ -97,11 +97,11 @@ class LightSet {
   // The environment or an emissive triangle, picked by estimated power, then a point on it (next
   // event estimation; Monte Carlo, weighted against BSDF sampling by the integrator).
   std::optional<LightSample> sample(const glm::dvec3& point, double uChoice, glm::dvec2 u) const;
-  // Densities of the other strategy for MIS, when a BSDF-sampled ray reaches the environment or
-  // an emissive triangle (whose emissive factor luminance is `emissiveLuminance`).
-  double pdfEnvironment(const glm::dvec3& direction) const;
-  // The environment's radiance in `direction` and, in *pdf, pdfEnvironment(direction): one lookup.
+  // When a BSDF-sampled ray reaches the environment: its radiance and, in *pdf, this strategy's
+  // density for MIS (choice x solid-angle density), in one lookup.
   glm::dvec3 environmentRadiance(const glm::dvec3& direction, double* pdf) const;
+  // The same density when a BSDF-sampled ray reaches an emissive triangle (whose emissive factor
+  // luminance is `emissiveLuminance`).
   double pdfEmissive(double emissiveLuminance, double distance, double cosAtLight) const;
   // Luminance of an emissive factor as used for the triangle choice.
   static double emissiveWeight(const glm::dvec3& emissiveFactor) { return luminance(emissiveFactor); }

@@ -72,14 +72,6 @@ Distribution2D::Distribution2D(std::span<const double> weights, int width, int h
   if (rows_.empty()) columns_.clear();
 }
 
-glm::dvec2 Distribution2D::sample(glm::dvec2 u, double* density) const {
-  double pRow = 0, pColumn = 0, v = 0, w = 0;
-  const std::size_t row = rows_.sampleDiscrete(u.y, &pRow, &v);
-  const std::size_t column = columns_[row].sampleDiscrete(u.x, &pColumn, &w);
-  if (density) *density = pRow * pColumn * width_ * height_;
-  return {(static_cast<double>(column) + w) / width_, (static_cast<double>(row) + v) / height_};
-}
-
 glm::dvec2 Distribution2D::sampleCell(glm::dvec2 u, std::size_t* cell) const {
   double v = 0, w = 0;
   const std::size_t row = rows_.sampleDiscrete(u.y, nullptr, &v);
@@ -88,11 +80,22 @@ glm::dvec2 Distribution2D::sampleCell(glm::dvec2 u, std::size_t* cell) const {
   return {(static_cast<double>(column) + w) / width_, (static_cast<double>(row) + v) / height_};
 }
 
+glm::dvec2 Distribution2D::sample(glm::dvec2 u, double* density) const {
+  std::size_t cell = 0;
+  const glm::dvec2 point = sampleCell(u, &cell);
+  if (density) *density = cellDensity(cell / static_cast<std::size_t>(width_), cell % static_cast<std::size_t>(width_));
+  return point;
+}
+
+double Distribution2D::cellDensity(std::size_t row, std::size_t column) const {
+  return rows_.probability(row) * columns_[row].probability(column) * width_ * height_;
+}
+
 double Distribution2D::density(glm::dvec2 point) const {
   if (empty()) return 0.0;
   const auto column = static_cast<std::size_t>(std::clamp(static_cast<int>(point.x * width_), 0, width_ - 1));
   const auto row = static_cast<std::size_t>(std::clamp(static_cast<int>(point.y * height_), 0, height_ - 1));
-  return rows_.probability(row) * columns_[row].probability(column) * width_ * height_;
+  return cellDensity(row, column);
 }
 
 }  // namespace dynbench::render

@@ -118,6 +118,8 @@ class Distribution2D {
   double density(glm::dvec2 point) const;
 
  private:
+  double cellDensity(std::size_t row, std::size_t column) const;
+
   int width_ = 0, height_ = 0;
   Distribution1D rows_;
   std::vector<Distribution1D> columns_;

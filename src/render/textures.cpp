@@ -14,19 +14,23 @@ float srgbToLinear(float c) {  // IEC 61966-2-1
   return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
+// Texel i of `image` as RGBA: grey expands to RGB, a missing alpha is 1.
+glm::vec4 rgba(const FloatImage& image, std::size_t i) {
+  const int c = image.channels;
+  const float* p = &image.pixels[i * static_cast<std::size_t>(c)];
+  if (c == 1) return {p[0], p[0], p[0], 1.0f};
+  if (c == 2) return {p[0], p[0], p[0], p[1]};  // grey + alpha
+  return {p[0], p[1], p[2], c >= 4 ? p[3] : 1.0f};
+}
+
 // The texel values of `image` as floats, sRGB-decoded when `srgb` (alpha stays linear).
 Texture floatTexture(const FloatImage& image, bool srgb) {
   Texture t;
   t.width = image.width;
   t.height = image.height;
   t.texels.resize(static_cast<std::size_t>(image.width) * image.height);
-  const int c = image.channels;
   for (std::size_t i = 0; i < t.texels.size(); ++i) {
-    const float* p = &image.pixels[i * static_cast<std::size_t>(c)];
-    glm::vec4 v;
-    if (c == 1) v = {p[0], p[0], p[0], 1.0f};
-    else if (c == 2) v = {p[0], p[0], p[0], p[1]};  // grey + alpha
-    else v = {p[0], p[1], p[2], c >= 4 ? p[3] : 1.0f};
+    glm::vec4 v = rgba(image, i);
     if (srgb)
       for (int k = 0; k < 3; ++k) v[k] = srgbToLinear(v[k]);
     t.texels[i] = v;
@@ -55,22 +59,15 @@ Texture toTexture(const FloatImage& image, bool srgb) {
   t.width = image.width;
   t.height = image.height;
   t.codes.resize(static_cast<std::size_t>(image.width) * image.height);
-  const int c = image.channels;
-  // A missing alpha is 1.0f in the float path: code 255 must decode to exactly that.
-  std::uint8_t opaque = 0;
-  bool exact = codeOf(1.0f, opaque);
-  for (std::size_t i = 0; exact && i < t.codes.size(); ++i) {
-    const float* p = &image.pixels[i * static_cast<std::size_t>(c)];
-    auto& code = t.codes[i];
-    if (c == 1) exact = codeOf(p[0], code[0]) && (code[1] = code[2] = code[0], code[3] = opaque, true);
-    else if (c == 2) exact = codeOf(p[0], code[0]) && codeOf(p[1], code[3]) && (code[1] = code[2] = code[0], true);
-    else exact = codeOf(p[0], code[0]) && codeOf(p[1], code[1]) && codeOf(p[2], code[2]) && (c < 4 ? (code[3] = opaque, true) : codeOf(p[3], code[3]));
+  for (std::size_t i = 0; i < t.codes.size(); ++i) {
+    const glm::vec4 v = rgba(image, i);
+    for (int k = 0; k < 4; ++k)
+      if (!codeOf(v[k], t.codes[i][static_cast<std::size_t>(k)])) return floatTexture(image, srgb);
   }
-  if (!exact) return floatTexture(image, srgb);
-  for (int k = 0; k < 256; ++k) {
-    const float v = seen[static_cast<std::size_t>(k)] ? level[static_cast<std::size_t>(k)] : static_cast<float>(k) / 255.0f;
-    t.decodeAlpha[static_cast<std::size_t>(k)] = v;
-    t.decodeColour[static_cast<std::size_t>(k)] = srgb ? srgbToLinear(v) : v;
+  for (std::size_t k = 0; k < 256; ++k) {
+    const float v = seen[k] ? level[k] : static_cast<float>(k) / 255.0f;
+    t.decodeAlpha[k] = v;
+    t.decodeColour[k] = srgb ? srgbToLinear(v) : v;
   }
   return t;
 }
