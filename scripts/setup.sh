@@ -20,6 +20,9 @@ packages=(
   # Blender: `render --engine cycles` (the thesis's renderer) and the tests that check dynbench's
   # datasets with Blender's glTF importer and its P/N buffers against Cycles
   blender python3-numpy
+  # the magma colour map of FLIP heatmaps, read from matplotlib's tables at build time
+  # (tools/colormap/magma_header.py)
+  python3-matplotlib
   # headless Chromium: the tests open `dynbench report`'s HTML in a real browser
   chromium
   # fuzzing the readers of untrusted input (the `fuzz` preset, CONTRIBUTING.md): clang 16 and its

@@ -36,6 +36,9 @@ void addReportCommand(CLI::App& app, CommandRun& run);
 // Registers `capture cube2`.
 void addCaptureCommand(CLI::App& app, CommandRun& run);
 
+// Registers `compare`.
+void addCompareCommand(CLI::App& app, CommandRun& run);
+
 // Registers `demo`.
 void addDemoCommand(CLI::App& app, CommandRun& run);
 

@@ -58,6 +58,7 @@ int main(int argc, char** argv) {
   cli::addDiscardCommand(app, run);
   cli::addReportCommand(app, run);
   cli::addCaptureCommand(app, run);
+  cli::addCompareCommand(app, run);
   cli::addDemoCommand(app, run);
 
   // `dynbench help [COMMAND]`
