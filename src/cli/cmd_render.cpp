@@ -114,6 +114,9 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--blender", o->job.blender, "Blender executable for --engine cycles");
   cmd->add_option("--env-constant", o->envConstant, "Light with a constant environment of radiance L or R,G,B instead of the dataset's");
   cmd->add_flag("--no-environment", o->noEnvironment, "No image-based light (black background)");
+  cmd->add_flag("--jitter", o->job.settings.jitter,
+                "Offset each frame's pixel samples from the centres by the 8-frame Halton (2, 3) sequence, as TAA input "
+                "(recorded as camera.jitter in each sidecar; docs/feature-buffers.md)");
   cmd->add_flag("--converge", o->job.settings.converge,
                 "Adaptive sampling: after max(--spp, 16) samples, sample each pixel in rounds until the standard error of its direct and of its "
                 "indirect luminance is at most --tolerance x discard's radiance threshold (docs/feature-buffers.md), or --max-spp");

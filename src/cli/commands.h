@@ -39,6 +39,9 @@ void addCaptureCommand(CLI::App& app, CommandRun& run);
 // Registers `compare`.
 void addCompareCommand(CLI::App& app, CommandRun& run);
 
+// Registers `evaluate`.
+void addEvaluateCommand(CLI::App& app, CommandRun& run);
+
 // Registers `demo`.
 void addDemoCommand(CLI::App& app, CommandRun& run);
 

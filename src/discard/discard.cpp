@@ -170,7 +170,8 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
         if (!q || outside(*q)) {
           bits |= kFrustum;
         } else {
-          const BilinearTaps taps = bilinearTaps(q->x, q->y, previous.width, previous.height);
+          // A jittered frame's buffers hold its samples at centre + jitter (render --jitter).
+          const BilinearTaps taps = bilinearTaps(q->x - previous.camera.jitter.x, q->y - previous.camera.jitter.y, previous.width, previous.height);
           bool historyMissesGeometry = false;
           for (int k = 0; k < 4; ++k)
             if (taps.weight[k] > 0 && previous.hit[taps.index[k]] <= 0) historyMissesGeometry = true;

@@ -4,6 +4,19 @@
 
 namespace dynbench::frames {
 
+glm::dvec2 jitterOffset(long frame) {
+  auto halton = [](long index, int base) {
+    double f = 1.0, r = 0.0;
+    for (long i = index; i > 0; i /= base) {
+      f /= base;
+      r += f * static_cast<double>(i % base);
+    }
+    return r;
+  };
+  const long index = 1 + ((frame % 8) + 8) % 8;
+  return {halton(index, 2) - 0.5, halton(index, 3) - 0.5};
+}
+
 void FeatureFrame::resize(int w, int h) {
   width = w;
   height = h;

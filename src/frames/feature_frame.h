@@ -22,7 +22,15 @@ struct FrameCamera {
   double yfov = 0.0;   // radians
   double znear = 0.0, zfar = 0.0;  // dataset length units
   int width = 0, height = 0;       // pixels
+  // Sub-pixel offset of every pixel's sample from its centre (render --jitter), in pixels (+x
+  // right, +y down); `projection` is the unjittered one. {0, 0} without jitter.
+  glm::dvec2 jitter{0.0};
 };
+
+// render --jitter's offset for a frame: the Halton (2, 3) sequence at index 1 + (frame mod 8),
+// minus 0.5, so that eight consecutive frames cover the pixel evenly (the sequence real-time TAA
+// uses, e.g. Unreal Engine 4; Karis 2014). In pixels, in [-0.5, 0.5).
+glm::dvec2 jitterOffset(long frame);
 
 // How a frame's radiance was sampled (the sidecar's `sampling` object; docs/feature-buffers.md).
 struct SamplingSummary {
@@ -49,6 +57,9 @@ struct FeatureFrame {
   std::vector<float> directVariance, indirectVariance;            // 1 per pixel
   std::vector<float> spp;                                         // 1 per pixel: samples taken
   std::optional<SamplingSummary> sampling;                        // the sidecar's `sampling`
+  // The sidecar's `cut`: the camera jumped between the previous frame and this one (a respawn or
+  // a switch of the followed player), so temporal methods start their history again here.
+  bool cut = false;
 
   std::size_t pixelCount() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(height); }
   bool hasVariance() const { return !directVariance.empty() && !indirectVariance.empty(); }

@@ -64,6 +64,7 @@ json sidecarJson(long frame, double time, const FrameCamera& camera, const json&
       {"aspect", static_cast<double>(camera.width) / camera.height},
       {"znear", camera.znear},
       {"zfar", camera.zfar},
+      {"jitter", {camera.jitter.x, camera.jitter.y}},
   };
   j["conventions"] = {
       {"matrices", "column-major, 16 numbers (glTF order); clip = projection * view * world_point"},
@@ -71,7 +72,8 @@ json sidecarJson(long frame, double time, const FrameCamera& camera, const json&
       {"clip_space", "OpenGL: NDC x, y, z in [-1, 1], depth -1 at znear"},
       {"pixels", "pixel (x, y) covers [x, x+1) x [y, y+1), row 0 at the top; x = (ndc.x + 1) / 2 * width, "
                  "y = (1 - ndc.y) / 2 * height"},
-      {"motion", "previous-frame pixel position minus this pixel's centre, in pixels"},
+      {"motion", "previous-frame pixel position of the surface point at this pixel's sample, minus the sample's position "
+                 "(the centre plus camera.jitter), in pixels"},
       {"units", "lengths in the dataset's units; radiance in the dataset's photometric units (cd/m2)"},
   };
   j["render"] = render;
@@ -166,6 +168,16 @@ Expected<Sidecar> readSidecar(const fs::path& path) {
     if (!v) return std::unexpected(v.error());
     *target = *v;
   }
+  if (j.contains("/camera/jitter"_json_pointer)) {
+    const json& jitter = j["camera"]["jitter"];
+    if (!jitter.is_array() || jitter.size() != 2 || !jitter[0].is_number() || !jitter[1].is_number())
+      return fail(ErrorCode::kInvalidData, "{}: /camera/jitter: expected two numbers (pixels)", path.string());
+    s.camera.jitter = {jitter[0].get<double>(), jitter[1].get<double>()};
+  }
+  if (j.contains("cut")) {
+    if (!j["cut"].is_boolean()) return fail(ErrorCode::kInvalidData, "{}: /cut: expected true or false", path.string());
+    s.cut = j["cut"].get<bool>();
+  }
   if (j.contains("render")) s.render = j["render"];
   if (j.contains("sampling")) {
     auto sampling = readSampling(j, path);
@@ -211,6 +223,7 @@ Expected<FeatureFrame> readFrame(const FrameEntry& entry, const ReadOptions& opt
   f.time = sidecar->time;
   f.camera = sidecar->camera;
   f.sampling = sidecar->sampling;
+  f.cut = sidecar->cut;
 
   auto image = readImage(entry.image);
   if (!image) return std::unexpected(image.error());
@@ -305,6 +318,7 @@ Expected<void> writeFrame(const fs::path& dir, const FeatureFrame& frame, const 
   // The sidecar last: its presence marks the frame complete.
   json sidecar = sidecarJson(frame.frame, frame.time, frame.camera, render);
   if (frame.sampling) sidecar["sampling"] = samplingJson(*frame.sampling);
+  if (frame.cut) sidecar["cut"] = true;
   return writeFileAtomic(frameSidecarPath(dir, frame.frame), sidecar.dump(2) + "\n");
 }
 

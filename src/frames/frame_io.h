@@ -31,6 +31,7 @@ struct Sidecar {
   FrameCamera camera;
   nlohmann::json render;  // null when absent (another renderer's frames)
   std::optional<SamplingSummary> sampling;
+  bool cut = false;  // /cut: the camera jumped since the previous frame
 };
 // Reads and checks a sidecar: /format must be "dynbench-frame" and /version one this build reads;
 // errors name the file and the JSON pointer.

@@ -217,6 +217,8 @@ Expected<void> CyclesBackend::render(const std::vector<FrameRequest>& requests, 
 }  // namespace
 
 Expected<std::unique_ptr<RenderBackend>> createCyclesBackend(const BackendContext& context) {
+  if (context.job.settings.jitter)
+    return fail(ErrorCode::kUnsupported, "--jitter is implemented by the embree engine only (Cycles renders pixel centres)");
   auto blender = findBlender(context.job.blender);
   if (!blender) return std::unexpected(blender.error());
   auto script = renderScript();

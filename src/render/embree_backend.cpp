@@ -45,6 +45,7 @@ class EmbreeBackend final : public RenderBackend {
       buffers.frame = request.frame;
       buffers.time = request.cameras.time;
       buffers.camera = request.cameras.camera.frameCamera();
+      if (tracer_->settings().jitter) buffers.camera.jitter = frames::jitterOffset(request.frame);
       if (auto ok = done(std::move(buffers)); !ok) return ok;
     }
     return {};

@@ -342,10 +342,11 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
   std::vector<PixelSums> sums(pixels);
   std::vector<SurfaceHit> firstHits(pixels);
   tbb::enumerable_thread_specific<PathScratch> scratches;
+  const glm::dvec2 jitter = settings_.jitter ? frames::jitterOffset(static_cast<long>(frameIndex)) : glm::dvec2(0.0);
 
   auto samplePixel = [&](std::size_t pixel, int upTo, PathScratch& scratch) {
     const int px = static_cast<int>(pixel % static_cast<std::size_t>(width)), py = static_cast<int>(pixel / static_cast<std::size_t>(width));
-    const Ray ray = camera.ray(px + 0.5, py + 0.5);
+    const Ray ray = camera.ray(px + 0.5 + jitter.x, py + 0.5 + jitter.y);
     const SurfaceHit& hit = firstHits[pixel];
     PixelSums& sum = sums[pixel];
     if (!hit.hit) {
@@ -370,7 +371,7 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
     for (int py = rows.begin(); py < rows.end(); ++py) {
       for (int px = 0; px < width; ++px) {
         const std::size_t pixel = static_cast<std::size_t>(py) * static_cast<std::size_t>(width) + static_cast<std::size_t>(px);
-        const Ray ray = camera.ray(px + 0.5, py + 0.5);
+        const Ray ray = camera.ray(px + 0.5 + jitter.x, py + 0.5 + jitter.y);
         const SurfaceHit hit = trace(ray);
         ++scratch.rays;
         firstHits[pixel] = hit;
@@ -385,8 +386,8 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
           const PixelProjection previous = previousCamera.project(rayTracing_->previousPosition(hit));
           // Behind the previous camera there is no pixel to point to: a vector far off screen.
           const glm::dvec2 target = previous.inFront ? previous.pixel : glm::dvec2(-1e9);
-          out.motion[2 * pixel] = static_cast<float>(target.x - (px + 0.5));
-          out.motion[2 * pixel + 1] = static_cast<float>(target.y - (py + 0.5));
+          out.motion[2 * pixel] = static_cast<float>(target.x - (px + 0.5 + jitter.x));
+          out.motion[2 * pixel + 1] = static_cast<float>(target.y - (py + 0.5 + jitter.y));
         }
         samplePixel(pixel, firstRound, scratch);
       }

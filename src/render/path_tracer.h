@@ -52,6 +52,10 @@ struct RenderSettings {
   bool converge = false;
   double tolerance = 0.25;
   int maxSamplesPerPixel = 4096;
+  // render --jitter: every pixel's sample (the hit that P, N, Z, id, motion and the radiance
+  // describe) is offset from the pixel centre by frames::jitterOffset(frame), as a real-time
+  // renderer jitters its projection for TAA.
+  bool jitter = false;
   double directThresholdFraction = 0.1, indirectThresholdFraction = 0.1;
 };
 

@@ -100,6 +100,7 @@ nlohmann::json renderRecord(const RenderJob& job) {
   if (s.converge) r["converge"] = {{"tolerance", s.tolerance}, {"max_spp", s.maxSamplesPerPixel},
                                    {"direct_threshold", s.directThresholdFraction}, {"indirect_threshold", s.indirectThresholdFraction}};
   if (s.lightCutoff) r["light_cutoff"] = *s.lightCutoff;
+  if (s.jitter) r["jitter"] = "halton23x8";
   // --float32 is recorded, so such a job does not take half-stored frames as complete.
   if (job.float32) r["storage"] = "float32";
   // The dataset file's size and modification time: frames of an older version of a dataset at the

@@ -1,0 +1,52 @@
+#include "evaluate/method.h"
+
+namespace dynbench::evaluate {
+
+RgbImage frameRadiance(const frames::FeatureFrame& frame) {
+  RgbImage img{frame.width, frame.height, std::vector<float>(3 * frame.pixelCount())};
+  for (std::size_t i = 0; i < img.rgb.size(); ++i) img.rgb[i] = frame.direct[i] + frame.indirect[i];
+  return img;
+}
+
+std::optional<discard::BilinearTaps> historyTaps(const frames::FeatureFrame& current, const frames::FeatureFrame& previous,
+                                                 const discard::Thresholds& absolute, int px, int py, bool useMotion) {
+  const std::size_t i = static_cast<std::size_t>(py) * current.width + px;
+  const glm::dvec2 sample(px + 0.5 + current.camera.jitter.x, py + 0.5 + current.camera.jitter.y);
+  const bool hit = current.hit[i] > 0;
+  const glm::dvec3 p(hit ? glm::dvec3(current.position[3 * i], current.position[3 * i + 1], current.position[3 * i + 2]) : glm::dvec3(0.0));
+  std::optional<glm::dvec2> q;
+  if (!hit) {
+    q = discard::reprojectDirection(previous.camera, discard::pixelDirection(current.camera, sample.x, sample.y));
+  } else if (useMotion && !current.motion.empty()) {
+    const glm::dvec2 motion(current.motion[2 * i], current.motion[2 * i + 1]);
+    if (std::abs(motion.x) < 1e8 && std::abs(motion.y) < 1e8) q = sample + motion;  // -1e9: behind the previous camera
+  } else {
+    q = discard::reproject(previous.camera, p);
+  }
+  if (!q || q->x < 0 || q->y < 0 || q->x > previous.width || q->y > previous.height) return std::nullopt;
+  // The previous frame's buffers are at its samples: centre + its jitter.
+  const discard::BilinearTaps taps =
+      discard::bilinearTaps(q->x - previous.camera.jitter.x, q->y - previous.camera.jitter.y, previous.width, previous.height);
+  for (int k = 0; k < 4; ++k)
+    if (taps.weight[k] > 0 && (previous.hit[taps.index[k]] > 0) != hit) return std::nullopt;
+  if (hit) {
+    const glm::dvec3 n(current.normal[3 * i], current.normal[3 * i + 1], current.normal[3 * i + 2]);
+    if (glm::length(p - discard::sample3(previous.position, taps)) > absolute.position ||
+        glm::length(n - discard::sample3(previous.normal, taps)) > absolute.normal)
+      return std::nullopt;
+  }
+  return taps;
+}
+
+const char* builtInMethodNames() { return "none, accumulate, taa, svgf, external:DIR"; }
+
+Expected<std::unique_ptr<TemporalMethod>> createMethod(const std::string& spec, const MethodContext& context) {
+  if (spec == "none") return makeNoneMethod();
+  if (spec == "accumulate") return makeAccumulateMethod(context);
+  if (spec == "taa") return makeTaaMethod();
+  if (spec == "svgf") return makeSvgfMethod();
+  if (spec.starts_with("external:")) return makeExternalMethod(spec.substr(9));
+  return fail(ErrorCode::kUsage, "unknown method '{}' (expected one of {})", spec, builtInMethodNames());
+}
+
+}  // namespace dynbench::evaluate

@@ -1,0 +1,67 @@
+#pragma once
+// A temporal method: a real-time algorithm that turns a sequence of noisy frames (radiance plus
+// G-buffers and motion, the feature-buffer contract) into output images, reusing its own history.
+// Each method is one file behind this interface (docs/metrics.md, "Temporal methods"); `evaluate`
+// runs it over a frames folder in order and scores every output against a converged reference.
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "discard/discard.h"
+#include "evaluate/flip.h"
+#include "frames/feature_frame.h"
+
+namespace dynbench::evaluate {
+
+struct MethodOutput {
+  RgbImage image;                     // linear radiance, the input's size
+  std::optional<double> historyUse;   // fraction of pixels whose history was kept (unknown: external)
+};
+
+class TemporalMethod {
+ public:
+  virtual ~TemporalMethod() = default;
+  virtual std::string name() const = 0;
+  // The parameters that define the method's output (recorded with its scores).
+  virtual nlohmann::json parameters() const = 0;
+  // Forgets all history: at the first frame and at every camera cut.
+  virtual void reset() = 0;
+  // The next frame in order; its output image.
+  virtual Expected<MethodOutput> process(const frames::FeatureFrame& frame) = 0;
+};
+
+struct MethodContext {
+  // The history tests of `accumulate` (and the scene size a relative position threshold needs):
+  // the discard stage's own tests.
+  discard::Thresholds thresholds;
+  double sceneSize = 0.0;
+};
+
+// "none", "accumulate", "taa", "svgf" or "external:DIR". Errors name the unknown method.
+Expected<std::unique_ptr<TemporalMethod>> createMethod(const std::string& spec, const MethodContext& context);
+// The built-in method names, for help texts.
+const char* builtInMethodNames();
+
+// Shared by the methods: the frame's full radiance (direct + indirect) as an RgbImage.
+RgbImage frameRadiance(const frames::FeatureFrame& frame);
+
+// Where pixel (px, py) of `current` finds its history in `previous`: the bilinear taps in the
+// previous frame's sample grid, or nullopt when it has none (off screen, Eq. 3.3; or a surface
+// whose history fails the discard stage's world-position and normal tests, or comes from the
+// background, and the other way round). Surfaces are followed by their motion vector (useMotion)
+// or by the camera matrices (thesis Eqs. 2.2-2.3); the background always by the matrices.
+// `absolute` are discard::absoluteThresholds.
+std::optional<discard::BilinearTaps> historyTaps(const frames::FeatureFrame& current, const frames::FeatureFrame& previous,
+                                                 const discard::Thresholds& absolute, int px, int py, bool useMotion);
+
+// Factories, one per method file.
+std::unique_ptr<TemporalMethod> makeNoneMethod();
+std::unique_ptr<TemporalMethod> makeAccumulateMethod(const MethodContext& context);
+std::unique_ptr<TemporalMethod> makeTaaMethod();
+std::unique_ptr<TemporalMethod> makeSvgfMethod();
+Expected<std::unique_ptr<TemporalMethod>> makeExternalMethod(const std::filesystem::path& dir);
+
+}  // namespace dynbench::evaluate

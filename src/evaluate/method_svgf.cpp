@@ -1,0 +1,212 @@
+// `svgf`: spatiotemporal variance-guided filtering, Schied et al., "Spatiotemporal Variance-Guided
+// Filtering: Real-Time Reconstruction for Path-Traced Global Illumination", HPG 2017 ([S17]).
+// Constants are the paper's unless marked [Falcor]: the authors' reference implementation of SVGF
+// in NVIDIA Falcor (SVGFReproject, SVGFFilterMoments, SVGFAtrous passes), where the paper leaves a
+// value open. Background pixels (no hit) have noise-free environment radiance and no G-buffer: they
+// are passed through and do not count as history kept.
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "evaluate/method.h"
+
+namespace dynbench::evaluate {
+namespace {
+
+constexpr double kAlphaColour = 0.2, kAlphaMoments = 0.2;  // [S17] §4.1: alpha = 0.2 for colour and moments
+constexpr int kHistoryCap = 32;                           // [Falcor] the history length saturates
+constexpr int kIterations = 5;                             // [S17] §4.3: five a-trous iterations
+constexpr double kSigmaZ = 1.0, kSigmaN = 128.0, kSigmaL = 4.0;  // [S17] §4.4
+constexpr double kDepthReject = 10.0, kNormalReject = 16.0;       // [Falcor] reprojection consistency
+constexpr int kVarianceRadius = 3;                                // [S17] §4.2: 7x7 bilateral
+constexpr double kMomentsSigmaL = 10.0;                           // [Falcor] luminance weight there
+constexpr double kAlbedoFloor = 1e-3;                             // demodulation of black albedo
+constexpr double kDiffuseShare = 0.96;                            // glTF dielectric: 1 - F0
+constexpr std::array<double, 3> kAtrous{3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0};  // [S17] §4.3: B3 spline 5x5
+
+double luminance(glm::dvec3 c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
+
+class SvgfMethod final : public TemporalMethod {
+ public:
+  std::string name() const override { return "svgf"; }
+  nlohmann::json parameters() const override {
+    return {{"alpha_colour", kAlphaColour}, {"alpha_moments", kAlphaMoments}, {"iterations", kIterations}, {"sigma_z", kSigmaZ},
+            {"sigma_n", kSigmaN}, {"sigma_l", kSigmaL}, {"history_cap", kHistoryCap}};
+  }
+  void reset() override { history_.reset(); }
+
+  Expected<MethodOutput> process(const frames::FeatureFrame& f) override {
+    const int w = f.width, h = f.height;
+    const std::size_t n = f.pixelCount();
+    auto at = [&](const std::vector<float>& b, std::size_t i) { return glm::dvec3(b[3 * i], b[3 * i + 1], b[3 * i + 2]); };
+    auto index = [w](int x, int y) { return static_cast<std::size_t>(y) * w + x; };
+    // Depth gradient (central differences where the neighbours are surfaces) for the depth weight.
+    std::vector<glm::dvec2> gradZ(n, glm::dvec2(0.0));
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        auto dz = [&](int x0, int y0, int x1, int y1) {
+          const std::size_t a = index(std::clamp(x0, 0, w - 1), std::clamp(y0, 0, h - 1)), b = index(std::clamp(x1, 0, w - 1), std::clamp(y1, 0, h - 1));
+          return f.hit[a] > 0 && f.hit[b] > 0 ? (f.depth[b] - f.depth[a]) / std::max(1, (x1 - x0) + (y1 - y0)) : 0.0;
+        };
+        gradZ[index(x, y)] = {dz(x - 1, y, x + 1, y), dz(x, y - 1, x, y + 1)};
+      }
+
+    // 1. Demodulate: illumination = radiance / albedo ([S17] §3). The radiance buffer holds the
+    // specular reflection too, which is not proportional to the base colour: a glTF dielectric
+    // reflects 0.96 base colour diffusely plus a 4 % (F0) white specular lobe (glTF 2.0, Appendix
+    // B), so the demodulating albedo is 0.96 base + 0.04. Dividing by the base colour alone
+    // magnifies the specular part of dark texels and spreads it over bright ones.
+    std::vector<glm::dvec3> albedo(n), illumination(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      albedo[i] = f.hit[i] > 0 ? glm::max(kDiffuseShare * at(f.albedo, i) + (1.0 - kDiffuseShare), kAlbedoFloor) : glm::dvec3(1.0);
+      illumination[i] = (at(f.direct, i) + at(f.indirect, i)) / albedo[i];
+    }
+
+    // 2. Temporal accumulation of illumination and its luminance moments ([S17] §4.1).
+    std::vector<glm::dvec2> moments(n);
+    std::vector<int> length(n, 1);
+    std::vector<double> variance(n, 0.0);
+    long kept = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = index(x, y);
+        const double l = luminance(illumination[i]);
+        moments[i] = {l, l * l};
+        if (f.hit[i] <= 0 || !history_ || history_->width != w || history_->height != h) continue;
+        const History& p = *history_;
+        // The motion vector starts at this pixel's sample; the previous buffers are at its samples.
+        const glm::dvec2 q = glm::dvec2(x + 0.5, y + 0.5) + f.camera.jitter + glm::dvec2(f.motion[2 * i], f.motion[2 * i + 1]) - p.jitter;
+        if (!(std::abs(f.motion[2 * i]) < 1e8) || q.x < 0 || q.y < 0 || q.x > w || q.y > h) continue;
+        const discard::BilinearTaps taps = discard::bilinearTaps(q.x, q.y, w, h);
+        const double fwidthZ = std::abs(gradZ[i].x) + std::abs(gradZ[i].y);
+        glm::dvec3 colour(0.0);
+        glm::dvec2 m(0.0);
+        double weight = 0.0, len = 0.0;
+        for (int k = 0; k < 4; ++k) {
+          const std::size_t j = taps.index[k];
+          if (taps.weight[k] <= 0 || p.hit[j] <= 0 || p.id[j] != f.id[i]) continue;  // the same instance
+          if (std::abs(p.depth[j] - f.depth[i]) / (fwidthZ + 1e-2) > kDepthReject) continue;
+          // [Falcor]'s normal test distance / (fwidth(n) + 0.01) > 16, with fwidth(n) taken as 0.
+          if (glm::length(p.normal[j] - at(f.normal, i)) / 1e-2 > kNormalReject) continue;
+          colour += taps.weight[k] * p.illumination[j], m += taps.weight[k] * p.moments[j], len += taps.weight[k] * p.length[j];
+          weight += taps.weight[k];
+        }
+        if (weight < 0.01) continue;  // [Falcor] too little valid history
+        colour /= weight, m /= weight;
+        length[i] = std::min(kHistoryCap, static_cast<int>(std::lround(len / weight)) + 1);
+        const double a = std::max(kAlphaColour, 1.0 / length[i]), am = std::max(kAlphaMoments, 1.0 / length[i]);
+        illumination[i] = colour + a * (illumination[i] - colour);
+        moments[i] = m + am * (moments[i] - m);
+        ++kept;
+      }
+
+    // 3. Variance: from the temporal moments, or where the history is short (< 4 frames) from the
+    // 7x7 bilateral neighbourhood's moments, boosted by 4 / length ([S17] §4.2, [Falcor]).
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = index(x, y);
+        if (f.hit[i] <= 0) continue;
+        if (length[i] >= 4) {
+          variance[i] = std::max(0.0, moments[i].y - moments[i].x * moments[i].x);
+          continue;
+        }
+        glm::dvec2 m(0.0);
+        double weight = 0.0;
+        for (int dy = -kVarianceRadius; dy <= kVarianceRadius; ++dy)
+          for (int dx = -kVarianceRadius; dx <= kVarianceRadius; ++dx) {
+            const int xx = x + dx, yy = y + dy;
+            if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+            const std::size_t j = index(xx, yy);
+            if (f.hit[j] <= 0) continue;
+            const double wz = std::exp(-std::abs(f.depth[i] - f.depth[j]) / (kSigmaZ * std::abs(glm::dot(gradZ[i], glm::dvec2(dx, dy))) + 1e-8));
+            const double wn = std::pow(std::max(0.0, glm::dot(at(f.normal, i), at(f.normal, j))), kSigmaN);
+            const double wl = std::exp(-std::abs(luminance(illumination[i]) - luminance(illumination[j])) / kMomentsSigmaL);
+            const double wgt = (dx == 0 && dy == 0) ? 1.0 : wz * wn * wl;
+            m += wgt * moments[j], weight += wgt;
+          }
+        m /= weight;
+        variance[i] = std::max(0.0, m.y - m.x * m.x) * 4.0 / length[i];
+      }
+
+    // 4. A-trous wavelet filter, 5 iterations with steps 1, 2, 4, 8, 16 ([S17] §4.3-4.4); the
+    // first iteration's output is the colour history of the next frame.
+    std::vector<glm::dvec3> feedback;
+    for (int iteration = 0; iteration < kIterations; ++iteration) {
+      const int step = 1 << iteration;
+      std::vector<glm::dvec3> nextIllumination = illumination;
+      std::vector<double> nextVariance = variance;
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          const std::size_t i = index(x, y);
+          if (f.hit[i] <= 0) continue;
+          // Variance prefiltered with a 3x3 Gaussian for the luminance weight ([S17] Eq. 5).
+          double blurred = 0.0, blurWeight = 0.0;
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              const int xx = std::clamp(x + dx, 0, w - 1), yy = std::clamp(y + dy, 0, h - 1);
+              const double g = (dx ? 0.5 : 1.0) * (dy ? 0.5 : 1.0);
+              blurred += g * variance[index(xx, yy)], blurWeight += g;
+            }
+          const double lumDenominator = kSigmaL * std::sqrt(std::max(0.0, blurred / blurWeight)) + 1e-10;
+          const double lp = luminance(illumination[i]);
+          const glm::dvec3 np = at(f.normal, i);
+          glm::dvec3 sum(0.0);
+          double sumW = 0.0, sumVar = 0.0;
+          for (int ky = -2; ky <= 2; ++ky)
+            for (int kx = -2; kx <= 2; ++kx) {
+              const int xx = x + kx * step, yy = y + ky * step;
+              if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+              const std::size_t j = index(xx, yy);
+              if (f.hit[j] <= 0) continue;
+              const double hk = kAtrous[std::abs(kx)] * kAtrous[std::abs(ky)];
+              // [S17] Eqs. 3-4: depth, normal and luminance edge-stopping weights.
+              const double wz = std::exp(-std::abs(f.depth[i] - f.depth[j]) /
+                                         (kSigmaZ * std::abs(glm::dot(gradZ[i], glm::dvec2(kx * step, ky * step))) + 1e-8));
+              const double wn = std::pow(std::max(0.0, glm::dot(np, at(f.normal, j))), kSigmaN);
+              const double wl = std::exp(-std::abs(lp - luminance(illumination[j])) / lumDenominator);
+              const double wgt = (kx == 0 && ky == 0) ? hk : hk * wz * wn * wl;
+              sum += wgt * illumination[j], sumW += wgt, sumVar += wgt * wgt * variance[j];
+            }
+          nextIllumination[i] = sum / sumW;
+          nextVariance[i] = sumVar / (sumW * sumW);  // [S17] Eq. 2
+        }
+      illumination.swap(nextIllumination);
+      variance.swap(nextVariance);
+      if (iteration == 0) feedback = illumination;
+    }
+
+    // 5. Remodulate with the albedo; keep this frame's history.
+    RgbImage out = frameRadiance(f);
+    History next;
+    next.width = w, next.height = h, next.jitter = f.camera.jitter;
+    next.illumination = feedback.empty() ? illumination : feedback;
+    next.moments = moments, next.length = length;
+    next.depth = f.depth, next.id = f.id, next.hit = f.hit;
+    next.normal.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      next.normal[i] = at(f.normal, i);
+      if (f.hit[i] <= 0) continue;
+      const glm::dvec3 c = illumination[i] * albedo[i];
+      for (int k = 0; k < 3; ++k) out.rgb[3 * i + k] = static_cast<float>(c[k]);
+    }
+    history_ = std::move(next);
+    return MethodOutput{std::move(out), static_cast<double>(kept) / static_cast<double>(n)};
+  }
+
+ private:
+  struct History {
+    int width = 0, height = 0;
+    glm::dvec2 jitter{0.0};
+    std::vector<glm::dvec3> illumination, normal;
+    std::vector<glm::dvec2> moments;
+    std::vector<int> length;
+    std::vector<float> depth, id, hit;
+  };
+  std::optional<History> history_;
+};
+
+}  // namespace
+
+std::unique_ptr<TemporalMethod> makeSvgfMethod() { return std::make_unique<SvgfMethod>(); }
+
+}  // namespace dynbench::evaluate

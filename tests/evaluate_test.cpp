@@ -1,0 +1,186 @@
+// Temporal methods and the evaluate harness (evaluate/method.h, evaluate/evaluate.h) on synthetic
+// frames with known noise: a static camera looking at a plane.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+#include "evaluate/evaluate.h"
+#include "evaluate/method.h"
+#include "frames/frame_io.h"
+
+namespace dynbench::evaluate {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kW = 64, kH = 48;
+constexpr double kSigma = 0.2;  // the input's noise, per pixel and channel
+
+// The true radiance of a pixel: a smooth pattern around 1.
+glm::dvec3 truth(int x, int y) { return glm::dvec3(1.0 + 0.3 * std::sin(0.2 * x), 0.8 + 0.2 * std::cos(0.15 * y), 0.6); }
+
+// Frame `index` of a static camera at the origin looking down -Z at the plane z = -5; the direct
+// radiance is the truth plus Gaussian noise of standard deviation `sigma` (0: the reference).
+frames::FeatureFrame planeFrame(long index, double sigma, std::uint32_t seed) {
+  frames::FeatureFrame f;
+  f.frame = index;
+  f.time = index / 24.0;
+  f.resize(kW, kH);
+  frames::FrameCamera& c = f.camera;
+  c.view = glm::lookAt(glm::dvec3(0.0), glm::dvec3(0, 0, -1), glm::dvec3(0, 1, 0));
+  c.world = glm::inverse(c.view);
+  c.projection = glm::perspective(glm::radians(60.0), static_cast<double>(kW) / kH, 0.1, 100.0);
+  c.yfov = glm::radians(60.0), c.znear = 0.1, c.zfar = 100.0, c.width = kW, c.height = kH;
+  std::mt19937 rng(seed * 7919u + static_cast<std::uint32_t>(index));
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * kW + x;
+      const glm::dvec3 d = discard::pixelDirection(c, x + 0.5, y + 0.5);
+      const glm::dvec3 p = d * (5.0 / -d.z);
+      for (int k = 0; k < 3; ++k) {
+        f.position[3 * i + k] = static_cast<float>(p[k]);
+        f.normal[3 * i + k] = k == 2 ? 1.0f : 0.0f;
+        f.albedo[3 * i + k] = 0.5f;
+        f.direct[3 * i + k] = static_cast<float>(truth(x, y)[k] + (sigma > 0 ? noise(rng) * sigma : 0.0));
+      }
+      f.depth[i] = 5.0f, f.id[i] = 0.0f, f.hit[i] = 1.0f;
+    }
+  return f;
+}
+
+double mseAgainstTruth(const RgbImage& image) {
+  double sum = 0.0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      for (int k = 0; k < 3; ++k) {
+        const double d = image.rgb[3 * (static_cast<std::size_t>(y) * kW + x) + k] - truth(x, y)[k];
+        sum += d * d;
+      }
+  return sum / (3.0 * kW * kH);
+}
+
+TEST(Methods, AccumulateErrorFallsAsOneOverSqrtNOnAStaticScene) {
+  // With alpha = max(1/n, 0.1) and every history kept, the output after n <= 10 frames is the mean
+  // of n independent frames: variance sigma^2 / n. After that each frame gives
+  // v' = (1 - 0.1)^2 v + 0.1^2 sigma^2, which tends to sigma^2 x 0.01 / 0.19 (= 0.0526 sigma^2).
+  // The measured MSE averages P = 3 x 64 x 48 independent squared Gaussians, so its relative
+  // standard deviation is sqrt(2 / P) = 1.47 %; 4 of those (5.9 %) bound each frame's ratio.
+  MethodContext context;
+  context.thresholds.relativePosition = true, context.thresholds.position = 0.01;
+  context.sceneSize = discard::sceneSize(planeFrame(0, 0.0, 1));
+  auto method = createMethod("accumulate", context);
+  ASSERT_TRUE(method.has_value());
+  (*method)->reset();
+  const double bound = 4.0 * std::sqrt(2.0 / (3.0 * kW * kH));
+  double expected = kSigma * kSigma;
+  for (int n = 1; n <= 30; ++n) {
+    if (n > 1) expected = n <= 10 ? kSigma * kSigma / n : 0.81 * expected + 0.01 * kSigma * kSigma;
+    auto out = (*method)->process(planeFrame(n, kSigma, 1));
+    ASSERT_TRUE(out.has_value());
+    EXPECT_NEAR(out->historyUse.value_or(-1), n == 1 ? 0.0 : 1.0, 1e-12) << "frame " << n;
+    const double ratio = mseAgainstTruth(out->image) / expected;
+    EXPECT_NEAR(ratio, 1.0, bound) << "frame " << n << ": MSE " << mseAgainstTruth(out->image) << ", expected " << expected;
+  }
+}
+
+TEST(Methods, TaaAndSvgfReduceNoiseOnAStaticScene) {
+  // Not a bound, a sanity floor: after 16 frames both must be well below the input's noise.
+  for (const char* name : {"taa", "svgf"}) {
+    auto method = createMethod(name, MethodContext{});
+    ASSERT_TRUE(method.has_value());
+    double mse = 0.0;
+    for (int n = 1; n <= 16; ++n) {
+      auto out = (*method)->process(planeFrame(n, kSigma, 2));
+      ASSERT_TRUE(out.has_value());
+      mse = mseAgainstTruth(out->image);
+    }
+    EXPECT_LT(mse, 0.5 * kSigma * kSigma) << name;
+  }
+  EXPECT_FALSE(createMethod("bogus", MethodContext{}).has_value());
+  EXPECT_FALSE(createMethod("external:/no/such/dir", MethodContext{}).has_value());
+}
+
+fs::path writeSequence(const std::string& name, double sigma, long cutAt, int count) {
+  const fs::path dir = fs::temp_directory_path() / ("dynbench_evaluate_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (int n = 0; n < count; ++n) {
+    frames::FeatureFrame f = planeFrame(100 + n, sigma, 3);
+    f.cut = (100 + n) == cutAt;
+    EXPECT_TRUE(frames::writeFrame(dir, f, nlohmann::json{{"engine", "test"}}, frames::WriteOptions{.float32 = true}).has_value());
+  }
+  return dir;
+}
+
+TEST(Evaluate, HistoryUseIsZeroAtCutsAndScoresAreDeterministic) {
+  const fs::path noisy = writeSequence("noisy", kSigma, 104, 8), reference = writeSequence("reference", 0.0, -1, 8);
+  EvaluateOptions o;
+  o.frames = noisy, o.reference = reference;
+  o.methods = {"none", "accumulate", "taa", "svgf"};
+  o.json = noisy / "eval.json", o.outDir = noisy / "out";
+  auto run = runEvaluate(o);
+  ASSERT_TRUE(run.has_value()) << run.error().message;
+  ASSERT_EQ(run->methods.size(), 4u);
+  for (const MethodScores& m : run->methods) {
+    ASSERT_EQ(m.frames.size(), 8u);
+    for (const FrameScores& s : m.frames) {
+      const bool cut = s.frame == 100 || s.frame == 104;
+      EXPECT_EQ(s.cut, cut) << m.name << " frame " << s.frame;
+      ASSERT_TRUE(s.historyUse.has_value());
+      if (cut || m.name == "none") {
+        EXPECT_EQ(*s.historyUse, 0.0) << m.name << " frame " << s.frame;
+        EXPECT_FALSE(s.tPsnr.has_value() && cut);
+      } else {
+        EXPECT_GT(*s.historyUse, 0.9) << m.name << " frame " << s.frame;
+      }
+    }
+    if (m.name != "none") EXPECT_LT(m.flip.mean, run->methods[0].flip.mean) << m.name << " is no better than the input";
+  }
+  // Deterministic: a second run writes the same JSON.
+  const std::string first = nlohmann::json::parse(std::ifstream(o.json)).dump();
+  auto again = runEvaluate(o);
+  ASSERT_TRUE(again.has_value());
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(o.json)).dump(), first);
+  // The outputs under --out follow the external contract: scored again as external:DIR they give
+  // the built-in method's scores.
+  EvaluateOptions external = o;
+  external.methods = {"external:" + (o.outDir / "svgf").string()};
+  external.json.clear(), external.outDir.clear();
+  auto rescored = runEvaluate(external);
+  ASSERT_TRUE(rescored.has_value()) << rescored.error().message;
+  EXPECT_NEAR(rescored->methods[0].flip.mean, run->methods[3].flip.mean, 1e-6);
+  EXPECT_NEAR(rescored->methods[0].relMse.mean, run->methods[3].relMse.mean, 1e-6);
+  EXPECT_FALSE(rescored->methods[0].frames[1].historyUse.has_value());
+  EXPECT_TRUE(fs::exists(o.outDir / "svgf" / "flip_worst.png"));
+  // The JSON reads back.
+  auto read = readEvaluateJson(o.json);
+  ASSERT_TRUE(read.has_value()) << read.error().message;
+  EXPECT_EQ(read->methods[2].name, "taa");
+  EXPECT_NEAR(read->methods[2].flip.mean, run->methods[2].flip.mean, 1e-12);
+}
+
+TEST(Evaluate, BadInputsGiveClearErrors) {
+  const fs::path noisy = writeSequence("bad_noisy", kSigma, -1, 3), reference = writeSequence("bad_reference", 0.0, -1, 2);
+  EvaluateOptions o;
+  o.frames = noisy, o.reference = reference, o.methods = {"none"};
+  auto run = runEvaluate(o);
+  ASSERT_FALSE(run.has_value());
+  EXPECT_NE(run.error().message.find("no reference for frame 102"), std::string::npos) << run.error().message;
+  o.reference = noisy, o.methods = {"median"};
+  run = runEvaluate(o);
+  ASSERT_FALSE(run.has_value());
+  EXPECT_NE(run.error().message.find("unknown method 'median'"), std::string::npos) << run.error().message;
+  const fs::path bad = noisy / "bad.json";
+  std::ofstream(bad) << R"({"format": "dynbench-evaluate", "methods": [{"name": "none", "mean": {"flip": {"mean": "x"}}}]})";
+  auto read = readEvaluateJson(bad);
+  ASSERT_FALSE(read.has_value());
+  EXPECT_NE(read.error().message.find("/methods/0/mean/flip/mean: expected a number"), std::string::npos) << read.error().message;
+}
+
+}  // namespace
+}  // namespace dynbench::evaluate
