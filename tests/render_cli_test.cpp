@@ -10,6 +10,8 @@
 
 #include "core/files.h"
 #include "core/image_io.h"
+#include "discard/discard.h"
+#include "frames/frame_io.h"
 #include "gltf_builder.h"
 #include "render/backend.h"
 #include "run_cli.h"
@@ -81,6 +83,50 @@ TEST(RenderCli, WritesTheContractAndResumes) {
   EXPECT_NE(r.out.find("3 frame(s) rendered, 0 already complete"), std::string::npos) << r.out;
   for (const auto& entry : fs::directory_iterator(out))
     EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+}
+
+TEST(RenderCli, JitterOffsetsEachFramesSamplesByTheHaltonSequence) {
+  // Halton (2, 3) at index 1 + (frame mod 8), minus 0.5: by hand, index 1 = (1/2, 1/3),
+  // index 2 = (1/4, 2/3), index 8 = (1/16, 8/9).
+  EXPECT_NEAR(frames::jitterOffset(0).x, 0.0, 1e-15);
+  EXPECT_NEAR(frames::jitterOffset(0).y, 1.0 / 3 - 0.5, 1e-15);
+  EXPECT_NEAR(frames::jitterOffset(1).x, -0.25, 1e-15);
+  EXPECT_NEAR(frames::jitterOffset(1).y, 2.0 / 3 - 0.5, 1e-15);
+  EXPECT_NEAR(frames::jitterOffset(7).x, 1.0 / 16 - 0.5, 1e-15);
+  EXPECT_NEAR(frames::jitterOffset(7).y, 8.0 / 9 - 0.5, 1e-15);
+  EXPECT_EQ(frames::jitterOffset(9), frames::jitterOffset(1));
+
+  const auto dir = test::freshDir("render_jitter");
+  const fs::path out = dir / "frames";
+  auto r = dynbench(fmt::format("render {} -o {} --res 32x18 --spp 1 --frames 0:1", kOrbit.string(), out.string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  // Jittered frames are not the same settings: both are rendered again.
+  r = dynbench(fmt::format("render {} -o {} --res 32x18 --spp 1 --frames 0:1 --jitter", kOrbit.string(), out.string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("2 frame(s) rendered, 0 already complete"), std::string::npos) << r.out;
+  auto entries = frames::listFrames(out);
+  ASSERT_TRUE(entries.has_value());
+  for (const auto& entry : *entries) {
+    auto frame = frames::readFrame(entry);
+    ASSERT_TRUE(frame.has_value()) << frame.error().message;
+    EXPECT_EQ(frame->camera.jitter, frames::jitterOffset(entry.frame));
+    // Every hit's world position projects (unjittered matrices) onto its pixel's centre + jitter.
+    int hits = 0;
+    for (int y = 0; y < frame->height; ++y)
+      for (int x = 0; x < frame->width; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * frame->width + x;
+        if (frame->hit[i] <= 0) continue;
+        const auto q = discard::reproject(frame->camera, {frame->position[3 * i], frame->position[3 * i + 1], frame->position[3 * i + 2]});
+        ASSERT_TRUE(q.has_value());
+        EXPECT_NEAR(q->x, x + 0.5 + frame->camera.jitter.x, 2e-3);
+        EXPECT_NEAR(q->y, y + 0.5 + frame->camera.jitter.y, 2e-3);
+        ++hits;
+      }
+    EXPECT_GT(hits, 50);
+  }
+  r = dynbench(fmt::format("render {} -o {} --res 32x18 --spp 1 --frames 0 --jitter --engine cycles", kOrbit.string(), (dir / "c").string()), dir);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("--jitter is implemented by the embree engine only"), std::string::npos) << r.err;
 }
 
 TEST(RenderCli, AChangedDatasetIsRenderedAgain) {
