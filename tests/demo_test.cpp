@@ -84,6 +84,24 @@ TEST(Demo, WholeChainOnAShortMatch) {
   const auto discardJson = nlohmann::json::parse(test::slurp(dir / "demo" / "runs" / "colos_bot" / "discard.json"));
   EXPECT_EQ(discardJson["frames"].size(), 11u);
   EXPECT_EQ(discardJson["mean"]["interval"]["direct_radiance"].size(), 2u);
+  // Temporal methods on both datasets: every method scored on every frame of the window, the
+  // first frame a reset, and the Markdown's table with a row per dataset and method.
+  for (const char* run : {"colos_bot", "colos_flythrough"}) {
+    const auto evaluation = nlohmann::json::parse(test::slurp(dir / "demo" / "runs" / run / "evaluate.json"));
+    ASSERT_EQ(evaluation["methods"].size(), 4u) << run;
+    for (const auto& method : evaluation["methods"]) {
+      EXPECT_EQ(method["frames"].size(), 12u) << run;
+      EXPECT_EQ(method["frames"][0]["history_use"].get<double>(), 0.0) << run;
+      EXPECT_GT(method["mean"]["flip"]["mean"].get<double>(), 0.0) << run;
+      // A line of the Markdown with the dataset in its first column and the method in its second.
+      bool found = false;
+      for (std::size_t at = md.find(fmt::format("| {} ", run)); at != std::string::npos && !found; at = md.find(fmt::format("| {} ", run), at + 1)) {
+        const std::string line = md.substr(at, md.find('\n', at) - at);
+        found = line.find(fmt::format(" | {} |", method["name"].get<std::string>())) != std::string::npos;
+      }
+      EXPECT_TRUE(found) << run << " " << method["name"];
+    }
+  }
 
   // Convergence (the acceptance, at a size the suite affords): the seeded segment (colos,
   // 4 bots, 3 s, seed 1), frames 40-47, rendered to convergence with two seeds gives direct and

@@ -38,16 +38,28 @@ TEST(Report, TablesAndImagesInTheBrowser) {
   const auto dir = test::freshDir("report");
   makeRun(dir / "slow", "0:4");
   makeRun(dir / "fast", "20:24");
+  // The slow run also scores two temporal methods on a 1-spp render of its frames.
+  const fs::path slow = dir / "slow";
+  for (const auto& args :
+       {fmt::format("render {} -o {} --frames 0:4 --res 32x18 --spp 1 --seed 2", kOrbit.string(), (slow / "input").string()),
+        fmt::format("evaluate {} --reference {} --methods none,accumulate --json {} --out {}", (slow / "input").string(), (slow / "frames").string(),
+                    (slow / "evaluate.json").string(), (slow / "evaluate").string())}) {
+    const auto e = dynbench(args, dir);
+    ASSERT_EQ(e.status, 0) << args << ": " << e.err;
+  }
   const auto r = dynbench(fmt::format("report {} {} -o {} --title 'Two runs'", (dir / "slow").string(), (dir / "fast").string(),
                                       (dir / "out" / "report.html").string()),
                           dir);
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string md = test::slurp(dir / "out" / "report.md");
   for (int t = 1; t <= 7; ++t) EXPECT_NE(md.find(fmt::format("Table 6.{}.", t)), std::string::npos) << t;
-  EXPECT_EQ(count(md, "| slow "), 7u);  // one row per table
+  EXPECT_EQ(count(md, "| slow "), 9u);  // one row per table, and one per temporal method
   EXPECT_EQ(count(md, "| fast "), 7u);
-  // Per run: A.1, A.2, the discard series, 3 thumbnails, 3 masks.
-  EXPECT_EQ(count(md, "!["), 18u);
+  EXPECT_NE(md.find("Temporal methods against the converged reference"), std::string::npos);
+  EXPECT_NE(md.find(" | accumulate |"), std::string::npos);
+  // Per run: A.1, A.2, the discard series, 3 thumbnails, 3 masks; the slow run's two worst-frame
+  // heatmaps; the methods' per-frame plot.
+  EXPECT_EQ(count(md, "!["), 21u);
   const std::string html = test::slurp(dir / "out" / "report.html");
   EXPECT_EQ(html.find("http://"), std::string::npos);  // self-contained: nothing to fetch
   EXPECT_EQ(html.find("src=\"report_files"), std::string::npos);
@@ -59,10 +71,10 @@ TEST(Report, TablesAndImagesInTheBrowser) {
                                  fs::absolute(dir / "out" / "report.html").string()),
                      dom),
             0);
-  EXPECT_NE(dom.find("data-images-decoded=\"18\""), std::string::npos) << dom.substr(0, 400);
-  EXPECT_NE(dom.find("data-images=\"18\""), std::string::npos);
-  EXPECT_EQ(count(dom, "<table>"), 7u);
-  EXPECT_EQ(count(dom, "<th scope=\"row\">slow</th>"), 7u);
+  EXPECT_NE(dom.find("data-images-decoded=\"21\""), std::string::npos) << dom.substr(0, 400);
+  EXPECT_NE(dom.find("data-images=\"21\""), std::string::npos);
+  EXPECT_EQ(count(dom, "<table>"), 8u);
+  EXPECT_EQ(count(dom, "<th scope=\"row\">slow</th>"), 9u);
   EXPECT_EQ(count(dom, "<th scope=\"row\">fast</th>"), 7u);
 }
 

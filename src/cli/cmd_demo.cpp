@@ -46,6 +46,9 @@ void addDemoCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--render-frames", o->options.renderFrames, "Consecutive frames rendered, around the middle of each dataset")
       ->check(between(2, 1000000));
   cmd->add_option("--bounces", o->options.bounces, "Bounces")->check(nonNegative());
+  cmd->add_option("--input-spp", o->options.inputSamplesPerPixel, "Samples per pixel of the temporal methods' input (evaluate)")
+      ->check(positive());
+  cmd->add_option("--methods", o->options.methods, "Temporal methods evaluated on each dataset (evaluate --methods)")->delimiter(',');
   cmd->callback([o, &run] { run = [o] { return runDemo(*o); }; });
 }
 

@@ -9,6 +9,7 @@
 #include "convert/merge_camera.h"
 #include "core/files.h"
 #include "core/math.h"
+#include "evaluate/evaluate.h"
 #include "pipeline/stages.h"
 #include "scene/evaluate.h"
 #include "scene/load.h"
@@ -84,8 +85,32 @@ Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, cons
   log(fmt::format("  discard: frustum {:.2f} %, world position {:.2f} %, shading normal {:.2f} %, direct {:.2f} ± {:.2f} %, indirect {:.2f} ± {:.2f} %",
                   mean.frustum, mean.position, mean.normal, mean.direct, mean.directInterval ? mean.directInterval->halfWidth() : 0.0,
                   mean.indirect, mean.indirectInterval ? mean.indirectInterval->halfWidth() : 0.0));
+
+  // Temporal methods: the same window rendered as a real-time renderer would (a few samples per
+  // pixel, another seed so its noise is independent of the reference's), each method run over it
+  // and scored against the converged frames above.
+  RenderStage input = render;
+  input.job.output = run / "input";
+  input.job.settings.converge = false;
+  input.job.settings.samplesPerPixel = o.inputSamplesPerPixel;
+  input.job.settings.seed = o.seed + 1;
+  auto renderedInput = runRender(input);
+  if (!renderedInput) return std::unexpected(renderedInput.error());
+  evaluate::EvaluateOptions evaluation;
+  evaluation.frames = input.job.output;
+  evaluation.reference = render.job.output;
+  evaluation.methods = o.methods;
+  evaluation.json = run / "evaluate.json";
+  evaluation.csv = run / "evaluate.csv";
+  evaluation.outDir = run / "evaluate";
+  auto evaluated = evaluate::runEvaluate(evaluation);
+  if (!evaluated) return std::unexpected(evaluated.error());
+  for (const auto& m : evaluated->methods)
+    log(fmt::format("  {} ({} spp input): FLIP {:.4f} ± {:.4f}, PSNR {:.2f} dB, history use {:.3f}", m.name, o.inputSamplesPerPixel, m.flip.mean,
+                    m.flip.standardError, m.psnr.mean, m.historyUse.mean));
   return {};
 }
+
 
 }  // namespace
 

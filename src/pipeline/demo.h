@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 
@@ -25,6 +26,10 @@ struct DemoOptions {
   int maxSamplesPerPixel = 512;
   int renderFrames = 48;
   int flythroughKeys = 4;  // key points of the fly-through's spline
+  // Temporal methods evaluated on each dataset: the window rendered again at this many samples per
+  // pixel (the input a real-time method gets), scored against the converged frames.
+  int inputSamplesPerPixel = 4;
+  std::vector<std::string> methods{"none", "accumulate", "taa", "svgf"};
 };
 
 // One line per stage (for the terminal and logs).

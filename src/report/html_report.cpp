@@ -8,6 +8,7 @@
 #include "core/files.h"
 #include "core/image_io.h"
 #include "discard/discard.h"
+#include "evaluate/evaluate.h"
 #include "frames/frame_io.h"
 #include "frames/preview.h"
 #include "report/plots.h"
@@ -28,6 +29,7 @@ struct Run {
   std::string cameraCsv;
   std::vector<fs::path> masks;
   std::vector<frames::FrameEntry> frames;
+  std::optional<evaluate::EvaluateRun> evaluation;  // RUN/evaluate.json, when the run has one
 };
 
 Expected<Run> readRun(const fs::path& dir) {
@@ -62,6 +64,11 @@ Expected<Run> readRun(const fs::path& dir) {
       if (e.path().extension() == ".png") run.masks.push_back(e.path());
     std::sort(run.masks.begin(), run.masks.end());
   }
+  if (fs::is_regular_file(dir / "evaluate.json", ec)) {
+    auto evaluated = evaluate::readEvaluateJson(dir / "evaluate.json");
+    if (!evaluated) return std::unexpected(evaluated.error());
+    run.evaluation = std::move(*evaluated);
+  }
   if (fs::is_directory(dir / "frames", ec))
     if (auto listed = frames::listFrames(dir / "frames")) run.frames = *listed;
   return run;
@@ -77,6 +84,11 @@ std::vector<Table> tables(const std::vector<Run>& runs) {
   }
   auto all = statsTables(statsRows);
   all.push_back(discardTable(discardRows));
+  std::vector<MethodsRow> methodRows;
+  for (const auto& r : runs)
+    if (r.evaluation)
+      for (const auto& m : r.evaluation->methods) methodRows.push_back({r.name, m});
+  if (!methodRows.empty()) all.push_back(temporalMethodsTable(methodRows));
   return all;
 }
 
@@ -84,6 +96,14 @@ struct Figure {
   std::string caption;
   fs::path png;  // in the assets folder
 };
+
+// A figure as HTML with its PNG inline.
+Expected<std::string> figureHtml(const Figure& f) {
+  auto bytes = readWholeFile(f.png);
+  if (!bytes) return std::unexpected(bytes.error());
+  return fmt::format("<figure><img alt=\"{0}\" src=\"data:image/png;base64,{1}\"><figcaption>{0}</figcaption></figure>\n",
+                     escapeHtml(f.caption), base64Encode(*bytes));
+}
 
 }  // namespace
 
@@ -122,6 +142,24 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
   fs::create_directories(files.assets, ec);
   if (ec) return fail(ErrorCode::kIo, "{}: cannot create: {}", files.assets.string(), ec.message());
 
+  // Temporal methods of every run on one axis, then per run (below) each method's worst frame.
+  std::vector<Figure> comparison;
+  {
+    std::vector<std::pair<std::string, std::vector<double>>> series;
+    for (const Run& r : runs)
+      if (r.evaluation)
+        for (const auto& m : r.evaluation->methods) {
+          std::vector<double> values;
+          for (const auto& f : m.frames) values.push_back(f.flip);
+          series.emplace_back(r.name + " " + m.name, std::move(values));
+        }
+    if (!series.empty()) {
+      auto written = writeMethodsPlot(series, files.assets, "all");
+      if (!written) return std::unexpected(written.error());
+      comparison.push_back({"ꟻLIP per frame of every temporal method and dataset (lower is better)", files.assets / "all_methods_flip.png"});
+    }
+  }
+
   // Figures: per run, A.1 / A.2 (when a camera series is there), the discard series, thumbnails, masks.
   std::vector<std::pair<std::string, std::vector<Figure>>> figures;
   for (std::size_t k = 0; k < runs.size(); ++k) {
@@ -158,6 +196,15 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
       if (ec) return fail(ErrorCode::kIo, "{}: cannot copy: {}", mask.string(), ec.message());
       list.push_back({"Discard mask " + mask.stem().string() + " (red frustum, yellow position, blue normal, magenta direct, cyan indirect)", copy});
     }
+    if (r.evaluation)
+      for (const auto& m : r.evaluation->methods) {
+        const fs::path heat = r.dir / "evaluate" / evaluate::methodFolder(m.name) / "flip_worst.png";
+        if (!fs::is_regular_file(heat, ec)) continue;
+        const fs::path copy = files.assets / fmt::format("{}_{}_flip_worst.png", stem, evaluate::methodFolder(m.name));
+        fs::copy_file(heat, copy, fs::copy_options::overwrite_existing, ec);
+        if (ec) return fail(ErrorCode::kIo, "{}: cannot copy: {}", heat.string(), ec.message());
+        list.push_back({fmt::format("{}: ꟻLIP error of its worst frame, {} (magma: black 0, yellow 1)", m.name, m.worstFrame), copy});
+      }
     figures.emplace_back(r.name, std::move(list));
   }
 
@@ -165,6 +212,8 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
   // Markdown twin.
   std::string md = fmt::format("# {}\n\n", options.title);
   for (const auto& t : allTables) md += markdownTable(t);
+  for (const auto& f : comparison)
+    md += fmt::format("![{}]({}/{})\n\n", f.caption, files.assets.filename().string(), f.png.filename().string());
   for (const auto& [name, list] : figures) {
     md += fmt::format("## {}\n\n", name);
     for (const auto& f : list)
@@ -187,13 +236,17 @@ figcaption {{ font-size: .85em; max-width: 600px; }}
 )",
                                  escapeHtml(options.title));
   for (const auto& t : allTables) html += htmlTable(t);
+  for (const auto& f : comparison) {
+    auto figure = figureHtml(f);
+    if (!figure) return std::unexpected(figure.error());
+    html += *figure;
+  }
   for (const auto& [name, list] : figures) {
     html += fmt::format("<section class=\"run\"><h2>{}</h2>\n", escapeHtml(name));
     for (const auto& f : list) {
-      auto bytes = readWholeFile(f.png);
-      if (!bytes) return std::unexpected(bytes.error());
-      html += fmt::format("<figure><img alt=\"{0}\" src=\"data:image/png;base64,{1}\"><figcaption>{0}</figcaption></figure>\n",
-                          escapeHtml(f.caption), base64Encode(*bytes));
+      auto figure = figureHtml(f);
+      if (!figure) return std::unexpected(figure.error());
+      html += *figure;
     }
     html += "</section>\n";
   }

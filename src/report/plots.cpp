@@ -1,5 +1,6 @@
 #include "report/plots.h"
 
+#include <algorithm>
 #include <fstream>
 
 #include "core/files.h"
@@ -111,6 +112,29 @@ Expected<std::vector<fs::path>> writeDiscardPlot(const std::vector<discard::Fram
   for (int column = 2; column <= 6; ++column)
     plot += fmt::format("{}{{data}} using 1:{} with lines lw 1.5 title columnhead", column > 2 ? ", " : "", column);
   return writeLineFigures(dir, stem, csv, {{"discard", title + ": discarded pixels per frame (Eq. 3.4)", "% of the image", plot}});
+}
+
+Expected<std::vector<fs::path>> writeMethodsPlot(const std::vector<std::pair<std::string, std::vector<double>>>& series, const fs::path& dir,
+                                                 const std::string& stem) {
+  std::size_t length = 0;
+  std::string csv = "frame in window";
+  for (const auto& [label, values] : series) {
+    std::string name = label;
+    std::replace(name.begin(), name.end(), ',', ' ');
+    csv += "," + name;
+    length = std::max(length, values.size());
+  }
+  csv += "\n";
+  for (std::size_t k = 0; k < length; ++k) {
+    csv += std::to_string(k);
+    for (const auto& [label, values] : series) csv += k < values.size() ? fmt::format(",{}", values[k]) : std::string(",");
+    csv += "\n";
+  }
+  std::string plot = "set xlabel 'frame in the rendered window'\nset datafile missing ''\nplot ";
+  for (std::size_t column = 0; column < series.size(); ++column)
+    plot += fmt::format("{}{{data}} using 1:{} with lines lw 1.5 dt {} title columnhead", column ? ", " : "", column + 2, 1 + column / 8);
+  plot += "\nset xlabel 'frame'";
+  return writeLineFigures(dir, stem, csv, {{"methods_flip", "ꟻLIP per frame of each temporal method (lower is better)", "mean ꟻLIP", plot}});
 }
 
 }  // namespace dynbench::report

@@ -24,6 +24,11 @@ Expected<std::vector<std::filesystem::path>> writeRotationPlotsFromCsv(const std
                                                                        const std::filesystem::path& dir, const std::string& stem);
 
 // Writes <dir>/<stem>_discard.{png,svg}: the per-frame discard percentages of each feature.
+// Per-frame ꟻLIP of every dataset's temporal methods on one axis (x: the frame's position in its
+// dataset's window, so datasets of different frame numbers line up). `series`: (label, values).
+Expected<std::vector<std::filesystem::path>> writeMethodsPlot(const std::vector<std::pair<std::string, std::vector<double>>>& series,
+                                                              const std::filesystem::path& dir, const std::string& stem);
+
 Expected<std::vector<std::filesystem::path>> writeDiscardPlot(const std::vector<discard::FramePercentages>& frames,
                                                               const std::string& title, const std::filesystem::path& dir,
                                                               const std::string& stem);

@@ -104,6 +104,21 @@ Table discardTable(const std::vector<DiscardRow>& rows, const std::string& detai
   return t;
 }
 
+Table temporalMethodsTable(const std::vector<MethodsRow>& rows) {
+  Table t;
+  t.title = "Temporal methods against the converged reference (mean ± standard error over frames; docs/metrics.md)";
+  t.header = {"dataset", "method", "ꟻLIP ↓", "PSNR (dB) ↑", "SSIM ↑", "tPSNR (dB) ↑", "warped error change ↓", "history use"};
+  auto cell = [](const evaluate::MeanWithError& m, int digits) {
+    return m.count ? fmt::format("{:.{}f} ± {:.{}f}", m.mean, digits, m.standardError, digits) : std::string("n/a");
+  };
+  for (const auto& r : rows) {
+    const auto& s = r.scores;
+    t.rows.push_back({r.dataset, s.name, cell(s.flip, 4), cell(s.psnr, 2), cell(s.ssim, 4), cell(s.tPsnr, 2), cell(s.warpedErrorChange, 4),
+                      cell(s.historyUse, 3)});
+  }
+  return t;
+}
+
 std::string markdownTable(const Table& t) { return fmt::format("{}\n\n{}\n", t.title, markdownTable(t.header, t.rows)); }
 
 std::string htmlTable(const Table& t) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "discard/discard.h"
+#include "evaluate/evaluate.h"
 #include "report/stats_output.h"
 
 namespace dynbench::report {
@@ -25,6 +26,14 @@ struct DiscardRow {
 };
 // Table 6.7, one row per dataset; `detail` is appended to the title (frame pairs, size).
 Table discardTable(const std::vector<DiscardRow>& rows, const std::string& detail = {});
+
+// "Temporal methods": one row per dataset and method, the means over frames with their standard
+// errors (evaluate --json).
+struct MethodsRow {
+  std::string dataset;
+  evaluate::MethodScores scores;
+};
+Table temporalMethodsTable(const std::vector<MethodsRow>& rows);
 
 std::string markdownTable(const Table& table);  // title, blank line, aligned Markdown table
 std::string htmlTable(const Table& table);      // <table> with a <caption>
