@@ -93,11 +93,15 @@ TEST(Demo, WholeChainOnAShortMatch) {
       EXPECT_EQ(method["frames"].size(), 12u) << run;
       EXPECT_EQ(method["frames"][0]["history_use"].get<double>(), 0.0) << run;
       EXPECT_GT(method["mean"]["flip"]["mean"].get<double>(), 0.0) << run;
-      // A line of the Markdown with the dataset in its first column and the method in its second.
+      // A line of the Markdown with the dataset in its first column and the method in its second
+      // (cells padded to the column's width).
       bool found = false;
       for (std::size_t at = md.find(fmt::format("| {} ", run)); at != std::string::npos && !found; at = md.find(fmt::format("| {} ", run), at + 1)) {
-        const std::string line = md.substr(at, md.find('\n', at) - at);
-        found = line.find(fmt::format(" | {} |", method["name"].get<std::string>())) != std::string::npos;
+        const std::size_t second = md.find('|', at + 1), third = md.find('|', second + 1);
+        std::string cell = md.substr(second + 1, third - second - 1);
+        cell.erase(0, cell.find_first_not_of(' '));
+        cell.erase(cell.find_last_not_of(' ') + 1);
+        found = cell == method["name"].get<std::string>();
       }
       EXPECT_TRUE(found) << run << " " << method["name"];
     }
