@@ -8,6 +8,8 @@
 #include <array>
 #include <cmath>
 
+#include <tbb/parallel_for.h>
+
 #include "evaluate/method.h"
 
 namespace dynbench::evaluate {
@@ -25,6 +27,14 @@ constexpr double kDiffuseShare = 0.96;                            // glTF dielec
 constexpr std::array<double, 3> kAtrous{3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0};  // [S17] §4.3: B3 spline 5x5
 
 double luminance(glm::dvec3 c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
+
+// max(0, n.n')^sigma_n with sigma_n = 128 = 2^7: seven squarings (std::pow was most of the filter's time).
+static_assert(kSigmaN == 128.0);
+double normalWeight(const glm::dvec3& a, const glm::dvec3& b) {
+  double w = std::max(0.0, glm::dot(a, b));
+  for (int i = 0; i < 7; ++i) w *= w;
+  return w;
+}
 
 class SvgfMethod final : public TemporalMethod {
  public:
@@ -102,7 +112,7 @@ class SvgfMethod final : public TemporalMethod {
 
     // 3. Variance: from the temporal moments, or where the history is short (< 4 frames) from the
     // 7x7 bilateral neighbourhood's moments, boosted by 4 / length ([S17] §4.2, [Falcor]).
-    for (int y = 0; y < h; ++y)
+    tbb::parallel_for(0, h, [&](int y) {
       for (int x = 0; x < w; ++x) {
         const std::size_t i = index(x, y);
         if (f.hit[i] <= 0) continue;
@@ -119,7 +129,7 @@ class SvgfMethod final : public TemporalMethod {
             const std::size_t j = index(xx, yy);
             if (f.hit[j] <= 0) continue;
             const double wz = std::exp(-std::abs(f.depth[i] - f.depth[j]) / (kSigmaZ * std::abs(glm::dot(gradZ[i], glm::dvec2(dx, dy))) + 1e-8));
-            const double wn = std::pow(std::max(0.0, glm::dot(at(f.normal, i), at(f.normal, j))), kSigmaN);
+            const double wn = normalWeight(at(f.normal, i), at(f.normal, j));
             const double wl = std::exp(-std::abs(luminance(illumination[i]) - luminance(illumination[j])) / kMomentsSigmaL);
             const double wgt = (dx == 0 && dy == 0) ? 1.0 : wz * wn * wl;
             m += wgt * moments[j], weight += wgt;
@@ -127,6 +137,7 @@ class SvgfMethod final : public TemporalMethod {
         m /= weight;
         variance[i] = std::max(0.0, m.y - m.x * m.x) * 4.0 / length[i];
       }
+    });
 
     // 4. A-trous wavelet filter, 5 iterations with steps 1, 2, 4, 8, 16 ([S17] §4.3-4.4); the
     // first iteration's output is the colour history of the next frame.
@@ -135,7 +146,8 @@ class SvgfMethod final : public TemporalMethod {
       const int step = 1 << iteration;
       std::vector<glm::dvec3> nextIllumination = illumination;
       std::vector<double> nextVariance = variance;
-      for (int y = 0; y < h; ++y)
+      // Rows are independent within an iteration.
+      tbb::parallel_for(0, h, [&](int y) {
         for (int x = 0; x < w; ++x) {
           const std::size_t i = index(x, y);
           if (f.hit[i] <= 0) continue;
@@ -162,7 +174,7 @@ class SvgfMethod final : public TemporalMethod {
               // [S17] Eqs. 3-4: depth, normal and luminance edge-stopping weights.
               const double wz = std::exp(-std::abs(f.depth[i] - f.depth[j]) /
                                          (kSigmaZ * std::abs(glm::dot(gradZ[i], glm::dvec2(kx * step, ky * step))) + 1e-8));
-              const double wn = std::pow(std::max(0.0, glm::dot(np, at(f.normal, j))), kSigmaN);
+              const double wn = normalWeight(np, at(f.normal, j));
               const double wl = std::exp(-std::abs(lp - luminance(illumination[j])) / lumDenominator);
               const double wgt = (kx == 0 && ky == 0) ? hk : hk * wz * wn * wl;
               sum += wgt * illumination[j], sumW += wgt, sumVar += wgt * wgt * variance[j];
@@ -170,6 +182,7 @@ class SvgfMethod final : public TemporalMethod {
           nextIllumination[i] = sum / sumW;
           nextVariance[i] = sumVar / (sumW * sumW);  // [S17] Eq. 2
         }
+      });
       illumination.swap(nextIllumination);
       variance.swap(nextVariance);
       if (iteration == 0) feedback = illumination;
