@@ -13,6 +13,7 @@
 
 #include <fmt/format.h>
 
+#include "core/image_io.h"
 #include "dynbench/version.h"
 #include "gltf_builder.h"
 #include "external_tools.h"
@@ -62,7 +63,8 @@ TEST(Cli, VersionAndHelp) {
 TEST(Cli, SameMistakeSameStatusInEveryCommand) {
   const auto dir = test::freshDir("cli_same_status");
   for (const std::string command : {"stats x.gltf", "capture-check x", "convert x -o y.gltf", "merge-camera a.gltf b.csv -o c.gltf",
-                                    "render x.gltf -o y", "discard x", "report x -o y.html", "capture cube2 -o x", "demo"}) {
+                                    "render x.gltf -o y", "discard x", "report x -o y.html", "capture cube2 -o x", "demo",
+                                    "compare a.exr b.exr", "evaluate x --reference y"}) {
     const auto r = dynbench(command + " --no-such-option", dir);
     EXPECT_EQ(r.status, 2) << command << ": " << r.err;
     EXPECT_NE(r.err.find("dynbench: error: The following argument was not expected: --no-such-option"), std::string::npos)
@@ -83,7 +85,9 @@ TEST(Cli, SameMistakeSameStatusInEveryCommand) {
                         Case{"discard x --threshold-normal -1", "--threshold-normal: must be 0 or more (got -1)"},
                         Case{"report x -o y.html --thumbnails -1", "--thumbnails: must be 0 or more (got -1)"},
                         Case{"convert x -o y.gltf --turbidity 1", "--turbidity: must be from 1.7 to 10 (got 1)"},
-                        Case{"render x.gltf -o y --spp many", "--spp: expected a number, got 'many'"}}) {
+                        Case{"render x.gltf -o y --spp many", "--spp: expected a number, got 'many'"},
+                        Case{"compare a.exr b.exr --ppd 0", "--ppd: must be positive (got 0)"},
+                        Case{"evaluate x --reference y --ppd -1", "--ppd: must be positive (got -1)"}}) {
     const auto r = dynbench(c.args, dir);
     EXPECT_EQ(r.status, 2) << c.args << ": " << r.err;
     EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << ": " << r.err;
@@ -190,6 +194,28 @@ TEST(Cli, BadInputFailsClearlyAndWritesNothing) {
 
   r = dynbench(fmt::format("stats {} --fps -3", yawScene(dir).string()), dir);
   EXPECT_NE(r.status, 0);
+}
+
+TEST(Cli, CompareAndEvaluateMapErrorsToStatuses) {
+  const auto dir = test::freshDir("cli_compare");
+  for (const auto& [name, w] : {std::pair{"a.exr", 16}, std::pair{"b.exr", 8}}) {
+    FloatImage image;
+    image.width = w, image.height = 16, image.channels = 3, image.pixels.assign(static_cast<std::size_t>(3 * w * 16), 0.5f);
+    ASSERT_TRUE(writeImage(dir / name, image).has_value());
+  }
+  auto r = dynbench("compare a.exr a.exr", dir);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("| a.exr | 0.0000 |"), std::string::npos) << r.out;
+  r = dynbench("compare a.exr b.exr", dir);
+  EXPECT_EQ(r.status, 5) << r.err;
+  EXPECT_NE(r.err.find("b.exr: 8x16 pixels, but the reference a.exr is 16x16"), std::string::npos) << r.err;
+  r = dynbench("compare a.exr missing.exr --json out.json", dir);
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("missing.exr"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out.json"));
+  r = dynbench("evaluate nowhere --reference nowhere", dir);
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("nowhere: not a folder of frames"), std::string::npos) << r.err;
 }
 
 TEST(Cli, SeveralDatasetsOneRowEach) {
