@@ -203,17 +203,18 @@ TEST(Cli, CompareAndEvaluateMapErrorsToStatuses) {
     image.width = w, image.height = 16, image.channels = 3, image.pixels.assign(static_cast<std::size_t>(3 * w * 16), 0.5f);
     ASSERT_TRUE(writeImage(dir / name, image).has_value());
   }
-  auto r = dynbench("compare a.exr a.exr", dir);
+  const std::string a = (dir / "a.exr").string(), b = (dir / "b.exr").string(), missing = (dir / "missing.exr").string();
+  auto r = dynbench(fmt::format("compare {} {}", a, a), dir);
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("| a.exr | 0.0000 |"), std::string::npos) << r.out;
-  r = dynbench("compare a.exr b.exr", dir);
+  r = dynbench(fmt::format("compare {} {}", a, b), dir);
   EXPECT_EQ(r.status, 5) << r.err;
-  EXPECT_NE(r.err.find("b.exr: 8x16 pixels, but the reference a.exr is 16x16"), std::string::npos) << r.err;
-  r = dynbench("compare a.exr missing.exr --json out.json", dir);
+  EXPECT_NE(r.err.find(b + ": 8x16 pixels, but the reference " + a + " is 16x16"), std::string::npos) << r.err;
+  r = dynbench(fmt::format("compare {} {} --json {}", a, missing, (dir / "out.json").string()), dir);
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_NE(r.err.find("missing.exr"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out.json"));
-  r = dynbench("evaluate nowhere --reference nowhere", dir);
+  r = dynbench(fmt::format("evaluate {0} --reference {0}", (dir / "nowhere").string()), dir);
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_NE(r.err.find("nowhere: not a folder of frames"), std::string::npos) << r.err;
 }

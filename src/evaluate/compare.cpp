@@ -36,6 +36,8 @@ int channelIndex(const FloatImage& image, const std::string& name) {
 }  // namespace
 
 Expected<LoadedImage> loadImage(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return fail(ErrorCode::kIo, "{}: no such image file", path.string());
   auto file = readImage(path);
   if (!file) return std::unexpected(file.error());
   LoadedImage out;
