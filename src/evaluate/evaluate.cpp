@@ -22,10 +22,8 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// What a method's temporal scores need of the frame before.
-struct Previous {
-  RgbImage output;
-};
+// PSNR (peak 1) of a difference of differences.
+double psnrOfMse(double mse) { return mse == 0.0 ? std::numeric_limits<double>::infinity() : 10.0 * std::log10(1.0 / mse); }
 
 MeanWithError meanOf(const std::vector<FrameScores>& frames, const std::function<std::optional<double>(const FrameScores&)>& get) {
   MeanWithError m;
@@ -41,53 +39,69 @@ MeanWithError meanOf(const std::vector<FrameScores>& frames, const std::function
   return m;
 }
 
-// PSNR (peak 1) of a difference of differences.
-double psnrOfMse(double mse) { return mse == 0.0 ? std::numeric_limits<double>::infinity() : 10.0 * std::log10(1.0 / mse); }
+// What the temporal scores of frame t need of the reference, the same for every method: the
+// display transform d() at frame t's reference exposure (applied to both frames of the pair), the
+// reference pair through it, and where each pixel's error of frame t - 1 is fetched from (the
+// reference's motion for surfaces, the camera matrices for the background; none where the
+// reference itself has no valid history: off screen or disoccluded).
+struct ReferencePair {
+  const RgbImage* current = nullptr;
+  const RgbImage* previous = nullptr;
+  double scale = 1.0;
+  RgbImage display, previousDisplay;
+  std::vector<std::optional<discard::BilinearTaps>> warp;
+  long warped = 0;  // pixels with a warp
+};
+ReferencePair referencePair(const RgbImage& ref, const RgbImage& refPrev, const frames::FeatureFrame& refFrame,
+                            const frames::FeatureFrame& refPrevFrame, const discard::Thresholds& absolute) {
+  ReferencePair pair;
+  pair.current = &ref, pair.previous = &refPrev;
+  pair.scale = displayScale(ref);
+  pair.display = toDisplay(ref, pair.scale), pair.previousDisplay = toDisplay(refPrev, pair.scale);
+  pair.warp.resize(refFrame.pixelCount());
+  for (int y = 0; y < refFrame.height; ++y)
+    for (int x = 0; x < refFrame.width; ++x) {
+      auto& taps = pair.warp[static_cast<std::size_t>(y) * refFrame.width + x];
+      taps = historyTaps(refFrame, refPrevFrame, absolute, x, y, /*useMotion=*/true);
+      if (taps) ++pair.warped;
+    }
+  return pair;
+}
 
 struct TemporalScores {
   double tPsnr, tRelMse, warpedErrorChange, warpValid;
 };
 
-// docs/metrics.md, "Temporal error". d() is the display transform at this frame's reference
-// exposure, applied to both frames of the pair.
-TemporalScores temporalScores(const RgbImage& out, const RgbImage& outPrev, const RgbImage& ref, const RgbImage& refPrev,
-                              const frames::FeatureFrame& refFrame, const frames::FeatureFrame& refPrevFrame,
-                              const discard::Thresholds& absolute) {
-  const double scale = displayScale(ref);
-  const RgbImage dOut = toDisplay(out, scale), dOutPrev = toDisplay(outPrev, scale), dRef = toDisplay(ref, scale),
-                 dRefPrev = toDisplay(refPrev, scale);
+// docs/metrics.md, "Temporal error".
+TemporalScores temporalScores(const RgbImage& out, const RgbImage& outPrev, const ReferencePair& ref) {
+  const RgbImage dOut = toDisplay(out, ref.scale), dOutPrev = toDisplay(outPrev, ref.scale);
+  const RgbImage &dRef = ref.display, &dRefPrev = ref.previousDisplay, &r = *ref.current, &rPrev = *ref.previous;
   TemporalScores s{};
   double sq = 0.0, rel = 0.0;
-  for (std::size_t k = 0; k < ref.rgb.size(); ++k) {
+  for (std::size_t k = 0; k < r.rgb.size(); ++k) {
     // Frame differences (Noisebase's temporal metrics): display for tPSNR, linear for tRelMSE.
     const double dd = (static_cast<double>(dOut.rgb[k]) - dOutPrev.rgb[k]) - (static_cast<double>(dRef.rgb[k]) - dRefPrev.rgb[k]);
     sq += dd * dd;
-    const double dl = (static_cast<double>(out.rgb[k]) - outPrev.rgb[k]) - (static_cast<double>(ref.rgb[k]) - refPrev.rgb[k]);
-    rel += dl * dl / (static_cast<double>(ref.rgb[k]) * ref.rgb[k] + 0.01);
+    const double dl = (static_cast<double>(out.rgb[k]) - outPrev.rgb[k]) - (static_cast<double>(r.rgb[k]) - rPrev.rgb[k]);
+    rel += dl * dl / (static_cast<double>(r.rgb[k]) * r.rgb[k] + 0.01);
   }
-  s.tPsnr = psnrOfMse(sq / ref.rgb.size());
-  s.tRelMse = rel / ref.rgb.size();
-  // e_t - warp(e_{t-1}), e = d(output) - d(reference), the previous error fetched where the
-  // reference's motion says each surface was (camera matrices for the background), pixels without
-  // valid history in the reference (off screen or disoccluded) left out.
+  s.tPsnr = psnrOfMse(sq / r.rgb.size());
+  s.tRelMse = rel / r.rgb.size();
+  // e_t - warp(e_{t-1}), e = d(output) - d(reference), over the pixels the reference's warp covers.
   double change = 0.0;
-  long valid = 0;
-  for (int y = 0; y < refFrame.height; ++y)
-    for (int x = 0; x < refFrame.width; ++x) {
-      const auto taps = historyTaps(refFrame, refPrevFrame, absolute, x, y, /*useMotion=*/true);
-      if (!taps) continue;
-      const std::size_t i = static_cast<std::size_t>(y) * refFrame.width + x;
-      for (int c = 0; c < 3; ++c) {
-        double previousError = 0.0;
-        for (int k = 0; k < 4; ++k)
-          previousError += taps->weight[k] * (static_cast<double>(dOutPrev.rgb[3 * taps->index[k] + c]) - dRefPrev.rgb[3 * taps->index[k] + c]);
-        const double d = (static_cast<double>(dOut.rgb[3 * i + c]) - dRef.rgb[3 * i + c]) - previousError;
-        change += d * d;
-      }
-      ++valid;
+  for (std::size_t i = 0; i < ref.warp.size(); ++i) {
+    if (!ref.warp[i]) continue;
+    const discard::BilinearTaps& taps = *ref.warp[i];
+    for (int c = 0; c < 3; ++c) {
+      double previousError = 0.0;
+      for (int k = 0; k < 4; ++k)
+        previousError += taps.weight[k] * (static_cast<double>(dOutPrev.rgb[3 * taps.index[k] + c]) - dRefPrev.rgb[3 * taps.index[k] + c]);
+      const double d = (static_cast<double>(dOut.rgb[3 * i + c]) - dRef.rgb[3 * i + c]) - previousError;
+      change += d * d;
     }
-  s.warpValid = static_cast<double>(valid) / static_cast<double>(refFrame.pixelCount());
-  s.warpedErrorChange = valid ? std::sqrt(change / (3.0 * valid)) : 0.0;
+  }
+  s.warpValid = static_cast<double>(ref.warped) / static_cast<double>(ref.warp.size());
+  s.warpedErrorChange = ref.warped ? std::sqrt(change / (3.0 * ref.warped)) : 0.0;
   return s;
 }
 
@@ -135,7 +149,9 @@ Expected<EvaluateRun> runEvaluate(const EvaluateOptions& options, const Evaluate
   for (const std::string& spec : options.methods) {
     auto m = createMethod(spec, context);
     if (!m) return std::unexpected(m.error());
-    run.methods.push_back(MethodScores{(*m)->name(), (*m)->parameters(), {}, {}, {}, {}, {}, {}, {}, {}, {}, -1});
+    MethodScores scores;
+    scores.name = (*m)->name(), scores.parameters = (*m)->parameters();
+    run.methods.push_back(std::move(scores));
     methods.push_back(std::move(*m));
   }
   if (!options.outDir.empty())
@@ -147,7 +163,7 @@ Expected<EvaluateRun> runEvaluate(const EvaluateOptions& options, const Evaluate
 
   std::optional<frames::FeatureFrame> previousReference;
   std::optional<RgbImage> previousReferenceImage;
-  std::vector<std::optional<Previous>> previous(methods.size());
+  std::vector<std::optional<RgbImage>> previousOutput(methods.size());
   long previousFrame = std::numeric_limits<long>::min();
   for (std::size_t f = 0; f < inputs->size(); ++f) {
     const frames::FrameEntry& entry = (*inputs)[f];
@@ -162,8 +178,10 @@ Expected<EvaluateRun> runEvaluate(const EvaluateOptions& options, const Evaluate
     const bool cut = f == 0 || input->cut || reference->cut || entry.frame != previousFrame + 1;
     const RgbImage referenceImage = frameRadiance(*reference);
     const discard::Thresholds absolute = discard::absoluteThresholds(options.thresholds, *reference, context.sceneSize);
+    std::optional<ReferencePair> pair;
+    if (!cut && previousReference) pair = referencePair(referenceImage, *previousReferenceImage, *reference, *previousReference, absolute);
     for (std::size_t m = 0; m < methods.size(); ++m) {
-      if (cut) methods[m]->reset(), previous[m].reset();
+      if (cut) methods[m]->reset(), previousOutput[m].reset();
       auto output = methods[m]->process(*input);
       if (!output) return std::unexpected(output.error());
       const ScoredImage scored = scoreImage(referenceImage, output->image, /*hdr=*/true, options.pixelsPerDegree);
@@ -171,9 +189,8 @@ Expected<EvaluateRun> runEvaluate(const EvaluateOptions& options, const Evaluate
       s.frame = entry.frame, s.cut = cut;
       s.flip = scored.scores.flip.mean, s.psnr = scored.scores.psnr, s.ssim = scored.scores.ssim, s.relMse = scored.scores.relMse;
       s.historyUse = output->historyUse;
-      if (!cut && previous[m] && previousReference) {
-        const TemporalScores t = temporalScores(output->image, previous[m]->output, referenceImage, *previousReferenceImage, *reference,
-                                                *previousReference, absolute);
+      if (pair && previousOutput[m]) {
+        const TemporalScores t = temporalScores(output->image, *previousOutput[m], *pair);
         s.tPsnr = t.tPsnr, s.tRelMse = t.tRelMse, s.warpedErrorChange = t.warpedErrorChange, s.warpValid = t.warpValid;
       }
       if (!options.outDir.empty()) {
@@ -181,7 +198,7 @@ Expected<EvaluateRun> runEvaluate(const EvaluateOptions& options, const Evaluate
         if (!written) return std::unexpected(written.error());
       }
       run.methods[m].frames.push_back(s);
-      previous[m] = Previous{std::move(output->image)};
+      previousOutput[m] = std::move(output->image);
     }
     previousReference = std::move(*reference);
     previousReferenceImage = referenceImage;

@@ -29,7 +29,10 @@ const glm::dmat3& xyzToRgbMatrix() {
   return m;
 }
 // The reference white: XYZ of linear RGB (1, 1, 1).
-glm::dvec3 whitePoint() { return rgbToXyzMatrix() * glm::dvec3(1.0); }
+const glm::dvec3& whitePoint() {
+  static const glm::dvec3 white = rgbToXyzMatrix() * glm::dvec3(1.0);
+  return white;
+}
 
 // CIELAB's f(t) and its inverse (CIE 15:2004, delta = 6/29).
 double labF(double t) {

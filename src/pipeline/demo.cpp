@@ -111,7 +111,6 @@ Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, cons
   return {};
 }
 
-
 }  // namespace
 
 Expected<void> writeFlythroughCsv(const fs::path& dataset, const fs::path& csv, int keys, double rate) {
