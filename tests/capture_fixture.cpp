@@ -50,6 +50,7 @@ Ids recordFrames(dbc_session* s, int frames) {
     EXPECT_EQ(dbc_frame_begin(s, static_cast<uint64_t>(100 + f), f / 60.0), DBC_OK) << dbc_last_error();
     const float eye[] = {0, 1.7f, static_cast<float>(f)};
     EXPECT_EQ(dbc_camera(s, ids.camera, eye, -5.0f, 3.0f * f, 0.0f), DBC_OK);
+    if (f == 7) EXPECT_EQ(dbc_camera_cut(s, ids.camera, "respawn"), DBC_OK) << dbc_last_error();
     EXPECT_EQ(dbc_static_model(s, ids.tree, "mapmodel/crate:1", rigid(0, {5, 0, 5})), DBC_OK);
     EXPECT_EQ(dbc_model(s, ids.arm, "chars/arm", armModelPose(f)), DBC_OK);
     const dbc_dual_quat pose[] = {armJointPose(f, 0), armJointPose(f, 1)};
@@ -59,7 +60,8 @@ Ids recordFrames(dbc_session* s, int frames) {
     EXPECT_EQ(dbc_light(s, ids.lamp, lampAt, white, DBC_LIGHT_POINT, 0, nullptr), DBC_OK);
     if (f == 2 || f == 3) {
       const float at[] = {0.5f, 1.5f, static_cast<float>(f)};
-      EXPECT_EQ(dbc_light(s, ids.flash, at, orange, DBC_LIGHT_POINT, 1, "flash"), DBC_OK);
+      const float fading[] = {orange[0] / 2, orange[1] / 2, orange[2] / 2};  // the flash fades to half in frame 3
+      EXPECT_EQ(dbc_light(s, ids.flash, at, f == 2 ? orange : fading, DBC_LIGHT_POINT, 1, "flash"), DBC_OK);
     }
     EXPECT_EQ(dbc_frame_end(s), DBC_OK) << dbc_last_error();
   }

@@ -1,8 +1,9 @@
 #pragma once
 // A synthetic capture written through the SDK's C API, shared by the capture and convert tests:
 // a two-joint skinned "arm" walking along +X, a spinning rigid "crate" absent in frames 4-6, a
-// static map model, a static lamp, a "flash" light in frames 2-3, and a camera yawing 3 degrees
-// and moving 1 unit a frame; frames 100..109 at 60 fps.
+// static map model, a static lamp, a "flash" light in frames 2-3 (orange, half as bright in frame 3),
+// and a camera yawing 3 degrees and moving 1 unit a frame, with a cut ("respawn") at frame 7;
+// frames 100..109 at 60 fps.
 #include <cstdint>
 #include <filesystem>
 #include <string>

@@ -79,6 +79,11 @@ TEST(Capture, WriteThenReadBack) {
     EXPECT_EQ(frame.number, 100u + frames);
     EXPECT_DOUBLE_EQ(frame.time, f / 60.0);  // times round-trip exactly (17 digits)
     ASSERT_EQ(frame.cameras.size(), 1u);
+    ASSERT_EQ(frame.cuts.size(), f == 7 ? 1u : 0u);
+    if (f == 7) {
+      EXPECT_EQ(frame.cuts[0].id, frame.cameras[0].id);
+      EXPECT_EQ(frame.cuts[0].reason, "respawn");
+    }
     EXPECT_FLOAT_EQ(static_cast<float>(frame.cameras[0].yaw), 3.0f * f);
     EXPECT_FLOAT_EQ(static_cast<float>(frame.cameras[0].position.z), static_cast<float>(f));
     EXPECT_EQ(frame.staticModels.size(), f == 0 ? 1u : 0u);  // static: recorded once
@@ -87,6 +92,7 @@ TEST(Capture, WriteThenReadBack) {
       if (l.dynamic) {
         ++flashFrames;
         EXPECT_EQ(l.modelType, "flash");
+        EXPECT_DOUBLE_EQ(l.color.r, f == 2 ? 1.0 : 0.5);
       }
     ASSERT_EQ(frame.joints.size(), 1u);
     ASSERT_EQ(frame.joints[0].joints.size(), 2u);
@@ -130,6 +136,8 @@ TEST(Capture, CheckSummarises) {
   const std::string text = summaryText(dir, *s);
   EXPECT_NE(text.find("frames:      10 (numbers 100..109)"), std::string::npos) << text;
   EXPECT_NE(text.find("60.00 frames/s"), std::string::npos) << text;
+  EXPECT_EQ(s->cutsByReason, (std::map<std::string, std::size_t>{{"respawn", 1}}));
+  EXPECT_NE(text.find("camera cuts: 1 (1 respawn)"), std::string::npos) << text;
 }
 
 TEST(CaptureSdk, RejectsBadCallsAndWritesNothingForThem) {
@@ -149,6 +157,8 @@ TEST(CaptureSdk, RejectsBadCallsAndWritesNothingForThem) {
   EXPECT_NE(std::string(dbc_last_error()).find("has 2 joints"), std::string::npos);
   const dbc_dual_quat two[] = {rigid(0, {}), rigid(0, {})};
   EXPECT_EQ(dbc_joints(s, 3, "chars/arm", 2, two), DBC_ERROR_ORDER);  // no dbc_model for id 3 yet
+  EXPECT_EQ(dbc_camera_cut(s, 1, "respawn"), DBC_ERROR_ORDER);  // camera 1 has no record in this frame yet
+  EXPECT_NE(std::string(dbc_last_error()).find("no dbc_camera record earlier in this frame"), std::string::npos) << dbc_last_error();
   ASSERT_EQ(dbc_camera(s, 1, p, 0, 0, 0), DBC_OK);
   EXPECT_EQ(dbc_model(s, 1, "chars/arm", rigid(0, {})), DBC_ERROR_ARGUMENT);  // id 1 is a camera
   EXPECT_EQ(dbc_model_begin(s, "late"), DBC_ERROR_ORDER);
@@ -267,6 +277,13 @@ TEST(BadCapture, UnknownModelAndUnknownCapturable) {
                      ErrorCode::kInvalidData, {"Capture.txt:4:", "capturable 7", "no model transform"});
   expectCaptureError(handCapture("bad_kind", kHeader + kGoodFrame + "f:2:1\nt:2:0:0:0:0:0:0\ne:2\n"), ErrorCode::kInvalidData,
                      {"Capture.txt:9:", "capturable 2 was a model"});
+}
+
+TEST(BadCapture, CutWithoutItsCamera) {
+  expectCaptureError(handCapture("bad_cut", kHeader + "f:1:0\nc:1:respawn\nt:1:0:0:0:0:0:0\ne:1\n"), ErrorCode::kInvalidData,
+                     {"Capture.txt:4:", "cut of camera 1", "no camera transform"});
+  expectCaptureError(handCapture("bad_cut_fields", kHeader + "f:1:0\nt:1:0:0:0:0:0:0\nc:1\ne:1\n"), ErrorCode::kParse,
+                     {"Capture.txt:5:", "needs 2 fields"});
 }
 
 TEST(BadCapture, TruncatedLastFrameIsAWarning) {

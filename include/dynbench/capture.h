@@ -94,6 +94,10 @@ uint64_t dbc_new_id(dbc_session* session);
 int dbc_frame_begin(dbc_session* session, uint64_t frame_number, double time_seconds);
 int dbc_camera(dbc_session* session, uint64_t id, const float position[3], float pitch_degrees, float yaw_degrees,
                float roll_degrees);
+/* The camera's transform this frame does not continue from its previous one (a respawn, a switch
+ * to another player, a teleporter): temporal methods reset their history here. After the camera's
+ * dbc_camera call in the same frame. reason: free text such as "respawn", "switch", "teleport". */
+int dbc_camera_cut(dbc_session* session, uint64_t camera_id, const char* reason);
 int dbc_static_model(dbc_session* session, uint64_t id, const char* model_path, dbc_dual_quat pose);
 int dbc_model(dbc_session* session, uint64_t id, const char* model_path, dbc_dual_quat pose);
 int dbc_joints(dbc_session* session, uint64_t id, const char* model_path, size_t joint_count,

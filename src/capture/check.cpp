@@ -49,6 +49,7 @@ Expected<CaptureSummary> checkCapture(const std::filesystem::path& directory, co
     s.modelRecords += frame.models.size() + frame.staticModels.size();
     s.jointRecords += frame.joints.size();
     s.lightRecords += frame.lights.size();
+    for (const auto& c : frame.cuts) ++s.cutsByReason[c.reason];
     if (onFrame) onFrame(s.frames);
   }
   s.closed = (*reader)->closed();
@@ -81,6 +82,10 @@ std::string summaryText(const std::filesystem::path& directory, const CaptureSum
   std::string types;
   for (const auto& [type, n] : s.lightsByModelType) types += fmt::format("{}{} {}", types.empty() ? "" : ", ", n, type);
   out += fmt::format("lights:      {} static, {} dynamic{}\n", s.staticLights, s.dynamicLights, types.empty() ? "" : " (" + types + ")");
+  std::size_t cuts = 0;
+  std::string reasons;
+  for (const auto& [reason, n] : s.cutsByReason) cuts += n, reasons += fmt::format("{}{} {}", reasons.empty() ? "" : ", ", n, reason);
+  out += fmt::format("camera cuts: {}{}\n", cuts, reasons.empty() ? "" : " (" + reasons + ")");
   out += fmt::format("models:      {} ({} skinned), {} meshes, {} vertices, {} triangles, {} joints\n", s.models, s.skinnedModelFiles,
                      s.meshes, s.vertices, s.triangles, s.joints);
   out += fmt::format("closed:      {}\n", s.closed ? "yes" : "no (the host stopped before closing the session)");
@@ -106,6 +111,7 @@ std::string summaryJson(const std::filesystem::path& directory, const CaptureSum
       {"models", {{"files", s.models}, {"skinned", s.skinnedModelFiles}, {"meshes", s.meshes}, {"vertices", s.vertices},
                   {"triangles", s.triangles}, {"joints", s.joints}}},
       {"records", {{"camera", s.cameraRecords}, {"model", s.modelRecords}, {"joints", s.jointRecords}, {"light", s.lightRecords}}},
+      {"camera_cuts", s.cutsByReason},
       {"warnings", s.warnings}};
   return j.dump(2) + "\n";
 }

@@ -25,6 +25,7 @@ struct CaptureSummary {
   // Model files.
   std::size_t models = 0, skinnedModelFiles = 0, meshes = 0, vertices = 0, triangles = 0, joints = 0;
   std::size_t cameraRecords = 0, modelRecords = 0, jointRecords = 0, lightRecords = 0;
+  std::map<std::string, std::size_t> cutsByReason;  // `c` records (camera cuts) by reason
   std::vector<std::string> warnings;
 };
 

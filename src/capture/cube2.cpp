@@ -40,9 +40,9 @@ Expected<std::string> cube2Script(const Cube2Options& o) {
   if (o.skill < kSkillRange.first || o.skill > kSkillRange.second)
     return fail(ErrorCode::kUsage, "--skill must be {} to {} (got {})", kSkillRange.first, kSkillRange.second, o.skill);
   std::string follow;
-  if (o.follow == "auto") follow = "nextfollow 1";
+  if (o.follow == "auto" || o.follow == "one") follow = "nextfollow 1";
   else if (!o.follow.empty() && o.follow.find_first_not_of("0123456789") == std::string::npos) follow = "follow " + o.follow;
-  else return fail(ErrorCode::kUsage, "--follow '{}': expected auto or a client number (bots are 128, 129, ...)", o.follow);
+  else return fail(ErrorCode::kUsage, "--follow '{}': expected auto, one or a client number (bots are 128, 129, ...)", o.follow);
   std::string bots;
   for (int b = 0; b < o.bots; ++b) bots += fmt::format("addbot {}; ", o.skill);
   // Map at 0.1 s, bots and spectating at 0.7 s, following at 1.2 s of game time (the server

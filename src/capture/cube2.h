@@ -27,7 +27,9 @@ struct Cube2Options {
   double seconds = 30.0;         // recorded game time
   double fps = 60.0;             // fixed clock
   unsigned seed = 1;
-  std::string follow = "auto";   // auto: the first bot, then the next whenever the followed one dies; or a client number (bots are 128, 129, ...)
+  // auto: the first bot, then the next whenever the followed one dies; one: the first bot for the
+  // whole capture (its respawns are cuts); or a client number (bots are 128, 129, ...)
+  std::string follow = "auto";
   double warmup = 2.0;           // game seconds between the map loading and recording
   int width = 640, height = 360;
   bool window = false;           // on the user's display instead of Xvfb

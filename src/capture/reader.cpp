@@ -244,6 +244,7 @@ using Kind = CapturableKind;
 void CaptureFrame::clear() {
   cameraSettings.reset();
   cameras.clear();
+  cuts.clear();
   staticModels.clear();
   models.clear();
   joints.clear();
@@ -433,6 +434,14 @@ Expected<bool> CaptureReader::next(CaptureFrame& frame) {
         c.roll = l.real(7, "roll");
         claim(c.id, Kind::kCamera, -1);
         frame.cameras.push_back(c);
+      } else if (token == "c") {
+        l.expectFields(2, "id:reason");
+        CameraCutRecord c;
+        c.id = l.integer<std::uint64_t>(1, "id");
+        c.reason = l.text(2);
+        if (std::none_of(frame.cameras.begin(), frame.cameras.end(), [&](const CameraRecord& r) { return r.id == c.id; }))
+          l.fail(fmt::format("cut of camera {}, which has no camera transform ('t') earlier in this frame", c.id));
+        frame.cuts.push_back(std::move(c));
       } else if (token == "p" || token == "m") {
         l.expectFields(10, "id:rx:ry:rz:rw:dx:dy:dz:dw:model_path");
         ModelRecord r;
@@ -480,7 +489,7 @@ Expected<bool> CaptureReader::next(CaptureFrame& frame) {
       } else if (token == "C") {
         frame.cameraSettings = cameraSettings(l);
       } else {
-        l.fail(fmt::format("unknown record '{}' in a frame; expected t, p, m, j, l, C or e", token), ErrorCode::kParse);
+        l.fail(fmt::format("unknown record '{}' in a frame; expected t, c, p, m, j, l, C or e", token), ErrorCode::kParse);
       }
     }
   } catch (const Failure& f) {

@@ -64,6 +64,11 @@ struct CameraRecord {
   double pitch = 0, yaw = 0, roll = 0;  // degrees
 };
 
+struct CameraCutRecord {  // `c`: the camera jumped between the previous frame and this one
+  std::uint64_t id = 0;
+  std::string reason;  // "respawn", "switch", "teleport", ...
+};
+
 struct ModelRecord {  // `p` (static map model) and `m` (model transform)
   std::uint64_t id = 0;
   int model = -1;  // index into CaptureReader::models()
@@ -91,6 +96,7 @@ struct CaptureFrame {
   std::size_t line = 0;  // line of its `f` record
   std::optional<CameraSettings> cameraSettings;  // a `C` record inside this frame
   std::vector<CameraRecord> cameras;
+  std::vector<CameraCutRecord> cuts;
   std::vector<ModelRecord> staticModels, models;
   std::vector<JointsRecord> joints;
   std::vector<LightRecord> lights;

@@ -59,6 +59,7 @@ struct dbc_session {
   double lastTime = 0.0;
   std::string frameText;
   std::set<std::uint64_t> modelsThisFrame;  // ids with an `m` record in the current frame
+  std::set<std::uint64_t> camerasThisFrame;  // ids with a `t` record in the current frame
   std::map<std::uint64_t, std::pair<Kind, std::string>> capturables;  // kind and model path per id
   std::uint64_t nextId = 1;
 
@@ -272,6 +273,7 @@ int dbc_frame_begin(dbc_session* s, uint64_t frame_number, double time_seconds) 
   s->lastTime = time_seconds;
   s->anyFrame = true;
   s->modelsThisFrame.clear();
+  s->camerasThisFrame.clear();
   return DBC_OK;
 }
 
@@ -282,7 +284,17 @@ int dbc_camera(dbc_session* s, uint64_t id, const float p[3], float pitch, float
   if (int rc = s->claim(id, Kind::kCamera, ""); rc != DBC_OK) return rc;
   std::string line = fmt::format("t:{}", id);
   for (float v : {p[0], p[1], p[2], pitch, yaw, roll}) appendFloat(line, v);
+  s->camerasThisFrame.insert(id);
   return s->writeRecord(line);
+}
+
+int dbc_camera_cut(dbc_session* s, uint64_t id, const char* reason) {
+  if (!s) return error(DBC_ERROR_ARGUMENT, "dbc_camera_cut: NULL session");
+  if (int rc = s->requireFrame("dbc_camera_cut"); rc != DBC_OK) return rc;
+  if (!s->camerasThisFrame.contains(id))
+    return error(DBC_ERROR_ORDER, fmt::format("dbc_camera_cut: camera {} has no dbc_camera record earlier in this frame", id));
+  const std::string text = reason && *reason ? reason : "cut";
+  return s->writeRecord(fmt::format("c:{}:{}", id, escapeField(text)));
 }
 
 static int modelRecord(dbc_session* s, char token, Kind kind, uint64_t id, const char* model_path, const dbc_dual_quat& pose) {

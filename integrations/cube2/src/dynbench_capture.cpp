@@ -54,6 +54,8 @@ struct CaptureState {
   bool followAuto = false;
   string directory = "";
   Uint32 windowStart = 0;  // wall clock when the capture window opened (SDL milliseconds)
+  int lastFollowLife = -1;  // dynbench_followlife of the last recorded frame
+  vec lastCameraPosition = vec(0, 0, 0);
 };
 
 CaptureState state;
@@ -221,16 +223,90 @@ void recordStaticLights() {
 // Dynamic lights (engine/dynlight.cpp) this frame, classified by how the game makes them
 // (fpsgame/weapon.cpp): DL_FLASH is a muzzle flash; a fading light is an explosion; a light that
 // lives one frame follows a projectile: rockets make radius-20 lights, grenades smaller ones.
-void recordDynamicLight(const vec &o, const vec &color, float radius, int flags, bool fading) {
-  float position[3];
-  toCapture(o, position);
-  const float rgb[3] = {color.x, color.y, color.z};
-  const char *type = (flags & DL_FLASH) ? "flash" : fading ? "explosion" : radius >= 16 ? "rocket" : "bouncer";
-  // A dynamic light is a new capturable each frame: the engine keeps no identity for it.
-  if (dbc_light(state.session, dbc_new_id(state.session), position, rgb, DBC_LIGHT_POINT, 1, type) != DBC_OK)
-    failCapture("dynamic light");
+//
+// Identity. The engine keeps no id for a dynamic light, so one is inferred from the previous
+// recorded frame, as dynbench_models.h does for parts:
+// - a light with a life span (flash, explosion: fade + peak > 0) stays one queue entry until it
+//   expires; the same owner, expiry, flags, fade, peak and base colour is the same light (a muzzle
+//   flash follows its owner's gun, so its position may change);
+// - a light re-added every frame (a projectile's) is the nearest unclaimed light of the previous
+//   frame with the same flags and base colour, within kDynbenchMaxStepUnits.
+// So a rocket's light is one light that moves and then disappears, and a muzzle flash one per shot.
+struct RecordedLight {
+  dynbench_dynlight light;
+  uint64_t id;
+};
+vector<RecordedLight> previousLights, currentLights;
+vector<bool> claimedLights;
+
+bool sameLife(const dynbench_dynlight &a, const dynbench_dynlight &b) {
+  return a.owner == b.owner && a.expire == b.expire && a.flags == b.flags && a.fade == b.fade && a.peak == b.peak && a.basecolor == b.basecolor;
 }
 
+uint64_t dynamicLightId(const dynbench_dynlight &d) {
+  const bool lifeSpan = d.fade + d.peak > 0;
+  int best = -1;
+  float bestDistance = kDynbenchMaxStepUnits;
+  loopv(previousLights) {
+    if (claimedLights[i]) continue;
+    const dynbench_dynlight &p = previousLights[i].light;
+    if (lifeSpan) {
+      if (sameLife(p, d)) { best = i; break; }
+      continue;
+    }
+    if (p.fade + p.peak > 0 || p.flags != d.flags || !(p.basecolor == d.basecolor)) continue;
+    const float distance = p.o.dist(d.o);
+    if (distance < bestDistance) { bestDistance = distance; best = i; }
+  }
+  if (best < 0) return dbc_new_id(state.session);
+  claimedLights[best] = true;
+  return previousLights[best].id;
+}
+
+void recordDynamicLight(const dynbench_dynlight &d) {
+  float position[3];
+  toCapture(d.o, position);
+  const float rgb[3] = {d.color.x, d.color.y, d.color.z};
+  const bool fading = d.fade + d.peak > 0;
+  const char *type = (d.flags & DL_FLASH) ? "flash" : fading ? "explosion" : d.radius >= 16 ? "rocket" : "bouncer";
+  RecordedLight recorded;
+  recorded.light = d;
+  recorded.id = dynamicLightId(d);
+  currentLights.add(recorded);
+  if (dbc_light(state.session, recorded.id, position, rgb, DBC_LIGHT_POINT, 1, type) != DBC_OK) failCapture("dynamic light");
+}
+
+void recordDynamicLights() {
+  claimedLights.setsize(0);
+  loopv(previousLights) claimedLights.add(false);
+  currentLights.setsize(0);
+  dynbench_visit_dynlights(recordDynamicLight);
+  previousLights = currentLights;
+}
+
+// Camera cuts: the camera's transform this frame does not continue the previous frame's when the
+// followed player changed ("switch"), died (the view becomes the game's death camera: "death"),
+// got a new life ("respawn", the game's lifesequence), or the camera moved further than
+// kDynbenchMaxStepUnits in one frame ("teleport": teleporters, jump pads at low frame rates).
+// dynbench_followlife (the patch, fpsgame/fps.cpp) is clientnum*256 + lifesequence*2 + dead.
+const char *cameraCut(const vec &position) {
+  const int followLife = execute("dynbench_followlife");
+  const int last = state.lastFollowLife;
+  const char *reason = nullptr;
+  if (state.recorded > 0) {
+    if (followLife < 0 || last < 0 || followLife / 256 != last / 256) {
+      if (followLife != last) reason = "switch";
+    } else if (followLife / 2 != last / 2) {
+      reason = "respawn";
+    } else if (followLife != last) {
+      reason = "death";
+    }
+    if (!reason && position.dist(state.lastCameraPosition) > kDynbenchMaxStepUnits) reason = "teleport";
+  }
+  state.lastFollowLife = followLife;
+  state.lastCameraPosition = position;
+  return reason;
+}
 
 // One rendered frame with the map loaded: exports the map first, records inside the window.
 void recordFrame(const char *map) {
@@ -268,13 +344,15 @@ void recordFrame(const char *map) {
   float position[3];
   toCapture(camera1->o, position);
   if (dbc_camera(state.session, state.cameraId, position, camera1->pitch, -camera1->yaw, -camera1->roll) != DBC_OK) failCapture("camera");
+  if (const char *cut = cameraCut(camera1->o))
+    if (dbc_camera_cut(state.session, state.cameraId, cut) != DBC_OK) failCapture("camera cut");
   if (firstFrame) recordStaticLights();
   if (!dynbench_models_write(state.session, firstFrame)) failCapture("model instances");
   if (state.recorded == state.verifyFrame) {
     defformatstring(path, "%s/skinning_frame_%lld.txt", state.directory, state.recorded);
     if (!dynbench_models_write_verification(path)) failCapture("skinning verification file");
   }
-  dynbench_visit_dynlights(recordDynamicLight);
+  recordDynamicLights();
   if (dbc_frame_end(state.session) != DBC_OK) failCapture("frame end");
   dynbench_models_next_frame(true);
   ++state.recorded;

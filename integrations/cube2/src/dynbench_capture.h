@@ -15,9 +15,26 @@ int dynbench_capture_clock_millis();
 // After each rendered frame: records it when the capture window is open, quits when it closes.
 void dynbench_capture_frame();
 
-// Implemented in engine/dynlight.cpp by the patch (struct dynlight is private to that file):
-// calls `visit` for every queued dynamic light.
-void dynbench_visit_dynlights(void (*visit)(const vec &o, const vec &color, float radius, int flags, bool fading));
+// How far (Cube units) a thing the engine keeps no identity for (a part drawn without a game
+// entity, a light re-added every frame) may move between two frames and keep its id: a rocket flies
+// 320 units/s, 5.3 units per frame at 60 fps and 13 at 24 fps; 48 allows down to about 7 fps. A
+// camera moving further than this in one frame has jumped (teleporter): a cut.
+static const float kDynbenchMaxStepUnits = 48.0f;
+
+// One queued dynamic light as the engine holds it (engine/dynlight.cpp; its struct is private).
+struct dynbench_dynlight {
+  vec o;               // position this frame
+  vec color;           // colour this frame, after the engine's peak and fade
+  vec basecolor;       // the colour it was added with (constant over its life)
+  float radius;        // radius this frame
+  int flags;           // DL_FLASH, DL_SHRINK, DL_EXPAND
+  int fade, peak;      // milliseconds; both 0 for a light re-added every frame (projectiles)
+  int expire;          // lastmillis at which it ends
+  const void *owner;   // the player a tracked light follows (muzzle flash), or NULL
+};
+
+// Implemented in engine/dynlight.cpp by the patch: calls `visit` for every queued dynamic light.
+void dynbench_visit_dynlights(void (*visit)(const dynbench_dynlight &light));
 
 // A stand-in for an entity's address where the engine seeds animation variety and phase from it
 // (animmodel.h calcanim): entities numbered in order of first appearance, scrambled.

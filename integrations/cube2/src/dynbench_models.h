@@ -22,7 +22,7 @@
 // Identity. The engine keeps no id for a rendered thing, so one is inferred: a part rendered for a
 // game entity (players, their attachments) keeps its id while it is rendered in consecutive frames
 // for the same entity; a part rendered without one (projectiles, gibs, items) takes the id of the
-// nearest instance of the same part in the previous frame, within kMaxStepUnits. The same thing
+// nearest instance of the same part in the previous frame, within kDynbenchMaxStepUnits (dynbench_capture.h). The same thing
 // rendered again in one frame (shadow, reflection passes) is recorded once.
 //
 // Limits: vertex-animated models (MD2/MD3 with several frames) are exported in their first frame
@@ -33,9 +33,6 @@
 
 namespace dynbench_models {
 
-// How far (Cube units) a part without an entity may move between two frames and keep its id: a
-// rocket flies about 3 units per frame at 60 fps, gibs and grenades less.
-static const float kMaxStepUnits = 48.0f;
 
 struct PartInstance {
   animmodel::part *part;
@@ -326,7 +323,7 @@ bool dynbench_models_export(dbc_session *session) {
   loopv(current) {
     PartInstance &c = *current[i];
     int best = -1;
-    float bestDistance = kMaxStepUnits;
+    float bestDistance = kDynbenchMaxStepUnits;
     loopvj(previous) {
       const PartInstance &p = *previous[j];
       if (claimed[j] || p.part != c.part || p.owner != c.owner) continue;
