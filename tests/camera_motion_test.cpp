@@ -50,6 +50,37 @@ TEST(CameraMotion, ConstantSpeedGivesKnownDistancePerFrame) {
   EXPECT_NEAR(m.rotation.max, 0.0, 1e-9);
 }
 
+TEST(CameraMotion, CutFramesAreLeftOutOfTheSummariesAndCounted) {
+  // 1 unit per frame along -Z at 24 fps for 2 s, except that the camera jumps 100 units along +X
+  // between the keys at 24/24 and 25/24 s, a cut its extras record. Without the cut: every change
+  // is 1. With it: 47 changes of 1 and one of sqrt(100^2 + 1).
+  GltfBuilder b;
+  const int n = b.node({{"name", "cam"},
+                        {"camera", b.perspectiveCamera()},
+                        {"extras", {{"dynbench_camera_cuts", {{{"from", 24 / 24.0f}, {"time", 25 / 24.0f}, {"reason", "respawn"}}}}}}});
+  std::vector<float> times, values;
+  for (int k = 0; k <= 48; ++k) {
+    times.push_back(static_cast<float>(k / 24.0));
+    for (float v : {k >= 25 ? 100.0f : 0.0f, 0.0f, -static_cast<float>(k)}) values.push_back(v);
+  }
+  b.channel(n, "translation", times, values);
+  const auto m = measure(b, "cuts");
+  EXPECT_EQ(m.cuts, 1u);
+  ASSERT_EQ(m.frames.size(), 49u);
+  for (const auto& f : m.frames) EXPECT_EQ(f.cut, f.frame == 25) << f.frame;
+  EXPECT_NEAR(m.position.mean, 1.0, 1e-4);
+  EXPECT_NEAR(m.position.max, 1.0, 1e-4);
+  EXPECT_NEAR(m.position.variance, 0.0, 1e-6);
+  const double jump = std::sqrt(100.0 * 100.0 + 1.0);
+  EXPECT_NEAR(m.includingCuts.position.max, jump, 1e-3);
+  EXPECT_NEAR(m.includingCuts.position.mean, (47.0 + jump) / 48.0, 1e-4);
+  // At 12 fps the jump lies inside the pair (22/24, 26/24]: frame 13 is the cut.
+  const auto half = measure(b, "cuts12", 12.0);
+  EXPECT_EQ(half.cuts, 1u);
+  for (const auto& f : half.frames) EXPECT_EQ(f.cut, f.frame == 13) << f.frame;
+  EXPECT_NEAR(half.position.max, 2.0, 1e-4);
+}
+
 TEST(CameraMotion, ConstantYawGivesThatYawAndZeroVariance) {
   // Yaw 7.5 degrees per frame for 48 frames: 360 degrees, crossing the +-180 seam; one key per frame.
   GltfBuilder b;

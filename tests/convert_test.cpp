@@ -16,6 +16,7 @@
 #include "run_cli.h"
 #include "scene/evaluate.h"
 #include "scene/load.h"
+#include "scene/queries.h"
 
 namespace dynbench::convert {
 namespace {
@@ -124,6 +125,18 @@ TEST(Convert, RoundTripMatchesTheCapture) {
     EXPECT_EQ(e.ownVisibility(flash, t), f >= 2 && f <= 6) << at;
     // ... at its captured position (0.5, 1.5, f) while recorded, then held.
     if (f >= 2) expectClose(glm::dvec3(e.worldMatrix(flash, t)[3]), {0.5, 1.5, std::min(f, 3)}, at + " flash position");
+    // ... with its captured brightness: 4 x 100 cd at full orange in frame 2, half in frame 3, then
+    // held (KHR_animation_pointer on the light's colour and intensity).
+    if (f >= 2) {
+      const scene::Light light = e.light(s.nodes[static_cast<std::size_t>(flash)].light, t);
+      EXPECT_NEAR(light.intensity, f == 2 ? 400.0 : 200.0, 1e-3) << at;
+      expectClose(glm::dvec3(light.color), {1.0, 0.5, 0.0}, at + " flash colour");
+    }
+    // The camera cut at frame 7 (a respawn): between the keys of frames 6 and 7 only.
+    if (f > 0) {
+      const double previous = static_cast<float>((f - 1) / 60.0);
+      EXPECT_EQ(scene::cameraCutBetween(s.nodes[static_cast<std::size_t>(camera)], previous, t), f == 7) << at;
+    }
     // Skinned vertices: world = model transform x sum_k w_k J_k IBM_k v, from the capture's values.
     const auto world = e.worldPositions(skinned, 0, t);
     ASSERT_EQ(world.size(), 4u);
@@ -141,6 +154,15 @@ TEST(Convert, RoundTripMatchesTheCapture) {
       expectClose(world[static_cast<std::size_t>(v)], expected, fmt::format("{} arm vertex {}", at, v));
     }
   }
+  const auto& cuts = s.nodes[static_cast<std::size_t>(camera)].cuts;
+  ASSERT_EQ(cuts.size(), 1u);
+  EXPECT_EQ(cuts[0].reason, "respawn");
+  EXPECT_DOUBLE_EQ(cuts[0].from, static_cast<float>(6 / 60.0));
+  EXPECT_DOUBLE_EQ(cuts[0].time, static_cast<float>(7 / 60.0));
+  // At 24 fps (frames at 0, 1/24, 2/24, ...) the jump from 0.1 s to 0.1167 s lies inside the pair
+  // (2/24, 3/24]: that frame is the cut.
+  EXPECT_TRUE(scene::cameraCutBetween(s.nodes[static_cast<std::size_t>(camera)], 2 / 24.0, 3 / 24.0));
+  EXPECT_FALSE(scene::cameraCutBetween(s.nodes[static_cast<std::size_t>(camera)], 1 / 24.0, 2 / 24.0));
   // Between frames 4 and 7 the crate's scale-0 fallback hides it too.
   EXPECT_TRUE(scene::hasZeroScale(e.worldMatrix(crate, static_cast<float>(5 / 60.0))));
 }

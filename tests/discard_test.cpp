@@ -283,9 +283,11 @@ TEST(Discard, ReprojectionRoundTripsThroughThePixelDirection) {
 }
 
 // A frames folder written to the contract (through the renderer's own sidecar writer).
-void writeFrames(const fs::path& dir, int count, int w, int h, bool variance = true) {
+// The camera yaws 2 degrees a frame; from frame cutAt on it has jumped a further 40 degrees, and
+// that frame's sidecar says cut.
+void writeFrames(const fs::path& dir, int count, int w, int h, bool variance = true, int cutAt = -1) {
   for (int k = 0; k < count; ++k) {
-    const auto cam = camera(2.0 * k, w, h, 50.0);
+    const auto cam = camera(2.0 * k + (cutAt >= 0 && k >= cutAt ? 40.0 : 0.0), w, h, 50.0);
     const FeatureFrame f = makeFrame(k, cam, farSphere);
     FloatImage image;
     image.width = w;
@@ -304,8 +306,47 @@ void writeFrames(const fs::path& dir, int count, int w, int h, bool variance = t
       image.pixels.push_back(static_cast<float>(1e-4 * (1 + i % 5)));
     }
     ASSERT_TRUE(writeImage(frames::frameImagePath(dir, k), image));
-    ASSERT_TRUE(writeFileAtomic(frames::frameSidecarPath(dir, k), frames::sidecarJson(k, k / 24.0, cam.frameCamera(), {}).dump()));
+    auto sidecar = frames::sidecarJson(k, k / 24.0, cam.frameCamera(), {});
+    if (k == cutAt) sidecar["cut"] = true;
+    ASSERT_TRUE(writeFileAtomic(frames::frameSidecarPath(dir, k), sidecar.dump()));
   }
+}
+
+TEST(DiscardCli, CameraCutsAreMarkedAndLeftOutOfTheMeanUnlessIncluded) {
+  const auto dir = test::freshDir("discard_cuts");
+  writeFrames(dir / "plain", 4, 48, 27);
+  writeFrames(dir / "cut", 4, 48, 27, true, 2);  // pairs (0,1), (1,2) cut, (2,3)
+  const auto plain = dynbench(fmt::format("discard {} --json {}", (dir / "plain").string(), (dir / "p.json").string()), dir);
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  const auto cut = dynbench(fmt::format("discard {} --json {} --csv {}", (dir / "cut").string(), (dir / "c.json").string(),
+                                        (dir / "c.csv").string()), dir);
+  ASSERT_EQ(cut.status, 0) << cut.err;
+  EXPECT_NE(cut.out.find("3 frame pairs of which 1 camera cuts are left out"), std::string::npos) << cut.out;
+  EXPECT_NE(cut.out.find("1 of 3 frame pairs are camera cuts; the mean leaves them out"), std::string::npos) << cut.out;  // spdlog warns on stdout
+  const auto p = nlohmann::json::parse(test::slurp(dir / "p.json"));
+  const auto c = nlohmann::json::parse(test::slurp(dir / "c.json"));
+  EXPECT_EQ(c["cut_pairs"], 1);
+  EXPECT_EQ(c["cuts_in_mean"], false);
+  EXPECT_EQ(c["frames"][1]["cut"], true);
+  EXPECT_FALSE(c["frames"][0].contains("cut"));
+  // The other pairs turn 2 degrees, as every pair of the plain folder: the mean over them is the
+  // plain folder's; the cut pair (a 42-degree turn) loses far more.
+  EXPECT_NEAR(c["mean"]["frustum"].get<double>(), p["mean"]["frustum"].get<double>(), 1e-9);
+  EXPECT_GT(c["frames"][1]["frustum"].get<double>(), 5 * p["mean"]["frustum"].get<double>());
+  const auto csv = test::slurp(dir / "c.csv");
+  EXPECT_NE(csv.find(",cut\n"), std::string::npos);
+  const auto all = dynbench(fmt::format("discard {} --include-cuts --json {}", (dir / "cut").string(), (dir / "a.json").string()), dir);
+  ASSERT_EQ(all.status, 0) << all.err;
+  const auto a = nlohmann::json::parse(test::slurp(dir / "a.json"));
+  EXPECT_EQ(a["cuts_in_mean"], true);
+  double sum = 0;
+  for (const auto& f : c["frames"]) sum += f["frustum"].get<double>();
+  EXPECT_NEAR(a["mean"]["frustum"].get<double>(), sum / 3, 1e-9);
+  // Only cuts: nothing to average without --include-cuts.
+  writeFrames(dir / "only", 2, 16, 9, true, 1);
+  const auto only = dynbench(fmt::format("discard {}", (dir / "only").string()), dir);
+  EXPECT_EQ(only.status, 5) << only.err;  // invalid data
+  EXPECT_NE(only.err.find("every frame pair is a camera cut"), std::string::npos) << only.err;
 }
 
 TEST(DiscardCli, TableJsonCsvAndMasks) {

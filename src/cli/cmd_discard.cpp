@@ -16,11 +16,12 @@ namespace fs = std::filesystem;
 struct DiscardCli {
   std::string frames, json, csv, masks, plots;
   discard::Thresholds thresholds;
+  bool includeCuts = false;
 };
 
 Expected<void> runDiscard(const DiscardCli& cli) {
   std::optional<Progress> progress;
-  auto outcome = pipeline::runDiscard({cli.frames, cli.thresholds, cli.json, cli.csv, cli.masks, cli.plots},
+  auto outcome = pipeline::runDiscard({cli.frames, cli.thresholds, cli.includeCuts, cli.json, cli.csv, cli.masks, cli.plots},
                                       [&](std::size_t done, std::size_t total) {
                                         if (!progress) progress.emplace("discard", total, "frames");
                                         progress->update(done);
@@ -63,6 +64,7 @@ void addDiscardCommand(CLI::App& app, CommandRun& run) {
                          fmt::format("Same as --radiance-test noise-aware: radiance discards only when the change exceeds {} standard "
                                      "deviations of the pixels' noise (needs *.var channels)",
                                      discard::Thresholds{}.noiseSigmas));
+  cmd->add_flag("--include-cuts", o->includeCuts, "Average camera-cut pairs too (frames whose sidecar says cut; left out by default)");
   cmd->add_option("--json", o->json, "Per-frame and mean percentages as JSON");
   cmd->add_option("--csv", o->csv, "Per-frame percentages as CSV");
   cmd->add_option("--plots", o->plots, "Write NAME_discard.png and .svg: per-frame discard percentages (gnuplot)");

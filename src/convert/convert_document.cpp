@@ -42,6 +42,14 @@ void Converter::buildDocument() {
     json target = {{"node", node}, {"path", path}};
     channels.push_back({{"sampler", samplers.size() - 1}, {"target", target}});
   };
+  auto lightChannel = [&](int input, int output, int light, const char* property) {
+    samplers.push_back({{"input", input}, {"output", output}, {"interpolation", "LINEAR"}});
+    channels.push_back({{"sampler", samplers.size() - 1},
+                        {"target", {{"path", "pointer"},
+                                    {"extensions", {{"KHR_animation_pointer",
+                                                     {{"pointer", fmt::format("/extensions/KHR_lights_punctual/lights/{}/{}", light, property)}}}}}}}});
+    usesAnimationPointer_ = true;
+  };
   auto pointerChannel = [&](int input, int output, int node) {
     samplers.push_back({{"input", input}, {"output", output}, {"interpolation", "STEP"}});
     channels.push_back({{"sampler", samplers.size() - 1},
@@ -84,6 +92,12 @@ void Converter::buildDocument() {
     json node = {{"name", fmt::format("{}_{}", kindName(t.kind), t.id)}};
     if (t.kind == Kind::kModel) node["name"] = fmt::format("model_{}_{}", t.id, reader_->models()[static_cast<std::size_t>(t.model)].path);
     if (t.kind == Kind::kCamera) node["camera"] = 0;
+    if (t.kind == Kind::kCamera && !t.cuts.empty()) {
+      json cuts = json::array();
+      for (const auto& c : t.cuts) cuts.push_back({{"from", c.from}, {"time", c.time}, {"reason", c.reason}});
+      node["extras"]["dynbench_camera_cuts"] = cuts;
+      report_.cameraCuts += t.cuts.size();
+    }
     const int mesh = t.kind == Kind::kModel ? meshOfModel_[static_cast<std::size_t>(t.model)] : -1;
     if (mesh >= 0 && !t.skinned) node["mesh"] = mesh;
     const bool nodeVisibility = t.hasVisibilityChannel() && options_.visibility != VisibilityMode::kScale;
@@ -99,6 +113,12 @@ void Converter::buildDocument() {
     if (t.kind != Kind::kLight) {
       region(t.span(), 16, t.rotationOffset, view);
       channel(input, accessor(view, 0, kFloat, t.span(), "VEC4"), "LINEAR", t.node, "rotation");
+    }
+    if (t.kind == Kind::kLight && t.colorVaries) {
+      region(t.span(), 12, t.colorOffset, view);
+      lightChannel(input, accessor(view, 0, kFloat, t.span(), "VEC3"), t.lightDefinition, "color");
+      region(t.span(), 4, t.intensityOffset, view);
+      lightChannel(input, accessor(view, 0, kFloat, t.span(), "SCALAR"), t.lightDefinition, "intensity");
     }
     if (t.hasVisibilityChannel() && ((nodeVisibility && t.kind != Kind::kCamera) || scaleVisibility)) {
       region(t.visibilityKeys, 4, t.visTimeOffset, view);

@@ -67,10 +67,8 @@ void Converter::writeOutputs() {
   if (!lights_.empty()) document["extensions"]["KHR_lights_punctual"] = {{"lights", lights_}};
   std::vector<std::string> used{"DYNBENCH_environment"};
   if (!lights_.empty()) used.push_back("KHR_lights_punctual");
-  if (usesVisibility_) {
-    used.push_back("KHR_node_visibility");
-    used.push_back("KHR_animation_pointer");
-  }
+  if (usesVisibility_) used.push_back("KHR_node_visibility");
+  if (usesVisibility_ || usesAnimationPointer_) used.push_back("KHR_animation_pointer");
   if (!used.empty()) document["extensionsUsed"] = used;
   for (const char* key : {"images", "textures", "materials", "meshes", "skins"})
     if (document.contains(key) && document[key].empty()) document.erase(key);

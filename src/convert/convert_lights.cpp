@@ -2,16 +2,22 @@
 
 namespace dynbench::convert::detail {
 
-int Converter::lightDefinition(const LightRecord& l, double share) {
+std::pair<glm::dvec3, double> Converter::lightColorIntensity(const glm::dvec3& capturedColor, const std::string& modelType,
+                                                            double share) const {
   // Engines have negative lights that darken (Cube 2 does); glTF lights only add light, and
   // KHR_lights_punctual colours are in [0, 1]: negative channels become 0.
-  const glm::dvec3 captured = glm::max(l.color, glm::dvec3(0.0));
+  const glm::dvec3 captured = glm::max(capturedColor, glm::dvec3(0.0));
   const double peak = std::max({captured.r, captured.g, captured.b});
-  const LightRule& rule = options_.lightRules.rule(l.modelType);
+  const LightRule& rule = options_.lightRules.rule(modelType);
   const glm::dvec3 color = peak > 0 ? captured / peak : glm::dvec3(1.0);
+  return {color, options_.lightRules.candelaPerUnit * peak * rule.intensityScale * share};
+}
+
+int Converter::lightDefinition(const LightRecord& l, double share) {
+  const auto [color, intensity] = lightColorIntensity(l.color, l.modelType, share);
   json light = {{"type", l.type == LightType::kSpot ? "spot" : l.type == LightType::kDirectional ? "directional" : "point"},
                 {"color", vec(color)},
-                {"intensity", options_.lightRules.candelaPerUnit * peak * rule.intensityScale * share},
+                {"intensity", intensity},
                 {"name", l.modelType}};
   if (l.type == LightType::kSpot) light["spot"] = {{"outerConeAngle", 0.7853981633974483}};
   lights_.push_back(light);
@@ -23,7 +29,9 @@ int Converter::lightDefinition(const LightRecord& l, double share) {
 void Converter::lightNodes(Track& t, int node) {
   const LightRule& rule = options_.lightRules.rule(t.light.modelType);
   if (rule.ringLights == 6) {
-    const int def = lightDefinition(t.light, 1.0 / 6);
+    t.lightShare = 1.0 / 6;
+    const int def = lightDefinition(t.light, t.lightShare);
+    t.lightDefinition = def;
     const double r = rule.ringRadiusMetres / reader_->settings().metresPerUnit;
     for (const glm::dvec3 axis : {glm::dvec3(1, 0, 0), glm::dvec3(-1, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, -1, 0),
                                   glm::dvec3(0, 0, 1), glm::dvec3(0, 0, -1)})
@@ -31,7 +39,9 @@ void Converter::lightNodes(Track& t, int node) {
                {"extensions", {{"KHR_lights_punctual", {{"light", def}}}}}},
               node);
   } else {
-    doc_["nodes"][static_cast<std::size_t>(node)]["extensions"]["KHR_lights_punctual"] = {{"light", lightDefinition(t.light, 1.0)}};
+    t.lightShare = 1.0;
+    t.lightDefinition = lightDefinition(t.light, t.lightShare);
+    doc_["nodes"][static_cast<std::size_t>(node)]["extensions"]["KHR_lights_punctual"] = {{"light", t.lightDefinition}};
   }
 }
 }  // namespace dynbench::convert::detail

@@ -45,6 +45,10 @@ void Converter::endFrame(std::size_t i, Key&& key) {
 template <typename Key>
 void Converter::scanFrame(const CaptureFrame& frame, std::size_t i, Key&& key) {
   for (const auto& c : frame.cameras) present(track(c.id, Kind::kCamera, -1), i, key);
+  for (const auto& c : frame.cuts) {
+    Track& t = track(c.id, Kind::kCamera, -1);
+    if (i > 0 && (t.cuts.empty() || t.cuts.back().time != times_[i])) t.cuts.push_back({times_[i - 1], times_[i], c.reason});
+  }
   for (const auto& m : frame.models) present(track(m.id, Kind::kModel, m.model), i, key);
   for (const auto& l : frame.lights) {
     Track& t = track(l.id, Kind::kLight, -1);
@@ -56,6 +60,8 @@ void Converter::scanFrame(const CaptureFrame& frame, std::size_t i, Key&& key) {
     if (!t.appeared) {
       t.light = l;
       t.extraFrames = options_.lightRules.rule(l.modelType).extraFrames;
+    } else if (l.color != t.light.color) {
+      t.colorVaries = true;
     }
     if (l.dynamic) present(t, i, key);
   }
@@ -110,6 +116,8 @@ void Converter::passTwo() {
     if (t.visTimeOffset) t.visTime = RegionWriter(bin_, t.visTimeOffset);
     if (t.visValueOffset) t.visValue = RegionWriter(bin_, t.visValueOffset);
     if (t.scaleOffset) t.scale = RegionWriter(bin_, t.scaleOffset);
+    if (t.colorOffset) t.color = RegionWriter(bin_, t.colorOffset);
+    if (t.intensityOffset) t.intensity = RegionWriter(bin_, t.intensityOffset);
     for (auto o : t.jointTranslationOffsets) t.jointTranslation.emplace_back(bin_, o);
     for (auto o : t.jointRotationOffsets) t.jointRotation.emplace_back(bin_, o);
   }
@@ -146,6 +154,7 @@ void Converter::passTwo() {
       Track& t = tracks_.at(l.id);
       if (!l.dynamic) continue;
       t.heldTranslation = l.position;
+      t.heldColor = l.color;
       if (!t.appeared) active.push_back(&t);
     }
     for (const auto& j : frame.joints) {
@@ -174,6 +183,11 @@ void Converter::passTwo() {
       if (t->translationOffset) t->translation.put(std::array<float, 3>{static_cast<float>(t->heldTranslation.x),
                                                                          static_cast<float>(t->heldTranslation.y),
                                                                          static_cast<float>(t->heldTranslation.z)});
+      if (t->colorOffset) {
+        const auto [color, intensity] = lightColorIntensity(t->heldColor, t->light.modelType, t->lightShare);
+        t->color.put(std::array<float, 3>{static_cast<float>(color.r), static_cast<float>(color.g), static_cast<float>(color.b)});
+        t->intensity.put(static_cast<float>(intensity));
+      }
       if (t->rotationOffset) {
         t->heldRotation = nearest(t->lastRotation, t->heldRotation);
         t->lastRotation = t->heldRotation;
@@ -195,7 +209,7 @@ void Converter::passTwo() {
     if (options_.onProgress) options_.onProgress(2, i + 1, times_.size());
   }
   for (auto& [id, t] : tracks_) {
-    for (RegionWriter* w : {&t.translation, &t.rotation, &t.visTime, &t.visValue, &t.scale}) w->flush();
+    for (RegionWriter* w : {&t.translation, &t.rotation, &t.visTime, &t.visValue, &t.scale, &t.color, &t.intensity}) w->flush();
     for (auto& w : t.jointTranslation) w.flush();
     for (auto& w : t.jointRotation) w.flush();
   }

@@ -48,14 +48,24 @@ struct Track {
   // Static records and light properties (from the first record).
   DualQuaternion staticPose;
   LightRecord light;
+  bool colorVaries = false;  // a dynamic light whose captured colour changes: colour and intensity are animated
+  int lightDefinition = -1;  // its KHR_lights_punctual light
+  double lightShare = 1.0;   // its share of the captured light (1/6 for each of a ring's lights)
+  struct Cut {
+    float from, time;  // the key before the jump and the key after it
+    std::string reason;
+  };
+  std::vector<Cut> cuts;  // a camera's cuts
   // Layout.
   int node = -1;
   std::uint64_t translationOffset = 0, rotationOffset = 0, visTimeOffset = 0, visValueOffset = 0, scaleOffset = 0;
   std::vector<std::uint64_t> jointTranslationOffsets, jointRotationOffsets;
   // Pass 2.
-  RegionWriter translation, rotation, visTime, visValue, scale;
+  std::uint64_t colorOffset = 0, intensityOffset = 0;
+  RegionWriter translation, rotation, visTime, visValue, scale, color, intensity;
   std::vector<RegionWriter> jointTranslation, jointRotation;
   glm::dvec3 heldTranslation{0.0};
+  glm::dvec3 heldColor{0.0};
   glm::dquat heldRotation{1, 0, 0, 0};
   std::vector<glm::dvec3> heldJointTranslation;
   std::vector<glm::dquat> heldJointRotation;
@@ -157,6 +167,10 @@ class Converter {
 
   void buildMeshes();
 
+  // KHR_lights_punctual colour (the captured colour over its largest channel) and intensity of a
+  // captured colour under the light rules; `share` divides it between a ring's lights.
+  std::pair<glm::dvec3, double> lightColorIntensity(const glm::dvec3& captured, const std::string& modelType, double share) const;
+
   int lightDefinition(const LightRecord& l, double share);
 
   // A light capturable: one light, or (ring rule) six around its node.
@@ -200,7 +214,7 @@ class Converter {
   std::map<std::pair<std::string, std::string>, int> materialByMaps_;
   std::map<std::uint64_t, int> visInputs_;
   int timesView_ = -1;
-  bool cameraChanged_ = false, usesVisibility_ = false;
+  bool cameraChanged_ = false, usesVisibility_ = false, usesAnimationPointer_ = false;
   ConvertReport report_;
 };
 

@@ -246,7 +246,7 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
 namespace dynbench::discard {
 
 Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thresholds& thresholds, const MaskSink& masks,
-                                   const DiscardProgress& progress) {
+                                   const DiscardProgress& progress, bool cutsInMean) {
   auto entries = frames::listFrames(dir);
   if (!entries) return std::unexpected(entries.error());
   if (entries->size() < 2) return fail(ErrorCode::kInvalidData, "{}: needs at least two frames (found {})", dir.string(), entries->size());
@@ -280,7 +280,9 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
       if (previous->frame + 1 != frame->frame) {
         run.warnings.push_back(fmt::format("frames {} and {} are not consecutive: pair skipped", previous->frame, frame->frame));
       } else {
-        const DiscardResult r = discardFrame(*frame, *previous, absoluteThresholds(thresholds, *frame, run.sceneSize));
+        DiscardResult r = discardFrame(*frame, *previous, absoluteThresholds(thresholds, *frame, run.sceneSize));
+        r.percentages.cut = frame->cut;
+        run.cutPairs += frame->cut ? 1 : 0;
         run.frames.push_back(r.percentages);
         if (masks)
           if (auto ok = masks(*frame, r); !ok) return std::unexpected(ok.error());
@@ -290,21 +292,32 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
     if (progress) progress(k + 1, entries->size());
   }
   if (run.frames.empty()) return fail(ErrorCode::kInvalidData, "{}: no two consecutive frames to compare", dir.string());
+  run.cutsInMean = cutsInMean;
+  // The pairs Eq. (3.5) averages over: all, or those that are not cuts.
+  std::vector<const FramePercentages*> averaged;
+  for (const auto& f : run.frames)
+    if (cutsInMean || !f.cut) averaged.push_back(&f);
+  if (averaged.empty())
+    return fail(ErrorCode::kInvalidData, "{}: every frame pair is a camera cut; nothing to average (--include-cuts averages them)", dir.string());
+  if (run.cutPairs > 0)
+    run.warnings.push_back(fmt::format("{} of {} frame pairs are camera cuts; the mean {}", run.cutPairs, run.frames.size(),
+                                       cutsInMean ? "includes them" : "leaves them out (--include-cuts keeps them)"));
   run.mean.frame = -1;
-  for (const auto& f : run.frames) {
+  for (const FramePercentages* p : averaged) {
+    const auto& f = *p;
     run.mean.frustum += f.frustum;
     run.mean.position += f.position;
     run.mean.normal += f.normal;
     run.mean.direct += f.direct;
     run.mean.indirect += f.indirect;
   }
-  const double n = static_cast<double>(run.frames.size());  // Eq. (3.5)
+  const double n = static_cast<double>(averaged.size());  // Eq. (3.5)
   for (double* v : {&run.mean.frustum, &run.mean.position, &run.mean.normal, &run.mean.direct, &run.mean.indirect}) *v /= n;
   if (thresholds.radianceTest == Thresholds::RadianceTest::kExpected) {
     // The mean of independent frame estimates: half-widths add in quadrature, over n.
     auto meanInterval = [&](double mean, std::optional<Interval> FramePercentages::*member) {
       double sumSq = 0.0;
-      for (const auto& f : run.frames) sumSq += std::pow((f.*member)->halfWidth(), 2);
+      for (const FramePercentages* f : averaged) sumSq += std::pow((f->*member)->halfWidth(), 2);
       const double half = std::sqrt(sumSq) / n;
       return Interval{std::max(0.0, mean - half), std::min(100.0, mean + half)};
     };
@@ -355,11 +368,14 @@ std::string discardJson(const DiscardRun& run, const std::string& framesDir) {
                      {"direct", t.direct},           {"indirect", t.indirect},                 {"absolute_radiance", t.absoluteRadiance},
                      {"radiance_test", radianceTestName(t.radianceTest)}, {"noise_sigmas", t.noiseSigmas}};
   j["mean"] = percentagesJson(run.mean);
+  j["cut_pairs"] = run.cutPairs;
+  j["cuts_in_mean"] = run.cutsInMean;
   j["frames"] = nlohmann::json::array();
   for (const auto& f : run.frames) {
     auto row = percentagesJson(f);
     row["frame"] = f.frame;
     row["time"] = f.time;
+    if (f.cut) row["cut"] = true;
     j["frames"].push_back(row);
   }
   j["warnings"] = run.warnings;
@@ -418,6 +434,12 @@ Expected<DiscardRun> readDiscardJson(const std::filesystem::path& path) {
     auto time = f.number(base + "/time");
     if (!time) return std::unexpected(time.error());
     p->frame = static_cast<long>(*frame);
+    if (f.has(base + "/cut")) {
+      auto cut = f.boolean(base + "/cut");
+      if (!cut) return std::unexpected(cut.error());
+      p->cut = *cut;
+      run.cutPairs += p->cut ? 1 : 0;
+    }
     p->time = *time;
     run.frames.push_back(*p);
   }

@@ -65,6 +65,7 @@ struct FramePercentages {
   double frustum = 0, position = 0, normal = 0, direct = 0, indirect = 0;  // percent of w x h
   // The radiance columns' 95 % intervals (the kExpected test; absent otherwise).
   std::optional<Interval> directInterval, indirectInterval;
+  bool cut = false;  // frame i's sidecar marks a camera cut: a jump, not motion
 };
 
 struct DiscardResult {
@@ -110,6 +111,8 @@ struct DiscardRun {
   Thresholds thresholds;                 // as given
   double sceneSize = 0.0;                // used by relativePosition
   int width = 0, height = 0;
+  std::size_t cutPairs = 0;              // pairs whose frame i is a camera cut
+  bool cutsInMean = false;               // whether the mean covers them (by default it leaves them out)
   std::vector<std::string> warnings;
 };
 
@@ -119,9 +122,12 @@ using MaskSink = std::function<Expected<void>(const FeatureFrame& current, const
 using DiscardProgress = std::function<void(std::size_t, std::size_t)>;
 
 // Streams a frames folder (two frames in memory at a time) and compares each frame with the one
-// before it. Frames must be consecutive; a gap skips that pair with a warning.
+// before it. Frames must be consecutive; a gap skips that pair with a warning. Pairs whose frame i
+// is a camera cut (sidecar `cut`) are compared and listed but left out of the mean unless
+// cutsInMean: after a jump every temporal method starts afresh, so its discard is not a property of
+// the motion.
 Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thresholds& thresholds, const MaskSink& masks = {},
-                                   const DiscardProgress& progress = {});
+                                   const DiscardProgress& progress = {}, bool cutsInMean = false);
 
 // The `discard --json` document: frames folder, size, thresholds, mean and per-frame percentages
 // (docs/cli.md); what `dynbench report` reads.

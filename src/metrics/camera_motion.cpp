@@ -41,7 +41,8 @@ Expected<CameraMotion> measureCameraMotion(const Scene& scene, double fps, const
   const std::size_t count = std::max<std::size_t>(1, frameCount(scene, fps));
   const Evaluator evaluator(scene);
   motion.frames.resize(count);
-  std::vector<double> dPosition, dRotation, dPitch, dYaw, dRoll;
+  // [0]: changes that are not cuts; [1]: all changes.
+  std::vector<double> dPosition[2], dRotation[2], dPitch[2], dYaw[2], dRoll[2];
   for (std::size_t i = 0; i < count; ++i) {
     CameraFrame& f = motion.frames[i];
     f.frame = i;
@@ -60,17 +61,27 @@ Expected<CameraMotion> measureCameraMotion(const Scene& scene, double fps, const
     f.yawDelta = std::abs(wrapDegrees(f.yawDegrees - prev.yawDegrees));             // Eq. (3.2)
     f.pitchDelta = std::abs(wrapDegrees(f.pitchDegrees - prev.pitchDegrees));
     f.rollDelta = std::abs(wrapDegrees(f.rollDegrees - prev.rollDegrees));
-    dPosition.push_back(f.positionDelta);
-    dRotation.push_back(f.rotationDelta);
-    dYaw.push_back(f.yawDelta);
-    dPitch.push_back(f.pitchDelta);
-    dRoll.push_back(f.rollDelta);
+    f.cut = cameraCutBetween(cameraNode, prev.time, f.time);
+    motion.cuts += f.cut ? 1 : 0;
+    for (int all = f.cut ? 1 : 0; all < 2; ++all) {
+      dPosition[all].push_back(f.positionDelta);
+      dRotation[all].push_back(f.rotationDelta);
+      dYaw[all].push_back(f.yawDelta);
+      dPitch[all].push_back(f.pitchDelta);
+      dRoll[all].push_back(f.rollDelta);
+    }
   }
-  motion.position = summarize(dPosition);
-  motion.rotation = summarize(dRotation);
-  motion.pitch = summarize(dPitch);
-  motion.yaw = summarize(dYaw);
-  motion.roll = summarize(dRoll);
+  motion.position = summarize(dPosition[0]);
+  motion.rotation = summarize(dRotation[0]);
+  motion.pitch = summarize(dPitch[0]);
+  motion.yaw = summarize(dYaw[0]);
+  motion.roll = summarize(dRoll[0]);
+  auto& all = motion.includingCuts;
+  all.position = summarize(dPosition[1]);
+  all.rotation = summarize(dRotation[1]);
+  all.pitch = summarize(dPitch[1]);
+  all.yaw = summarize(dYaw[1]);
+  all.roll = summarize(dRoll[1]);
   return motion;
 }
 

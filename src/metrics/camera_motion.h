@@ -29,6 +29,7 @@ struct CameraFrame {
   double positionDelta = 0.0;    // Eq. (3.1), scene units per frame
   double rotationDelta = 0.0;    // Eq. (2.4) as the full rotation angle, degrees per frame
   double yawDelta = 0.0, pitchDelta = 0.0, rollDelta = 0.0;  // Eq. (3.2), |wrapped difference|, degrees
+  bool cut = false;  // the camera cut (jumped) since the previous frame: scene::cameraCutBetween
 };
 
 struct CameraMotion {
@@ -37,10 +38,15 @@ struct CameraMotion {
   std::string cameraName;
   double fps = 0.0;
   std::vector<CameraFrame> frames;
-  // Over the frames 1..N-1 (N-1 changes):
+  std::size_t cuts = 0;  // frames 1..N-1 that are cuts
+  // Over the changes of frames 1..N-1 that are not cuts (a cut is a jump, not motion):
   Summary position;  // Table 6.4, scene units per frame
   Summary rotation;  // Table 6.5, degrees per frame
   Summary pitch, yaw, roll;  // Table 6.6, degrees per frame
+  // The same over all N-1 changes, cuts included.
+  struct {
+    Summary position, rotation, pitch, yaw, roll;
+  } includingCuts;
 };
 
 

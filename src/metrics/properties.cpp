@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -26,10 +27,10 @@ DatasetProperties measureProperties(const Scene& scene, double fps) {
   p.warnings = scene.warnings;
   // Several animations driving the same node property usually means separate clips (walk, run)
   // that were never meant to play at once; all play together here and the later one wins.
-  std::set<std::pair<int, AnimationPath>> driven, conflicting;
+  std::set<std::tuple<int, int, AnimationPath>> driven, conflicting;
   for (const auto& a : scene.animations) {
-    std::set<std::pair<int, AnimationPath>> own;
-    for (const auto& c : a.channels) own.insert({c.node, c.path});
+    std::set<std::tuple<int, int, AnimationPath>> own;
+    for (const auto& c : a.channels) own.insert({c.node, c.light, c.path});
     for (const auto& key : own)
       if (!driven.insert(key).second) conflicting.insert(key);
   }

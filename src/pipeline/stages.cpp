@@ -110,23 +110,27 @@ Expected<DiscardOutcome> runDiscard(const DiscardStage& stage, const discard::Di
       return writeImage(stage.masks / fmt::format("discard_{:05d}.png", frame.frame),
                         FloatImage{frame.width, frame.height, 3, discard::maskImage(frame, r.mask), {}, {}, {}});
     };
-  auto run = discard::discardFolder(stage.frames, t, masks, progress);
+  auto run = discard::discardFolder(stage.frames, t, masks, progress, stage.includeCuts);
   if (!run) return std::unexpected(run.error());
   DiscardOutcome out;
   const std::string name = stage.frames.filename().empty() ? stage.frames.parent_path().filename().string() : stage.frames.filename().string();
   out.markdown = report::markdownTable(
-      report::discardTable({{name, run->mean}}, fmt::format("{} frame pairs, {}x{}", run->frames.size(), run->width, run->height)));
+      report::discardTable({{name, run->mean}}, fmt::format("{} frame pairs{}, {}x{}", run->frames.size(),
+                                                            run->cutPairs == 0 ? ""
+                                                            : run->cutsInMean ? fmt::format(", {} of them camera cuts", run->cutPairs)
+                                                                              : fmt::format(" of which {} camera cuts are left out", run->cutPairs),
+                                                            run->width, run->height)));
   if (!stage.json.empty())
     if (auto ok = writeFileAtomic(stage.json, discard::discardJson(*run, stage.frames.string())); !ok) return std::unexpected(ok.error());
   if (!stage.csv.empty()) {
     std::string csv =
-        "frame,time,frustum,world_position,shading_normal,direct_radiance,indirect_radiance,direct_low,direct_high,indirect_low,indirect_high\n";
+        "frame,time,frustum,world_position,shading_normal,direct_radiance,indirect_radiance,direct_low,direct_high,indirect_low,indirect_high,cut\n";
     // Interval columns are empty for the tests that give none.
     auto bound = [](const std::optional<discard::Interval>& i, bool high) { return i ? fmt::format("{}", high ? i->high : i->low) : std::string(); };
     for (const auto& f : run->frames)
-      csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", f.frame, f.time, f.frustum, f.position, f.normal, f.direct, f.indirect,
+      csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{}\n", f.frame, f.time, f.frustum, f.position, f.normal, f.direct, f.indirect,
                          bound(f.directInterval, false), bound(f.directInterval, true), bound(f.indirectInterval, false),
-                         bound(f.indirectInterval, true));
+                         bound(f.indirectInterval, true), f.cut ? 1 : 0);
     if (auto ok = writeFileAtomic(stage.csv, csv); !ok) return std::unexpected(ok.error());
   }
   if (!stage.plots.empty())

@@ -51,6 +51,7 @@ Expected<render::RenderSummary> runRender(const RenderStage& stage, const render
 struct DiscardStage {
   std::filesystem::path frames;             // a frames folder (feature-buffer contract)
   discard::Thresholds thresholds;
+  bool includeCuts = false;                 // camera-cut pairs in the mean (left out by default)
   std::filesystem::path json, csv;          // optional outputs
   std::filesystem::path masks, plots;       // optional: discard_NNNNN.png per frame; NAME_discard.png/.svg
 };

@@ -158,7 +158,7 @@ Expected<void> CyclesBackend::render(const std::vector<FrameRequest>& requests, 
     frame["lights"] = nlohmann::json::array();
     for (std::size_t n = 0; n < scene.nodes.size(); ++n) {
       if (scene.nodes[n].light < 0) continue;
-      const auto& l = scene.lights[static_cast<std::size_t>(scene.nodes[n].light)];
+      const auto& l = pose.lights[static_cast<std::size_t>(scene.nodes[n].light)];  // colour and intensity as animated
       const RigidPose rigid = decomposeRigid(pose.world[n]);
       glm::dmat4 world = glm::mat4_cast(rigid.rotation);
       world[3] = glm::dvec4(rigid.position, 1.0);

@@ -126,7 +126,7 @@ Expected<void> LightSet::build(const scene::Scene& scene, const RayTracingScene&
   for (std::size_t n = 0; n < scene.nodes.size() && n < pose.world.size(); ++n) {
     const int li = scene.nodes[n].light;
     if (li < 0 || !pose.visible[n]) continue;
-    const auto& l = scene.lights[static_cast<std::size_t>(li)];
+    const auto& l = pose.lights[static_cast<std::size_t>(li)];  // colour and intensity as animated
     Punctual p;
     p.type = l.type;
     const RigidPose rigid = decomposeRigid(pose.world[n]);

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <chrono>
 #include <thread>
+#include <set>
 
 #include <tbb/global_control.h>
 
@@ -80,7 +81,8 @@ Expected<FrameCameras> frameCameras(const scene::Evaluator& evaluator, int camer
   const double previous = t - 1.0 / job.fps;
   return FrameCameras{t, previous,
                       RenderCamera(evaluator.worldMatrix(cameraNode, t), lens, job.settings.width, job.settings.height),
-                      RenderCamera(evaluator.worldMatrix(cameraNode, previous), lens, job.settings.width, job.settings.height)};
+                      RenderCamera(evaluator.worldMatrix(cameraNode, previous), lens, job.settings.width, job.settings.height),
+                      scene::cameraCutBetween(node, previous, t)};
 }
 
 nlohmann::json renderRecord(const RenderJob& job) {
@@ -135,10 +137,12 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
   if (todo.empty()) return summary;
 
   std::vector<FrameRequest> requests;
+  std::set<long> cuts;
   const scene::Evaluator evaluator(scene);
   for (long f : todo) {
     auto cameras = frameCameras(evaluator, *cameraNode, job, f);
     if (!cameras) return std::unexpected(cameras.error());
+    if (cameras->cut) cuts.insert(f);
     requests.push_back({f, std::move(*cameras)});
   }
   const auto started = std::chrono::steady_clock::now();
@@ -155,6 +159,7 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
   RowProgress rows;
   if (progress) rows = [&](std::size_t i, int done) { progress(i * height + static_cast<std::size_t>(done), rowsTotal, i, requests.size()); };
   const FrameSink write = [&](frames::FeatureFrame&& frame) -> Expected<void> {
+    frame.cut = cuts.contains(frame.frame);  // the sidecar's `cut`: temporal methods and discard reset here
     if (auto ok = frames::writeFrame(job.output, frame, record, {.float32 = job.float32}); !ok) return ok;
     summary.rendered.push_back(frame.frame);
     if (frame.sampling) {

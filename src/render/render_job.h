@@ -63,6 +63,7 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
 struct FrameCameras {
   double time = 0.0, previousTime = 0.0;
   RenderCamera camera, previous;
+  bool cut = false;  // the dataset marks a camera cut between previousTime and time (scene::cameraCutBetween)
 };
 Expected<FrameCameras> frameCameras(const scene::Evaluator& evaluator, int cameraNode, const RenderJob& job, long frame);
 

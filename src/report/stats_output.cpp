@@ -119,6 +119,12 @@ std::string statsJson(const std::vector<StatsRow>& rows, double fps) {
       motion["pitch_degrees"] = summaryJson(m.pitch);
       motion["yaw_degrees"] = summaryJson(m.yaw);
       motion["roll_degrees"] = summaryJson(m.roll);
+      // The summaries above leave cut frames out (docs/metrics.md); these keep them.
+      motion["cuts"] = m.cuts;
+      const auto& all = m.includingCuts;
+      motion["with_cuts"] = {{"position", summaryJson(all.position)}, {"rotation_degrees", summaryJson(all.rotation)},
+                                  {"pitch_degrees", summaryJson(all.pitch)}, {"yaw_degrees", summaryJson(all.yaw)},
+                                  {"roll_degrees", summaryJson(all.roll)}};
     }
     datasets.push_back({{"name", r.name}, {"path", r.path}, {"properties", properties}, {"camera_motion", motion},
                         {"warnings", p.warnings}});
@@ -133,7 +139,7 @@ std::string statsCsv(const std::vector<StatsRow>& rows) {
       "name,path,file_format,total_bytes,faces,animated_camera,morph_targets,material_count,texture_count,texture_bytes,"
       "material_workflow,animation_frames,static_objects,dynamic_rigid_objects,armatures,static_point_lights,"
       "dynamic_point_lights,camera,position_mean,position_variance,position_max,rotation_mean_deg,rotation_variance_deg,"
-      "rotation_max_deg,pitch_mean_deg,pitch_variance_deg,yaw_mean_deg,yaw_variance_deg,roll_mean_deg,roll_variance_deg\n";
+      "rotation_max_deg,pitch_mean_deg,pitch_variance_deg,yaw_mean_deg,yaw_variance_deg,roll_mean_deg,roll_variance_deg,cuts\n";
   for (const auto& r : rows) {
     const auto& p = r.properties;
     const auto& m = r.motion;
@@ -143,11 +149,11 @@ std::string statsCsv(const std::vector<StatsRow>& rows) {
                        p.staticObjects, p.dynamicRigidObjects, p.armatures, p.staticPointLights, p.dynamicPointLights,
                        csvField(m.hasCamera ? m.cameraName : ""));
     if (m.hasCamera) {
-      out += fmt::format(",{},{},{},{},{},{},{},{},{},{},{},{}", m.position.mean, m.position.variance, m.position.max,
+      out += fmt::format(",{},{},{},{},{},{},{},{},{},{},{},{},{}", m.position.mean, m.position.variance, m.position.max,
                          m.rotation.mean, m.rotation.variance, m.rotation.max, m.pitch.mean, m.pitch.variance, m.yaw.mean,
-                         m.yaw.variance, m.roll.mean, m.roll.variance);
+                         m.yaw.variance, m.roll.mean, m.roll.variance, m.cuts);
     } else {
-      out += ",,,,,,,,,,,,";
+      out += ",,,,,,,,,,,,,";
     }
     out += "\n";
   }
@@ -157,11 +163,11 @@ std::string statsCsv(const std::vector<StatsRow>& rows) {
 std::string cameraSeriesCsv(const metrics::CameraMotion& motion) {
   std::string out =
       "frame,time_s,x,y,z,yaw_deg,pitch_deg,roll_deg,position_delta,rotation_delta_deg,yaw_delta_deg,pitch_delta_deg,"
-      "roll_delta_deg\n";
+      "roll_delta_deg,cut\n";
   for (const auto& f : motion.frames)
-    out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{}\n", f.frame, f.time, f.position.x, f.position.y, f.position.z,
+    out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", f.frame, f.time, f.position.x, f.position.y, f.position.z,
                        f.yawDegrees, f.pitchDegrees, f.rollDegrees, f.positionDelta, f.rotationDelta, f.yawDelta,
-                       f.pitchDelta, f.rollDelta);
+                       f.pitchDelta, f.rollDelta, f.cut ? 1 : 0);
   return out;
 }
 
@@ -231,6 +237,11 @@ Expected<StatsRow> readStatsRow(const nlohmann::json& document, const std::files
         if (!v) return std::unexpected(v.error());
         *value = *v;
       }
+    if (f.has(motion + "cuts")) {  // older stats files have no cuts
+      auto cuts = f.count(motion + "cuts");
+      if (!cuts) return std::unexpected(cuts.error());
+      m.cuts = static_cast<std::size_t>(*cuts);
+    }
   }
   return row;
 }

@@ -105,18 +105,25 @@ bool hasZeroScale(const glm::dmat4& world) {
          glm::length(glm::dvec3(world[2])) < kEpsilon;
 }
 
-Evaluator::Evaluator(const Scene& scene) : scene_(scene), drivers_(scene.nodes.size()) {
+Evaluator::Evaluator(const Scene& scene) : scene_(scene), drivers_(scene.nodes.size()), lightDrivers_(scene.lights.size()) {
   for (const auto& animation : scene.animations) {
     for (const auto& channel : animation.channels) {
-      auto& d = drivers_[static_cast<std::size_t>(channel.node)];
       const Sampler* sampler = &animation.samplers[static_cast<std::size_t>(channel.sampler)];
       if (sampler->times.empty()) continue;
+      if (channel.light >= 0) {
+        auto& l = lightDrivers_[static_cast<std::size_t>(channel.light)];
+        (channel.path == AnimationPath::kLightColor ? l.color : l.intensity) = sampler;
+        continue;
+      }
+      auto& d = drivers_[static_cast<std::size_t>(channel.node)];
       switch (channel.path) {
         case AnimationPath::kTranslation: d.translation = sampler; break;
         case AnimationPath::kRotation: d.rotation = sampler; break;
         case AnimationPath::kScale: d.scale = sampler; break;
         case AnimationPath::kWeights: d.weights = sampler; break;
         case AnimationPath::kVisibility: d.visibility = sampler; break;
+        case AnimationPath::kLightColor:
+        case AnimationPath::kLightIntensity: break;  // handled above
       }
     }
   }
@@ -258,7 +265,25 @@ void Evaluator::worldGeometry(int node, std::size_t primitive, double t, const S
   }
 }
 
+Light Evaluator::light(int index, double t) const {
+  Light l = scene_.lights[static_cast<std::size_t>(index)];
+  const LightDrivers& d = lightDrivers_[static_cast<std::size_t>(index)];
+  if (d.color) {
+    double v[3];
+    sampleValues(*d.color, t, v);
+    l.color = glm::vec3(static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]));
+  }
+  if (d.intensity) {
+    double v = 0;
+    sampleValues(*d.intensity, t, std::span<double>(&v, 1));
+    l.intensity = static_cast<float>(v);
+  }
+  return l;
+}
+
 void Evaluator::evaluate(double t, ScenePose& pose) const {
+  pose.lights.resize(scene_.lights.size());
+  for (std::size_t l = 0; l < scene_.lights.size(); ++l) pose.lights[l] = light(static_cast<int>(l), t);
   const std::size_t count = scene_.nodes.size();
   pose.world.resize(count);
   pose.visible.resize(count);

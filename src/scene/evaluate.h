@@ -21,6 +21,7 @@ glm::dquat sampleRotation(const Sampler& sampler, double t);
 struct ScenePose {
   std::vector<glm::dmat4> world;  // world matrix of every node
   std::vector<char> visible;      // 1 when the node is shown (see Evaluator::visible)
+  std::vector<Light> lights;      // every light of Scene::lights, colour and intensity animated
 };
 
 class Evaluator {
@@ -37,6 +38,8 @@ class Evaluator {
   // world scale is not zero on any axis.
   bool visible(int node, double t) const;
   std::vector<double> morphWeights(int node, double t) const;
+  // Scene::lights[light] with its KHR_animation_pointer colour and intensity at t.
+  Light light(int light, double t) const;
   // Every node at once, parents before children.
   void evaluate(double t, ScenePose& pose) const;
 
@@ -64,8 +67,13 @@ class Evaluator {
     const Sampler* weights = nullptr;
     const Sampler* visibility = nullptr;
   };
+  struct LightDrivers {
+    const Sampler* color = nullptr;
+    const Sampler* intensity = nullptr;
+  };
   const Scene& scene_;
   std::vector<Drivers> drivers_;
+  std::vector<LightDrivers> lightDrivers_;
   std::vector<int> order_;  // nodes in parent-before-child order
 };
 

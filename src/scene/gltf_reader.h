@@ -221,7 +221,13 @@ class GltfReader {
   void readScenes();
 
   // Parses "/nodes/N/extensions/KHR_node_visibility/visible"; -1 for any other pointer.
+  void readCameraCuts(const json& extras, const std::string& pointer, Node& node);
   static int visibilityPointerNode(const std::string& pointer);
+  struct LightPointer {
+    int light = -1;
+    AnimationPath path = AnimationPath::kLightColor;
+  };
+  static LightPointer lightPointer(const std::string& pointer);
 
   void readAnimations();
 

@@ -339,6 +339,7 @@ void GltfReader::readNodes() {
       node.light = index(*lp, "light", child(child(p, "extensions"), "KHR_lights_punctual"), scene_.lights.size(), "light", true);
     if (const json* vis = extension(n, "KHR_node_visibility"))
       node.visible = boolean(*vis, "visible", child(child(p, "extensions"), "KHR_node_visibility"), true);
+    if (const json* extras = member(n, "extras"); extras && extras->is_object()) readCameraCuts(*extras, child(p, "extras"), node);
     node.children = indexList(n, "children", p, nodes.size(), "node");
   }
   for (std::size_t i = 0; i < scene_.nodes.size(); ++i) {
@@ -410,6 +411,25 @@ void GltfReader::readScenes() {
       invalid(child(child(p, "nodes"), k), fmt::format("node {} is not a root node", scene_.roots[k]));
 }
 
+// A camera node's extras.dynbench_camera_cuts: [{"from": seconds, "time": seconds, "reason": text},
+// ...] in increasing time (docs/dataset.md).
+void GltfReader::readCameraCuts(const json& extras, const std::string& p, Node& node) {
+  const json& cuts = array(extras, "dynbench_camera_cuts", p);
+  const auto cp = child(p, "dynbench_camera_cuts");
+  for (std::size_t k = 0; k < cuts.size(); ++k) {
+    const json& c = objectAt(cuts, k, cp);
+    Node::Cut cut;
+    cut.time = number(c, "time", child(cp, k), 0.0, true);
+    cut.from = number(c, "from", child(cp, k), cut.time);
+    cut.reason = string(c, "reason", child(cp, k));
+    if (!std::isfinite(cut.time) || (!node.cuts.empty() && !(cut.time > node.cuts.back().time)))
+      invalid(child(child(cp, k), "time"), "expected a finite time greater than the previous cut's");
+    if (!std::isfinite(cut.from) || cut.from > cut.time)
+      invalid(child(child(cp, k), "from"), fmt::format("expected a finite time not after the cut's time {}", cut.time));
+    node.cuts.push_back(std::move(cut));
+  }
+}
+
 // Parses "/nodes/N/extensions/KHR_node_visibility/visible"; -1 for any other pointer.
 int GltfReader::visibilityPointerNode(const std::string& pointer) {
   static constexpr std::string_view prefix = "/nodes/";
@@ -418,6 +438,21 @@ int GltfReader::visibilityPointerNode(const std::string& pointer) {
   const auto digits = pointer.substr(prefix.size(), pointer.size() - prefix.size() - suffix.size());
   if (digits.empty() || digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), ::isdigit)) return -1;
   return std::stoi(digits);
+}
+
+// Parses "/extensions/KHR_lights_punctual/lights/N/color" (or /intensity): the light and the
+// property; light -1 for any other pointer.
+GltfReader::LightPointer GltfReader::lightPointer(const std::string& pointer) {
+  static constexpr std::string_view prefix = "/extensions/KHR_lights_punctual/lights/";
+  if (!pointer.starts_with(prefix)) return {};
+  const auto rest = pointer.substr(prefix.size());
+  const auto slash = rest.find('/');
+  if (slash == std::string::npos) return {};
+  const auto digits = rest.substr(0, slash), property = rest.substr(slash + 1);
+  if (digits.empty() || digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), ::isdigit)) return {};
+  if (property == "color") return {std::stoi(digits), AnimationPath::kLightColor};
+  if (property == "intensity") return {std::stoi(digits), AnimationPath::kLightIntensity};
+  return {};
 }
 
 void GltfReader::readAnimations() {
@@ -446,16 +481,26 @@ void GltfReader::readAnimations() {
         const json* ptr = extension(*target, "KHR_animation_pointer");
         const std::string pointer = ptr ? string(*ptr, "pointer", child(child(tp, "extensions"), "KHR_animation_pointer")) : "";
         const int node = visibilityPointerNode(pointer);
-        if (node < 0) {
+        const LightPointer light = lightPointer(pointer);
+        if (node < 0 && light.light < 0) {
           scene_.warnings.push_back(fmt::format("{}: {}: animation pointer '{}' is ignored (dynbench animates only "
-                                                "node transforms, morph weights and KHR_node_visibility)", display_, cp, pointer));
+                                                "node transforms, morph weights, KHR_node_visibility and KHR_lights_punctual "
+                                                "colour and intensity)", display_, cp, pointer));
           continue;
         }
-        if (static_cast<std::size_t>(node) >= scene_.nodes.size())
-          invalid(tp, fmt::format("pointer '{}' names node {} but the file has {} nodes", pointer, node, scene_.nodes.size()));
-        channel.node = node;
-        channel.path = AnimationPath::kVisibility;
-        components = 1;
+        if (node >= 0) {
+          if (static_cast<std::size_t>(node) >= scene_.nodes.size())
+            invalid(tp, fmt::format("pointer '{}' names node {} but the file has {} nodes", pointer, node, scene_.nodes.size()));
+          channel.node = node;
+          channel.path = AnimationPath::kVisibility;
+          components = 1;
+        } else {
+          if (static_cast<std::size_t>(light.light) >= scene_.lights.size())
+            invalid(tp, fmt::format("pointer '{}' names light {} but the file has {} lights", pointer, light.light, scene_.lights.size()));
+          channel.light = light.light;
+          channel.path = light.path;
+          components = light.path == AnimationPath::kLightColor ? 3 : 1;
+        }
       } else {
         channel.node = index(*target, "node", tp, scene_.nodes.size(), "node");
         if (channel.node < 0) continue;  // glTF: a channel without a node is ignored

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -20,11 +21,18 @@ std::size_t frameCount(const Scene& scene, double fps) {
   return frameCount(scene.timeRange(), animated, fps);
 }
 
+bool cameraCutBetween(const Node& camera, double after, double upTo) {
+  const auto slack = [](double t) { return 4.0 * std::numeric_limits<float>::epsilon() * std::max(1.0, std::abs(t)); };
+  for (const auto& cut : camera.cuts)
+    if (after < cut.time - slack(cut.time) && upTo > cut.from + slack(cut.from)) return true;
+  return false;
+}
+
 std::vector<char> dynamicNodes(const Scene& scene) {
   std::vector<char> animated(scene.nodes.size(), 0);
   for (const auto& animation : scene.animations)
     for (const auto& channel : animation.channels)
-      if (channel.path != AnimationPath::kWeights) animated[static_cast<std::size_t>(channel.node)] = 1;
+      if (channel.node >= 0 && channel.path != AnimationPath::kWeights) animated[static_cast<std::size_t>(channel.node)] = 1;
   std::vector<char> dynamic(scene.nodes.size(), 0);
   for (std::size_t i = 0; i < scene.nodes.size(); ++i)
     for (int n = static_cast<int>(i); n >= 0 && !dynamic[i]; n = scene.nodes[static_cast<std::size_t>(n)].parent)

@@ -27,4 +27,10 @@ std::vector<char> nodesInScene(const Scene& scene);
 // animated camera node, else the first camera node; -1 when the scene has no camera at all.
 Expected<int> selectCameraNode(const Scene& scene, const std::optional<std::string>& selector);
 
+// True when a cut of the camera node (Node::cuts, the jump from key `from` to key `time`) overlaps
+// (after, upTo]: the frame at upTo does not continue the frame at `after`. At another frame rate
+// than the capture's, the frames on both sides of a jump's interpolated segment are cuts. Cut times
+// are glTF key times (float): comparisons allow a float's precision.
+bool cameraCutBetween(const Node& camera, double after, double upTo);
+
 }  // namespace dynbench::scene

@@ -57,6 +57,8 @@ const char* toString(AnimationPath path) {
     case AnimationPath::kScale: return "scale";
     case AnimationPath::kWeights: return "weights";
     case AnimationPath::kVisibility: return "visibility";
+    case AnimationPath::kLightColor: return "light color";
+    case AnimationPath::kLightIntensity: return "light intensity";
   }
   return "?";
 }

@@ -147,12 +147,22 @@ struct Node {
   int light = -1;
   std::vector<double> weights;  // morph weights overriding the mesh's defaults, if non-empty
   bool visible = true;          // KHR_node_visibility "visible" at rest
+  // A camera node's cuts (extras.dynbench_camera_cuts, docs/dataset.md): the camera jumps between
+  // the key at `from` and the key at `time` (seconds) instead of moving (a respawn, a switch to
+  // another player); in increasing order.
+  struct Cut {
+    double from = 0.0, time = 0.0;
+    std::string reason;
+  };
+  std::vector<Cut> cuts;
 };
 
 enum class Interpolation { kStep, kLinear, kCubicSpline };
 const char* toString(Interpolation interpolation);
 
-enum class AnimationPath { kTranslation, kRotation, kScale, kWeights, kVisibility };
+// kLightColor and kLightIntensity: KHR_animation_pointer to a KHR_lights_punctual light's colour or
+// intensity (the channel names a light, not a node).
+enum class AnimationPath { kTranslation, kRotation, kScale, kWeights, kVisibility, kLightColor, kLightIntensity };
 const char* toString(AnimationPath path);
 
 // One glTF animation sampler. `values` holds, per key, `components` floats, three times over for
@@ -166,8 +176,9 @@ struct Sampler {
 
 struct Channel {
   int sampler = -1;
-  int node = -1;
+  int node = -1;   // -1 for a light's channel
   AnimationPath path = AnimationPath::kTranslation;
+  int light = -1;  // kLightColor, kLightIntensity: index into Scene::lights
 };
 
 struct Animation {
