@@ -156,6 +156,29 @@ TEST(Cube2, SecondMapConvertsAndValidates) {
               j["camera_motion"]["rotation_degrees"]["mean"].get<double>());
 }
 
+TEST(Cube2, PresetsSetGameSettingsAndExplicitOptionsWin) {
+  capture::Cube2Options o;
+  ASSERT_TRUE(capture::applyCube2Preset("hard", o));
+  EXPECT_EQ(o.mode, "instagib");
+  EXPECT_LE(o.skill, 100);  // above 100 the game's bots aim instantly
+  capture::Cube2Options kept;
+  kept.bots = 3;
+  kept.follow = "one";
+  ASSERT_TRUE(capture::applyCube2Preset("calm", kept, {"bots", "follow"}));
+  EXPECT_EQ(kept.map, "two_towers");
+  EXPECT_EQ(kept.bots, 3);
+  EXPECT_EQ(kept.follow, "one");
+  const auto bad = capture::applyCube2Preset("insane", o);
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().code, ErrorCode::kUsage);
+  EXPECT_NE(bad.error().message.find("calm, fps, hard"), std::string::npos) << bad.error().message;
+  for (const auto& p : capture::cube2Presets()) {  // every preset makes a valid match script
+    capture::Cube2Options each;
+    ASSERT_TRUE(capture::applyCube2Preset(p.name, each));
+    EXPECT_TRUE(capture::cube2Script(each)) << p.name;
+  }
+}
+
 TEST(Cube2, BadOptionsFailClearly) {
   const auto dir = test::freshDir("cube2_bad");
   auto r = dynbench(fmt::format("capture cube2 -o {} --mode deathmatch", (dir / "x").string()), dir);
@@ -170,6 +193,9 @@ TEST(Cube2, BadOptionsFailClearly) {
   r = dynbench(fmt::format("capture cube2 -o {} --skill 102", (dir / "x").string()), dir);
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("--skill: must be from 1 to 101 (got 102)"), std::string::npos) << r.err;
+  r = dynbench(fmt::format("capture cube2 -o {} --preset insane", (dir / "x").string()), dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("--preset: insane not in {calm,fps,hard}"), std::string::npos) << r.err;
   r = dynbench(fmt::format("capture cube2 -o {} --client {}", (dir / "x").string(), (dir / "nothing").string()), dir);
   EXPECT_EQ(r.status, 7) << r.err;
   EXPECT_NE(r.err.find("nothing"), std::string::npos) << r.err;

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -27,6 +28,34 @@ Expected<fs::path> findCube2Client(const fs::path& requested) {
   return fail(ErrorCode::kExternalTool,
               "the Cube 2 client with dynbench's capture hooks is not built: run scripts/setup.sh, then cmake --build "
               "(target cube2_client), or pass --client PATH");
+}
+
+const std::vector<Cube2Preset>& cube2Presets() {
+  // Bot skill stays at most 100: above it Sauerbraten's bots aim instantly (fpsgame/ai.cpp), turning
+  // up to 180 degrees in one frame, which no player does.
+  static const std::vector<Cube2Preset> presets = {
+      {"calm", "two_towers", "ffa", 2, 40, "one", "two slow bots on a large map; the camera stays with one"},
+      {"fps", "colos", "ffa", 6, 80, "auto", "a deathmatch on a mid-sized arena, the camera following a bot and then the next"},
+      {"hard", "colos", "instagib", 8, 90, "auto", "instagib (one shot kills) with eight skilled bots: constant fights, fast turns"},
+  };
+  return presets;
+}
+
+Expected<void> applyCube2Preset(const std::string& name, Cube2Options& o, const std::vector<std::string>& keep) {
+  const auto& presets = cube2Presets();
+  const auto preset = std::find_if(presets.begin(), presets.end(), [&](const Cube2Preset& p) { return name == p.name; });
+  if (preset == presets.end()) {
+    std::string names;
+    for (const auto& p : presets) names += (names.empty() ? "" : ", ") + std::string(p.name);
+    return fail(ErrorCode::kUsage, "--preset '{}': expected one of {}", name, names);
+  }
+  auto kept = [&](const char* field) { return std::find(keep.begin(), keep.end(), field) != keep.end(); };
+  if (!kept("map")) o.map = preset->map;
+  if (!kept("mode")) o.mode = preset->mode;
+  if (!kept("bots")) o.bots = preset->bots;
+  if (!kept("skill")) o.skill = preset->skill;
+  if (!kept("follow")) o.follow = preset->follow;
+  return {};
 }
 
 Expected<std::string> cube2Script(const Cube2Options& o) {

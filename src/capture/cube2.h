@@ -6,6 +6,7 @@
 #include <functional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "core/error.h"
 
@@ -44,6 +45,23 @@ struct Cube2Report {
 
 // (frames recorded, frames total)
 using Cube2Progress = std::function<void(std::size_t, std::size_t)>;
+
+// Named capture presets: game settings and the camera-follow policy only (never synthetic camera
+// motion), from calm to harder than the thesis's human-played Eternal Valley FPS. Their measured
+// Tables 6.4-6.7 are in docs/presets.md.
+struct Cube2Preset {
+  const char* name;
+  const char* map;
+  const char* mode;
+  int bots;
+  int skill;
+  const char* follow;
+  const char* description;
+};
+const std::vector<Cube2Preset>& cube2Presets();
+// Sets the preset's map, mode, bots, skill and follow in `options`, except the fields named in
+// `keep` ("map", "mode", "bots", "skill", "follow": given explicitly). Unknown name: kUsage.
+Expected<void> applyCube2Preset(const std::string& name, Cube2Options& options, const std::vector<std::string>& keep = {});
 
 // The client the build made (integrations/cube2/build.sh), or an error saying how to get one.
 Expected<std::filesystem::path> findCube2Client(const std::filesystem::path& requested);

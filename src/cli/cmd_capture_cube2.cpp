@@ -38,6 +38,9 @@ void addCaptureCommand(CLI::App& app, CommandRun& run) {
               "Example: dynbench capture cube2 -o captures/colos --map colos --bots 6 --seconds 10");
   std::string output;
   cmd->add_option("-o,--output", o->output, "Capture folder (new or empty)")->required();
+  auto preset = std::make_shared<std::string>();
+  cmd->add_option("--preset", *preset, "calm, fps or hard: map, mode, bots, skill and follow together (docs/presets.md); options given explicitly win")
+      ->check(CLI::IsMember({"calm", "fps", "hard"}));
   cmd->add_option("--map", o->map, "Map (others with bot waypoints: cyber1, md2, ...)");
   cmd->add_option("--mode", o->mode, "Game mode")
       ->check(CLI::IsMember({"ffa", "teamplay", "instagib", "efficiency", "tactics"}));
@@ -54,7 +57,16 @@ void addCaptureCommand(CLI::App& app, CommandRun& run) {
   cmd->add_flag("--window", o->window, "Use the current display instead of Xvfb");
   cmd->add_option("--client", o->client, "The Cube 2 client with the capture hooks (empty: the one the build made)");
   cmd->add_option("--data", o->data, "Game data (Debian's cube2-data)");
-  cmd->callback([o, &run] { run = [o] { return runCube2(*o); }; });
+  cmd->callback([o, preset, cmd, &run] {
+    std::vector<std::string> given;
+    for (const char* field : {"map", "mode", "bots", "skill", "follow"})
+      if (cmd->count(std::string("--") + field) > 0) given.push_back(field);
+    run = [o, preset, given]() -> Expected<void> {
+      if (!preset->empty())
+        if (auto ok = capture::applyCube2Preset(*preset, *o, given); !ok) return ok;
+      return runCube2(*o);
+    };
+  });
 }
 
 }  // namespace dynbench::cli

@@ -416,15 +416,27 @@ int dynbench_capture_clock_millis() {
   return state.clockBase + static_cast<int>(static_cast<double>(state.clockFrames) * 1000.0 / state.fps + 0.5);
 }
 
+// Entities numbered in order of first appearance. A deleted entity's slot is cleared
+// (dynbench_capture_forget_entity): the allocator may give its address to a later entity (a ragdoll
+// is a copy of the dead player, made at respawn), and whether it does depends on the heap, which
+// other threads share, so a reused address must not inherit the old number.
+static vector<const void *> seenEntities;  // a few dozen players and ragdolls: a linear search is enough
+
 unsigned dynbench_capture_entity_seed(const void *entity) {
   if (!entity) return 0;
-  static vector<const void *> seen;  // a few dozen players and ragdolls: a linear search is enough
-  int index = seen.find(entity);
+  int index = seenEntities.find(entity);
   if (index < 0) {
-    index = seen.length();
-    seen.add(entity);
+    index = seenEntities.length();
+    seenEntities.add(entity);
   }
   return (uint(index) + 1u) * 2654435761u;  // Knuth's multiplicative hash spreads the low bits
+}
+
+void dynbench_capture_forget_entity(const void *entity) {
+  if (!state.enabled || !entity) return;
+  const int index = seenEntities.find(entity);
+  if (index >= 0) seenEntities[index] = nullptr;
+  dynbench_models_forget_owner(entity);
 }
 
 bool dynbench_capture_recording() { return state.enabled && state.record && state.session && !state.done && state.firstMapMillis >= 0; }

@@ -39,6 +39,9 @@ void dynbench_visit_dynlights(void (*visit)(const dynbench_dynlight &light));
 // A stand-in for an entity's address where the engine seeds animation variety and phase from it
 // (animmodel.h calcanim): entities numbered in order of first appearance, scrambled.
 unsigned dynbench_capture_entity_seed(const void *entity);
+// Called by the patch from dynent's destructor: the entity is gone, and a later one at its address
+// is another (its seed and its parts' ids are not inherited).
+void dynbench_capture_forget_entity(const void *entity);
 
 // True while a capture session is open and the map is loaded: the model part hook collects then.
 bool dynbench_capture_recording();
@@ -61,5 +64,8 @@ bool dynbench_models_write_verification(const char *path);
 void dynbench_models_next_frame(bool keepIds);
 // Parts recorded in the last recorded frame.
 int dynbench_models_count();
+// The entity was deleted: parts of the last frame drawn for it no longer match a new entity at
+// the same address.
+void dynbench_models_forget_owner(const void *entity);
 
 #endif

@@ -409,3 +409,11 @@ void dynbench_models_next_frame(bool keepIds) {
 }
 
 int dynbench_models_count() { return dynbench_models::previous.length(); }
+
+void dynbench_models_forget_owner(const void *entity) {
+  using namespace dynbench_models;
+  // A sentinel owner: matches no entity, and is not NULL (NULL owners match by distance).
+  static const char gone = 0;
+  loopv(previous) if (previous[i]->owner == entity) previous[i]->owner = reinterpret_cast<const dynent *>(&gone);
+  loopv(current) if (current[i]->owner == entity) current[i]->owner = reinterpret_cast<const dynent *>(&gone);
+}
