@@ -1,6 +1,9 @@
 #include "pipeline/demo.h"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -11,6 +14,7 @@
 #include "core/math.h"
 #include "evaluate/evaluate.h"
 #include "pipeline/stages.h"
+#include "render/raytracing_scene.h"
 #include "scene/evaluate.h"
 #include "scene/load.h"
 #include "scene/queries.h"
@@ -22,16 +26,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Catmull-Rom through p1..p2 with neighbours p0, p3, at s in [0, 1].
-glm::dvec3 catmullRom(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2, const glm::dvec3& p3, double s) {
-  const double s2 = s * s, s3 = s2 * s;
-  return 0.5 * ((2.0 * p1) + (-p0 + p2) * s + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * s2 + (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * s3);
-}
-
 // What makes a capture: the match options. Compared as text with the record beside a capture.
 // Raised whenever the Cube 2 adapter changes what it records (2: the map's normals decoded as the
-// signed bytes they are), so that captures an older adapter made are not reused.
-constexpr int kCaptureAdapterVersion = 2;
+// signed bytes they are; 3: lights keep their identity across frames, camera cuts), so that
+// captures an older adapter made are not reused.
+constexpr int kCaptureAdapterVersion = 3;
 
 std::string captureKey(const DemoOptions& o) {
   return fmt::format("{{\"map\": \"{}\", \"bots\": {}, \"seconds\": {}, \"seed\": {}, \"adapter\": {}}}\n", o.map, o.bots, o.seconds,
@@ -113,48 +112,163 @@ Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, cons
 
 }  // namespace
 
-Expected<void> writeFlythroughCsv(const fs::path& dataset, const fs::path& csv, int keys, double rate) {
+namespace {
+
+// Linear interpolation along a polyline by arc length s (clamped to its ends).
+struct Polyline {
+  std::vector<glm::dvec3> points;
+  std::vector<double> arc;  // cumulative length at each point
+  explicit Polyline(std::vector<glm::dvec3> p) : points(std::move(p)) {
+    arc.assign(points.size(), 0.0);
+    for (std::size_t k = 1; k < points.size(); ++k) arc[k] = arc[k - 1] + glm::length(points[k] - points[k - 1]);
+  }
+  double length() const { return arc.empty() ? 0.0 : arc.back(); }
+  glm::dvec3 at(double s) const {
+    if (points.size() == 1 || s <= 0) return points.front();
+    if (s >= length()) return points.back();
+    const auto k = static_cast<std::size_t>(std::upper_bound(arc.begin(), arc.end(), s) - arc.begin()) - 1;
+    const double span = arc[k + 1] - arc[k];
+    return span > 0 ? glm::mix(points[k], points[k + 1], (s - arc[k]) / span) : points[k];
+  }
+};
+
+// Moving average over +-half samples. kKeepEnds: the window shrinks symmetrically at the ends, so
+// the first and last values stay where they are (a path keeps its ends); kHoldEnds: the values
+// beyond the ends are the end values held, so the ends are as smooth as the middle (a heading).
+enum class Ends { kKeep, kHold };
+template <typename T>
+std::vector<T> movingAverage(const std::vector<T>& v, std::size_t half, Ends ends) {
+  const std::size_t n = v.size();
+  // Prefix sums over v padded with `half` held values on each side.
+  std::vector<T> prefix(n + 2 * half + 1, T(0));
+  for (std::size_t k = 0; k < n + 2 * half; ++k) prefix[k + 1] = prefix[k] + v[std::clamp(k, half, half + n - 1) - half];
+  std::vector<T> out(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t h = ends == Ends::kKeep ? std::min({half, k, n - 1 - k}) : half;
+    out[k] = (prefix[k + half + h + 1] - prefix[k + half - h]) / static_cast<double>(2 * h + 1);
+  }
+  return out;
+}
+
+}  // namespace
+
+Expected<FlythroughReport> writeFlythroughCsv(const fs::path& dataset, const fs::path& csv, const FlythroughOptions& o) {
   auto scene = scene::loadScene(dataset);
   if (!scene) return std::unexpected(scene.error());
   auto cameraNode = scene::selectCameraNode(*scene, std::nullopt);
   if (!cameraNode) return std::unexpected(cameraNode.error());
+  if (*cameraNode < 0) return fail(ErrorCode::kInvalidData, "{}: no camera to fly along", dataset.string());
   const auto range = scene->timeRange();
-  if (!(range.end > range.start)) return fail(ErrorCode::kInvalidData, "{}: no animation to fly along", dataset.string());
-  keys = std::max(keys, 2);
+  const double duration = range.end - range.start;
+  if (!(duration > 0)) return fail(ErrorCode::kInvalidData, "{}: no animation to fly along", dataset.string());
+  const auto& node = scene->nodes[static_cast<std::size_t>(*cameraNode)];
   const scene::Evaluator evaluator(*scene);
-  std::vector<glm::dvec3> points;
-  for (int k = 0; k < keys; ++k) {
-    const double t = range.start + (range.end - range.start) * k / (keys - 1);
-    points.emplace_back(evaluator.worldMatrix(*cameraNode, t)[3]);
-  }
-  auto position = [&](double u) {  // u in [0, keys - 1]
-    const int i = std::clamp(static_cast<int>(std::floor(u)), 0, keys - 2);
-    const double s = u - i;
-    const auto& p0 = points[static_cast<std::size_t>(std::max(i - 1, 0))];
-    const auto& p3 = points[static_cast<std::size_t>(std::min(i + 2, keys - 1))];
-    return catmullRom(p0, points[static_cast<std::size_t>(i)], points[static_cast<std::size_t>(i + 1)], p3, s);
-  };
-  std::string out = "time,x,y,z,qx,qy,qz,qw\n";
-  const int samples = std::max(2, static_cast<int>(std::ceil((range.end - range.start) * rate)) + 1);
-  double yaw = 0.0;
-  for (int n = 0; n < samples; ++n) {
-    const double t = (range.end - range.start) * n / (samples - 1);  // evenly spaced, ending at the last key
-    const double u = t / (range.end - range.start) * (keys - 1);
-    const glm::dvec3 p = position(u);
-    // Look along the path, level, turning at most kMaxTurn degrees per second towards the
-    // horizontal tangent: a fly-through pans, it does not snap (ORCA's cameras turn slowly).
-    constexpr double kMaxTurn = 30.0;
-    const glm::dvec3 ahead = position(std::min(u + 0.05, static_cast<double>(keys - 1))) - position(std::max(u - 0.05, 0.0));
-    if (ahead.x * ahead.x + ahead.z * ahead.z > 1e-12) {
-      const double target = std::atan2(-ahead.x, -ahead.z);
-      if (n == 0) yaw = target;
-      const double step = kMaxTurn * kPi / 180.0 * (range.end - range.start) / (samples - 1);  // per actual sample spacing
-      yaw += std::clamp(std::remainder(target - yaw, 2.0 * kPi), -step, step);
+  const std::size_t samples = std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil(duration * o.rate)) + 1);
+  auto timeAt = [&](std::size_t n) { return range.start + duration * static_cast<double>(n) / static_cast<double>(samples - 1); };
+
+  // The bot's longest stretch (by distance) between camera cuts.
+  FlythroughReport report;
+  std::vector<glm::dvec3> best, current;
+  std::size_t currentStart = 0;
+  auto closeStretch = [&](std::size_t end) {
+    if (Polyline(current).length() > Polyline(best).length() || best.empty()) {
+      best = current;
+      report.stretchStart = timeAt(currentStart);
+      report.stretchEnd = timeAt(end);
     }
-    const glm::dquat q = glm::angleAxis(yaw, glm::dvec3(0, 1, 0));
-    out += fmt::format("{},{},{},{},{},{},{},{}\n", t, p.x, p.y, p.z, q.x, q.y, q.z, q.w);
+  };
+  for (std::size_t n = 0; n < samples; ++n) {
+    if (n > 0 && scene::cameraCutBetween(node, timeAt(n - 1), timeAt(n))) {
+      closeStretch(n - 1);
+      current.clear();
+      currentStart = n;
+    }
+    current.emplace_back(evaluator.worldMatrix(*cameraNode, timeAt(n))[3]);
   }
-  return writeFileAtomic(csv, out);
+  closeStretch(samples - 1);
+  const Polyline stretch(best);
+  report.stretchLength = stretch.length();
+  const double unitSpeed = o.speed / o.metresPerUnit;
+
+  // The stretch resampled every scene unit, then smoothed as widely as keeps the path out of walls.
+  std::vector<glm::dvec3> even;
+  for (double s = 0; s < stretch.length(); s += 1.0) even.push_back(stretch.at(s));
+  even.push_back(stretch.at(stretch.length()));  // the stretch's own end
+  if (even.size() < 2) even.push_back(even.back());
+  auto poseTime = [&](std::size_t n) { return duration * static_cast<double>(n) / static_cast<double>(samples - 1); };
+  std::optional<Polyline> path;
+  std::vector<glm::dvec3> positions(samples);
+  for (double width : {64.0, 32.0, 16.0, 8.0, 4.0, 0.0}) {
+    Polyline candidate(movingAverage(even, static_cast<std::size_t>(width / 2), Ends::kKeep));
+    report.length = std::min(candidate.length(), unitSpeed * duration);  // smoothing shortens the path
+    for (std::size_t n = 0; n < samples; ++n) positions[n] = candidate.at(report.length * poseTime(n) / duration);
+    // The chords the renderer's frames make (dataset frame rate) as well as the poses' own.
+    std::vector<glm::dvec3> frames;
+    for (double t = 0; t <= duration + 1e-9; t += 1.0 / o.frameRate) frames.push_back(candidate.at(report.length * t / duration));
+    auto crossPoses = render::segmentsThroughStaticGeometry(*scene, positions);
+    if (!crossPoses) return std::unexpected(crossPoses.error());
+    auto crossFrames = render::segmentsThroughStaticGeometry(*scene, frames);
+    if (!crossFrames) return std::unexpected(crossFrames.error());
+    report.smoothing = width;
+    path.emplace(std::move(candidate));
+    if (crossPoses->empty() && crossFrames->empty()) break;
+    if (width == 0.0)
+      return fail(ErrorCode::kInvalidData, "{}: the bot's own path crosses static geometry ({} segments); no fly-through made", dataset.string(),
+                  crossPoses->size() + crossFrames->size());
+  }
+
+  // Heading: towards the path lookAhead further on, level but for half the path's slope (at most
+  // 10 degrees); yaw and pitch then averaged over a window that widens until their per-frame
+  // changes at frameRate are within the ORCA bounds.
+  const double ahead = o.lookAhead / o.metresPerUnit;
+  std::vector<double> rawYaw(samples), rawPitch(samples);
+  for (std::size_t n = 0; n < samples; ++n) {
+    const double s = report.length * poseTime(n) / duration;
+    glm::dvec3 d = path->at(s + ahead) - path->at(s);
+    if (glm::length(glm::dvec2(d.x, d.z)) < 1e-6) d = path->at(s) - path->at(std::max(0.0, s - ahead));
+    const double horizontal = glm::length(glm::dvec2(d.x, d.z));
+    double yaw = horizontal > 1e-6 ? std::atan2(-d.x, -d.z) : (n > 0 ? rawYaw[n - 1] : 0.0);
+    if (n > 0) yaw = rawYaw[n - 1] + std::remainder(yaw - rawYaw[n - 1], 2.0 * kPi);  // unwrapped
+    rawYaw[n] = yaw;
+    rawPitch[n] = std::clamp(0.5 * std::atan2(d.y, std::max(horizontal, 1e-6)), -radians(10.0), radians(10.0));
+  }
+  std::vector<double> yaw, pitch;
+  // Mean and variance of |change| per frame at frameRate, the poses interpolated linearly.
+  auto perFrame = [&](const std::vector<double>& angle) {
+    std::vector<double> changes;
+    auto at = [&](double t) {
+      const double u = std::clamp(t / duration, 0.0, 1.0) * static_cast<double>(samples - 1);
+      const auto k = std::min(static_cast<std::size_t>(u), samples - 2);
+      return angle[k] + (u - static_cast<double>(k)) * (angle[k + 1] - angle[k]);
+    };
+    for (double t = 1.0 / o.frameRate; t <= duration + 1e-9; t += 1.0 / o.frameRate)
+      changes.push_back(std::abs(degrees(at(t) - at(t - 1.0 / o.frameRate))));
+    double mean = 0, variance = 0;
+    for (double c : changes) mean += c / static_cast<double>(changes.size());
+    for (double c : changes) variance += (c - mean) * (c - mean) / static_cast<double>(changes.size());
+    return std::pair{mean, variance};
+  };
+  // Yaw and pitch each get the narrowest window (in steps of 10 %) that meets their bounds, so they
+  // keep as much of the path's motion as ORCA's cameras have.
+  auto smooth = [&](const std::vector<double>& raw, double maxMean, double maxVariance, std::vector<double>& out, double& window, double& mean,
+                    double& variance) {
+    for (window = 1.0;; window *= 1.1) {
+      out = movingAverage(raw, static_cast<std::size_t>(0.5 * window * o.rate), Ends::kHold);
+      std::tie(mean, variance) = perFrame(out);
+      if ((mean <= maxMean && variance <= maxVariance) || window > duration) return;
+    }
+  };
+  smooth(rawYaw, o.maxYawMean, o.maxYawVariance, yaw, report.headingWindow, report.yawMean, report.yawVariance);
+  smooth(rawPitch, o.maxPitchMean, o.maxPitchVariance, pitch, report.pitchWindow, report.pitchMean, report.pitchVariance);
+  std::string out = "time,x,y,z,qx,qy,qz,qw\n";
+  for (std::size_t n = 0; n < samples; ++n) {
+    const glm::dquat q = glm::angleAxis(yaw[n], glm::dvec3(0, 1, 0)) * glm::angleAxis(pitch[n], glm::dvec3(1, 0, 0));
+    const glm::dvec3& p = positions[n];
+    out += fmt::format("{},{},{},{},{},{},{},{}\n", poseTime(n), p.x, p.y, p.z, q.x, q.y, q.z, q.w);
+  }
+  report.poses = samples;
+  if (auto ok = writeFileAtomic(csv, out); !ok) return std::unexpected(ok.error());
+  return report;
 }
 
 Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
@@ -208,7 +322,12 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
   if (!newer(fly, bot)) {
     log("fly-through: a smooth camera over the same match -> " + fly.string());
     const fs::path csv = datasets / "flythrough.csv";
-    if (auto ok = writeFlythroughCsv(bot, csv, o.flythroughKeys, 60.0); !ok) return std::unexpected(ok.error());
+    auto flown = writeFlythroughCsv(bot, csv);
+    if (!flown) return std::unexpected(flown.error());
+    log(fmt::format("  along the bot's path from {:.2f} s to {:.2f} s (no cut between), {:.0f} of its {:.0f} units at {:.2f} units/s, "
+                    "smoothed over {:.0f} units, heading over {:.2f} s, pitch over {:.2f} s: yaw {:.3f} (variance {:.3f}), pitch {:.3f} ({:.4f}) degrees per frame",
+                    flown->stretchStart, flown->stretchEnd, flown->length, flown->stretchLength, flown->length / (flown->poses > 1 ? (flown->poses - 1) / 60.0 : 1.0),
+                    flown->smoothing, flown->headingWindow, flown->pitchWindow, flown->yawMean, flown->yawVariance, flown->pitchMean, flown->pitchVariance));
     convert::MergeCameraOptions merge;
     merge.dataset = bot;
     merge.run = csv;

@@ -99,4 +99,9 @@ class SphereIndex {
   std::vector<glm::dvec4> spheres_;
 };
 
+// Indices k of the segments points[k] -> points[k+1] that pass through the scene's static
+// geometry (nodes no animation moves; players and projectiles are left out): the check that a
+// camera path never goes through a wall. Alpha-masked surfaces block where they are opaque.
+Expected<std::vector<std::size_t>> segmentsThroughStaticGeometry(const scene::Scene& scene, const std::vector<glm::dvec3>& points);
+
 }  // namespace dynbench::render
