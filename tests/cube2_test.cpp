@@ -126,6 +126,42 @@ TEST(Cube2, SeededMatchIsDeterministicAndConverts) {
   std::printf("map normals: %zu of %zu corners within 25 degrees of their face normal; %zu upward triangles\n", alongFace, corners, upward);
   EXPECT_GT(static_cast<double>(alongFace), 0.99 * static_cast<double>(corners));
   EXPECT_GT(upward, 500u);
+  // Light identity: a light is one capturable over the frames it lives (a rocket's, a flash's), not
+  // a new one per frame: far fewer lights than light records.
+  r = dynbench(fmt::format("capture-check {} --json {}", (dir / "a").string(), (dir / "check.json").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto check = nlohmann::json::parse(test::slurp(dir / "check.json"));
+  const int dynamicLights = check["capturables"]["dynamic_lights"].get<int>(), lightRecords = check["records"]["light"].get<int>();
+  EXPECT_GT(dynamicLights, 0);
+  EXPECT_LE(5 * dynamicLights, lightRecords) << dynamicLights << " dynamic lights, " << lightRecords << " light records";
+  // Camera cuts: in this match the followed bot dies at 2.65 s and the camera switches to the next
+  // one; stats leave the cut frames out, and the jump is larger than any motion left.
+  ASSERT_TRUE(check["camera_cuts"].contains("switch")) << check["camera_cuts"];
+  EXPECT_GE(check["camera_cuts"]["switch"].get<int>(), 1);
+  EXPECT_GE(j["camera_motion"]["cuts"].get<int>(), 1);
+  EXPECT_GT(j["camera_motion"]["with_cuts"]["rotation_degrees"]["max"].get<double>(),
+            3 * j["camera_motion"]["rotation_degrees"]["max"].get<double>());
+  // Animated map models (colos's two waving flags, md5anim "mapmodel") are recorded every frame,
+  // not frozen in their first pose: their joints move.
+  int flags = 0;
+  for (std::size_t n = 0; n < dataset->nodes.size(); ++n) {
+    const auto& node = dataset->nodes[n];
+    EXPECT_FALSE(node.name.starts_with("static_") && node.name.ends_with("ffflag")) << node.name;
+    if (!(node.name.starts_with("model_") && node.name.ends_with("_ffflag"))) continue;
+    ++flags;
+    ASSERT_FALSE(node.children.empty()) << node.name;
+    // Some joint under the flag moves between 1 s and 2 s.
+    double moved = 0;
+    std::vector<int> stack{static_cast<int>(n)};
+    while (!stack.empty()) {
+      const int k = stack.back();
+      stack.pop_back();
+      moved = std::max(moved, glm::distance(glm::dvec3(evaluator.worldMatrix(k, 1.0)[3]), glm::dvec3(evaluator.worldMatrix(k, 2.0)[3])));
+      for (int c : dataset->nodes[static_cast<std::size_t>(k)].children) stack.push_back(c);
+    }
+    EXPECT_GT(moved, 0.01) << node.name << " does not move";
+  }
+  EXPECT_EQ(flags, 2);
   // A bot's first-person view turns far faster than a slow fly-through: over 15 degrees per second
   // on average (0.25 per frame at 60 fps), three times a slow 5 degrees-per-second pan.
   EXPECT_GT(j["camera_motion"]["rotation_degrees"]["mean"].get<double>() * 60.0, 15.0);

@@ -25,6 +25,10 @@
 // nearest instance of the same part in the previous frame, within kDynbenchMaxStepUnits (dynbench_capture.h). The same thing
 // rendered again in one frame (shadow, reflection passes) is recorded once.
 //
+// Map models are recorded once as static models, except those with a skeletal animation of their
+// own (ANIM_MAPMODEL), which are evaluated every recorded frame and recorded like any skinned model,
+// owned by their map entity.
+//
 // Limits: vertex-animated models (MD2/MD3 with several frames) are exported in their first frame
 // and move rigidly; the engine blends bones as dual quaternions, glTF skins blend matrices.
 
@@ -47,6 +51,10 @@ struct PartInstance {
 
 static vector<PartInstance *> current, previous, staticParts;
 static bool exportingStatic = false;
+// Map models with an animation of their own (a waving flag): recorded every frame as dynamic models
+// owned by their map entity (a stable address for the whole match), not frozen in a static pose.
+static vector<int> animatedMapEntities;                 // indices into entities::getents()
+static const dynent *mapModelOwner = NULL;             // set while one of them is evaluated
 
 static void clearList(vector<PartInstance *> &list) { list.deletecontents(); }
 
@@ -217,6 +225,25 @@ static bool isMapModel(const model *m) {
   return false;
 }
 
+// A map model whose skeletal parts have an animation for ANIM_MAPMODEL (md5anim "mapmodel").
+static bool hasMapModelAnimation(model *m) {
+  // Every Cube 2 model format (md2, md3, md5, iqm, smd, obj) is an animmodel; the game builds without RTTI.
+  animmodel *am = static_cast<animmodel *>(m);
+  loopv(am->parts) {
+    animmodel::part *p = am->parts[i];
+    if (p->meshes && isSkeletal(p) && p->anims[0] && p->anims[0][ANIM_MAPMODEL & ANIM_INDEX].length() > 0) return true;
+  }
+  return false;
+}
+
+// The engine's own call for a map model entity (renderva.cpp rendermapmodel), without drawing:
+// the part hook sees its transforms.
+static void evaluateMapModel(extentity &e, model *m) {
+  int anim = ANIM_MAPMODEL | ANIM_LOOP, basetime = 0;
+  if (e.flags & EF_ANIM) entities::animatemapmodel(e, anim, basetime);
+  m->render(anim | ANIM_NORENDER, basetime, 0, e.o, e.attr1, 0, NULL, NULL, vec(1, 1, 1), vec(0, 0, 1), 1);
+}
+
 // Model-space joint transforms of a skeletal part as it was just drawn: J = bdata . base per bone
 // (bdata is the skinning transform, base the bind pose), found again in the skeleton's cache.
 static void skeletalJoints(animmodel::part *p, const animmodel::animstate *as, float pitch, const vec &axis, const vec &forward,
@@ -267,21 +294,22 @@ static bool drawnBefore(const PartInstance *a, const PartInstance *b) {
 void animmodel::dynbench_capture_part(part *p, const animstate *as, float pitch, const vec &axis, const vec &forward, dynent *d, int anim) {
   using namespace dynbench_models;
   if (!dynbench_capture_recording() || !p->meshes) return;
-  if (!exportingStatic) {
+  if (!exportingStatic && !mapModelOwner) {
     if (anim & ANIM_NORENDER) return;  // not drawn (e.g. computed only for its tags)
-    if (!d && isMapModel(p->model)) return;  // recorded once, as a static model
+    if (!d && isMapModel(p->model)) return;  // recorded once as a static model, or by its own pass when animated
   }
+  const dynent *owner = d ? d : mapModelOwner;
   const matrix4 &world = matrixstack[matrixpos];
   const vec origin = world.gettranslation();
   vector<PartInstance *> &list = exportingStatic ? staticParts : current;
   // Drawn again this frame (shadow map, reflection, refraction): recorded once.
   loopv(list) {
     const PartInstance &other = *list[i];
-    if (other.part == p && other.owner == d && (d || other.origin.dist(origin) < 1e-3f)) return;
+    if (other.part == p && other.owner == owner && (owner || other.origin.dist(origin) < 1e-3f)) return;
   }
   PartInstance *instance = new PartInstance;
   instance->part = p;
-  instance->owner = d;
+  instance->owner = owner;
   instance->origin = origin;
   instance->rotation = quat(world);
   instance->rotation.normalize();
@@ -302,9 +330,11 @@ bool dynbench_models_capture_static(dbc_session *session) {
     if (e.type != ET_MAPMODEL) continue;
     model *m = loadmapmodel(e.attr2);
     if (!m) continue;
-    int anim = ANIM_MAPMODEL | ANIM_LOOP, basetime = 0;
-    if (e.flags & EF_ANIM) entities::animatemapmodel(e, anim, basetime);
-    m->render(anim | ANIM_NORENDER, basetime, 0, e.o, e.attr1, 0, NULL, NULL, vec(1, 1, 1), vec(0, 0, 1), 1);
+    if (hasMapModelAnimation(m)) {
+      animatedMapEntities.add(i);  // recorded every frame by dynbench_models_export
+      continue;
+    }
+    evaluateMapModel(e, m);
   }
   exportingStatic = false;
   staticParts.sort(drawnBefore);
@@ -314,6 +344,15 @@ bool dynbench_models_capture_static(dbc_session *session) {
 
 bool dynbench_models_export(dbc_session *session) {
   using namespace dynbench_models;
+  const vector<extentity *> &ents = entities::getents();
+  loopv(animatedMapEntities) {
+    extentity &e = *ents[animatedMapEntities[i]];
+    model *m = loadmapmodel(e.attr2);
+    if (!m) continue;
+    mapModelOwner = reinterpret_cast<const dynent *>(&e);
+    evaluateMapModel(e, m);
+    mapModelOwner = NULL;
+  }
   current.sort(drawnBefore);
   loopv(current) if (!exportModel(session, current[i]->part)) return false;
   // Ids: the same entity's part in the previous frame, else the nearest unclaimed instance of the
