@@ -115,6 +115,11 @@ TEST(Cli, StatsWritesTablesJsonCsvSeriesAndPlots) {
   EXPECT_TRUE(d["properties"]["animated_camera"].get<bool>());
   EXPECT_NEAR(d["camera_motion"]["yaw_degrees"]["mean"].get<double>(), 7.5, 1e-4);
   EXPECT_NEAR(d["camera_motion"]["rotation_degrees"]["max"].get<double>(), 7.5, 1e-4);
+  // The thesis's Table 6.5 convention: Eq. 2.4 taken literally, half the angle (a 7.5-degree turn
+  // is ||ln q|| = 3.75 degrees); the variance of a constant turn stays 0.
+  EXPECT_NEAR(d["camera_motion"]["rotation_eq24"]["mean"].get<double>(), 3.75, 1e-4);
+  EXPECT_NEAR(d["camera_motion"]["rotation_eq24"]["max"].get<double>(), 3.75, 1e-4);
+  EXPECT_NEAR(d["camera_motion"]["rotation_eq24"]["variance"].get<double>(), d["camera_motion"]["rotation_degrees"]["variance"].get<double>() / 4, 1e-12);
   EXPECT_NEAR(d["camera_motion"]["position"]["mean"].get<double>(), 2.0, 1e-4);
   EXPECT_EQ(d["camera_motion"]["camera"], "eye");
 

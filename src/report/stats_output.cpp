@@ -116,6 +116,9 @@ std::string statsJson(const std::vector<StatsRow>& rows, double fps) {
     if (m.hasCamera) {
       motion["position"] = summaryJson(m.position);
       motion["rotation_degrees"] = summaryJson(m.rotation);
+      // Eq. 2.4 evaluated literally, ||ln(q_{i-1}^-1 q_i)||, is half the rotation angle: the thesis's
+      // Table 6.5 convention (docs/metrics.md). Mean and max halve, the variance quarters.
+      motion["rotation_eq24"] = summaryJson({m.rotation.mean / 2, m.rotation.variance / 4, m.rotation.max / 2});
       motion["pitch_degrees"] = summaryJson(m.pitch);
       motion["yaw_degrees"] = summaryJson(m.yaw);
       motion["roll_degrees"] = summaryJson(m.roll);

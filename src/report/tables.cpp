@@ -74,7 +74,7 @@ std::vector<Table> statsTables(const std::vector<StatsRow>& rows) {
                         cells.push_back(r.motion.hasCamera ? fmt::format("{}", r.motion.cuts) : "-");
                         return cells;
                       }));
-  out.push_back(table("Table 6.5. Change in camera rotation per frame (degrees, geodesic).", {"dataset", "mean", "variance", "max"}, rows,
+  out.push_back(table("Table 6.5. Change in camera rotation per frame (degrees, geodesic, the full angle; Eq. 2.4 taken literally, as the thesis's table, gives half: --json rotation_eq24).", {"dataset", "mean", "variance", "max"}, rows,
                       [](const StatsRow& r) { return motionCells(r, r.motion.rotation, true); }));
   out.push_back(table("Table 6.6. Change in camera rotation per axis (degrees / frame).",
                       {"dataset", "pitch mean", "pitch variance", "yaw mean", "yaw variance", "roll mean", "roll variance"}, rows,
