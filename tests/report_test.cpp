@@ -78,6 +78,36 @@ TEST(Report, TablesAndImagesInTheBrowser) {
   EXPECT_EQ(count(dom, "<th scope=\"row\">fast</th>"), 7u);
 }
 
+TEST(Report, ThesisReferenceRowsAreMarkedPublishedAndConverted) {
+  const auto dir = test::freshDir("report_reference");
+  makeRun(dir / "run", "0:4");
+  auto r = dynbench(fmt::format("report {} -o {} --thumbnails 0 --reference thesis", (dir / "run").string(), (dir / "r.html").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string md = test::slurp(dir / "r.md");
+  // Six published rows in each of Tables 6.1-6.7, beside the measured one.
+  EXPECT_EQ(count(md, "| Eternal Valley FPS (published) "), 7u);
+  EXPECT_EQ(count(md, "| Emerald Square (published) "), 7u);
+  EXPECT_EQ(count(md, "| run "), 7u);
+  EXPECT_NE(md.find("not measured"), std::string::npos);
+  // Table 6.5 in dynbench's full angle: 2 x 1.931, 4 x 4.526, 2 x 13.665.
+  const auto t65 = md.find("Table 6.5."), t66 = md.find("Table 6.6.");
+  const auto row = md.find("| Eternal Valley FPS (published) ", t65);
+  ASSERT_LT(row, t66);
+  const std::string line = md.substr(row, md.find('\n', row) - row);
+  for (const char* cell : {"3.862", "18.104", "27.330"}) EXPECT_NE(line.find(cell), std::string::npos) << line;
+  // Table 6.7 as published.
+  const auto t67 = md.find("Table 6.7.");
+  const auto discardRow = md.find("| Eternal Valley FPS (published) ", t67);
+  ASSERT_NE(discardRow, std::string::npos);
+  EXPECT_NE(md.substr(discardRow, 120).find("29.085"), std::string::npos);
+  const std::string html = test::slurp(dir / "r.html");
+  EXPECT_NE(html.find("<p class=\"reference\">"), std::string::npos);
+  r = dynbench(fmt::format("report {} -o {} --reference orca", (dir / "run").string(), (dir / "bad.html").string()), dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("--reference: orca not in {thesis}"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "bad.html"));
+}
+
 TEST(Report, BadRunsFailClearly) {
   const auto dir = test::freshDir("report_bad");
   fs::create_directories(dir / "empty");

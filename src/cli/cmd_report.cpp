@@ -9,6 +9,7 @@ struct ReportCli {
   std::vector<std::string> runs;
   std::string output, title = "dynbench report";
   int thumbnails = 3;
+  std::string reference;
 };
 
 Expected<void> runReport(const ReportCli& cli) {
@@ -17,6 +18,7 @@ Expected<void> runReport(const ReportCli& cli) {
   options.output = cli.output;
   options.title = cli.title;
   options.thumbnails = cli.thumbnails;
+  options.reference = cli.reference;
   auto files = pipeline::runReport(options);
   if (!files) return std::unexpected(files.error());
   fmt::print("{}\n{}\n", files->html.string(), files->markdown.string());
@@ -36,6 +38,8 @@ void addReportCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("-o,--output", o->output, "The report (.html; report.md and report_files/ beside it)")->required();
   cmd->add_option("--title", o->title, "Report title");
   cmd->add_option("--thumbnails", o->thumbnails, "Thumbnails and masks per run (0: none)")->check(nonNegative());
+  cmd->add_option("--reference", o->reference, "thesis: add the thesis's published rows (Tables 6.1-6.7), marked as published")
+      ->check(CLI::IsMember({"thesis"}));
   cmd->callback([o, &run] { run = [o] { return runReport(*o); }; });
 }
 

@@ -12,6 +12,7 @@
 #include "frames/frame_io.h"
 #include "frames/preview.h"
 #include "report/plots.h"
+#include "report/reference.h"
 #include "report/stats_output.h"
 #include "report/tables.h"
 #include "core/json_fields.h"
@@ -208,9 +209,20 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
     figures.emplace_back(r.name, std::move(list));
   }
 
-  const auto allTables = tables(runs);
+  auto allTables = tables(runs);
+  std::string referenceNote;
+  if (!options.reference.empty()) {
+    if (options.reference != "thesis") return fail(ErrorCode::kUsage, "--reference '{}': expected thesis", options.reference);
+    auto reference = thesisReference();
+    if (!reference) return std::unexpected(reference.error());
+    appendReferenceRows(allTables, *reference);
+    referenceNote = "Rows marked (published) are not measured: they are the thesis's own numbers (" + reference->source +
+                    "). Table 6.5's are converted to the full angle (mean and max doubled, variance times four); Table 6.4's are in each "
+                    "dataset's own units; Table 6.7's come from the thesis's Cycles renders at 1920x1080 and 1024 spp.";
+  }
   // Markdown twin.
   std::string md = fmt::format("# {}\n\n", options.title);
+  if (!referenceNote.empty()) md += referenceNote + "\n\n";
   for (const auto& t : allTables) md += markdownTable(t);
   for (const auto& f : comparison)
     md += fmt::format("![{}]({}/{})\n\n", f.caption, files.assets.filename().string(), f.png.filename().string());
@@ -235,6 +247,7 @@ figcaption {{ font-size: .85em; max-width: 600px; }}
 <h1>{0}</h1>
 )",
                                  escapeHtml(options.title));
+  if (!referenceNote.empty()) html += "<p class=\"reference\">" + escapeHtml(referenceNote) + "</p>\n";
   for (const auto& t : allTables) html += htmlTable(t);
   for (const auto& f : comparison) {
     auto figure = figureHtml(f);

@@ -22,6 +22,7 @@ struct ReportOptions {
   std::filesystem::path output;  // report.html; the Markdown twin is report.md beside it
   std::string title = "dynbench report";
   int thumbnails = 3;  // per run, evenly spaced
+  std::string reference;  // "thesis": add the thesis's published rows to Tables 6.1-6.7 (report/reference.h)
 };
 
 struct ReportFiles {
