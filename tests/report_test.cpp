@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "core/files.h"
+#include "core/image_io.h"
 #include "gltf_builder.h"
 #include "external_tools.h"
 #include "run_cli.h"
@@ -57,9 +58,19 @@ TEST(Report, TablesAndImagesInTheBrowser) {
   EXPECT_EQ(count(md, "| fast "), 7u);
   EXPECT_NE(md.find("Temporal methods against the converged reference"), std::string::npos);
   EXPECT_NE(md.find(" | accumulate |"), std::string::npos);
-  // Per run: A.1, A.2, the discard series, 3 thumbnails, 3 masks; the slow run's two worst-frame
-  // heatmaps; the methods' per-frame plot.
-  EXPECT_EQ(count(md, "!["), 21u);
+  // Every run on shared axes: rotation per frame, its distribution, discard per frame, Table 6.7's
+  // bars; per run: A.1, A.2, the discard series, 3 thumbnails, 3 masks; the slow run's two
+  // worst-frame heatmaps; the methods' per-frame plot.
+  EXPECT_EQ(count(md, "!["), 25u);
+  for (const char* png : {"all_rotation.png", "all_cdf_rotation_cdf.png", "all_discard.png", "all_table67.png"}) {
+    auto header = readImageHeader(dir / "out" / "report_files" / png);
+    ASSERT_TRUE(header) << png << ": " << header.error().message;
+    EXPECT_EQ(header->width, 1200) << png;
+  }
+  // The shared plots name every run in their legend.
+  const std::string bars = test::slurp(dir / "out" / "report_files" / "all_table67.svg");
+  EXPECT_NE(bars.find(">slow<"), std::string::npos);
+  EXPECT_NE(bars.find(">fast<"), std::string::npos);
   const std::string html = test::slurp(dir / "out" / "report.html");
   EXPECT_EQ(html.find("http://"), std::string::npos);  // self-contained: nothing to fetch
   EXPECT_EQ(html.find("src=\"report_files"), std::string::npos);
@@ -71,8 +82,8 @@ TEST(Report, TablesAndImagesInTheBrowser) {
                                  fs::absolute(dir / "out" / "report.html").string()),
                      dom),
             0);
-  EXPECT_NE(dom.find("data-images-decoded=\"21\""), std::string::npos) << dom.substr(0, 400);
-  EXPECT_NE(dom.find("data-images=\"21\""), std::string::npos);
+  EXPECT_NE(dom.find("data-images-decoded=\"25\""), std::string::npos) << dom.substr(0, 400);
+  EXPECT_NE(dom.find("data-images=\"25\""), std::string::npos);
   EXPECT_EQ(count(dom, "<table>"), 8u);
   EXPECT_EQ(count(dom, "<th scope=\"row\">slow</th>"), 9u);
   EXPECT_EQ(count(dom, "<th scope=\"row\">fast</th>"), 7u);
@@ -102,6 +113,10 @@ TEST(Report, ThesisReferenceRowsAreMarkedPublishedAndConverted) {
   EXPECT_NE(md.substr(discardRow, 120).find("29.085"), std::string::npos);
   const std::string html = test::slurp(dir / "r.html");
   EXPECT_NE(html.find("<p class=\"reference\">"), std::string::npos);
+  // Table 6.7's bars show the published rows beside the measured one.
+  const std::string bars = test::slurp(dir / "r_files" / "all_table67.svg");
+  EXPECT_NE(bars.find("Eternal Valley FPS (published)"), std::string::npos);
+  EXPECT_NE(bars.find(">run<"), std::string::npos);
   r = dynbench(fmt::format("report {} -o {} --reference orca", (dir / "run").string(), (dir / "bad.html").string()), dir);
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("--reference: orca not in {thesis}"), std::string::npos) << r.err;

@@ -1,7 +1,9 @@
 #include "report/html_report.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -93,6 +95,29 @@ std::vector<Table> tables(const std::vector<Run>& runs) {
   return all;
 }
 
+// The geodesic rotation per frame of a camera series CSV (stats --series), NaN where there is none:
+// frame 0 and cut frames (the series' `cut` column, when it has one).
+std::vector<double> rotationSeries(const std::string& csv) {
+  std::vector<double> out;
+  std::istringstream in(csv);
+  std::string header, line;
+  if (!std::getline(in, header)) return out;
+  int rotationColumn = -1, cutColumn = -1, column = 0;
+  for (std::istringstream h(header); std::getline(h, line, ','); ++column) {
+    if (line == "rotation_delta_deg") rotationColumn = column;
+    if (line == "cut") cutColumn = column;
+  }
+  if (rotationColumn < 0) return out;
+  for (std::size_t row = 0; std::getline(in, line); ++row) {
+    std::vector<std::string> cells;
+    for (std::istringstream c(line); std::getline(c, header, ',');) cells.push_back(header);
+    const bool cut = cutColumn >= 0 && cutColumn < static_cast<int>(cells.size()) && cells[static_cast<std::size_t>(cutColumn)] == "1";
+    const bool has = rotationColumn < static_cast<int>(cells.size());
+    out.push_back(row == 0 || cut || !has ? std::nan("") : std::strtod(cells[static_cast<std::size_t>(rotationColumn)].c_str(), nullptr));
+  }
+  return out;
+}
+
 struct Figure {
   std::string caption;
   fs::path png;  // in the assets folder
@@ -143,8 +168,46 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
   fs::create_directories(files.assets, ec);
   if (ec) return fail(ErrorCode::kIo, "{}: cannot create: {}", files.assets.string(), ec.message());
 
-  // Temporal methods of every run on one axis, then per run (below) each method's worst frame.
+  // Every run on the same axes: rotation per frame and its distribution, discard per frame, Table
+  // 6.7 as bars (with the thesis's published rows when asked for).
   std::vector<Figure> comparison;
+  {
+    std::vector<ComparisonSeries> series;
+    for (const Run& r : runs) {
+      ComparisonSeries s;
+      s.name = r.name;
+      s.rotation = rotationSeries(r.cameraCsv);
+      s.discard = r.discard.frames;
+      s.mean = r.discard.mean;
+      series.push_back(std::move(s));
+    }
+    if (!options.reference.empty())
+      if (auto reference = thesisReference())
+        for (const auto& t : reference->tables)
+          if (t.table == "6.7")
+            for (const auto& row : t.rows) {
+              ComparisonSeries s;
+              s.name = row.dataset;
+              s.published = true;
+              discard::FramePercentages m;
+              double* cells[5] = {&m.frustum, &m.position, &m.normal, &m.direct, &m.indirect};
+              for (std::size_t c = 0; c < 5 && c < row.cells.size(); ++c) *cells[c] = std::strtod(row.cells[c].c_str(), nullptr);
+              s.mean = m;
+              series.push_back(std::move(s));
+            }
+    auto written = writeComparisonPlots(series, files.assets, "all");
+    if (!written) return std::unexpected(written.error());
+    static const std::map<std::string, std::string> captions = {
+        {"all_rotation.png", "Geodesic change in camera rotation per frame, every dataset on one axis (cut frames left out)"},
+        {"all_cdf_rotation_cdf.png", "Cumulative distribution of the change in rotation per frame: the share of frames turning at most x degrees"},
+        {"all_discard.png", "Discarded pixels per frame pair, one panel per feature, every dataset on one axis (cut pairs left out)"},
+        {"all_table67.png", "Table 6.7 as bars: mean discard per feature; whiskers: 95 % intervals of the radiance columns"}};
+    for (const auto& png : *written) {
+      const auto caption = captions.find(png.filename().string());
+      comparison.push_back({caption != captions.end() ? caption->second : png.stem().string(), png});
+    }
+  }
+  // Temporal methods of every run on one axis, then per run (below) each method's worst frame.
   {
     std::vector<std::pair<std::string, std::vector<double>>> series;
     for (const Run& r : runs)

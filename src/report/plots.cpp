@@ -1,6 +1,7 @@
 #include "report/plots.h"
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 
 #include "core/files.h"
@@ -38,7 +39,7 @@ struct LineFigure {
 };
 
 Expected<std::vector<fs::path>> writeLineFigures(const fs::path& dir, const std::string& stem, const std::string& csv,
-                                                 const std::vector<LineFigure>& figures) {
+                                                 const std::vector<LineFigure>& figures, int height = 450) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) return fail(ErrorCode::kIo, "{}: cannot create folder: {}", dir.string(), ec.message());
@@ -49,8 +50,8 @@ Expected<std::vector<fs::path>> writeLineFigures(const fs::path& dir, const std:
   std::vector<std::pair<fs::path, fs::path>> moves;
   std::string script = "set datafile separator ','\nset key autotitle columnhead\nset grid\nset xlabel 'frame'\n";
   for (const auto& figure : figures) {
-    for (const auto& [terminal, ext] : {std::pair{"pngcairo noenhanced size 1200,450 font ',10'", ".png"},
-                                        std::pair{"svg noenhanced size 1200,450 dynamic font ',10'", ".svg"}}) {
+    for (const auto& [terminal, ext] : {std::pair{fmt::format("pngcairo noenhanced size 1200,{} font ',10'", height), ".png"},
+                                        std::pair{fmt::format("svg noenhanced size 1200,{} dynamic font ',10'", height), ".svg"}}) {
       const fs::path target = dir / (stem + "_" + figure.name + ext);
       const fs::path tmp = temporarySibling(target);
       std::string plot = figure.plot;
@@ -135,6 +136,150 @@ Expected<std::vector<fs::path>> writeMethodsPlot(const std::vector<std::pair<std
     plot += fmt::format("{}{{data}} using 1:{} with lines lw 1.5 dt {} title columnhead", column ? ", " : "", column + 2, 1 + column / 8);
   plot += "\nset xlabel 'frame'";
   return writeLineFigures(dir, stem, csv, {{"methods_flip", "ꟻLIP per frame of each temporal method (lower is better)", "mean ꟻLIP", plot}});
+}
+
+namespace {
+
+// A CSV column name without the separator.
+std::string columnName(std::string name) {
+  std::replace(name.begin(), name.end(), ',', ' ');
+  return name;
+}
+
+std::string cell(double v) { return std::isfinite(v) ? fmt::format("{}", v) : std::string(); }
+
+const char* const kDiscardFeatures[5] = {"frustum", "world position", "shading normal", "direct radiance", "indirect radiance"};
+
+}  // namespace
+
+Expected<std::vector<fs::path>> writeComparisonPlots(const std::vector<ComparisonSeries>& series, const fs::path& dir,
+                                                     const std::string& stem) {
+  std::vector<fs::path> pngs;
+  auto keepPngs = [&](const std::vector<fs::path>& written) {
+    for (const auto& p : written)
+      if (p.extension() == ".png") pngs.push_back(p);
+  };
+  // Rotation per frame, overlaid, and its cumulative distribution (cut frames left out).
+  std::vector<const ComparisonSeries*> rotating;
+  for (const auto& s : series)
+    if (!s.rotation.empty()) rotating.push_back(&s);
+  if (!rotating.empty()) {
+    std::size_t length = 0;
+    std::string csv = "frame", cdf;
+    std::vector<std::vector<double>> sorted;
+    for (const auto* s : rotating) {
+      csv += "," + columnName(s->name);
+      cdf += (cdf.empty() ? "" : ",") + columnName(s->name) + "," + columnName(s->name) + " share";
+      length = std::max(length, s->rotation.size());
+      std::vector<double> values;
+      for (double v : s->rotation)
+        if (std::isfinite(v)) values.push_back(v);
+      std::sort(values.begin(), values.end());
+      sorted.push_back(std::move(values));
+    }
+    csv += "\n";
+    cdf += "\n";
+    for (std::size_t k = 0; k < length; ++k) {
+      csv += std::to_string(k);
+      for (const auto* s : rotating) csv += "," + (k < s->rotation.size() ? cell(s->rotation[k]) : std::string());
+      csv += "\n";
+    }
+    std::size_t longest = 0;
+    for (const auto& v : sorted) longest = std::max(longest, v.size());
+    for (std::size_t k = 0; k < longest; ++k) {
+      for (std::size_t d = 0; d < sorted.size(); ++d) {
+        const auto& v = sorted[d];
+        cdf += d ? "," : "";
+        cdf += k < v.size() ? fmt::format("{},{}", v[k], static_cast<double>(k + 1) / static_cast<double>(v.size())) : std::string(",");
+      }
+      cdf += "\n";
+    }
+    std::string plot = "set datafile missing ''\nplot ";
+    for (std::size_t d = 0; d < rotating.size(); ++d) plot += fmt::format("{}{{data}} using 1:{} with lines lw 1.2 title columnhead", d ? ", " : "", d + 2);
+    auto written = writeLineFigures(dir, stem, csv,
+                                    {{"rotation", "Geodesic change in camera rotation per frame, every dataset (cut frames left out)", "degrees / frame", plot}});
+    if (!written) return std::unexpected(written.error());
+    keepPngs(*written);
+    std::string cdfPlot = "set datafile missing ''\nset xlabel 'degrees / frame'\nset logscale x\nset key bottom right\nplot ";
+    for (std::size_t d = 0; d < rotating.size(); ++d)
+      cdfPlot += fmt::format("{}{{data}} using {}:{} with steps lw 1.5 title columnhead({})", d ? ", " : "", 2 * d + 1, 2 * d + 2, 2 * d + 1);
+    cdfPlot += "\nunset logscale x\nset xlabel 'frame'\nset key default";
+    written = writeLineFigures(dir, stem + "_cdf", cdf,
+                               {{"rotation_cdf", "Share of frames turning at most x degrees (cumulative distribution, cut frames left out)", "share of frames", cdfPlot}});
+    if (!written) return std::unexpected(written.error());
+    keepPngs(*written);
+  }
+  // Discard per frame, one panel per feature, every dataset overlaid.
+  std::vector<const ComparisonSeries*> discarding;
+  for (const auto& s : series)
+    if (!s.discard.empty()) discarding.push_back(&s);
+  if (!discarding.empty()) {
+    std::size_t length = 0;
+    std::string csv = "frame in window";
+    for (int f = 0; f < 5; ++f)
+      for (const auto* s : discarding) csv += "," + columnName(s->name) + " " + kDiscardFeatures[f];
+    for (const auto* s : discarding) length = std::max(length, s->discard.size());
+    csv += "\n";
+    for (std::size_t k = 0; k < length; ++k) {
+      csv += std::to_string(k);
+      for (int f = 0; f < 5; ++f)
+        for (const auto* s : discarding) {
+          if (k >= s->discard.size() || s->discard[k].cut) {
+            csv += ",";
+            continue;
+          }
+          const auto& p = s->discard[k];
+          const double v[5] = {p.frustum, p.position, p.normal, p.direct, p.indirect};
+          csv += "," + cell(v[f]);
+        }
+      csv += "\n";
+    }
+    std::string plot = "set datafile missing ''\nset multiplot layout 5,1\nset xlabel 'frame pair in the rendered window'\n";
+    for (int f = 0; f < 5; ++f) {
+      plot += fmt::format("set title '{} discard per frame, every dataset (cut pairs left out)'\nplot ", kDiscardFeatures[f]);
+      for (std::size_t d = 0; d < discarding.size(); ++d)
+        plot += fmt::format("{}{{data}} using 1:{} with lines lw 1.2 title {}", d ? ", " : "", 2 + f * discarding.size() + d, quoted(discarding[d]->name));
+      plot += "\n";
+    }
+    plot += "unset multiplot\nset xlabel 'frame'";
+    auto written = writeLineFigures(dir, stem, csv, {{"discard", "", "% of the image", plot}}, 1500);
+    if (!written) return std::unexpected(written.error());
+    keepPngs(*written);
+  }
+  // Table 6.7 as grouped bars: x is the feature, one bar per dataset, the 95 % interval where known.
+  std::vector<const ComparisonSeries*> means;
+  for (const auto& s : series)
+    if (s.mean) means.push_back(&s);
+  if (!means.empty()) {
+    std::string csv = "feature";
+    for (const auto* s : means) csv += "," + columnName(s->name) + (s->published ? " (published)" : "") + ",low,high";
+    csv += "\n";
+    for (int f = 0; f < 5; ++f) {
+      csv += std::to_string(f);
+      for (const auto* s : means) {
+        const auto& m = *s->mean;
+        const double v[5] = {m.frustum, m.position, m.normal, m.direct, m.indirect};
+        const std::optional<discard::Interval>& interval = f == 3 ? m.directInterval : f == 4 ? m.indirectInterval : std::optional<discard::Interval>{};
+        csv += fmt::format(",{},{},{}", v[f], interval ? interval->low : v[f], interval ? interval->high : v[f]);
+      }
+      csv += "\n";
+    }
+    const double width = 0.8 / static_cast<double>(means.size());
+    std::string plot = fmt::format("set style fill solid 0.7 border -1\nset boxwidth {}\nset xrange [-0.5:4.5]\nset yrange [0:*]\nset xlabel ''\n", width);
+    plot += "set xtics ('frustum' 0, 'world position' 1, 'shading normal' 2, 'direct radiance' 3, 'indirect radiance' 4)\nset key outside right\nplot ";
+    for (std::size_t d = 0; d < means.size(); ++d) {
+      const double offset = (static_cast<double>(d) - 0.5 * static_cast<double>(means.size() - 1)) * width;
+      const std::size_t c = 2 + 3 * d;
+      // boxerrorbars with five columns: x, y, ylow, yhigh, box width.
+      plot += fmt::format("{}{{data}} using ($1+{}):{}:{}:{}:({}) with boxerrorbars title columnhead({})", d ? ", " : "", offset, c, c + 1, c + 2,
+                          width, c);
+    }
+    plot += "\nset xtics autofreq\nunset xrange\nunset yrange\nset key default\nset xlabel 'frame'";
+    auto written = writeLineFigures(dir, stem, csv, {{"table67", "Table 6.7: discarded pixels, % of the image (bars: mean; whiskers: 95 % interval)", "% of the image", plot}});
+    if (!written) return std::unexpected(written.error());
+    keepPngs(*written);
+  }
+  return pngs;
 }
 
 }  // namespace dynbench::report
