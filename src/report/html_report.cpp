@@ -120,15 +120,16 @@ std::vector<double> rotationSeries(const std::string& csv) {
 
 struct Figure {
   std::string caption;
-  fs::path png;  // in the assets folder
+  fs::path png;       // in the assets folder
+  bool wide = false;  // shown at the page's width (the shared-axes comparisons), not as a 600-pixel tile
 };
 
 // A figure as HTML with its PNG inline.
 Expected<std::string> figureHtml(const Figure& f) {
   auto bytes = readWholeFile(f.png);
   if (!bytes) return std::unexpected(bytes.error());
-  return fmt::format("<figure><img alt=\"{0}\" src=\"data:image/png;base64,{1}\"><figcaption>{0}</figcaption></figure>\n",
-                     escapeHtml(f.caption), base64Encode(*bytes));
+  return fmt::format("<figure{2}><img alt=\"{0}\" src=\"data:image/png;base64,{1}\"><figcaption>{0}</figcaption></figure>\n",
+                     escapeHtml(f.caption), base64Encode(*bytes), f.wide ? " class=\"wide\"" : "");
 }
 
 }  // namespace
@@ -204,7 +205,7 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
         {"all_table67.png", "Table 6.7 as bars: mean discard per feature; whiskers: 95 % intervals of the radiance columns"}};
     for (const auto& png : *written) {
       const auto caption = captions.find(png.filename().string());
-      comparison.push_back({caption != captions.end() ? caption->second : png.stem().string(), png});
+      comparison.push_back({caption != captions.end() ? caption->second : png.stem().string(), png, true});
     }
   }
   // Temporal methods of every run on one axis, then per run (below) each method's worst frame.
@@ -220,7 +221,7 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
     if (!series.empty()) {
       auto written = writeMethodsPlot(series, files.assets, "all");
       if (!written) return std::unexpected(written.error());
-      comparison.push_back({"ꟻLIP per frame of every temporal method and dataset (lower is better)", files.assets / "all_methods_flip.png"});
+      comparison.push_back({"ꟻLIP per frame of every temporal method and dataset (lower is better)", files.assets / "all_methods_flip.png", true});
     }
   }
 
@@ -279,9 +280,10 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
     auto reference = thesisReference();
     if (!reference) return std::unexpected(reference.error());
     appendReferenceRows(allTables, *reference);
-    referenceNote = "Rows marked (published) are not measured: they are the thesis's own numbers (" + reference->source +
-                    "). Table 6.5's are converted to the full angle (mean and max doubled, variance times four); Table 6.4's are in each "
-                    "dataset's own units; Table 6.7's come from the thesis's Cycles renders at 1920x1080 and 1024 spp.";
+    referenceNote = "Rows marked (published), in grey, are not measured here: they are the thesis's own numbers (J. Alanko, Dynamic "
+                    "benchmark for graphics rendering, Tampere University 2021, Tables 6.1-6.7). Table 6.5's are converted to the full "
+                    "angle (mean and max doubled, variance times four); Table 6.4's are in each dataset's own units; Table 6.7's come from "
+                    "the thesis's Cycles renders at 1920x1080 and 1024 spp.";
   }
   // Markdown twin.
   std::string md = fmt::format("# {}\n\n", options.title);
@@ -306,6 +308,10 @@ td {{ text-align: right; font-variant-numeric: tabular-nums; }}
 figure {{ display: inline-block; margin: .5em; vertical-align: top; }}
 figure img {{ max-width: 600px; border: 1px solid #ccc; }}
 figcaption {{ font-size: .85em; max-width: 600px; }}
+tr.published {{ color: #777; font-style: italic; }}
+figure.wide {{ display: block; }}
+figure.wide img, figure.wide figcaption {{ max-width: min(100%, 1200px); }}
+p.reference {{ max-width: 60em; }}
 </style></head><body>
 <h1>{0}</h1>
 )",

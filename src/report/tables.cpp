@@ -130,7 +130,8 @@ std::string htmlTable(const Table& t) {
   for (const auto& h : t.header) out += "<th>" + escapeHtml(h) + "</th>";
   out += "</tr></thead>\n<tbody>\n";
   for (const auto& row : t.rows) {
-    out += "<tr>";
+    // Published reference rows (report/reference.h) are set apart from measured ones.
+    out += !row.empty() && row[0].ends_with("(published)") ? "<tr class=\"published\">" : "<tr>";
     for (std::size_t c = 0; c < row.size(); ++c)
       out += (c == 0 ? "<th scope=\"row\">" : "<td>") + escapeHtml(row[c]) + (c == 0 ? "</th>" : "</td>");
     out += "</tr>\n";
