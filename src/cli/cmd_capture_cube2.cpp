@@ -25,6 +25,13 @@ Expected<void> runCube2(const capture::Cube2Options& options) {
   return {};
 }
 
+// The preset names, from their one definition (capture/cube2.h).
+std::vector<std::string> presetNames() {
+  std::vector<std::string> names;
+  for (const auto& p : capture::cube2Presets()) names.emplace_back(p.name);
+  return names;
+}
+
 }  // namespace
 
 void addCaptureCommand(CLI::App& app, CommandRun& run) {
@@ -40,7 +47,7 @@ void addCaptureCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("-o,--output", o->output, "Capture folder (new or empty)")->required();
   auto preset = std::make_shared<std::string>();
   cmd->add_option("--preset", *preset, "calm, fps or hard: map, mode, bots, skill and follow together (docs/presets.md); options given explicitly win")
-      ->check(CLI::IsMember({"calm", "fps", "hard"}));
+      ->check(CLI::IsMember(presetNames()));
   cmd->add_option("--map", o->map, "Map (others with bot waypoints: cyber1, md2, ...)");
   cmd->add_option("--mode", o->mode, "Game mode")
       ->check(CLI::IsMember({"ffa", "teamplay", "instagib", "efficiency", "tactics"}));

@@ -164,15 +164,18 @@ Expected<FlythroughReport> writeFlythroughCsv(const fs::path& dataset, const fs:
   const auto& node = scene->nodes[static_cast<std::size_t>(*cameraNode)];
   const scene::Evaluator evaluator(*scene);
   const std::size_t samples = std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil(duration * o.rate)) + 1);
-  auto timeAt = [&](std::size_t n) { return range.start + duration * static_cast<double>(n) / static_cast<double>(samples - 1); };
+  auto poseTime = [&](std::size_t n) { return duration * static_cast<double>(n) / static_cast<double>(samples - 1); };  // from the start
+  auto timeAt = [&](std::size_t n) { return range.start + poseTime(n); };
 
   // The bot's longest stretch (by distance) between camera cuts.
   FlythroughReport report;
   std::vector<glm::dvec3> best, current;
   std::size_t currentStart = 0;
   auto closeStretch = [&](std::size_t end) {
-    if (Polyline(current).length() > Polyline(best).length() || best.empty()) {
+    const double length = Polyline(current).length();
+    if (length > report.stretchLength || best.empty()) {
       best = current;
+      report.stretchLength = length;
       report.stretchStart = timeAt(currentStart);
       report.stretchEnd = timeAt(end);
     }
@@ -187,7 +190,6 @@ Expected<FlythroughReport> writeFlythroughCsv(const fs::path& dataset, const fs:
   }
   closeStretch(samples - 1);
   const Polyline stretch(best);
-  report.stretchLength = stretch.length();
   const double unitSpeed = o.speed / o.metresPerUnit;
 
   // The stretch resampled every scene unit, then smoothed as widely as keeps the path out of walls.
@@ -195,7 +197,8 @@ Expected<FlythroughReport> writeFlythroughCsv(const fs::path& dataset, const fs:
   for (double s = 0; s < stretch.length(); s += 1.0) even.push_back(stretch.at(s));
   even.push_back(stretch.at(stretch.length()));  // the stretch's own end
   if (even.size() < 2) even.push_back(even.back());
-  auto poseTime = [&](std::size_t n) { return duration * static_cast<double>(n) / static_cast<double>(samples - 1); };
+  auto walls = render::StaticGeometry::create(*scene);  // built once for every width tried
+  if (!walls) return std::unexpected(walls.error());
   std::optional<Polyline> path;
   std::vector<glm::dvec3> positions(samples);
   for (double width : {64.0, 32.0, 16.0, 8.0, 4.0, 0.0}) {
@@ -205,16 +208,13 @@ Expected<FlythroughReport> writeFlythroughCsv(const fs::path& dataset, const fs:
     // The chords the renderer's frames make (dataset frame rate) as well as the poses' own.
     std::vector<glm::dvec3> frames;
     for (double t = 0; t <= duration + 1e-9; t += 1.0 / o.frameRate) frames.push_back(candidate.at(report.length * t / duration));
-    auto crossPoses = render::segmentsThroughStaticGeometry(*scene, positions);
-    if (!crossPoses) return std::unexpected(crossPoses.error());
-    auto crossFrames = render::segmentsThroughStaticGeometry(*scene, frames);
-    if (!crossFrames) return std::unexpected(crossFrames.error());
+    const auto crossPoses = walls->segmentsThrough(positions), crossFrames = walls->segmentsThrough(frames);
     report.smoothing = width;
     path.emplace(std::move(candidate));
-    if (crossPoses->empty() && crossFrames->empty()) break;
+    if (crossPoses.empty() && crossFrames.empty()) break;
     if (width == 0.0)
       return fail(ErrorCode::kInvalidData, "{}: the bot's own path crosses static geometry ({} segments); no fly-through made", dataset.string(),
-                  crossPoses->size() + crossFrames->size());
+                  crossPoses.size() + crossFrames.size());
   }
 
   // Heading: towards the path lookAhead further on, level but for half the path's slope (at most
@@ -267,6 +267,7 @@ Expected<FlythroughReport> writeFlythroughCsv(const fs::path& dataset, const fs:
     out += fmt::format("{},{},{},{},{},{},{},{}\n", poseTime(n), p.x, p.y, p.z, q.x, q.y, q.z, q.w);
   }
   report.poses = samples;
+  report.speed = report.length / duration;
   if (auto ok = writeFileAtomic(csv, out); !ok) return std::unexpected(ok.error());
   return report;
 }
@@ -326,7 +327,7 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
     if (!flown) return std::unexpected(flown.error());
     log(fmt::format("  along the bot's path from {:.2f} s to {:.2f} s (no cut between), {:.0f} of its {:.0f} units at {:.2f} units/s, "
                     "smoothed over {:.0f} units, heading over {:.2f} s, pitch over {:.2f} s: yaw {:.3f} (variance {:.3f}), pitch {:.3f} ({:.4f}) degrees per frame",
-                    flown->stretchStart, flown->stretchEnd, flown->length, flown->stretchLength, flown->length / (flown->poses > 1 ? (flown->poses - 1) / 60.0 : 1.0),
+                    flown->stretchStart, flown->stretchEnd, flown->length, flown->stretchLength, flown->speed,
                     flown->smoothing, flown->headingWindow, flown->pitchWindow, flown->yawMean, flown->yawVariance, flown->pitchMean, flown->pitchVariance));
     convert::MergeCameraOptions merge;
     merge.dataset = bot;

@@ -57,6 +57,7 @@ struct FlythroughOptions {
 struct FlythroughReport {
   double stretchStart = 0, stretchEnd = 0;  // s: the bot's cut-free stretch the path follows
   double stretchLength = 0, length = 0;     // scene units: the stretch, and the path flown
+  double speed = 0;                         // scene units per second flown
   double smoothing = 0;                     // scene units: width of the path's moving average
   double headingWindow = 0, pitchWindow = 0;  // s: width of the yaw's and the pitch's moving averages
   // Per-frame changes at frameRate, degrees (Table 6.6's definitions, |wrapped difference|).

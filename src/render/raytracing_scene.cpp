@@ -386,7 +386,7 @@ void SphereIndex::query(const glm::dvec3& p, std::vector<std::uint32_t>& found) 
   rtcPointQuery(impl_->scene, &query, &context, sphereQueryVisit, &q);
 }
 
-Expected<std::vector<std::size_t>> segmentsThroughStaticGeometry(const scene::Scene& scene, const std::vector<glm::dvec3>& points) {
+Expected<StaticGeometry> StaticGeometry::create(const scene::Scene& scene) {
   scene::Scene still = scene;
   const auto dynamic = scene::dynamicNodes(still);
   for (std::size_t n = 0; n < still.nodes.size(); ++n)
@@ -394,13 +394,23 @@ Expected<std::vector<std::size_t>> segmentsThroughStaticGeometry(const scene::Sc
   auto tracer = RayTracingScene::create(still);
   if (!tracer) return std::unexpected(tracer.error());
   if (auto ok = (*tracer)->update(still.timeRange().start); !ok) return std::unexpected(ok.error());
+  return StaticGeometry(std::move(*tracer));
+}
+
+std::vector<std::size_t> StaticGeometry::segmentsThrough(const std::vector<glm::dvec3>& points) const {
   std::vector<std::size_t> crossing;
   for (std::size_t k = 0; k + 1 < points.size(); ++k) {
     const glm::dvec3 d = points[k + 1] - points[k];
     const double length = glm::length(d);
-    if (length > 0 && (*tracer)->occluded(points[k], d / length, length)) crossing.push_back(k);
+    if (length > 0 && tracer_->occluded(points[k], d / length, length)) crossing.push_back(k);
   }
   return crossing;
+}
+
+Expected<std::vector<std::size_t>> segmentsThroughStaticGeometry(const scene::Scene& scene, const std::vector<glm::dvec3>& points) {
+  auto geometry = StaticGeometry::create(scene);
+  if (!geometry) return std::unexpected(geometry.error());
+  return geometry->segmentsThrough(points);
 }
 
 }  // namespace dynbench::render

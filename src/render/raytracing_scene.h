@@ -99,9 +99,21 @@ class SphereIndex {
   std::vector<glm::dvec4> spheres_;
 };
 
-// Indices k of the segments points[k] -> points[k+1] that pass through the scene's static
-// geometry (nodes no animation moves; players and projectiles are left out): the check that a
-// camera path never goes through a wall. Alpha-masked surfaces block where they are opaque.
+// The scene's static geometry alone (nodes no animation moves; players and projectiles are left
+// out), built once and asked about many camera paths: which segments points[k] -> points[k+1] pass
+// through it (the check that a camera never goes through a wall). Alpha-masked surfaces block where
+// they are opaque.
+class StaticGeometry {
+ public:
+  static Expected<StaticGeometry> create(const scene::Scene& scene);
+  std::vector<std::size_t> segmentsThrough(const std::vector<glm::dvec3>& points) const;
+
+ private:
+  explicit StaticGeometry(std::unique_ptr<RayTracingScene> tracer) : tracer_(std::move(tracer)) {}
+  std::unique_ptr<RayTracingScene> tracer_;
+};
+
+// StaticGeometry::create, then segmentsThrough: for a single path.
 Expected<std::vector<std::size_t>> segmentsThroughStaticGeometry(const scene::Scene& scene, const std::vector<glm::dvec3>& points);
 
 }  // namespace dynbench::render
