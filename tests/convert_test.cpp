@@ -431,6 +431,8 @@ TEST(MergeCamera, CsvPoseLogReplacesTheCameraKeepingRoll) {
   }
   // Everything else is untouched: the crate still disappears in frames 4-6.
   EXPECT_FALSE(e.visible(nodeNamed(*merged, "model_3_mapmodel/crate:1"), static_cast<float>(5 / 60.0)));
+  // The captured camera's cut (frame 7) belonged to the motion the run replaced: it is gone.
+  EXPECT_TRUE(merged->nodes[static_cast<std::size_t>(camera)].cuts.empty());
   // The input dataset still has its own camera.
   auto original = scene::loadScene(c.dataset);
   ASSERT_TRUE(original);

@@ -189,6 +189,12 @@ Expected<MergeCameraReport> mergeCamera(const MergeCameraOptions& options) {
       animation["samplers"].push_back({{"input", input}, {"output", output}, {"interpolation", "LINEAR"}});
       animation["channels"].push_back({{"sampler", animation["samplers"].size() - 1}, {"target", {{"node", *node}, {"path", path}}}});
     }
+    // The old camera's cuts were jumps of its motion, which the run replaces: they go with it.
+    auto& cameraNode = doc["nodes"][static_cast<std::size_t>(*node)];
+    if (cameraNode.contains("extras") && cameraNode["extras"].is_object()) {
+      cameraNode["extras"].erase("dynbench_camera_cuts");
+      if (cameraNode["extras"].empty()) cameraNode.erase("extras");
+    }
   } catch (const Failure& f) {
     fs::remove(tmpBin, ec);
     return std::unexpected(f.error);
