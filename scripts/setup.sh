@@ -25,6 +25,8 @@ packages=(
   python3-matplotlib
   # headless Chromium: the tests open `dynbench report`'s HTML in a real browser
   chromium
+  # ffmpeg: `dynbench report` encodes each run's video (VP9 WebM) with it
+  ffmpeg
   # fuzzing the readers of untrusted input (the `fuzz` preset, CONTRIBUTING.md): clang 16 and its
   # libFuzzer runtime
   clang-16 libclang-rt-16-dev

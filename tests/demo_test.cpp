@@ -136,6 +136,7 @@ TEST(Demo, FlythroughFollowsTheBotsLongestStretchAroundAWallAndTurnsGently) {
 
 TEST(Demo, WholeChainOnAShortMatch) {
   DYNBENCH_NEEDS(test::missingCube2());
+  DYNBENCH_NEEDS(test::missingFfmpeg());
   const fs::path dir = test::freshDir("demo_chain");
   const auto r = dynbench(fmt::format("demo -o {} --seconds 3 --bots 4 --res 32x18 --spp 1 --max-spp 32 --render-frames 12 --bounces 1", (dir / "demo").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err << r.out;
@@ -175,6 +176,14 @@ TEST(Demo, WholeChainOnAShortMatch) {
     }
   }
   EXPECT_TRUE(fs::exists(dir / "demo" / "report.html"));
+  // The report shows each dataset's converged window as a video beside its discard masks, and says
+  // how it was sampled.
+  EXPECT_NE(r.out.find("self-contained ("), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" images, 2 videos inline)"), std::string::npos) << r.out;
+  for (const char* run : {"colos_bot", "colos_flythrough"})
+    EXPECT_NE(md.find(fmt::format("Video and thumbnails: {}/frames, converged (render --converge, tolerance 0.5): ", run)),
+              std::string::npos)
+        << md;
   EXPECT_TRUE(fs::exists(dir / "demo" / "runs" / "colos_bot" / "discard.json"));
   // The demo renders a converged window and Table 6.7 prints the radiance columns' intervals.
   EXPECT_NE(md.find(" ± "), std::string::npos) << md;

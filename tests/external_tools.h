@@ -23,6 +23,9 @@ inline std::string missingBlender() {
 inline std::string missingChromium() {
   return onPath("chromium") ? "" : "Chromium is not installed (Debian package chromium; scripts/setup.sh)";
 }
+inline std::string missingFfmpeg() {
+  return onPath("ffmpeg") ? "" : "ffmpeg is not installed (Debian package ffmpeg; scripts/setup.sh)";
+}
 inline std::string missingGltfValidator() {
   if (!onPath("node")) return "node is not installed (Debian package nodejs; scripts/setup.sh)";
   const auto validator = std::filesystem::path(DYNBENCH_SOURCE_DIR) / "tools/gltf-validator/node_modules/gltf-validator";

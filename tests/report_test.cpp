@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include <nlohmann/json.hpp>
+
 #include "core/files.h"
 #include "core/image_io.h"
 #include "gltf_builder.h"
@@ -18,9 +20,9 @@ namespace fs = std::filesystem;
 
 const fs::path kOrbit = fs::path(DYNBENCH_SOURCE_DIR) / "examples" / "orbit" / "orbit.gltf";
 
-void makeRun(const fs::path& run, const std::string& frames) {
+void makeRun(const fs::path& run, const std::string& frames, const std::string& sampling = "--spp 2") {
   for (const auto& args : {fmt::format("stats {} --json {} --series {}", kOrbit.string(), (run / "stats.json").string(), run.string()),
-                           fmt::format("render {} -o {} --frames {} --res 32x18 --spp 2", kOrbit.string(), (run / "frames").string(), frames),
+                           fmt::format("render {} -o {} --frames {} --res 32x18 {}", kOrbit.string(), (run / "frames").string(), frames, sampling),
                            fmt::format("discard {} --json {} --masks {}", (run / "frames").string(), (run / "discard.json").string(),
                                        (run / "masks").string())}) {
     const auto r = dynbench(args, run.parent_path());
@@ -36,9 +38,10 @@ std::size_t count(const std::string& text, const std::string& what) {
 }
 
 TEST(Report, TablesAndImagesInTheBrowser) {
+  DYNBENCH_NEEDS(test::missingFfmpeg());
   const auto dir = test::freshDir("report");
   makeRun(dir / "slow", "0:4");
-  makeRun(dir / "fast", "20:24");
+  makeRun(dir / "fast", "20:24", "--converge --spp 4 --max-spp 16");
   // The slow run also scores two temporal methods on a 1-spp render of its frames.
   const fs::path slow = dir / "slow";
   for (const auto& args :
@@ -52,6 +55,10 @@ TEST(Report, TablesAndImagesInTheBrowser) {
                                       (dir / "out" / "report.html").string()),
                           dir);
   ASSERT_EQ(r.status, 0) << r.err;
+  // The command reports the page's size and what it holds.
+  const std::string html = test::slurp(dir / "out" / "report.html");
+  EXPECT_NE(r.out.find(fmt::format("report.html: {:.2f} MB, self-contained (25 images, 2 videos inline)", html.size() / 1e6)), std::string::npos)
+      << r.out;
   const std::string md = test::slurp(dir / "out" / "report.md");
   for (int t = 1; t <= 7; ++t) EXPECT_NE(md.find(fmt::format("Table 6.{}.", t)), std::string::npos) << t;
   EXPECT_EQ(count(md, "| slow "), 9u);  // one row per table, and one per temporal method
@@ -71,9 +78,25 @@ TEST(Report, TablesAndImagesInTheBrowser) {
   const std::string bars = test::slurp(dir / "out" / "report_files" / "all_table67.svg");
   EXPECT_NE(bars.find(">slow<"), std::string::npos);
   EXPECT_NE(bars.find(">fast<"), std::string::npos);
-  const std::string html = test::slurp(dir / "out" / "report.html");
   EXPECT_EQ(html.find("http://"), std::string::npos);  // self-contained: nothing to fetch
   EXPECT_EQ(html.find("src=\"report_files"), std::string::npos);
+  // A video per run (linked from the Markdown, inline in the page), and what the frames show: the
+  // slow run's fixed 2 spp, the fast run's converged render.
+  EXPECT_EQ(count(md, "_motion.webm)"), 2u);
+  EXPECT_EQ(count(html, "<video src=\"data:video/webm;base64,"), 2u);
+  EXPECT_NE(md.find("Video and thumbnails: slow/frames, 2 spp;"), std::string::npos) << md;
+  {
+    const std::string prefix = "Video and thumbnails: fast/frames, converged (render --converge, tolerance 0.25): ";
+    const auto at = md.find(prefix);
+    ASSERT_NE(at, std::string::npos) << md;
+    int low = 0, high = 0;  // "4-16 spp per pixel", or "16 spp per pixel" when every pixel took the same
+    const int read = std::sscanf(md.c_str() + at + prefix.size(), "%d-%d spp per pixel", &low, &high);
+    ASSERT_GE(read, 1) << md.substr(at, 200);
+    EXPECT_GE(low, 4);
+    EXPECT_LE(read == 2 ? high : low, 16);
+  }
+  EXPECT_NE(md.find("Frames 0-4 at 24 fps (5 frames)"), std::string::npos) << md;
+  EXPECT_NE(md.find("Frames 20-24 at 24 fps (5 frames)"), std::string::npos) << md;
 
   DYNBENCH_NEEDS(test::missingChromium());
   std::string dom;
@@ -87,12 +110,73 @@ TEST(Report, TablesAndImagesInTheBrowser) {
   EXPECT_EQ(count(dom, "<table>"), 8u);
   EXPECT_EQ(count(dom, "<th scope=\"row\">slow</th>"), 9u);
   EXPECT_EQ(count(dom, "<th scope=\"row\">fast</th>"), 7u);
+
+  // Every image decodes, and every video plays to its end in Chromium with the frames and the size
+  // it was made with: 5 frames of 32x18, the discard mask beside each.
+  std::string media;
+  ASSERT_EQ(runShell(fmt::format("{0}/tests/tools/chromium_eval.py file://{1} --script {0}/tests/tools/decode_media.js", DYNBENCH_SOURCE_DIR,
+                                 fs::absolute(dir / "out" / "report.html").string()),
+                     media),
+            0);
+  const auto decoded = nlohmann::json::parse(media, nullptr, false);
+  ASSERT_TRUE(decoded.is_object()) << media;
+  EXPECT_EQ(decoded["images"], 25) << media;
+  EXPECT_EQ(decoded["imagesDecoded"], 25) << media;
+  ASSERT_EQ(decoded["videos"].size(), 2u) << media;
+  for (const auto& v : decoded["videos"]) {
+    EXPECT_EQ(v["frames"], 5) << media;
+    EXPECT_EQ(v["declaredFrames"], 5) << media;
+    EXPECT_EQ(v["width"], 64) << media;
+    EXPECT_EQ(v["height"], 18) << media;
+  }
+}
+
+TEST(Report, VideosAreOptionalAndNeedFfmpeg) {
+  DYNBENCH_NEEDS(test::missingFfmpeg());
+  const auto dir = test::freshDir("report_video");
+  makeRun(dir / "run", "0:2");
+  // --video-frames 0: no video.
+  auto r = dynbench(fmt::format("report {} -o {} --video-frames 0", (dir / "run").string(), (dir / "none.html").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(test::slurp(dir / "none.html").find("<video"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "none_files" / "run1_motion.webm"));
+  // 4 shared plots, A.1, A.2, the discard series, 3 thumbnails and the run's 2 masks.
+  EXPECT_NE(r.out.find("(12 images, 0 videos inline)"), std::string::npos) << r.out;
+  // --video-frames 2: the first two frames, and the caption says they are part of three.
+  r = dynbench(fmt::format("report {} -o {} --video-frames 2", (dir / "run").string(), (dir / "two.html").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(test::slurp(dir / "two.md").find("Frames 0-1 at 24 fps (2 frames): direct + indirect radiance, tone-mapped; beside it, the discard mask"),
+            std::string::npos);
+  EXPECT_NE(test::slurp(dir / "two.md").find("the first 2 of the run's 3 frames"), std::string::npos);
+  // A mask that is not its frame's size: status 5, naming the file, and no page.
+  fs::copy(dir / "run", dir / "odd", fs::copy_options::recursive);
+  ASSERT_TRUE(writeImage(dir / "odd" / "masks" / "discard_00001.png", FloatImage{10, 10, 3, std::vector<float>(300, 0.5f), {}, {}, {}}));
+  r = dynbench(fmt::format("report {} -o {}", (dir / "odd").string(), (dir / "odd.html").string()), dir);
+  EXPECT_EQ(r.status, 5) << r.err;
+  EXPECT_NE(r.err.find("odd/masks/discard_00001.png: 10x10 with 3 channels, but its frame is 32x18 RGB"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "odd.html"));
+  // Without ffmpeg on PATH (gnuplot still there): a clear error naming the package, status 7, and no
+  // page and no temporary files left.
+  const fs::path bin = dir / "bin";
+  fs::create_directories(bin);
+  fs::create_symlink(findOnPath("gnuplot"), bin / "gnuplot");
+  std::string out;
+  const int status = runShell(fmt::format("PATH={} {} report {} -o {} 2>{}", bin.string(), DYNBENCH_EXE, (dir / "run").string(),
+                                          (dir / "out" / "r.html").string(), (dir / "err.txt").string()),
+                              out);
+  EXPECT_EQ(status, 7);
+  const std::string err = test::slurp(dir / "err.txt");
+  EXPECT_NE(err.find("ffmpeg"), std::string::npos) << err;
+  EXPECT_NE(err.find("install Debian's ffmpeg"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir / "out" / "r.html"));
+  for (const auto& e : fs::directory_iterator(dir / "out" / "r_files"))
+    EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos) << e.path();
 }
 
 TEST(Report, ThesisReferenceRowsAreMarkedPublishedAndConverted) {
   const auto dir = test::freshDir("report_reference");
   makeRun(dir / "run", "0:4");
-  auto r = dynbench(fmt::format("report {} -o {} --thumbnails 0 --reference thesis", (dir / "run").string(), (dir / "r.html").string()), dir);
+  auto r = dynbench(fmt::format("report {} -o {} --thumbnails 0 --video-frames 0 --reference thesis", (dir / "run").string(), (dir / "r.html").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string md = test::slurp(dir / "r.md");
   // Six published rows in each of Tables 6.1-6.7, beside the measured one.

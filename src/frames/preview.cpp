@@ -28,8 +28,9 @@ glm::dvec3 PreviewToneMap::operator()(const FeatureFrame& frame, std::size_t pix
   return glm::pow(glm::clamp(c, 0.0, 1.0), glm::dvec3(1.0 / 2.2));
 }
 
-std::vector<float> previewImage(const FeatureFrame& frame) {
-  const PreviewToneMap map(frame);
+std::vector<float> previewImage(const FeatureFrame& frame) { return previewImage(frame, PreviewToneMap(frame)); }
+
+std::vector<float> previewImage(const FeatureFrame& frame, const PreviewToneMap& map) {
   std::vector<float> rgb(3 * frame.pixelCount());
   for (std::size_t i = 0; i < frame.pixelCount(); ++i) {
     const glm::dvec3 c = map(frame, i);

@@ -14,6 +14,8 @@ namespace dynbench::frames {
 class PreviewToneMap {
  public:
   explicit PreviewToneMap(const FeatureFrame& frame);
+  // A fixed exposure, e.g. one for every frame of a video, so that it does not flicker.
+  explicit PreviewToneMap(double exposure) : exposure_(exposure) {}
   // Display RGB in [0, 1] of pixel i.
   glm::dvec3 operator()(const FeatureFrame& frame, std::size_t pixel) const;
   double exposure() const { return exposure_; }  // the scale applied to radiance
@@ -22,7 +24,9 @@ class PreviewToneMap {
   double exposure_ = 1.0;
 };
 
-// The whole frame tone-mapped: 3 floats per pixel in [0, 1], row 0 at the top.
+// The whole frame tone-mapped: 3 floats per pixel in [0, 1], row 0 at the top; with the frame's
+// own exposure, or with `map`'s.
 std::vector<float> previewImage(const FeatureFrame& frame);
+std::vector<float> previewImage(const FeatureFrame& frame, const PreviewToneMap& map);
 
 }  // namespace dynbench::frames

@@ -352,6 +352,7 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
   r.title = fmt::format("dynbench demo: {} with {} bots, first-person bot vs fly-through", o.map, o.bots);
   auto files = runReport(r);
   if (!files) return std::unexpected(files.error());
+  log(fmt::format("report: {:.2f} MB, self-contained ({} images, {} videos inline)", files->htmlBytes / 1e6, files->images, files->videos));
   return files->html;
 }
 

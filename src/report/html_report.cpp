@@ -19,6 +19,7 @@
 #include "report/reference.h"
 #include "report/stats_output.h"
 #include "report/tables.h"
+#include "report/video.h"
 #include "core/json_fields.h"
 
 namespace dynbench::report {
@@ -120,18 +121,59 @@ std::vector<double> rotationSeries(const std::string& csv) {
   return out;
 }
 
+// Up to n indices of [0, count), evenly spaced from the first to the last, none twice.
+std::vector<std::size_t> evenlySpaced(std::size_t count, int n) {
+  std::vector<std::size_t> picked;
+  for (int t = 0; t < n && count > 0; ++t) {
+    const std::size_t k = static_cast<std::size_t>(t) * (count - 1) / static_cast<std::size_t>(std::max(1, n - 1));
+    if (picked.empty() || picked.back() != k) picked.push_back(k);
+  }
+  return picked;
+}
+
 struct Figure {
   std::string caption;
-  fs::path png;       // in the assets folder
+  fs::path png;       // in the assets folder: a PNG, or the WebM of `video`
   bool wide = false;  // shown at the page's width (the shared-axes comparisons), not as a 600-pixel tile
+  std::optional<Video> video = std::nullopt;
+  bool pixels = false;  // a frame-sized image (thumbnail, mask, heatmap): enlarged by a whole factor, pixels kept sharp
 };
 
-// A figure as HTML with its PNG inline.
+// A run's section: its figures, and how its frames were sampled (said once, above them).
+struct RunFigures {
+  std::string name, sampling;
+  std::vector<Figure> list;
+};
+
+// A figure as HTML with its PNG (or WebM) inline. Videos play muted in a loop, with controls to
+// pause and step; data-frames is the frame count the encoder was given.
 Expected<std::string> figureHtml(const Figure& f) {
   auto bytes = readWholeFile(f.png);
   if (!bytes) return std::unexpected(bytes.error());
-  return fmt::format("<figure{2}><img alt=\"{0}\" src=\"data:image/png;base64,{1}\"><figcaption>{0}</figcaption></figure>\n",
-                     escapeHtml(f.caption), base64Encode(*bytes), f.wide ? " class=\"wide\"" : "");
+  if (f.video) {
+    // Small videos are shown enlarged by a whole factor, pixels kept sharp, to at least 270 rows.
+    const int factor = std::max(1, std::min((270 + f.video->height - 1) / f.video->height, 1200 / f.video->width));
+    return fmt::format(
+        "<figure class=\"wide\"><video src=\"data:video/webm;base64,{1}\" width=\"{2}\" height=\"{3}\" data-frames=\"{4}\" "
+        "autoplay loop muted playsinline controls></video><figcaption>{0}</figcaption></figure>\n",
+        escapeHtml(f.caption), base64Encode(*bytes), f.video->width * factor, f.video->height * factor, f.video->frames);
+  }
+  std::string size;
+  if (f.pixels) {
+    // Up to 400 pixels wide, so that three fit beside each other on a laptop's screen.
+    auto header = readImageHeader(f.png);
+    if (!header) return std::unexpected(header.error());
+    const int factor = std::max(1, 400 / std::max(1, header->width));
+    size = fmt::format(" class=\"pixels\" width=\"{}\" height=\"{}\"", header->width * factor, header->height * factor);
+  }
+  return fmt::format("<figure{2}><img alt=\"{0}\" src=\"data:image/png;base64,{1}\"{3}><figcaption>{0}</figcaption></figure>\n",
+                     escapeHtml(f.caption), base64Encode(*bytes), f.wide ? " class=\"wide\"" : "", size);
+}
+
+// A figure in the Markdown twin: an image, or a link to the video (Markdown has no video).
+std::string figureMarkdown(const Figure& f, const fs::path& assets) {
+  const std::string file = assets.filename().string() + "/" + f.png.filename().string();
+  return f.video ? fmt::format("[{}]({})\n\n", f.caption, file) : fmt::format("![{}]({})\n\n", f.caption, file);
 }
 
 }  // namespace
@@ -235,7 +277,7 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
   }
 
   // Figures: per run, A.1 / A.2 (when a camera series is there), the discard series, thumbnails, masks.
-  std::vector<std::pair<std::string, std::vector<Figure>>> figures;
+  std::vector<RunFigures> figures;
   for (std::size_t k = 0; k < runs.size(); ++k) {
     const Run& r = runs[k];
     const std::string stem = fmt::format("run{}", k + 1);
@@ -252,23 +294,49 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
       if (!written) return std::unexpected(written.error());
       list.push_back({"Discarded pixels per frame (Eq. 3.4)", files.assets / (stem + "_discard.png")});
     }
+    // The video and thumbnails share one exposure, so that they neither flicker nor disagree, and
+    // say how many samples per pixel they show.
     const int n = std::max(0, options.thumbnails);
-    for (int t = 0; t < n && !r.frames.empty(); ++t) {
-      const auto& entry = r.frames[static_cast<std::size_t>(t) * (r.frames.size() - 1) / static_cast<std::size_t>(std::max(1, n - 1))];
+    std::optional<frames::PreviewToneMap> toneMap;
+    std::string sampling;
+    if (!r.frames.empty() && (n > 0 || options.videoFrames > 0)) {
+      auto map = clipToneMap(r.frames);
+      if (!map) return std::unexpected(map.error());
+      toneMap = *map;
+      auto note = samplingNote(r.frames);
+      if (!note) return std::unexpected(note.error());
+      sampling = *note;
+    }
+    if (toneMap && options.videoFrames > 0) {
+      VideoOptions videoOptions;
+      videoOptions.maxFrames = options.videoFrames;
+      auto video = writeRunVideo(r.frames, r.dir / "masks", *toneMap, files.assets / (stem + "_motion.webm"), videoOptions);
+      if (!video) return std::unexpected(video.error());
+      std::string caption = fmt::format("Frames {}-{} at {:g} fps ({} frames): direct + indirect radiance, tone-mapped", video->firstFrame,
+                                        video->lastFrame, video->fps, video->frames);
+      if (video->masks)
+        caption += "; beside it, the discard mask of the pair ending at each frame (red frustum, yellow position, blue normal, magenta "
+                   "direct, cyan indirect; grey: no pair, at the first frame or a camera cut)";
+      if (static_cast<std::size_t>(video->frames) < r.frames.size())
+        caption += fmt::format("; the first {} of the run's {} frames", video->frames, r.frames.size());
+      list.insert(list.begin(), {caption, video->file, true, *video});  // first: motion is the subject
+    }
+    for (const std::size_t k : evenlySpaced(r.frames.size(), n)) {
+      const auto& entry = r.frames[k];
       auto frame = frames::readFrame(entry);
       if (!frame) return std::unexpected(frame.error());
-      auto rgb = frames::previewImage(*frame);
+      auto rgb = frames::previewImage(*frame, *toneMap);
       const fs::path png = files.assets / fmt::format("{}_frame_{:05d}.png", stem, entry.frame);
       if (auto ok = writeImage(png, FloatImage{frame->width, frame->height, 3, std::move(rgb), {}, {}, {}}); !ok) return std::unexpected(ok.error());
-      list.push_back({fmt::format("Frame {} (direct + indirect, tone-mapped)", entry.frame), png});
-      if (t == 0 && r.frames.size() == 1) break;
+      list.push_back({fmt::format("Frame {} (direct + indirect, tone-mapped)", entry.frame), png, false, std::nullopt, true});
     }
-    for (int t = 0; t < n && !r.masks.empty(); ++t) {
-      const fs::path& mask = r.masks[static_cast<std::size_t>(t) * (r.masks.size() - 1) / static_cast<std::size_t>(std::max(1, n - 1))];
+    for (const std::size_t k : evenlySpaced(r.masks.size(), n)) {
+      const fs::path& mask = r.masks[k];
       const fs::path copy = files.assets / fmt::format("{}_{}", stem, mask.filename().string());
       fs::copy_file(mask, copy, fs::copy_options::overwrite_existing, ec);
       if (ec) return fail(ErrorCode::kIo, "{}: cannot copy: {}", mask.string(), ec.message());
-      list.push_back({"Discard mask " + mask.stem().string() + " (red frustum, yellow position, blue normal, magenta direct, cyan indirect)", copy});
+      list.push_back({"Discard mask " + mask.stem().string() + " (red frustum, yellow position, blue normal, magenta direct, cyan indirect)", copy,
+                      false, std::nullopt, true});
     }
     if (r.evaluation)
       for (const auto& m : r.evaluation->methods) {
@@ -277,9 +345,12 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
         const fs::path copy = files.assets / fmt::format("{}_{}_flip_worst.png", stem, evaluate::methodFolder(m.name));
         fs::copy_file(heat, copy, fs::copy_options::overwrite_existing, ec);
         if (ec) return fail(ErrorCode::kIo, "{}: cannot copy: {}", heat.string(), ec.message());
-        list.push_back({fmt::format("{}: ꟻLIP error of its worst frame, {} (magma: black 0, yellow 1)", m.name, m.worstFrame), copy});
+        list.push_back(
+            {fmt::format("{}: ꟻLIP error of its worst frame, {} (magma: black 0, yellow 1)", m.name, m.worstFrame), copy, false, std::nullopt, true});
       }
-    figures.emplace_back(r.name, std::move(list));
+    if (!sampling.empty())
+      sampling = fmt::format("Video and thumbnails: {}/frames, {}; one exposure for all of them.", r.dir.filename().string(), sampling);
+    figures.push_back({r.name, sampling, std::move(list)});
   }
 
   auto allTables = tables(runs);
@@ -295,12 +366,11 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
   std::string md = fmt::format("# {}\n\n", options.title);
   if (!referenceNote.empty()) md += referenceNote + "\n\n";
   for (const auto& t : allTables) md += markdownTable(t);
-  for (const auto& f : comparison)
-    md += fmt::format("![{}]({}/{})\n\n", f.caption, files.assets.filename().string(), f.png.filename().string());
-  for (const auto& [name, list] : figures) {
+  for (const auto& f : comparison) md += figureMarkdown(f, files.assets);
+  for (const auto& [name, sampling, list] : figures) {
     md += fmt::format("## {}\n\n", name);
-    for (const auto& f : list)
-      md += fmt::format("![{}]({}/{})\n\n", f.caption, files.assets.filename().string(), f.png.filename().string());
+    if (!sampling.empty()) md += sampling + "\n\n";
+    for (const auto& f : list) md += figureMarkdown(f, files.assets);
   }
   // HTML: everything inline.
   std::string html = fmt::format(R"(<!DOCTYPE html>
@@ -316,8 +386,11 @@ figure img {{ max-width: 600px; border: 1px solid #ccc; }}
 figcaption {{ font-size: .85em; max-width: 600px; }}
 tr.published {{ color: #777; font-style: italic; }}
 figure.wide {{ display: block; }}
-figure.wide img, figure.wide figcaption {{ max-width: min(100%, 1200px); }}
+figure.wide img, figure.wide figcaption, figure.wide video {{ max-width: min(100%, 1200px); height: auto; }}
 p.reference {{ max-width: 60em; }}
+video {{ image-rendering: pixelated; background: #000; }}
+img.pixels {{ image-rendering: pixelated; }}
+figure:has(img.pixels) figcaption {{ max-width: 400px; }}
 </style></head><body>
 <h1>{0}</h1>
 )",
@@ -329,8 +402,9 @@ p.reference {{ max-width: 60em; }}
     if (!figure) return std::unexpected(figure.error());
     html += *figure;
   }
-  for (const auto& [name, list] : figures) {
+  for (const auto& [name, sampling, list] : figures) {
     html += fmt::format("<section class=\"run\"><h2>{}</h2>\n", escapeHtml(name));
+    if (!sampling.empty()) html += "<p class=\"sampling\">" + escapeHtml(sampling) + "</p>\n";
     for (const auto& f : list) {
       auto figure = figureHtml(f);
       if (!figure) return std::unexpected(figure.error());
@@ -350,6 +424,10 @@ window.addEventListener('load', () => {
 )";
   if (auto ok = writeFileAtomic(files.markdown, md); !ok) return std::unexpected(ok.error());
   if (auto ok = writeFileAtomic(files.html, html); !ok) return std::unexpected(ok.error());
+  files.htmlBytes = html.size();
+  for (const auto& [name, sampling, list] : figures)
+    for (const auto& f : list) ++(f.video ? files.videos : files.images);
+  files.images += static_cast<int>(comparison.size());
   return files;
 }
 
