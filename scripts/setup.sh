@@ -27,6 +27,9 @@ packages=(
   chromium
   # ffmpeg: `dynbench report` encodes each run's video (VP9 WebM) with it
   ffmpeg
+  # Slurm and munge: `--slurm` job arrays, tried and tested on a single-node cluster on localhost
+  # (scripts/slurm-local.sh; docs/cluster.md)
+  slurm-wlm munge
   # fuzzing the readers of untrusted input (the `fuzz` preset, CONTRIBUTING.md): clang 16 and its
   # libFuzzer runtime
   clang-16 libclang-rt-16-dev

@@ -26,6 +26,11 @@ inline std::string missingChromium() {
 inline std::string missingFfmpeg() {
   return onPath("ffmpeg") ? "" : "ffmpeg is not installed (Debian package ffmpeg; scripts/setup.sh)";
 }
+inline std::string missingSlurm() {
+  for (const char* program : {"/usr/sbin/slurmctld", "/usr/sbin/slurmd", "/usr/sbin/munged"})
+    if (!std::filesystem::exists(program)) return "Slurm is not installed (Debian packages slurm-wlm and munge; scripts/setup.sh)";
+  return onPath("sbatch") ? "" : "sbatch is not on PATH (Debian package slurm-client; scripts/setup.sh)";
+}
 inline std::string missingGltfValidator() {
   if (!onPath("node")) return "node is not installed (Debian package nodejs; scripts/setup.sh)";
   const auto validator = std::filesystem::path(DYNBENCH_SOURCE_DIR) / "tools/gltf-validator/node_modules/gltf-validator";

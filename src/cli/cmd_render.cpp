@@ -7,6 +7,7 @@
 #include "cli/commands.h"
 #include "core/progress.h"
 #include "render/backend.h"
+#include "pipeline/slurm.h"
 #include "pipeline/stages.h"
 
 namespace dynbench::cli {
@@ -20,7 +21,37 @@ struct RenderCli {
   std::string resolution = fmt::format("{}x{}", render::RenderSettings{}.width, render::RenderSettings{}.height);
   std::optional<std::string> envConstant;
   bool noEnvironment = false;
+  bool slurm = false;
+  pipeline::slurm::Options slurmOptions;
 };
+
+// render --slurm: the same job as a Slurm job array (pipeline/slurm.h), waited for on a terminal
+// with progress, and a non-zero exit naming what is missing when tasks failed.
+Expected<void> renderOnSlurm(const render::RenderJob& job, const pipeline::slurm::Options& options) {
+  std::optional<Progress> progress;
+  const auto started = std::chrono::steady_clock::now();
+  pipeline::slurm::RenderArrayProgress report = [&](const pipeline::slurm::RenderArrayStatus& s) {
+    if (!progress) progress.emplace("slurm render", s.framesTotal, "frames");
+    progress->update(s.framesComplete, fmt::format("tasks {} pending, {} running, {} failed", s.pending, s.running, s.failed));
+  };
+  auto outcome = pipeline::slurm::renderArray({job}, options, report);
+  progress.reset();
+  if (!outcome) return std::unexpected(outcome.error());
+  fmt::print("{}: Slurm job {}, {} task(s) of at most {} frame(s), script {}\n", job.output.string(), outcome->jobId, outcome->tasks,
+             options.framesPerTask, outcome->script.string());
+  if (!outcome->waited) return {};
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (!outcome->missing.empty()) {
+    std::size_t missing = 0;
+    for (const auto& [task, frames] : outcome->missing) missing += frames.size();
+    return fail(ErrorCode::kIncomplete, "Slurm job {} ended with {} frame(s) missing:\n{}Rerun only those tasks: {}", outcome->jobId, missing,
+                pipeline::slurm::missingFramesText(*outcome), outcome->resubmit);
+  }
+  std::size_t frames = 0;
+  for (const auto& c : outcome->chunks) frames += c.size();
+  fmt::print("{}: all {} frame(s) complete in {:.1f} s\n", job.output.string(), frames, seconds);
+  return {};
+}
 
 Expected<void> runRender(const RenderCli& cli) {
   render::RenderJob job = cli.job;
@@ -42,6 +73,7 @@ Expected<void> runRender(const RenderCli& cli) {
     if (!range) return std::unexpected(range.error());
     job.frames = *range;
   }
+  if (cli.slurm) return renderOnSlurm(job, cli.slurmOptions);
 
   // Progress on a terminal only: rows (of all frames) done, frames done, samples per second.
   std::optional<Progress> progress;
@@ -129,6 +161,20 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
                   "Irradiance below which a point or spot light without a range is skipped (0: never; default: automatic, at most "
                   "0.1% of the environment's mean irradiance dropped in all; docs/feature-buffers.md)")
       ->check(nonNegative());
+  // Slurm (docs/cluster.md): each option maps to one sbatch option.
+  auto* slurm = cmd->add_flag("--slurm", o->slurm,
+                              "Render as a Slurm job array (DIR/slurm/render.sbatch), one task per --frames-per-task frames, and wait for it");
+  const std::string group = "Slurm (with --slurm)";
+  cmd->add_option("--frames-per-task", o->slurmOptions.framesPerTask, "Frames per array task")
+      ->check(positive())->needs(slurm)->group(group)->capture_default_str();
+  cmd->add_option("--partition", o->slurmOptions.partition, "sbatch --partition")->needs(slurm)->group(group);
+  cmd->add_option("--time", o->slurmOptions.time, "sbatch --time per task, [D-]HH:MM:SS")->needs(slurm)->group(group);
+  cmd->add_option("--cpus-per-task", o->slurmOptions.cpusPerTask, "sbatch --cpus-per-task; each task renders with this many threads")
+      ->check(positive())->needs(slurm)->group(group)->capture_default_str();
+  cmd->add_option("--mem", o->slurmOptions.mem, "sbatch --mem per task (e.g. 4G)")->needs(slurm)->group(group);
+  cmd->add_option("--sbatch-option", o->slurmOptions.sbatchOptions, "Another sbatch option, verbatim (repeatable): --sbatch-option=--account=X")
+      ->needs(slurm)->group(group)->allow_extra_args(false);
+  cmd->add_flag("--submit-only", o->slurmOptions.submitOnly, "Submit the array and return without waiting")->needs(slurm)->group(group);
   cmd->callback([o, &run] { run = [o] { return runRender(*o); }; });
 }
 

@@ -17,6 +17,7 @@ enum class ErrorCode {
   kInvalidData = 5,    // well-formed but violates the format (glTF spec, ranges, keyframes)
   kUnsupported = 6,    // valid, but uses something dynbench does not implement
   kExternalTool = 7,   // a helper program (gnuplot) is missing or failed
+  kIncomplete = 8,     // work run elsewhere (a Slurm job array) ended with results missing
 };
 
 struct Error {

@@ -46,6 +46,9 @@ int dynbench_image_write_v2(const char* path, const char* temporary, int width, 
     for (int c = 0; c < channels; ++c) spec.channelformats.push_back(formats[c] == 'h' ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
   }
   if (compression) spec.attribute("compression", compression);
+  // No write time in the file (OpenImageIO stamps EXR's capDate with the clock unless DateTime is
+  // set): the same frame rendered twice, here or as a Slurm task, is the same bytes.
+  spec.attribute("DateTime", "");
   if (!out->open(temporary, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, pixels) || !out->close()) {
     setError(error, errorSize, out->geterror());
     return 1;

@@ -88,15 +88,31 @@ Expected<StatsOutcome> runStats(const StatsStage& stage, const StatsProgress& pr
   return out;
 }
 
-Expected<render::RenderSummary> runRender(const RenderStage& stage, const render::RenderProgress& progress,
-                                          std::vector<std::string>* sceneWarnings) {
-  const render::RenderJob& job = stage.job;
+namespace {
+
+// The render job's scene: the dataset, reduced to --animation when one is named.
+Expected<scene::Scene> renderScene(const render::RenderJob& job) {
   auto scene = scene::loadScene(job.dataset);
   if (!scene) return std::unexpected(scene.error());
   if (job.animation && !scene::keepOnlyAnimation(*scene, *job.animation))
     return fail(ErrorCode::kUsage, "{}: --animation '{}' names no animation", job.dataset.string(), *job.animation);
+  return scene;
+}
+
+}  // namespace
+
+Expected<render::RenderSummary> runRender(const RenderStage& stage, const render::RenderProgress& progress,
+                                          std::vector<std::string>* sceneWarnings) {
+  auto scene = renderScene(stage.job);
+  if (!scene) return std::unexpected(scene.error());
   if (sceneWarnings) sceneWarnings->insert(sceneWarnings->end(), scene->warnings.begin(), scene->warnings.end());
-  return render::renderDataset(*scene, job, progress);
+  return render::renderDataset(*scene, stage.job, progress);
+}
+
+Expected<std::vector<long>> renderFrames(const RenderStage& stage) {
+  auto scene = renderScene(stage.job);
+  if (!scene) return std::unexpected(scene.error());
+  return render::jobFrames(*scene, stage.job);
 }
 
 Expected<DiscardOutcome> runDiscard(const DiscardStage& stage, const discard::DiscardProgress& progress) {

@@ -46,6 +46,9 @@ struct RenderStage {
 };
 Expected<render::RenderSummary> runRender(const RenderStage& stage, const render::RenderProgress& progress = {},
                                           std::vector<std::string>* sceneWarnings = nullptr);
+// The frames the stage covers (its --frames range within the dataset's animation), loading the
+// dataset as runRender does.
+Expected<std::vector<long>> renderFrames(const RenderStage& stage);
 
 // ---- discard: Table 6.7 -----------------------------------------------------------------------
 struct DiscardStage {

@@ -1,0 +1,361 @@
+#include "pipeline/slurm.h"
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <sstream>
+#include <thread>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "core/files.h"
+#include "core/process.h"
+#include "frames/frame_io.h"
+#include "scene/load.h"
+
+namespace dynbench::pipeline::slurm {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Output {
+  int status = -1;
+  std::vector<std::string> lines;  // stdout and stderr, merged
+  std::string text() const { return fmt::format("{}", fmt::join(lines, "\n")); }
+};
+
+// Runs a Slurm command and keeps what it printed. Fails only when it cannot be started.
+Expected<Output> slurmCommand(std::vector<std::string> argv) {
+  Output out;
+  ProcessOptions p;
+  p.argv = std::move(argv);
+  p.onLine = [&](std::string_view line) {
+    out.lines.emplace_back(line);
+    return true;
+  };
+  auto run = runProcess(p);
+  if (!run)
+    return fail(ErrorCode::kExternalTool, "{}: {}; --slurm needs Slurm's commands (Debian: slurm-client, or slurm-wlm as scripts/setup.sh installs)",
+                p.argv.front(), run.error().message);
+  out.status = run->exitStatus;
+  return out;
+}
+
+fs::path thisExecutable() {
+  std::error_code ec;
+  auto self = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? fs::path("dynbench") : self;
+}
+
+// "0:3" for frames 0..3 every frame, "0:6:2" for 0, 2, 4, 6.
+std::string frameRangeArgument(const std::vector<long>& chunk, long step) {
+  if (chunk.size() == 1) return std::to_string(chunk.front());
+  return step == 1 ? fmt::format("{}:{}", chunk.front(), chunk.back()) : fmt::format("{}:{}:{}", chunk.front(), chunk.back(), step);
+}
+
+// Frames as ranges: "12-15, 40".
+std::string framesText(const std::vector<long>& frames) {
+  std::string out;
+  for (std::size_t i = 0; i < frames.size();) {
+    std::size_t j = i;
+    while (j + 1 < frames.size() && frames[j + 1] == frames[j] + 1) ++j;
+    out += (out.empty() ? "" : ", ") + (i == j ? std::to_string(frames[i]) : fmt::format("{}-{}", frames[i], frames[j]));
+    i = j + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string shellQuote(const std::string& word) {
+  const bool plain = !word.empty() && std::all_of(word.begin(), word.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || std::string_view("-_./:=,+@%").find(c) != std::string_view::npos;
+  });
+  if (plain) return word;
+  std::string quoted = "'";
+  for (char c : word) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
+
+std::optional<long> parseSlurmTime(const std::string& text) {
+  // Slurm's forms (sbatch(1), --time): MM, MM:SS, HH:MM:SS, D-HH, D-HH:MM, D-HH:MM:SS.
+  long days = 0;
+  std::string rest = text;
+  if (const auto dash = text.find('-'); dash != std::string::npos) {
+    try {
+      std::size_t used = 0;
+      days = std::stol(text.substr(0, dash), &used);
+      if (used != dash) return std::nullopt;
+    } catch (...) {
+      return std::nullopt;
+    }
+    rest = text.substr(dash + 1);
+  }
+  std::vector<long> parts;
+  std::istringstream in(rest);
+  for (std::string part; std::getline(in, part, ':');) {
+    if (part.empty() || !std::all_of(part.begin(), part.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+      return std::nullopt;
+    parts.push_back(std::stol(part));
+  }
+  if (parts.empty() || parts.size() > 3) return std::nullopt;
+  if (text.find('-') != std::string::npos) {  // D-HH[:MM[:SS]]
+    parts.resize(3, 0);
+    return ((days * 24 + parts[0]) * 60 + parts[1]) * 60 + parts[2];
+  }
+  if (parts.size() == 1) return parts[0] * 60;                      // MM
+  if (parts.size() == 2) return parts[0] * 60 + parts[1];           // MM:SS
+  return (parts[0] * 60 + parts[1]) * 60 + parts[2];                // HH:MM:SS
+}
+
+Expected<void> checkCluster(const Options& options) {
+  if (findOnPath("sbatch").empty())
+    return fail(ErrorCode::kExternalTool,
+                "--slurm: sbatch is not on PATH; run where Slurm's commands are (a cluster's login node), install them (Debian: "
+                "slurm-client), or render without --slurm");
+  auto ping = slurmCommand({"scontrol", "ping"});
+  if (!ping) return std::unexpected(ping.error());
+  if (ping->status != 0 || ping->text().find("is UP") == std::string::npos)
+    return fail(ErrorCode::kExternalTool, "--slurm: the Slurm controller does not answer (scontrol ping: {}){}",
+                ping->lines.empty() ? "no output" : ping->lines.front(),
+                std::getenv("SLURM_CONF") ? fmt::format("; SLURM_CONF is {}", std::getenv("SLURM_CONF")) : std::string());
+  if (!options.partition.empty()) {
+    auto shown = slurmCommand({"scontrol", "-o", "show", "partition", options.partition});
+    if (!shown) return std::unexpected(shown.error());
+    if (shown->status != 0 || shown->text().find("PartitionName=" + options.partition) == std::string::npos) {
+      auto all = slurmCommand({"sinfo", "-h", "-o", "%R"});
+      std::string names = all && all->status == 0 ? fmt::format("{}", fmt::join(all->lines, ", ")) : "unknown";
+      return fail(ErrorCode::kUsage, "--partition {}: no such partition on this cluster (its partitions: {})", options.partition, names);
+    }
+  }
+  if (!options.time.empty() && !parseSlurmTime(options.time))
+    return fail(ErrorCode::kUsage, "--time '{}': expected [D-]HH:MM:SS, HH:MM:SS, MM:SS or MM", options.time);
+  if (options.framesPerTask < 1) return fail(ErrorCode::kUsage, "--frames-per-task {}: expected at least 1", options.framesPerTask);
+  if (options.cpusPerTask < 1) return fail(ErrorCode::kUsage, "--cpus-per-task {}: expected at least 1", options.cpusPerTask);
+  return {};
+}
+
+Expected<std::string> submit(const fs::path& script, const std::vector<std::string>& extra) {
+  std::vector<std::string> test = {"sbatch", "--test-only"};
+  test.insert(test.end(), extra.begin(), extra.end());
+  test.push_back(script.string());
+  auto tested = slurmCommand(test);
+  if (!tested) return std::unexpected(tested.error());
+  if (tested->status != 0)
+    return fail(ErrorCode::kExternalTool, "{}: Slurm would not accept the job (sbatch --test-only: {}); nothing was submitted", script.string(),
+                tested->text());
+  std::vector<std::string> argv = {"sbatch", "--parsable"};
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  argv.push_back(script.string());
+  auto submitted = slurmCommand(argv);
+  if (!submitted) return std::unexpected(submitted.error());
+  // --parsable prints "JOBID" or "JOBID;CLUSTER" (after any warnings).
+  std::string id = submitted->lines.empty() ? "" : submitted->lines.back();
+  id = id.substr(0, id.find(';'));
+  if (submitted->status != 0 || id.empty() || !std::all_of(id.begin(), id.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+    return fail(ErrorCode::kExternalTool, "{}: sbatch failed: {}", script.string(), submitted->text());
+  return id;
+}
+
+Expected<std::vector<QueuedTask>> queuedTasks(const std::string& jobId) {
+  auto listed = slurmCommand({"squeue", "-h", "-r", "-j", jobId, "-o", "%K %T"});
+  if (!listed) return std::unexpected(listed.error());
+  std::vector<QueuedTask> tasks;
+  if (listed->status != 0) {
+    // A job the controller has forgotten (older than MinJobAge) is no longer queued.
+    if (listed->text().find("Invalid job id") != std::string::npos) return tasks;
+    return fail(ErrorCode::kExternalTool, "squeue -j {}: {}", jobId, listed->text());
+  }
+  for (const auto& line : listed->lines) {
+    QueuedTask t;
+    std::istringstream in(line);
+    if (in >> t.task >> t.state) tasks.push_back(t);
+  }
+  return tasks;
+}
+
+std::map<int, std::string> taskStates(const std::string& jobId) {
+  std::map<int, std::string> states;
+  auto shown = slurmCommand({"scontrol", "-o", "show", "job", jobId});
+  if (!shown || shown->status != 0) return states;
+  for (const auto& line : shown->lines) {
+    auto field = [&](const std::string& key) -> std::string {
+      const auto at = line.find(" " + key + "=");
+      if (at == std::string::npos) return {};
+      const auto start = at + key.size() + 2;
+      return line.substr(start, line.find(' ', start) - start);
+    };
+    const std::string task = field("ArrayTaskId"), state = field("JobState");
+    if (!task.empty() && std::all_of(task.begin(), task.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+      states[std::stoi(task)] = state;
+  }
+  return states;
+}
+
+std::string scriptHeader(const std::string& name, int tasks, const fs::path& logDir, const Options& options) {
+  // The signal comes signalSeconds before the time limit, but at most a quarter of a short limit in.
+  long signal = options.signalSeconds;
+  if (auto limit = parseSlurmTime(options.time)) signal = std::clamp<long>(*limit / 4, 1, signal);
+  std::string h = "#!/bin/bash\n";
+  h += fmt::format("#SBATCH --job-name={}\n", name);
+  h += fmt::format("#SBATCH --array=0-{}\n", tasks - 1);
+  h += fmt::format("#SBATCH --output={}\n", (logDir / "task-%A_%a.log").string());
+  h += "#SBATCH --open-mode=append\n";  // a requeued task adds to its log instead of replacing it
+  h += "#SBATCH --requeue\n";
+  h += fmt::format("#SBATCH --signal=B:USR1@{}\n", signal);
+  h += fmt::format("#SBATCH --cpus-per-task={}\n", options.cpusPerTask);
+  if (!options.partition.empty()) h += fmt::format("#SBATCH --partition={}\n", options.partition);
+  if (!options.time.empty()) h += fmt::format("#SBATCH --time={}\n", options.time);
+  if (!options.mem.empty()) h += fmt::format("#SBATCH --mem={}\n", options.mem);
+  for (const auto& o : options.sbatchOptions) h += fmt::format("#SBATCH {}\n", o);
+  return h;
+}
+
+std::vector<std::string> renderArguments(const render::RenderJob& job) {
+  const auto& s = job.settings;
+  std::vector<std::string> a = {job.dataset.string(), "-o", job.output.string(), "--res", fmt::format("{}x{}", s.width, s.height),
+                                "--spp", std::to_string(s.samplesPerPixel), "--bounces", std::to_string(s.bounces),
+                                "--fps", fmt::format("{:.17g}", job.fps), "--seed", std::to_string(s.seed), "--engine", job.engine};
+  if (job.camera) a.insert(a.end(), {"--camera", *job.camera});
+  if (job.animation) a.insert(a.end(), {"--animation", *job.animation});
+  if (job.engine == "cycles") a.insert(a.end(), {"--blender", job.blender});
+  if (s.constantEnvironment)
+    a.insert(a.end(), {"--env-constant", fmt::format("{:.17g},{:.17g},{:.17g}", s.constantEnvironment->x, s.constantEnvironment->y,
+                                                     s.constantEnvironment->z)});
+  else if (!s.useEnvironment)
+    a.push_back("--no-environment");
+  if (s.jitter) a.push_back("--jitter");
+  if (s.converge)
+    a.insert(a.end(), {"--converge", "--tolerance", fmt::format("{:.17g}", s.tolerance), "--max-spp", std::to_string(s.maxSamplesPerPixel)});
+  if (s.lightCutoff) a.insert(a.end(), {"--light-cutoff", fmt::format("{:.17g}", *s.lightCutoff)});
+  if (job.float32) a.push_back("--float32");
+  return a;
+}
+
+Expected<RenderArrayOutcome> renderArray(const RenderStage& stageIn, const Options& options, const RenderArrayProgress& progress) {
+  if (auto ok = checkCluster(options); !ok) return std::unexpected(ok.error());
+  // Absolute paths: the job may start in another folder, on another machine of the cluster.
+  RenderStage stage = stageIn;
+  stage.job.dataset = fs::absolute(stage.job.dataset).lexically_normal();
+  stage.job.output = fs::absolute(stage.job.output).lexically_normal();
+  auto frames = renderFrames(stage);  // also checks the dataset loads, before anything is submitted
+  if (!frames) return std::unexpected(frames.error());
+  if (frames->empty()) return fail(ErrorCode::kUsage, "{}: --frames selects no frame of the dataset", stage.job.dataset.string());
+
+  RenderArrayOutcome out;
+  for (std::size_t k = 0; k < frames->size(); k += static_cast<std::size_t>(options.framesPerTask))
+    out.chunks.emplace_back(frames->begin() + static_cast<std::ptrdiff_t>(k),
+                            frames->begin() + static_cast<std::ptrdiff_t>(std::min(frames->size(), k + options.framesPerTask)));
+  out.tasks = static_cast<int>(out.chunks.size());
+
+  const fs::path jobDir = stage.job.output / "slurm";
+  std::error_code ec;
+  fs::create_directories(jobDir, ec);
+  if (ec) return fail(ErrorCode::kIo, "{}: cannot create the job's folder: {}", jobDir.string(), ec.message());
+  out.script = jobDir / "render.sbatch";
+
+  const fs::path exe = options.executable.empty() ? thisExecutable() : options.executable;
+  std::string script = scriptHeader("dynbench-render", out.tasks, jobDir, options);
+  script += fmt::format(
+      "#\n"
+      "# dynbench render as a Slurm job array, written by `dynbench render --slurm` (docs/cluster.md).\n"
+      "# Task k renders chunk k below with the same settings and seed as a local render; frames already\n"
+      "# complete are skipped, so a requeued or resubmitted task resumes from its last complete frame.\n"
+      "# Submit it all again: sbatch {0}\n"
+      "# Only some tasks:     sbatch --array=3,5 {0}\n"
+      "set -u\n",
+      shellQuote(out.script.string()));
+  script += "chunks=(";
+  for (const auto& c : out.chunks) script += (&c == &out.chunks.front() ? "" : " ") + frameRangeArgument(c, stage.job.frames.step);
+  script += ")\n";
+  script += "frames=${chunks[$SLURM_ARRAY_TASK_ID]}\n";
+  script += fmt::format("output={}\n", shellQuote(stage.job.output.string()));
+  script +=
+      "# The signal before the time limit (or a preemption): stop the render, remove the temporary\n"
+      "# files of the frame it was writing (NAME.tmp-PID; finished files are renamed into place), and put\n"
+      "# this task, only this one, back in the queue.\n"
+      "on_signal() {\n"
+      "  echo \"dynbench: stopping frames $frames; task ${SLURM_ARRAY_JOB_ID}_${SLURM_ARRAY_TASK_ID} goes back to the queue\"\n"
+      "  kill -TERM \"$render\" 2>/dev/null\n"
+      "  wait \"$render\" 2>/dev/null\n"
+      "  rm -f \"$output\"/*.tmp-\"$render\"\n"
+      "  scontrol requeue \"${SLURM_ARRAY_JOB_ID}_${SLURM_ARRAY_TASK_ID}\"\n"
+      "  exit 0\n"
+      "}\n"
+      "trap on_signal USR1\n";
+  std::string command = shellQuote(exe.string()) + " render";
+  for (const auto& a : renderArguments(stage.job)) command += " " + shellQuote(a);
+  script += command + " --frames \"$frames\" --threads \"${SLURM_CPUS_PER_TASK:-1}\" &\n";
+  script += "render=$!\nwait \"$render\"\n";
+  if (auto ok = writeFileAtomic(out.script, script); !ok) return std::unexpected(ok.error());
+  ::chmod(out.script.c_str(), 0755);
+
+  auto id = submit(out.script);
+  if (!id) return std::unexpected(id.error());
+  out.jobId = *id;
+  if (options.submitOnly) return out;
+
+  // Wait: frames complete from the files, tasks from squeue, until no task is queued any more.
+  const auto record = render::renderRecord(stage.job);
+  std::vector<bool> done(frames->size(), false);
+  auto countComplete = [&] {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < frames->size(); ++i) {
+      if (!done[i]) done[i] = frames::frameComplete(stage.job.output, (*frames)[i], record);
+      n += done[i];
+    }
+    return n;
+  };
+  auto chunkComplete = [&](int task) {
+    const std::size_t first = static_cast<std::size_t>(task) * static_cast<std::size_t>(options.framesPerTask);
+    for (std::size_t i = first; i < first + out.chunks[static_cast<std::size_t>(task)].size(); ++i)
+      if (!done[i]) return false;
+    return true;
+  };
+  for (;;) {
+    auto queued = queuedTasks(out.jobId);
+    if (!queued) return std::unexpected(queued.error());
+    RenderArrayStatus status;
+    status.framesTotal = frames->size();
+    status.framesComplete = countComplete();
+    std::vector<bool> inQueue(static_cast<std::size_t>(out.tasks), false);
+    for (const auto& t : *queued) {
+      if (t.task >= 0 && t.task < out.tasks) inQueue[static_cast<std::size_t>(t.task)] = true;
+      (t.state == "PENDING" || t.state == "REQUEUED" || t.state == "REQUEUE_HOLD" ? status.pending : status.running)++;
+    }
+    for (int k = 0; k < out.tasks; ++k) status.failed += !inQueue[static_cast<std::size_t>(k)] && !chunkComplete(k);
+    if (progress) progress(status);
+    if (queued->empty()) break;
+    std::this_thread::sleep_for(options.poll);
+  }
+  out.waited = true;
+  countComplete();
+  for (int k = 0; k < out.tasks; ++k) {
+    const auto& chunk = out.chunks[static_cast<std::size_t>(k)];
+    const std::size_t first = static_cast<std::size_t>(k) * static_cast<std::size_t>(options.framesPerTask);
+    for (std::size_t i = 0; i < chunk.size(); ++i)
+      if (!done[first + i]) out.missing[k].push_back(chunk[i]);
+  }
+  if (!out.missing.empty()) {
+    const auto states = taskStates(out.jobId);
+    std::vector<int> tasks;
+    for (const auto& [task, missingFrames] : out.missing) {
+      tasks.push_back(task);
+      if (auto s = states.find(task); s != states.end()) out.taskStates[task] = s->second;
+    }
+    out.resubmit = fmt::format("sbatch --array={} {}", fmt::join(tasks, ","), shellQuote(out.script.string()));
+  }
+  return out;
+}
+
+std::string missingFramesText(const RenderArrayOutcome& outcome) {
+  std::string text;
+  for (const auto& [task, frames] : outcome.missing) {
+    const auto state = outcome.taskStates.find(task);
+    text += fmt::format("  task {}{}: frames {}\n", task, state != outcome.taskStates.end() ? " (" + state->second + ")" : "", framesText(frames));
+  }
+  return text;
+}
+
+}  // namespace dynbench::pipeline::slurm

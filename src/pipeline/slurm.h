@@ -1,0 +1,94 @@
+#pragma once
+// Slurm job arrays (docs/cluster.md): the one place that talks to Slurm, through its own commands
+// (sbatch, squeue, scontrol), so dynbench uses a site's scheduler as it is. A job script is written
+// into the output folder (kept, readable, re-submittable by hand), submitted as one `sbatch
+// --array`, and, unless asked not to, waited for: its progress from the files it writes and from
+// squeue, and at the end the work still missing, by task, with the sbatch command that reruns only
+// those tasks. The job runs dynbench itself (this executable, by absolute path), whose stages are
+// resumable, so a task that is requeued or rerun continues from its last complete frame.
+#include <chrono>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "pipeline/stages.h"
+
+namespace dynbench::pipeline::slurm {
+
+// What sbatch is asked for (each maps to one sbatch option; docs/cluster.md has the table).
+struct Options {
+  int framesPerTask = 8;                   // frames (or items) per array task
+  std::string partition;                   // --partition; empty: the cluster's default
+  std::string time;                        // --time, [D-]HH:MM:SS, MM:SS or MM; empty: the partition's default
+  int cpusPerTask = 1;                     // --cpus-per-task; each task renders with this many threads
+  std::string mem;                         // --mem (e.g. 4G); empty: the cluster's default
+  std::vector<std::string> sbatchOptions;  // more, verbatim (--account=X, --qos=Y, --constraint=Z, ...)
+  bool submitOnly = false;                 // submit and return; do not wait
+  int signalSeconds = 120;                 // the job's signal (B:USR1) this long before its time limit
+  std::filesystem::path executable;        // the dynbench the job runs; empty: this process's
+  std::chrono::milliseconds poll{2000};    // how often the wait looks at squeue and the files
+};
+
+// A job's array tasks as squeue lists them now (pending, running, completing, requeued, ...).
+struct QueuedTask {
+  int task = 0;
+  std::string state;  // squeue's %T: PENDING, RUNNING, COMPLETING, ...
+};
+
+// sbatch on PATH, a controller that answers, and the partition (when one is named) known to it;
+// a clear error otherwise, before anything is submitted.
+Expected<void> checkCluster(const Options& options);
+
+// Submits a job script; `extra` goes to sbatch before it (e.g. --array=3,5, --dependency=afterok:12).
+// First `sbatch --test-only`, so a request the cluster can never satisfy fails here. Returns the job id.
+Expected<std::string> submit(const std::filesystem::path& script, const std::vector<std::string>& extra = {});
+// The job's tasks still in the queue (empty once all have left it).
+Expected<std::vector<QueuedTask>> queuedTasks(const std::string& jobId);
+// The final state of each array task scontrol still remembers (COMPLETED, FAILED, CANCELLED, ...).
+std::map<int, std::string> taskStates(const std::string& jobId);
+
+// The #SBATCH lines and the signal trap shared by every dynbench job script: `name`, the array
+// (`tasks` tasks), the log files, --requeue, the signal before the time limit, and the options.
+std::string scriptHeader(const std::string& name, int tasks, const std::filesystem::path& logDir, const Options& options);
+
+// A word for a POSIX shell script, single-quoted when it needs to be.
+std::string shellQuote(const std::string& word);
+
+// Seconds of a Slurm time ("[D-]HH:MM:SS", "HH:MM:SS", "MM:SS", "MM"); nullopt when malformed.
+std::optional<long> parseSlurmTime(const std::string& text);
+
+// ---- render as an array ------------------------------------------------------------------------
+// The render job's command-line options, so that the job's `dynbench render` makes the frames the
+// local one would (the inverse of `dynbench render`'s parsing; the tests check they agree).
+std::vector<std::string> renderArguments(const render::RenderJob& job);
+
+struct RenderArrayStatus {
+  std::size_t framesComplete = 0, framesTotal = 0;
+  int pending = 0, running = 0, failed = 0;  // tasks; failed: left the queue with frames missing
+};
+using RenderArrayProgress = std::function<void(const RenderArrayStatus&)>;
+
+struct RenderArrayOutcome {
+  std::string jobId;
+  std::filesystem::path script;
+  int tasks = 0;
+  std::vector<std::vector<long>> chunks;           // task k's frames
+  std::map<int, std::vector<long>> missing;        // after the wait: task -> its frames not complete
+  std::map<int, std::string> taskStates;           // scontrol's final state of the tasks that missed frames
+  std::string resubmit;                            // the command that reruns only those tasks
+  bool waited = false;
+};
+
+// Renders `stage`'s frames as a Slurm job array: DIR/slurm/render.sbatch, one task per
+// options.framesPerTask frames, each `dynbench render` of its chunk with the same settings and seed
+// (frames are the same bytes as a local render: the seed is per frame). Waits unless submitOnly.
+Expected<RenderArrayOutcome> renderArray(const RenderStage& stage, const Options& options, const RenderArrayProgress& progress = {});
+
+// The missing frames by task, one line each: "  task 3 (CANCELLED): frames 12-15".
+std::string missingFramesText(const RenderArrayOutcome& outcome);
+
+}  // namespace dynbench::pipeline::slurm
