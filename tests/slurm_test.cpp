@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <algorithm>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -232,6 +233,56 @@ TEST_F(Slurm, BadRequestsFailBeforeAnythingIsSubmitted) {
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_EQ(shell("squeue -h -o %i"), before);  // nothing was submitted
   for (const char* folder : {"a", "b", "c", "d", "e"}) EXPECT_FALSE(fs::exists(dir / folder / "frame_00000.exr")) << folder;
+}
+
+TEST_F(Slurm, CaptureArrayOfSeedsMatchesLocalCaptures) {
+  DYNBENCH_NEEDS(test::missingCube2());
+  const auto dir = test::freshDir("slurm_capture");
+  const std::string match = "--seconds 1 --bots 2 --warmup 2";
+  auto r = dynbench(fmt::format("capture cube2 -o {} {} --slurm --seeds 4:5", (dir / "cluster").string(), match), dir);
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("2 capture(s)"), std::string::npos) << r.out;
+  EXPECT_NE(test::slurp(dir / "cluster" / "slurm" / "capture.sbatch").find("seeds=(4 5)"), std::string::npos);
+  for (int seed : {4, 5}) EXPECT_FALSE(fs::exists(dir / "cluster" / fmt::format("seed_{}.partial", seed)));
+  // Each task's capture is the one a local capture with its seed makes, byte for byte.
+  r = dynbench(fmt::format("capture cube2 -o {} {} --seed 5", (dir / "local5").string(), match), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string local = test::slurp(dir / "local5" / "Capture.txt");
+  EXPECT_FALSE(local.empty());
+  EXPECT_TRUE(local == test::slurp(dir / "cluster" / "seed_5" / "Capture.txt"));
+  EXPECT_FALSE(local == test::slurp(dir / "cluster" / "seed_4" / "Capture.txt"));  // another seed, another match
+  // --seeds without --slurm is a usage error.
+  r = dynbench(fmt::format("capture cube2 -o {} --seeds 1:2", (dir / "x").string()), dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+}
+
+TEST_F(Slurm, DemoAsAChainOfJobsGivesTheLocalDemosTables) {
+  DYNBENCH_NEEDS(test::missingCube2());
+  DYNBENCH_NEEDS(test::missingFfmpeg());
+  const auto dir = test::freshDir("slurm_demo");
+  const std::string options = "--seconds 3 --bots 4 --res 32x18 --spp 1 --max-spp 32 --render-frames 12 --bounces 1";
+  auto r = dynbench(fmt::format("demo -o {} {} --slurm --frames-per-task 12", (dir / "cluster").string(), options), dir);
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  // Three jobs chained: the datasets, an array of 4 render tasks (48 frame renders, 12 a task),
+  // the report; Slurm's record of the render job names its dependency on the datasets job.
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.out, m, std::regex("Slurm jobs: datasets (\\d+) .*render (\\d+) \\(4 tasks.*report (\\d+) "))) << r.out;
+  for (const char* script : {"datasets.sbatch", "render.sbatch", "report.sbatch"})
+    EXPECT_TRUE(fs::exists(dir / "cluster" / "slurm" / script)) << script;
+  EXPECT_NE(test::slurp(dir / "cluster" / "slurm" / "render.sbatch").find("#SBATCH --array=0-3\n"), std::string::npos);
+  r = dynbench(fmt::format("demo -o {} {}", (dir / "local").string(), options), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  // The same tables, every cell (the figures' file names aside).
+  auto tables = [](const std::string& md) {
+    std::string rows;
+    std::istringstream in(md);
+    for (std::string line; std::getline(in, line);)
+      if (line.starts_with("|") || line.starts_with("Table")) rows += line + "\n";
+    return rows;
+  };
+  const std::string local = tables(test::slurp(dir / "local" / "report.md"));
+  EXPECT_GT(std::count(local.begin(), local.end(), '\n'), 30);
+  EXPECT_EQ(local, tables(test::slurp(dir / "cluster" / "report.md")));
 }
 
 TEST(SlurmScript, TimesAndQuotingAsSlurmAndTheShellRead) {

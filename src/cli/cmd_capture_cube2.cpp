@@ -25,6 +25,35 @@ Expected<void> runCube2(const capture::Cube2Options& options) {
   return {};
 }
 
+// capture cube2 --slurm --seeds A:B: one capture per seed as a Slurm job array (pipeline/slurm.h).
+Expected<void> captureOnSlurm(const capture::Cube2Options& options, const std::string& seeds, const pipeline::slurm::Options& slurm) {
+  unsigned first = 0, last = 0;
+  char colon = 0, extra = 0;
+  const int n = std::sscanf(seeds.c_str(), "%u%c%u%c", &first, &colon, &last, &extra);
+  if (n == 1) last = first;
+  else if (n != 3 || colon != ':') return fail(ErrorCode::kUsage, "--seeds '{}': expected A:B (seeds A to B) or A", seeds);
+  std::optional<Progress> progress;
+  auto outcome = pipeline::slurm::captureArray(options, first, last, slurm, [&](const pipeline::slurm::ArrayStatus& s) {
+    if (!progress) progress.emplace("slurm capture", static_cast<std::size_t>(last - first + 1), "captures");
+    progress->update(static_cast<std::size_t>(s.done), fmt::format("tasks {} pending, {} running, {} failed", s.pending, s.running, s.failed));
+  });
+  progress.reset();
+  if (!outcome) return std::unexpected(outcome.error());
+  fmt::print("{}: Slurm job {}, {} capture(s), script {}\n", options.output.string(), outcome->jobId, outcome->seeds.size(),
+             outcome->script.string());
+  if (!outcome->waited) return {};
+  if (!outcome->failed.empty()) {
+    std::string list;
+    for (int task : outcome->failed)
+      list += fmt::format("  task {}: seed {} ({} missing)\n", task, outcome->seeds[static_cast<std::size_t>(task)],
+                          (outcome->captures[static_cast<std::size_t>(task)] / "Capture.txt").string());
+    return fail(ErrorCode::kIncomplete, "Slurm job {} ended with {} capture(s) missing:\n{}Rerun only those tasks: {}", outcome->jobId,
+                outcome->failed.size(), list, outcome->resubmit);
+  }
+  for (const auto& c : outcome->captures) fmt::print("{}\n", c.string());
+  return {};
+}
+
 // The preset names, from their one definition (capture/cube2.h).
 std::vector<std::string> presetNames() {
   std::vector<std::string> names;
@@ -64,13 +93,19 @@ void addCaptureCommand(CLI::App& app, CommandRun& run) {
   cmd->add_flag("--window", o->window, "Use the current display instead of Xvfb");
   cmd->add_option("--client", o->client, "The Cube 2 client with the capture hooks (empty: the one the build made)");
   cmd->add_option("--data", o->data, "Game data (Debian's cube2-data)");
-  cmd->callback([o, preset, cmd, &run] {
+  auto slurm = std::make_shared<std::pair<bool, pipeline::slurm::Options>>();
+  auto seeds = std::make_shared<std::string>();
+  addSlurmOptions(cmd, slurm->first, slurm->second, "DIR/slurm/capture.sbatch, one task per seed of --seeds, each into DIR/seed_N", false);
+  cmd->add_option("--seeds", *seeds, "With --slurm: capture seeds A to B (A:B), one array task each")->group("Slurm (with --slurm)");
+  cmd->callback([o, preset, cmd, slurm, seeds, &run] {
     std::vector<std::string> given;
     for (const char* field : {"map", "mode", "bots", "skill", "follow"})
       if (cmd->count(std::string("--") + field) > 0) given.push_back(field);
-    run = [o, preset, given]() -> Expected<void> {
+    run = [o, preset, given, slurm, seeds]() -> Expected<void> {
       if (!preset->empty())
         if (auto ok = capture::applyCube2Preset(*preset, *o, given); !ok) return ok;
+      if (slurm->first) return captureOnSlurm(*o, seeds->empty() ? std::to_string(o->seed) : *seeds, slurm->second);
+      if (!seeds->empty()) return fail(ErrorCode::kUsage, "--seeds: only with --slurm (one capture per seed); for one capture use --seed");
       return runCube2(*o);
     };
   });

@@ -1,7 +1,9 @@
 // `dynbench demo [-o DIR]`: the whole chain on a seeded Cube 2 match (src/pipeline/demo.h).
 #include "capture/cube2.h"
 #include "cli/commands.h"
+#include "core/progress.h"
 #include "pipeline/demo.h"
+#include "pipeline/slurm.h"
 
 namespace dynbench::cli {
 namespace {
@@ -9,19 +11,57 @@ namespace {
 struct DemoCli {
   demo::DemoOptions options;
   std::string resolution = fmt::format("{}x{}", demo::DemoOptions{}.width, demo::DemoOptions{}.height);
+  std::string part = "all";
+  bool slurm = false;
+  pipeline::slurm::Options slurmOptions;
 };
+
+// demo --slurm: the chain of jobs (pipeline/slurm.h), waited for with progress.
+Expected<void> demoOnSlurm(const demo::DemoOptions& o, pipeline::slurm::Options slurm) {
+  slurm.framesPerTask = o.framesPerTask;
+  std::optional<Progress> progress;
+  std::string last;
+  auto outcome = pipeline::slurm::demoChain(o, slurm, [&](const pipeline::slurm::DemoChainStatus& s) {
+    const std::string line = fmt::format("datasets {}, render tasks {} pending, {} running, {} done, report {}", s.datasets, s.render.pending,
+                                         s.render.running, s.render.done, s.report);
+    if (Progress("demo", 0, "").enabled()) {
+      if (!progress) progress.emplace("slurm demo", 3, "jobs");
+      progress->update(static_cast<std::size_t>((s.datasets == "done") + (s.render.pending + s.render.running == 0 && s.datasets == "done") +
+                                                (s.report == "done")),
+                       line);
+    } else if (line != last) {
+      fmt::print("{}\n", line);  // in a log: each change once
+      std::fflush(stdout);
+    }
+    last = line;
+  });
+  progress.reset();
+  if (!outcome) return std::unexpected(outcome.error());
+  fmt::print("Slurm jobs: datasets {} ({}), render {} ({} tasks, {}), report {} ({})\n", outcome->datasetsJob, outcome->datasetsScript.string(),
+             outcome->renderJob, outcome->renderTasks, outcome->renderScript.string(), outcome->reportJob, outcome->reportScript.string());
+  if (!outcome->waited) return {};
+  if (!outcome->failure.empty())
+    return fail(ErrorCode::kIncomplete, "demo --slurm: {}. Rerun `dynbench demo ... --slurm`: every part reuses what is complete", outcome->failure);
+  fmt::print("report: {}\n", outcome->report.string());
+  return {};
+}
 
 Expected<void> runDemo(const DemoCli& cli) {
   demo::DemoOptions o = cli.options;
   auto res = parseResolution(cli.resolution);
   if (!res) return std::unexpected(res.error());
   std::tie(o.width, o.height) = *res;
+  o.part = cli.part == "datasets" ? demo::DemoPart::kDatasets : cli.part == "render" ? demo::DemoPart::kRenderTask : demo::DemoPart::kAll;
+  if (cli.slurm) {
+    if (o.part != demo::DemoPart::kAll) return fail(ErrorCode::kUsage, "--part: not with --slurm (the jobs it submits run the parts)");
+    return demoOnSlurm(o, cli.slurmOptions);
+  }
   auto report = demo::runDemo(o, [](const std::string& line) {
     fmt::print("{}\n", line);
     std::fflush(stdout);
   });
   if (!report) return std::unexpected(report.error());
-  fmt::print("report: {}\n", report->string());
+  if (o.part == demo::DemoPart::kAll) fmt::print("report: {}\n", report->string());
   return {};
 }
 
@@ -49,6 +89,16 @@ void addDemoCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--input-spp", o->options.inputSamplesPerPixel, "Samples per pixel of the temporal methods' input (evaluate)")
       ->check(positive());
   cmd->add_option("--methods", o->options.methods, "Temporal methods evaluated on each dataset (evaluate --methods)")->delimiter(',');
+  cmd->add_option("--threads", o->options.threads, "Render threads (0: all cores)")->check(nonNegative());
+  cmd->add_option("--frames-per-task", o->options.framesPerTask, "Frame renders per render task (with --slurm, or --part render)")
+      ->check(positive())->capture_default_str();
+  cmd->add_option("--part", o->part, "Run one part of the chain, as `demo --slurm`'s jobs do: datasets (capture, convert, fly-through) "
+                                     "or render (task --render-task's frame renders); all: everything")
+      ->check(CLI::IsMember({"all", "datasets", "render"}));
+  cmd->add_option("--render-task", o->options.renderTask, "With --part render: which task's frame renders")->check(nonNegative());
+  addSlurmOptions(cmd, o->slurm, o->slurmOptions,
+                  "OUT/slurm: datasets, then an array of render tasks of --frames-per-task frame renders, then the report, chained with afterok",
+                  false);
   cmd->callback([o, &run] { run = [o] { return runDemo(*o); }; });
 }
 

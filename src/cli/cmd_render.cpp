@@ -32,7 +32,8 @@ Expected<void> renderOnSlurm(const render::RenderJob& job, const pipeline::slurm
   const auto started = std::chrono::steady_clock::now();
   pipeline::slurm::RenderArrayProgress report = [&](const pipeline::slurm::RenderArrayStatus& s) {
     if (!progress) progress.emplace("slurm render", s.framesTotal, "frames");
-    progress->update(s.framesComplete, fmt::format("tasks {} pending, {} running, {} failed", s.pending, s.running, s.failed));
+    progress->update(s.framesComplete,
+                     fmt::format("tasks {} pending, {} running, {} failed", s.tasks.pending, s.tasks.running, s.tasks.failed));
   };
   auto outcome = pipeline::slurm::renderArray({job}, options, report);
   progress.reset();
@@ -161,20 +162,7 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
                   "Irradiance below which a point or spot light without a range is skipped (0: never; default: automatic, at most "
                   "0.1% of the environment's mean irradiance dropped in all; docs/feature-buffers.md)")
       ->check(nonNegative());
-  // Slurm (docs/cluster.md): each option maps to one sbatch option.
-  auto* slurm = cmd->add_flag("--slurm", o->slurm,
-                              "Render as a Slurm job array (DIR/slurm/render.sbatch), one task per --frames-per-task frames, and wait for it");
-  const std::string group = "Slurm (with --slurm)";
-  cmd->add_option("--frames-per-task", o->slurmOptions.framesPerTask, "Frames per array task")
-      ->check(positive())->needs(slurm)->group(group)->capture_default_str();
-  cmd->add_option("--partition", o->slurmOptions.partition, "sbatch --partition")->needs(slurm)->group(group);
-  cmd->add_option("--time", o->slurmOptions.time, "sbatch --time per task, [D-]HH:MM:SS")->needs(slurm)->group(group);
-  cmd->add_option("--cpus-per-task", o->slurmOptions.cpusPerTask, "sbatch --cpus-per-task; each task renders with this many threads")
-      ->check(positive())->needs(slurm)->group(group)->capture_default_str();
-  cmd->add_option("--mem", o->slurmOptions.mem, "sbatch --mem per task (e.g. 4G)")->needs(slurm)->group(group);
-  cmd->add_option("--sbatch-option", o->slurmOptions.sbatchOptions, "Another sbatch option, verbatim (repeatable): --sbatch-option=--account=X")
-      ->needs(slurm)->group(group)->allow_extra_args(false);
-  cmd->add_flag("--submit-only", o->slurmOptions.submitOnly, "Submit the array and return without waiting")->needs(slurm)->group(group);
+  addSlurmOptions(cmd, o->slurm, o->slurmOptions, "DIR/slurm/render.sbatch, one task per --frames-per-task frames", true);
   cmd->callback([o, &run] { run = [o] { return runRender(*o); }; });
 }
 

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "core/error.h"
+#include "pipeline/slurm.h"
 
 namespace dynbench::cli {
 
@@ -41,6 +42,10 @@ void addCompareCommand(CLI::App& app, CommandRun& run);
 
 // Registers `evaluate`.
 void addEvaluateCommand(CLI::App& app, CommandRun& run);
+
+// The --slurm flag and its sbatch options (docs/cluster.md); `what` says what the array runs,
+// perTask adds --frames-per-task.
+void addSlurmOptions(CLI::App* cmd, bool& slurm, pipeline::slurm::Options& options, const std::string& what, bool perTask);
 
 // Registers `demo`.
 void addDemoCommand(CLI::App& app, CommandRun& run);

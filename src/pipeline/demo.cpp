@@ -37,16 +37,12 @@ std::string captureKey(const DemoOptions& o) {
                      o.seed, kCaptureAdapterVersion);
 }
 
-// stats, render, discard for one dataset into RUN.
-Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, const DemoOptions& o, const DemoLog& log) {
-  StatsStage stats;
-  stats.inputs = {dataset};
-  stats.fps = o.fps;
-  stats.json = run / "stats.json";
-  stats.seriesDir = run;
-  auto measured = runStats(stats);
-  if (!measured) return std::unexpected(measured.error());
-
+// The two renders of a dataset: converged reference frames (RUN/frames) and the temporal methods'
+// input (RUN/input), of the same window of frames around the middle of the dataset.
+struct DatasetRenders {
+  RenderStage reference, input;
+};
+DatasetRenders datasetRenders(const fs::path& dataset, const fs::path& run, const DemoOptions& o, long animationFrames) {
   RenderStage render;
   render.job.dataset = dataset;
   render.job.output = run / "frames";
@@ -59,14 +55,43 @@ Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, cons
   render.job.settings.converge = true;
   render.job.settings.tolerance = o.tolerance;
   render.job.settings.maxSamplesPerPixel = o.maxSamplesPerPixel;
+  render.job.threads = o.threads;
   {
     // The window: renderFrames consecutive frames around the middle of the dataset (its frame
-    // count at o.fps, as stats just measured it).
-    const long count = static_cast<long>(measured->rows.front().properties.animationFrames);
-    const long window = std::min<long>(count, std::max(2, o.renderFrames));
-    render.job.frames.first = (count - window) / 2;
+    // count at o.fps, as stats measures it).
+    const long window = std::min<long>(animationFrames, std::max(2, o.renderFrames));
+    render.job.frames.first = (animationFrames - window) / 2;
     render.job.frames.last = render.job.frames.first + window - 1;
   }
+  // The temporal methods' input: the same window rendered as a real-time renderer would (a few
+  // samples per pixel, another seed so its noise is independent of the reference's).
+  RenderStage input = render;
+  input.job.output = run / "input";
+  input.job.settings.converge = false;
+  input.job.settings.samplesPerPixel = o.inputSamplesPerPixel;
+  input.job.settings.seed = o.seed + 1;
+  return {render, input};
+}
+
+// The dataset's frame count at o.fps (Table 6.1's), from stats; with `json`, its stats files too.
+Expected<long> measureStats(const fs::path& dataset, const fs::path& run, const DemoOptions& o, bool files) {
+  StatsStage stats;
+  stats.inputs = {dataset};
+  stats.fps = o.fps;
+  if (files) {
+    stats.json = run / "stats.json";
+    stats.seriesDir = run;
+  }
+  auto measured = runStats(stats);
+  if (!measured) return std::unexpected(measured.error());
+  return static_cast<long>(measured->rows.front().properties.animationFrames);
+}
+
+// stats, render, discard for one dataset into RUN.
+Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, const DemoOptions& o, const DemoLog& log) {
+  auto frames = measureStats(dataset, run, o, true);
+  if (!frames) return std::unexpected(frames.error());
+  const auto [render, input] = datasetRenders(dataset, run, o, *frames);
   auto rendered = runRender(render);
   if (!rendered) return std::unexpected(rendered.error());
   log(fmt::format("  rendered {} frames ({} already there) in {:.0f} s", rendered->rendered.size(), rendered->skipped.size(), rendered->seconds));
@@ -85,14 +110,7 @@ Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, cons
                   mean.frustum, mean.position, mean.normal, mean.direct, mean.directInterval ? mean.directInterval->halfWidth() : 0.0,
                   mean.indirect, mean.indirectInterval ? mean.indirectInterval->halfWidth() : 0.0));
 
-  // Temporal methods: the same window rendered as a real-time renderer would (a few samples per
-  // pixel, another seed so its noise is independent of the reference's), each method run over it
-  // and scored against the converged frames above.
-  RenderStage input = render;
-  input.job.output = run / "input";
-  input.job.settings.converge = false;
-  input.job.settings.samplesPerPixel = o.inputSamplesPerPixel;
-  input.job.settings.seed = o.seed + 1;
+  // Temporal methods: each run over the input window and scored against the converged frames above.
   auto renderedInput = runRender(input);
   if (!renderedInput) return std::unexpected(renderedInput.error());
   evaluate::EvaluateOptions evaluation;
@@ -336,6 +354,38 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
     if (auto merged = convert::mergeCamera(merge); !merged) return std::unexpected(merged.error());
   } else {
     log("fly-through: " + fly.string() + " is newer than its source, reused");
+  }
+
+  if (o.part == DemoPart::kDatasets) return fly;
+
+  if (o.part == DemoPart::kRenderTask) {
+    // Item i of the demo's renders (dataset, then reference before input, then frame), and task k
+    // renders items k*F .. k*F+F-1, grouped by render into frame ranges.
+    std::vector<std::pair<RenderStage, long>> items;
+    for (const fs::path& dataset : {bot, fly}) {
+      const fs::path run = o.output / "runs" / dataset.stem();
+      auto frames = measureStats(dataset, run, o, false);
+      if (!frames) return std::unexpected(frames.error());
+      const auto renders = datasetRenders(dataset, run, o, *frames);
+      for (const RenderStage* stage : {&renders.reference, &renders.input})
+        for (long f = stage->job.frames.first; f <= stage->job.frames.last; ++f) items.emplace_back(*stage, f);
+    }
+    const std::size_t first = static_cast<std::size_t>(o.renderTask) * static_cast<std::size_t>(o.framesPerTask);
+    const std::size_t last = std::min(items.size(), first + static_cast<std::size_t>(o.framesPerTask));
+    if (first >= items.size()) log(fmt::format("render task {}: nothing to render (the demo has {} frame renders)", o.renderTask, items.size()));
+    for (std::size_t i = first; i < last;) {
+      std::size_t j = i;
+      while (j + 1 < last && items[j + 1].first.job.output == items[i].first.job.output) ++j;
+      RenderStage chunk = items[i].first;
+      chunk.job.frames.first = items[i].second;
+      chunk.job.frames.last = items[j].second;
+      auto rendered = runRender(chunk);
+      if (!rendered) return std::unexpected(rendered.error());
+      log(fmt::format("render task {}: {} frames {}-{}: {} rendered, {} already complete", o.renderTask, chunk.job.output.string(),
+                      chunk.job.frames.first, chunk.job.frames.last, rendered->rendered.size(), rendered->skipped.size()));
+      i = j + 1;
+    }
+    return o.output;
   }
 
   std::vector<fs::path> runs;

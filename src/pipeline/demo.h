@@ -4,12 +4,21 @@
 // the ORCA fly-throughs), then per dataset stats, render, discard, and one report.
 #include <filesystem>
 #include <functional>
+#include <algorithm>
 #include <string>
 #include <vector>
 
 #include "core/error.h"
 
 namespace dynbench::demo {
+
+// What one run of the demo does: all of it, or one part of `demo --slurm`'s chain (each part reuses
+// what the parts before it made).
+enum class DemoPart {
+  kAll,         // capture, convert, fly-through, then stats, render, discard, evaluate and report
+  kDatasets,    // capture, convert and fly-through only
+  kRenderTask,  // only task renderTask's frames of the renders (framesPerTask frame renders a task)
+};
 
 struct DemoOptions {
   std::filesystem::path output = "dynbench-demo";
@@ -29,12 +38,19 @@ struct DemoOptions {
   // pixel (the input a real-time method gets), scored against the converged frames.
   int inputSamplesPerPixel = 4;
   std::vector<std::string> methods{"none", "accumulate", "taa", "svgf"};
+  int threads = 0;  // render threads (0: all cores)
+  DemoPart part = DemoPart::kAll;
+  int renderTask = 0, framesPerTask = 8;  // with kRenderTask
 };
+
+// The number of frame renders the demo makes (two datasets, reference and input, renderFrames
+// each at most): what `demo --slurm` divides among its render tasks.
+inline int demoFrameRenders(const DemoOptions& o) { return 2 * 2 * std::max(2, o.renderFrames); }
 
 // One line per stage (for the terminal and logs).
 using DemoLog = std::function<void(const std::string&)>;
 
-// Returns the report's path.
+// Returns the report's path (kAll), the fly-through dataset (kDatasets) or the output folder.
 Expected<std::filesystem::path> runDemo(const DemoOptions& options, const DemoLog& log);
 
 // The fly-through: the kind of camera the thesis compared against (the artist-placed paths of

@@ -193,6 +193,62 @@ std::map<int, std::string> taskStates(const std::string& jobId) {
   return states;
 }
 
+Expected<std::vector<int>> waitForArray(const std::string& jobId, int tasks, const std::function<bool(int)>& taskComplete,
+                                        const std::function<void(const ArrayStatus&)>& progress, const Options& options) {
+  for (;;) {
+    auto queued = queuedTasks(jobId);
+    if (!queued) return std::unexpected(queued.error());
+    ArrayStatus status;
+    std::vector<bool> inQueue(static_cast<std::size_t>(tasks), false);
+    for (const auto& t : *queued) {
+      if (t.task >= 0 && t.task < tasks) inQueue[static_cast<std::size_t>(t.task)] = true;
+      (t.state == "PENDING" || t.state == "REQUEUED" || t.state == "REQUEUE_HOLD" ? status.pending : status.running)++;
+    }
+    std::vector<int> failed;
+    for (int k = 0; k < tasks; ++k) {
+      if (inQueue[static_cast<std::size_t>(k)]) continue;
+      if (taskComplete(k)) {
+        ++status.done;
+      } else {
+        failed.push_back(k);
+        ++status.failed;
+      }
+    }
+    if (progress) progress(status);
+    if (queued->empty()) return failed;
+    std::this_thread::sleep_for(options.poll);
+  }
+}
+
+std::string resubmitCommand(const std::vector<int>& tasks, const fs::path& script) {
+  return fmt::format("sbatch --array={} {}", fmt::join(tasks, ","), shellQuote(script.string()));
+}
+
+fs::path jobExecutable(const Options& options) { return options.executable.empty() ? thisExecutable() : options.executable; }
+
+Expected<void> writeScript(const fs::path& path, const std::string& text) {
+  if (auto ok = writeFileAtomic(path, text); !ok) return std::unexpected(ok.error());
+  if (::chmod(path.c_str(), 0755) != 0) return fail(ErrorCode::kIo, "{}: cannot make it executable", path.string());
+  return {};
+}
+
+std::string signalTrap(const std::string& work, const std::string& cleanup) {
+  return fmt::format(
+      "# The signal before the time limit (or a preemption): stop the work, remove what it left\n"
+      "# unfinished, and put this task, only this one, back in the queue.\n"
+      "on_signal() {{\n"
+      "  echo \"dynbench: stopping {0}; task ${{SLURM_ARRAY_JOB_ID}}_${{SLURM_ARRAY_TASK_ID}} goes back to the queue\"\n"
+      "  kill -TERM \"$child\" 2>/dev/null\n"
+      "  wait \"$child\" 2>/dev/null\n"
+      "  {1}\n"
+      "  scontrol requeue \"${{SLURM_ARRAY_JOB_ID}}_${{SLURM_ARRAY_TASK_ID}}\"\n"
+      "  exit 0\n"
+      "}}\n"
+      "trap on_signal USR1\n"
+      "echo \"dynbench: task ${{SLURM_ARRAY_JOB_ID}}_${{SLURM_ARRAY_TASK_ID}} started $(date -u +%Y-%m-%dT%H:%M:%S.%N) on $(hostname)\"\n",
+      work, cleanup);
+}
+
 std::string scriptHeader(const std::string& name, int tasks, const fs::path& logDir, const Options& options) {
   // The signal comes signalSeconds before the time limit, but at most a quarter of a short limit in.
   long signal = options.signalSeconds;
@@ -255,7 +311,7 @@ Expected<RenderArrayOutcome> renderArray(const RenderStage& stageIn, const Optio
   if (ec) return fail(ErrorCode::kIo, "{}: cannot create the job's folder: {}", jobDir.string(), ec.message());
   out.script = jobDir / "render.sbatch";
 
-  const fs::path exe = options.executable.empty() ? thisExecutable() : options.executable;
+  const fs::path exe = jobExecutable(options);
   std::string script = scriptHeader("dynbench-render", out.tasks, jobDir, options);
   script += fmt::format(
       "#\n"
@@ -271,25 +327,13 @@ Expected<RenderArrayOutcome> renderArray(const RenderStage& stageIn, const Optio
   script += ")\n";
   script += "frames=${chunks[$SLURM_ARRAY_TASK_ID]}\n";
   script += fmt::format("output={}\n", shellQuote(stage.job.output.string()));
-  script +=
-      "# The signal before the time limit (or a preemption): stop the render, remove the temporary\n"
-      "# files of the frame it was writing (NAME.tmp-PID; finished files are renamed into place), and put\n"
-      "# this task, only this one, back in the queue.\n"
-      "on_signal() {\n"
-      "  echo \"dynbench: stopping frames $frames; task ${SLURM_ARRAY_JOB_ID}_${SLURM_ARRAY_TASK_ID} goes back to the queue\"\n"
-      "  kill -TERM \"$render\" 2>/dev/null\n"
-      "  wait \"$render\" 2>/dev/null\n"
-      "  rm -f \"$output\"/*.tmp-\"$render\"\n"
-      "  scontrol requeue \"${SLURM_ARRAY_JOB_ID}_${SLURM_ARRAY_TASK_ID}\"\n"
-      "  exit 0\n"
-      "}\n"
-      "trap on_signal USR1\n";
+  // The render's unfinished files are NAME.tmp-PID (finished ones are renamed into place).
+  script += signalTrap("frames $frames", "rm -f \"$output\"/*.tmp-\"$child\"");
   std::string command = shellQuote(exe.string()) + " render";
   for (const auto& a : renderArguments(stage.job)) command += " " + shellQuote(a);
   script += command + " --frames \"$frames\" --threads \"${SLURM_CPUS_PER_TASK:-1}\" &\n";
-  script += "render=$!\nwait \"$render\"\n";
-  if (auto ok = writeFileAtomic(out.script, script); !ok) return std::unexpected(ok.error());
-  ::chmod(out.script.c_str(), 0755);
+  script += "child=$!\nwait \"$child\"\n";
+  if (auto ok = writeScript(out.script, script); !ok) return std::unexpected(ok.error());
 
   auto id = submit(out.script);
   if (!id) return std::unexpected(id.error());
@@ -313,22 +357,14 @@ Expected<RenderArrayOutcome> renderArray(const RenderStage& stageIn, const Optio
       if (!done[i]) return false;
     return true;
   };
-  for (;;) {
-    auto queued = queuedTasks(out.jobId);
-    if (!queued) return std::unexpected(queued.error());
-    RenderArrayStatus status;
-    status.framesTotal = frames->size();
-    status.framesComplete = countComplete();
-    std::vector<bool> inQueue(static_cast<std::size_t>(out.tasks), false);
-    for (const auto& t : *queued) {
-      if (t.task >= 0 && t.task < out.tasks) inQueue[static_cast<std::size_t>(t.task)] = true;
-      (t.state == "PENDING" || t.state == "REQUEUED" || t.state == "REQUEUE_HOLD" ? status.pending : status.running)++;
-    }
-    for (int k = 0; k < out.tasks; ++k) status.failed += !inQueue[static_cast<std::size_t>(k)] && !chunkComplete(k);
-    if (progress) progress(status);
-    if (queued->empty()) break;
-    std::this_thread::sleep_for(options.poll);
-  }
+  auto failed = waitForArray(
+      out.jobId, out.tasks, chunkComplete,
+      [&](const ArrayStatus& tasks) {
+        RenderArrayStatus status{countComplete(), frames->size(), tasks};
+        if (progress) progress(status);
+      },
+      options);
+  if (!failed) return std::unexpected(failed.error());
   out.waited = true;
   countComplete();
   for (int k = 0; k < out.tasks; ++k) {
@@ -344,7 +380,7 @@ Expected<RenderArrayOutcome> renderArray(const RenderStage& stageIn, const Optio
       tasks.push_back(task);
       if (auto s = states.find(task); s != states.end()) out.taskStates[task] = s->second;
     }
-    out.resubmit = fmt::format("sbatch --array={} {}", fmt::join(tasks, ","), shellQuote(out.script.string()));
+    out.resubmit = resubmitCommand(tasks, out.script);
   }
   return out;
 }
@@ -356,6 +392,174 @@ std::string missingFramesText(const RenderArrayOutcome& outcome) {
     text += fmt::format("  task {}{}: frames {}\n", task, state != outcome.taskStates.end() ? " (" + state->second + ")" : "", framesText(frames));
   }
   return text;
+}
+
+std::vector<std::string> captureArguments(const capture::Cube2Options& o) {
+  std::vector<std::string> a = {"--map", o.map, "--mode", o.mode, "--bots", std::to_string(o.bots), "--skill", std::to_string(o.skill),
+                                "--seconds", fmt::format("{:.17g}", o.seconds), "--fps", fmt::format("{:.17g}", o.fps), "--follow", o.follow,
+                                "--warmup", fmt::format("{:.17g}", o.warmup), "--width", std::to_string(o.width), "--height",
+                                std::to_string(o.height), "--data", fs::absolute(o.data).string()};
+  if (!o.client.empty()) a.insert(a.end(), {"--client", fs::absolute(o.client).string()});
+  return a;
+}
+
+Expected<CaptureArrayOutcome> captureArray(const capture::Cube2Options& captureIn, unsigned firstSeed, unsigned lastSeed, const Options& options,
+                                           const CaptureArrayProgress& progress) {
+  if (lastSeed < firstSeed) return fail(ErrorCode::kUsage, "--seeds {}:{}: the last seed is before the first", firstSeed, lastSeed);
+  if (captureIn.window) return fail(ErrorCode::kUsage, "--window: a cluster's nodes have no display; capture there under Xvfb (the default)");
+  if (auto ok = checkCluster(options); !ok) return std::unexpected(ok.error());
+  capture::Cube2Options capture = captureIn;
+  const fs::path dir = fs::absolute(capture.output).lexically_normal();
+  CaptureArrayOutcome out;
+  for (unsigned long long seed = firstSeed; seed <= lastSeed; ++seed) {
+    out.seeds.push_back(static_cast<unsigned>(seed));
+    out.captures.push_back(dir / fmt::format("seed_{}", seed));
+  }
+  const int tasks = static_cast<int>(out.seeds.size());
+  const fs::path jobDir = dir / "slurm";
+  std::error_code ec;
+  fs::create_directories(jobDir, ec);
+  if (ec) return fail(ErrorCode::kIo, "{}: cannot create the job's folder: {}", jobDir.string(), ec.message());
+  out.script = jobDir / "capture.sbatch";
+  std::string script = scriptHeader("dynbench-capture", tasks, jobDir, options);
+  script += fmt::format(
+      "#\n"
+      "# dynbench capture cube2 as a Slurm job array, written by `dynbench capture cube2 --slurm` (docs/cluster.md).\n"
+      "# Task k captures seed k of the list below into seed_N, through seed_N.partial, renamed when complete.\n"
+      "# Submit it all again: sbatch {0}\n"
+      "# Only some tasks:     sbatch --array=3,5 {0}\n"
+      "set -u\n",
+      shellQuote(out.script.string()));
+  script += fmt::format("seeds=({})\n", fmt::join(out.seeds, " "));
+  script += "seed=${seeds[$SLURM_ARRAY_TASK_ID]}\n";
+  script += fmt::format("final={}/seed_$seed\npartial=$final.partial\n", shellQuote(dir.string()));
+  script += "if [[ -f $final/Capture.txt ]]; then echo \"dynbench: $final already holds a capture\"; exit 0; fi\n";
+  script += "rm -rf \"$partial\"\n";
+  script += signalTrap("the capture of seed $seed", "rm -rf \"$partial\"");
+  std::string command = shellQuote(jobExecutable(options).string()) + " capture cube2 -o \"$partial\" --seed \"$seed\"";
+  for (const auto& a : captureArguments(capture)) command += " " + shellQuote(a);
+  script += command + " &\n";
+  script += "child=$!\nwait \"$child\" || exit $?\n";
+  script += "mv \"$partial\" \"$final\"\n";
+  if (auto ok = writeScript(out.script, script); !ok) return std::unexpected(ok.error());
+  auto id = submit(out.script);
+  if (!id) return std::unexpected(id.error());
+  out.jobId = *id;
+  if (options.submitOnly) return out;
+  auto failed = waitForArray(
+      out.jobId, tasks, [&](int k) { return fs::is_regular_file(out.captures[static_cast<std::size_t>(k)] / "Capture.txt"); }, progress, options);
+  if (!failed) return std::unexpected(failed.error());
+  out.waited = true;
+  out.failed = *failed;
+  if (!out.failed.empty()) out.resubmit = resubmitCommand(out.failed, out.script);
+  return out;
+}
+
+std::vector<std::string> demoArguments(const demo::DemoOptions& o) {
+  return {"-o", fs::absolute(o.output).lexically_normal().string(), "--map", o.map, "--bots", std::to_string(o.bots), "--seconds",
+          fmt::format("{:.17g}", o.seconds), "--seed", std::to_string(o.seed), "--fps", fmt::format("{:.17g}", o.fps), "--res",
+          fmt::format("{}x{}", o.width, o.height), "--spp", std::to_string(o.samplesPerPixel), "--tolerance", fmt::format("{:.17g}", o.tolerance),
+          "--max-spp", std::to_string(o.maxSamplesPerPixel), "--render-frames", std::to_string(o.renderFrames), "--bounces",
+          std::to_string(o.bounces), "--input-spp", std::to_string(o.inputSamplesPerPixel), "--methods", fmt::format("{}", fmt::join(o.methods, ","))};
+}
+
+Expected<DemoChainOutcome> demoChain(const demo::DemoOptions& demoIn, const Options& options,
+                                     const std::function<void(const DemoChainStatus&)>& progress) {
+  if (auto ok = checkCluster(options); !ok) return std::unexpected(ok.error());
+  demo::DemoOptions demo = demoIn;
+  demo.output = fs::absolute(demo.output).lexically_normal();
+  const fs::path jobDir = demo.output / "slurm";
+  std::error_code ec;
+  fs::create_directories(jobDir, ec);
+  if (ec) return fail(ErrorCode::kIo, "{}: cannot create the jobs' folder: {}", jobDir.string(), ec.message());
+  DemoChainOutcome out;
+  out.renderTasks = (demo::demoFrameRenders(demo) + options.framesPerTask - 1) / options.framesPerTask;
+  std::string command = shellQuote(jobExecutable(options).string()) + " demo";
+  for (const auto& a : demoArguments(demo)) command += " " + shellQuote(a);
+  // Every part is the demo itself, run in the background so the signal trap can stop it; its
+  // outputs are written through temporary names, so a stopped part leaves nothing to clean.
+  auto script = [&](const std::string& name, int tasks, const std::string& part, const std::string& what) {
+    std::string text = scriptHeader("dynbench-demo-" + name, tasks, jobDir, options);
+    text += fmt::format("#\n# Part of `dynbench demo --slurm` (docs/cluster.md): {}.\nset -u\n", what);
+    text += signalTrap("the demo's " + name, ":");
+    text += command + part + " &\nchild=$!\nwait \"$child\"\n";
+    return text;
+  };
+  out.datasetsScript = jobDir / "datasets.sbatch";
+  out.renderScript = jobDir / "render.sbatch";
+  out.reportScript = jobDir / "report.sbatch";
+  Options single = options;
+  for (const auto& [path, text] :
+       {std::pair{out.datasetsScript, script("datasets", 1, " --part datasets", "capture, convert and the fly-through")},
+        std::pair{out.renderScript,
+                  script("render", out.renderTasks,
+                         fmt::format(" --part render --render-task \"$SLURM_ARRAY_TASK_ID\" --frames-per-task {} --threads \"${{SLURM_CPUS_PER_TASK:-1}}\"",
+                                     options.framesPerTask),
+                         fmt::format("task k renders frame renders {0}k to {0}k+{1} of the demo's {2}", options.framesPerTask,
+                                     options.framesPerTask - 1, demo::demoFrameRenders(demo)))},
+        std::pair{out.reportScript, script("report", 1, "", "the whole demo, reusing the datasets and frames: stats, discard, evaluate, report")}})
+    if (auto ok = writeScript(path, text); !ok) return std::unexpected(ok.error());
+  auto datasets = submit(out.datasetsScript);
+  if (!datasets) return std::unexpected(datasets.error());
+  out.datasetsJob = *datasets;
+  auto render = submit(out.renderScript, {"--dependency=afterok:" + out.datasetsJob, "--kill-on-invalid-dep=yes"});
+  if (!render) return std::unexpected(render.error());
+  out.renderJob = *render;
+  auto report = submit(out.reportScript, {"--dependency=afterok:" + out.renderJob, "--kill-on-invalid-dep=yes"});
+  if (!report) return std::unexpected(report.error());
+  out.reportJob = *report;
+  if (options.submitOnly) return out;
+
+  const auto submitted = fs::file_time_type::clock::now();
+  const fs::path reportFile = demo.output / "report.html";
+  auto reportWritten = [&] {
+    std::error_code e;
+    return fs::is_regular_file(reportFile, e) && fs::last_write_time(reportFile, e) >= submitted;
+  };
+  // One-task jobs by their squeue state; the render array by its tasks.
+  auto state = [&](const std::string& job, const std::function<bool()>& complete) -> Expected<std::string> {
+    auto q = queuedTasks(job);
+    if (!q) return std::unexpected(q.error());
+    if (!q->empty()) return q->front().state;
+    return complete() ? std::string("done") : std::string("failed");
+  };
+  const fs::path fly = demo.output / "datasets" / (demo.map + "_flythrough.gltf");
+  for (;;) {
+    DemoChainStatus status;
+    auto a = state(out.datasetsJob, [&] { return fs::is_regular_file(fly); });
+    if (!a) return std::unexpected(a.error());
+    status.datasets = *a;
+    auto r = queuedTasks(out.renderJob);
+    if (!r) return std::unexpected(r.error());
+    for (const auto& t : *r) (t.state == "PENDING" ? status.render.pending : status.render.running)++;
+    status.render.done = out.renderTasks - status.render.pending - status.render.running;
+    auto c = state(out.reportJob, reportWritten);
+    if (!c) return std::unexpected(c.error());
+    status.report = *c;
+    if (progress) progress(status);
+    if (status.report == "done" || status.report == "failed") break;
+    std::this_thread::sleep_for(options.poll);
+  }
+  out.waited = true;
+  if (reportWritten()) {
+    out.report = reportFile;
+    return out;
+  }
+  // Which part failed: the first whose job did not complete.
+  for (const auto& [name, job] : {std::pair{"datasets", out.datasetsJob}, std::pair{"render", out.renderJob}, std::pair{"report", out.reportJob}}) {
+    const auto states = taskStates(job);
+    std::vector<int> bad;
+    for (const auto& [task, st] : states)
+      if (st != "COMPLETED") bad.push_back(task);
+    if (!bad.empty() || states.empty()) {
+      out.failure = fmt::format("the {} job ({}) did not complete{}; its logs: {}", name, job,
+                                states.empty() ? "" : fmt::format(" (task(s) {}: {})", fmt::join(bad, ","), states.at(bad.front())),
+                                (jobDir / fmt::format("task-{}_*.log", job)).string());
+      break;
+    }
+  }
+  if (out.failure.empty()) out.failure = fmt::format("the report job ({}) ended without writing {}", out.reportJob, reportFile.string());
+  return out;
 }
 
 }  // namespace dynbench::pipeline::slurm

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "capture/cube2.h"
+#include "pipeline/demo.h"
 #include "core/error.h"
 #include "pipeline/stages.h"
 
@@ -51,9 +53,28 @@ Expected<std::vector<QueuedTask>> queuedTasks(const std::string& jobId);
 // The final state of each array task scontrol still remembers (COMPLETED, FAILED, CANCELLED, ...).
 std::map<int, std::string> taskStates(const std::string& jobId);
 
+// Array tasks by state while a job runs; failed: left the queue without its work complete.
+struct ArrayStatus {
+  int pending = 0, running = 0, failed = 0, done = 0;
+};
+// Waits until no task of `jobId` is queued, polling squeue every options.poll; a task that has left
+// the queue is done when taskComplete(task) and failed otherwise. Returns the failed tasks.
+Expected<std::vector<int>> waitForArray(const std::string& jobId, int tasks, const std::function<bool(int)>& taskComplete,
+                                        const std::function<void(const ArrayStatus&)>& progress, const Options& options);
+// "sbatch --array=3,5 SCRIPT": reruns only those tasks.
+std::string resubmitCommand(const std::vector<int>& tasks, const std::filesystem::path& script);
+// The path of the dynbench executable a job runs.
+std::filesystem::path jobExecutable(const Options& options);
+// Writes an executable job script through a temporary name.
+Expected<void> writeScript(const std::filesystem::path& path, const std::string& text);
+
 // The #SBATCH lines and the signal trap shared by every dynbench job script: `name`, the array
 // (`tasks` tasks), the log files, --requeue, the signal before the time limit, and the options.
 std::string scriptHeader(const std::string& name, int tasks, const std::filesystem::path& logDir, const Options& options);
+
+// The USR1 trap of a job script: `work` names what is stopped in its message, `cleanup` is the shell
+// command that removes what the work left unfinished; the work runs in the background as $child.
+std::string signalTrap(const std::string& work, const std::string& cleanup);
 
 // A word for a POSIX shell script, single-quoted when it needs to be.
 std::string shellQuote(const std::string& word);
@@ -68,7 +89,7 @@ std::vector<std::string> renderArguments(const render::RenderJob& job);
 
 struct RenderArrayStatus {
   std::size_t framesComplete = 0, framesTotal = 0;
-  int pending = 0, running = 0, failed = 0;  // tasks; failed: left the queue with frames missing
+  ArrayStatus tasks;
 };
 using RenderArrayProgress = std::function<void(const RenderArrayStatus&)>;
 
@@ -90,5 +111,49 @@ Expected<RenderArrayOutcome> renderArray(const RenderStage& stage, const Options
 
 // The missing frames by task, one line each: "  task 3 (CANCELLED): frames 12-15".
 std::string missingFramesText(const RenderArrayOutcome& outcome);
+
+// ---- capture as an array -----------------------------------------------------------------------
+// The capture's command-line options but its output and seed (the inverse of `capture cube2`'s parsing).
+std::vector<std::string> captureArguments(const capture::Cube2Options& options);
+
+struct CaptureArrayOutcome {
+  std::string jobId;
+  std::filesystem::path script;
+  std::vector<unsigned> seeds;               // task k captures seeds[k] into DIR/seed_N
+  std::vector<std::filesystem::path> captures;
+  std::vector<int> failed;                   // tasks whose capture is missing after the wait
+  std::string resubmit;
+  bool waited = false;
+};
+using CaptureArrayProgress = std::function<void(const ArrayStatus&)>;
+// One Cube 2 capture per seed, firstSeed..lastSeed, as a Slurm job array: DIR/slurm/capture.sbatch,
+// task k capturing seed firstSeed + k into DIR/seed_N (through DIR/seed_N.partial, renamed when
+// complete, so a folder under its final name is a whole capture). Waits unless submitOnly.
+Expected<CaptureArrayOutcome> captureArray(const capture::Cube2Options& capture, unsigned firstSeed, unsigned lastSeed, const Options& options,
+                                           const CaptureArrayProgress& progress = {});
+
+// ---- the demo as a chain of jobs ---------------------------------------------------------------
+// The demo's command-line options but its part (the inverse of `dynbench demo`'s parsing).
+std::vector<std::string> demoArguments(const demo::DemoOptions& options);
+
+struct DemoChainStatus {
+  std::string datasets, report;  // the one-task jobs' states: PENDING, RUNNING, done, failed
+  ArrayStatus render;
+};
+struct DemoChainOutcome {
+  std::string datasetsJob, renderJob, reportJob;
+  std::filesystem::path datasetsScript, renderScript, reportScript;
+  int renderTasks = 0;
+  std::filesystem::path report;  // OUT/report.html when the chain completed
+  std::string failure;           // which job failed and where its log is; empty when complete
+  bool waited = false;
+};
+// `demo --slurm`: three jobs in OUT/slurm, each the demo itself: datasets.sbatch (capture, convert,
+// fly-through), render.sbatch (an array: the frame renders, options.framesPerTask a task) after it,
+// and report.sbatch (the whole demo, reusing everything, so only stats, discard, evaluate and the
+// report are left) after the renders, chained with --dependency=afterok and
+// --kill-on-invalid-dep=yes. Waits for the report unless submitOnly.
+Expected<DemoChainOutcome> demoChain(const demo::DemoOptions& demo, const Options& options,
+                                     const std::function<void(const DemoChainStatus&)>& progress = {});
 
 }  // namespace dynbench::pipeline::slurm
