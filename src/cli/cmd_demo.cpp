@@ -20,11 +20,12 @@ struct DemoCli {
 Expected<void> demoOnSlurm(const demo::DemoOptions& o, pipeline::slurm::Options slurm) {
   slurm.framesPerTask = o.framesPerTask;
   std::optional<Progress> progress;
+  const bool terminal = Progress("slurm demo", 3, "jobs").enabled();
   std::string last;
   auto outcome = pipeline::slurm::demoChain(o, slurm, [&](const pipeline::slurm::DemoChainStatus& s) {
     const std::string line = fmt::format("datasets {}, render tasks {} pending, {} running, {} done, report {}", s.datasets, s.render.pending,
                                          s.render.running, s.render.done, s.report);
-    if (Progress("demo", 0, "").enabled()) {
+    if (terminal) {
       if (!progress) progress.emplace("slurm demo", 3, "jobs");
       progress->update(static_cast<std::size_t>((s.datasets == "done") + (s.render.pending + s.render.running == 0 && s.datasets == "done") +
                                                 (s.report == "done")),

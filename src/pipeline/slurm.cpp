@@ -12,7 +12,6 @@
 #include "core/files.h"
 #include "core/process.h"
 #include "frames/frame_io.h"
-#include "scene/load.h"
 
 namespace dynbench::pipeline::slurm {
 namespace {
@@ -52,6 +51,20 @@ fs::path thisExecutable() {
 std::string frameRangeArgument(const std::vector<long>& chunk, long step) {
   if (chunk.size() == 1) return std::to_string(chunk.front());
   return step == 1 ? fmt::format("{}:{}", chunk.front(), chunk.back()) : fmt::format("{}:{}:{}", chunk.front(), chunk.back(), step);
+}
+
+bool allDigits(const std::string& text) {
+  return !text.empty() && std::all_of(text.begin(), text.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
+}
+
+// squeue's states of a task that waits to run (requeued ones too); any other is running or ending.
+bool waiting(const std::string& state) { return state == "PENDING" || state == "REQUEUED" || state == "REQUEUE_HOLD"; }
+
+// The job's command line: this dynbench by absolute path, the verb, each argument quoted.
+std::string jobCommand(const Options& options, const std::string& verb, const std::vector<std::string>& arguments) {
+  std::string command = shellQuote(jobExecutable(options).string()) + " " + verb;
+  for (const auto& a : arguments) command += " " + shellQuote(a);
+  return command;
 }
 
 // Frames as ranges: "12-15, 40".
@@ -95,8 +108,7 @@ std::optional<long> parseSlurmTime(const std::string& text) {
   std::vector<long> parts;
   std::istringstream in(rest);
   for (std::string part; std::getline(in, part, ':');) {
-    if (part.empty() || !std::all_of(part.begin(), part.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
-      return std::nullopt;
+    if (!allDigits(part)) return std::nullopt;
     parts.push_back(std::stol(part));
   }
   if (parts.empty() || parts.size() > 3) return std::nullopt;
@@ -137,23 +149,23 @@ Expected<void> checkCluster(const Options& options) {
 }
 
 Expected<std::string> submit(const fs::path& script, const std::vector<std::string>& extra) {
-  std::vector<std::string> test = {"sbatch", "--test-only"};
-  test.insert(test.end(), extra.begin(), extra.end());
-  test.push_back(script.string());
-  auto tested = slurmCommand(test);
+  auto sbatch = [&](const char* mode) {
+    std::vector<std::string> argv = {"sbatch", mode};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    argv.push_back(script.string());
+    return slurmCommand(argv);
+  };
+  auto tested = sbatch("--test-only");
   if (!tested) return std::unexpected(tested.error());
   if (tested->status != 0)
     return fail(ErrorCode::kExternalTool, "{}: Slurm would not accept the job (sbatch --test-only: {}); nothing was submitted", script.string(),
                 tested->text());
-  std::vector<std::string> argv = {"sbatch", "--parsable"};
-  argv.insert(argv.end(), extra.begin(), extra.end());
-  argv.push_back(script.string());
-  auto submitted = slurmCommand(argv);
+  auto submitted = sbatch("--parsable");
   if (!submitted) return std::unexpected(submitted.error());
   // --parsable prints "JOBID" or "JOBID;CLUSTER" (after any warnings).
   std::string id = submitted->lines.empty() ? "" : submitted->lines.back();
   id = id.substr(0, id.find(';'));
-  if (submitted->status != 0 || id.empty() || !std::all_of(id.begin(), id.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+  if (submitted->status != 0 || !allDigits(id))
     return fail(ErrorCode::kExternalTool, "{}: sbatch failed: {}", script.string(), submitted->text());
   return id;
 }
@@ -187,7 +199,7 @@ std::map<int, std::string> taskStates(const std::string& jobId) {
       return line.substr(start, line.find(' ', start) - start);
     };
     const std::string task = field("ArrayTaskId"), state = field("JobState");
-    if (!task.empty() && std::all_of(task.begin(), task.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }))
+    if (allDigits(task))
       states[std::stoi(task)] = state;
   }
   return states;
@@ -202,7 +214,7 @@ Expected<std::vector<int>> waitForArray(const std::string& jobId, int tasks, con
     std::vector<bool> inQueue(static_cast<std::size_t>(tasks), false);
     for (const auto& t : *queued) {
       if (t.task >= 0 && t.task < tasks) inQueue[static_cast<std::size_t>(t.task)] = true;
-      (t.state == "PENDING" || t.state == "REQUEUED" || t.state == "REQUEUE_HOLD" ? status.pending : status.running)++;
+      (waiting(t.state) ? status.pending : status.running)++;
     }
     std::vector<int> failed;
     for (int k = 0; k < tasks; ++k) {
@@ -311,7 +323,6 @@ Expected<RenderArrayOutcome> renderArray(const RenderStage& stageIn, const Optio
   if (ec) return fail(ErrorCode::kIo, "{}: cannot create the job's folder: {}", jobDir.string(), ec.message());
   out.script = jobDir / "render.sbatch";
 
-  const fs::path exe = jobExecutable(options);
   std::string script = scriptHeader("dynbench-render", out.tasks, jobDir, options);
   script += fmt::format(
       "#\n"
@@ -329,9 +340,7 @@ Expected<RenderArrayOutcome> renderArray(const RenderStage& stageIn, const Optio
   script += fmt::format("output={}\n", shellQuote(stage.job.output.string()));
   // The render's unfinished files are NAME.tmp-PID (finished ones are renamed into place).
   script += signalTrap("frames $frames", "rm -f \"$output\"/*.tmp-\"$child\"");
-  std::string command = shellQuote(exe.string()) + " render";
-  for (const auto& a : renderArguments(stage.job)) command += " " + shellQuote(a);
-  script += command + " --frames \"$frames\" --threads \"${SLURM_CPUS_PER_TASK:-1}\" &\n";
+  script += jobCommand(options, "render", renderArguments(stage.job)) + " --frames \"$frames\" --threads \"${SLURM_CPUS_PER_TASK:-1}\" &\n";
   script += "child=$!\nwait \"$child\"\n";
   if (auto ok = writeScript(out.script, script); !ok) return std::unexpected(ok.error());
 
@@ -351,11 +360,12 @@ Expected<RenderArrayOutcome> renderArray(const RenderStage& stageIn, const Optio
     }
     return n;
   };
+  // Task k's frames are items k*F .. of the frame list, as the chunks were cut.
+  auto chunkFirst = [&](int task) { return static_cast<std::size_t>(task) * static_cast<std::size_t>(options.framesPerTask); };
   auto chunkComplete = [&](int task) {
-    const std::size_t first = static_cast<std::size_t>(task) * static_cast<std::size_t>(options.framesPerTask);
-    for (std::size_t i = first; i < first + out.chunks[static_cast<std::size_t>(task)].size(); ++i)
-      if (!done[i]) return false;
-    return true;
+    const std::size_t first = chunkFirst(task);
+    return std::all_of(done.begin() + static_cast<std::ptrdiff_t>(first),
+                       done.begin() + static_cast<std::ptrdiff_t>(first + out.chunks[static_cast<std::size_t>(task)].size()), [](bool d) { return d; });
   };
   auto failed = waitForArray(
       out.jobId, out.tasks, chunkComplete,
@@ -369,9 +379,8 @@ Expected<RenderArrayOutcome> renderArray(const RenderStage& stageIn, const Optio
   countComplete();
   for (int k = 0; k < out.tasks; ++k) {
     const auto& chunk = out.chunks[static_cast<std::size_t>(k)];
-    const std::size_t first = static_cast<std::size_t>(k) * static_cast<std::size_t>(options.framesPerTask);
     for (std::size_t i = 0; i < chunk.size(); ++i)
-      if (!done[first + i]) out.missing[k].push_back(chunk[i]);
+      if (!done[chunkFirst(k) + i]) out.missing[k].push_back(chunk[i]);
   }
   if (!out.missing.empty()) {
     const auto states = taskStates(out.jobId);
@@ -436,9 +445,7 @@ Expected<CaptureArrayOutcome> captureArray(const capture::Cube2Options& captureI
   script += "if [[ -f $final/Capture.txt ]]; then echo \"dynbench: $final already holds a capture\"; exit 0; fi\n";
   script += "rm -rf \"$partial\"\n";
   script += signalTrap("the capture of seed $seed", "rm -rf \"$partial\"");
-  std::string command = shellQuote(jobExecutable(options).string()) + " capture cube2 -o \"$partial\" --seed \"$seed\"";
-  for (const auto& a : captureArguments(capture)) command += " " + shellQuote(a);
-  script += command + " &\n";
+  script += jobCommand(options, "capture cube2", captureArguments(capture)) + " -o \"$partial\" --seed \"$seed\" &\n";
   script += "child=$!\nwait \"$child\" || exit $?\n";
   script += "mv \"$partial\" \"$final\"\n";
   if (auto ok = writeScript(out.script, script); !ok) return std::unexpected(ok.error());
@@ -474,8 +481,7 @@ Expected<DemoChainOutcome> demoChain(const demo::DemoOptions& demoIn, const Opti
   if (ec) return fail(ErrorCode::kIo, "{}: cannot create the jobs' folder: {}", jobDir.string(), ec.message());
   DemoChainOutcome out;
   out.renderTasks = (demo::demoFrameRenders(demo) + options.framesPerTask - 1) / options.framesPerTask;
-  std::string command = shellQuote(jobExecutable(options).string()) + " demo";
-  for (const auto& a : demoArguments(demo)) command += " " + shellQuote(a);
+  const std::string command = jobCommand(options, "demo", demoArguments(demo));
   // Every part is the demo itself, run in the background so the signal trap can stop it; its
   // outputs are written through temporary names, so a stopped part leaves nothing to clean.
   auto script = [&](const std::string& name, int tasks, const std::string& part, const std::string& what) {
@@ -531,7 +537,7 @@ Expected<DemoChainOutcome> demoChain(const demo::DemoOptions& demoIn, const Opti
     status.datasets = *a;
     auto r = queuedTasks(out.renderJob);
     if (!r) return std::unexpected(r.error());
-    for (const auto& t : *r) (t.state == "PENDING" ? status.render.pending : status.render.running)++;
+    for (const auto& t : *r) (waiting(t.state) ? status.render.pending : status.render.running)++;
     status.render.done = out.renderTasks - status.render.pending - status.render.running;
     auto c = state(out.reportJob, reportWritten);
     if (!c) return std::unexpected(c.error());

@@ -121,6 +121,9 @@ std::vector<double> rotationSeries(const std::string& csv) {
   return out;
 }
 
+// The colours of discard::maskImage, in its order of reasons.
+constexpr const char* kMaskLegend = "red frustum, yellow position, blue normal, magenta direct, cyan indirect";
+
 // Up to n indices of [0, count), evenly spaced from the first to the last, none twice.
 std::vector<std::size_t> evenlySpaced(std::size_t count, int n) {
   std::vector<std::size_t> picked;
@@ -315,8 +318,8 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
       std::string caption = fmt::format("Frames {}-{} at {:g} fps ({} frames): direct + indirect radiance, tone-mapped", video->firstFrame,
                                         video->lastFrame, video->fps, video->frames);
       if (video->masks)
-        caption += "; beside it, the discard mask of the pair ending at each frame (red frustum, yellow position, blue normal, magenta "
-                   "direct, cyan indirect; grey: no pair, at the first frame or a camera cut)";
+        caption += fmt::format("; beside it, the discard mask of the pair ending at each frame ({}; grey: no pair, at the first frame or a camera cut)",
+                               kMaskLegend);
       if (static_cast<std::size_t>(video->frames) < r.frames.size())
         caption += fmt::format("; the first {} of the run's {} frames", video->frames, r.frames.size());
       list.insert(list.begin(), {caption, video->file, true, *video});  // first: motion is the subject
@@ -335,7 +338,7 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
       const fs::path copy = files.assets / fmt::format("{}_{}", stem, mask.filename().string());
       fs::copy_file(mask, copy, fs::copy_options::overwrite_existing, ec);
       if (ec) return fail(ErrorCode::kIo, "{}: cannot copy: {}", mask.string(), ec.message());
-      list.push_back({"Discard mask " + mask.stem().string() + " (red frustum, yellow position, blue normal, magenta direct, cyan indirect)", copy,
+      list.push_back({fmt::format("Discard mask {} ({})", mask.stem().string(), kMaskLegend), copy,
                       false, std::nullopt, true});
     }
     if (r.evaluation)
