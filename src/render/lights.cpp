@@ -78,7 +78,23 @@ double EnvironmentLight::solidAnglePdf(double density, double v) const {
 }
 
 glm::dvec3 EnvironmentLight::radiance(const glm::dvec3& direction, double* pdf) const {
-  const glm::dvec2 uv = equirectCoordinates(direction);
+  return radianceAt(equirectCoordinates(direction), pdf);
+}
+
+void EnvironmentLight::prefetchPixel(glm::dvec2 uv) const { __builtin_prefetch(&pixels_[pixelAt(uv)]); }
+
+void EnvironmentLight::prefetchSampleTable(glm::dvec2 u) const {
+  if (height_ > 1) distribution_.prefetch(u);
+}
+
+void EnvironmentLight::prefetchSamplePixel(glm::dvec2 u) const {
+  if (height_ <= 1 || distribution_.empty()) return;
+  std::size_t cell = 0;
+  distribution_.sampleCell(u, &cell);
+  __builtin_prefetch(&pixels_[cell]);
+}
+
+glm::dvec3 EnvironmentLight::radianceAt(glm::dvec2 uv, double* pdf) const {
   const glm::vec4& pixel = pixels_[pixelAt(uv)];
   if (distribution_.empty()) *pdf = 0.0;
   else if (height_ == 1) *pdf = 1.0 / (4.0 * kPi);
@@ -278,12 +294,28 @@ std::optional<LightSample> LightSet::sample(const glm::dvec3& point, double uCho
 }
 
 glm::dvec3 LightSet::environmentRadiance(const glm::dvec3& direction, double* pdf) const {
+  return environmentRadianceAt(equirectCoordinates(direction), pdf);
+}
+
+glm::dvec3 LightSet::environmentRadianceAt(glm::dvec2 uv, double* pdf) const {
   *pdf = 0.0;
   if (!environment_) return glm::dvec3(0.0);
   double p = 0.0;
-  const glm::dvec3 le = environment_->radiance(direction, &p);
+  const glm::dvec3 le = environment_->radianceAt(uv, &p);
   if (environmentChoice_ > 0) *pdf = environmentChoice_ * p;
   return le;
+}
+
+void LightSet::prefetchSample(double uChoice, glm::dvec2 u, int stage) const {
+  if (choice_.empty()) return;
+  if (choice_.sampleDiscrete(uChoice) == 0) {  // the same pick sample() makes: a two-entry table
+    if (stage == 0) environment_->prefetchSampleTable(u);
+    else environment_->prefetchSamplePixel(u);
+  } else if (stage == 0) {
+    triangleChoice_.prefetch(u.x);
+  } else {
+    __builtin_prefetch(&triangles_[triangleChoice_.sampleDiscrete(u.x)]);
+  }
 }
 
 // Choice of the triangle ∝ area x weight, then uniform on it: the area cancels, leaving

@@ -32,10 +32,17 @@ class EnvironmentLight {
   glm::dvec3 radiance(const glm::dvec3& direction) const;
   // Radiance and solid-angle density in one lookup (a path that escapes needs both).
   glm::dvec3 radiance(const glm::dvec3& direction, double* pdf) const;
+  // The same at image point uv = equirectCoordinates(direction), computed by the caller.
+  glm::dvec3 radianceAt(glm::dvec2 uv, double* pdf) const;
   // A direction towards the environment with its solid-angle density and, when asked, the
   // radiance from it (the sampled pixel's, without mapping the direction back).
   glm::dvec3 sample(glm::dvec2 u, double* pdf, glm::dvec3* radiance = nullptr) const;
   double pdf(const glm::dvec3& direction) const;
+  // Memory prefetches for the batched path tracer: the pixel radianceAt(uv) reads; the table
+  // entry sample(u) reads first; then (once that entry has arrived) the pixel it picks.
+  void prefetchPixel(glm::dvec2 uv) const;
+  void prefetchSampleTable(glm::dvec2 u) const;
+  void prefetchSamplePixel(glm::dvec2 u) const;
   // Mean radiance over the sphere (luminance), for choosing between lights.
   double meanLuminance() const { return meanLuminance_; }
 
@@ -100,6 +107,15 @@ class LightSet {
   // When a BSDF-sampled ray reaches the environment: its radiance and, in *pdf, this strategy's
   // density for MIS (choice x solid-angle density), in one lookup.
   glm::dvec3 environmentRadiance(const glm::dvec3& direction, double* pdf) const;
+  // The same at image point uv = equirectCoordinates(direction).
+  glm::dvec3 environmentRadianceAt(glm::dvec2 uv, double* pdf) const;
+  // Memory prefetches for the batched path tracer. Stage 0 starts loading the table entries that
+  // sample(point, uChoice, u) reads first; stage 1, issued after stage 0's loads have had time to
+  // arrive, the data those entries point to (the environment pixel or the emissive triangle).
+  void prefetchSample(double uChoice, glm::dvec2 u, int stage) const;
+  void prefetchEnvironment(glm::dvec2 uv) const {
+    if (environment_) environment_->prefetchPixel(uv);
+  }
   // The same density when a BSDF-sampled ray reaches an emissive triangle (whose emissive factor
   // luminance is `emissiveLuminance`).
   double pdfEmissive(double emissiveLuminance, double distance, double cosAtLight) const;

@@ -15,6 +15,9 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr int kMinFirstRound = 16;
+// Paths traced together (PathTracer::tracePaths): enough that a path's prefetched loads arrive
+// while the others trace.
+constexpr int kBatch = 32;
 
 // Rays leave a surface from a point pushed off it along the geometric normal, by an amount that
 // grows with the coordinates' magnitude (Embree intersects in single precision).
@@ -85,6 +88,31 @@ glm::dvec2 PathTracer::texCoord(int node, int primitive, unsigned triangle, glm:
   return (1.0 - b.x - b.y) * glm::dvec2(prim.uvs[idx[0]]) + b.x * glm::dvec2(prim.uvs[idx[1]]) + b.y * glm::dvec2(prim.uvs[idx[2]]);
 }
 
+glm::dvec2 PathTracer::texCoord(const SurfaceHit& hit) const {
+  const auto& n = scene_.nodes[static_cast<std::size_t>(hit.node)];
+  const auto& prim = scene_.meshes[static_cast<std::size_t>(n.mesh)].primitives[static_cast<std::size_t>(hit.primitive)];
+  if (prim.uvs.empty()) return glm::dvec2(0.0);
+  const glm::dvec2 b = hit.barycentric;
+  return (1.0 - b.x - b.y) * glm::dvec2(prim.uvs[hit.vertices[0]]) + b.x * glm::dvec2(prim.uvs[hit.vertices[1]]) +
+         b.y * glm::dvec2(prim.uvs[hit.vertices[2]]);
+}
+
+void PathTracer::prefetchTexCoords(const SurfaceHit& hit) const {
+  const auto& n = scene_.nodes[static_cast<std::size_t>(hit.node)];
+  const auto& prim = scene_.meshes[static_cast<std::size_t>(n.mesh)].primitives[static_cast<std::size_t>(hit.primitive)];
+  if (prim.uvs.empty()) return;
+  for (const std::uint32_t v : hit.vertices) __builtin_prefetch(&prim.uvs[v]);
+}
+
+void PathTracer::prefetchTextures(const SurfaceHit& hit, glm::dvec2 uv) const {
+  const scene::Material* m = materialOf(hit.node, hit.primitive);
+  if (!m) return;
+  textures_.prefetch(m->baseColorTexture, true, uv);
+  if (m->workflow == scene::MaterialWorkflow::kMetallicRoughness) textures_.prefetch(m->metallicRoughnessTexture, false, uv);
+  textures_.prefetch(m->normalTexture, false, uv);
+  if (m->emissiveFactor != glm::vec3(0.0f)) textures_.prefetch(m->emissiveTexture, true, uv);
+}
+
 // glTF alphaMode MASK: the surface exists where base colour alpha (factor x texture) >= cutoff.
 bool PathTracer::alphaOpaque(int node, int primitive, unsigned triangle, glm::dvec2 b) const {
   const scene::Material* m = materialOf(node, primitive);
@@ -104,10 +132,9 @@ glm::dvec3 PathTracer::emission(int node, int primitive, unsigned triangle, glm:
   return e;
 }
 
-PathTracer::Shading PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo) const {
+PathTracer::Shading PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv) const {
   Shading s;
   const scene::Material* m = materialOf(hit.node, hit.primitive);
-  const glm::dvec2 uv = texCoord(hit.node, hit.primitive, hit.triangle, hit.barycentric);
   // glTF's default material when a primitive has none: white, metallic 1, roughness 1 (§3.9.6).
   SurfaceMaterial& mat = s.material;
   mat.metallic = 1.0;
@@ -198,98 +225,158 @@ struct PathTracer::PathSample {
   glm::dvec3 direct{0.0}, indirect{0.0};
 };
 
+// One path of a batch between its stages.
+struct PathTracer::PathState {
+  Random rng;
+  Ray ray;
+  SurfaceHit hit;  // of `ray` (depth > 0)
+  glm::dvec3 throughput{1.0};
+  PathSample out;
+  double previousBsdfPdf = 0.0;  // solid-angle pdf of the BSDF sample that made `ray`
+  bool previousDelta = true;     // camera rays: nothing else could have found the emitter
+  bool active = true;
+  // The light sample's random numbers, drawn in the trace stage (in the order the path draws
+  // them: nothing else draws between the hit and them) so that their tables can be prefetched.
+  double uChoice = 0.0;
+  glm::dvec2 uLight{0.0};
+  glm::dvec2 uv{0.0};  // the hit's texture coordinates, or the environment image point of an escape
+};
+
 // Per-thread working memory of the path loop, so the per-ray path does not allocate.
 struct PathTracer::PathScratch {
   std::vector<std::uint32_t> reach;  // punctual lights in reach of a shading point
+  std::vector<PathState> paths;      // a batch
   std::uint64_t rays = 0, shadingPoints = 0, punctualEvaluated = 0;
 };
 
-PathTracer::PathSample PathTracer::tracePath(const Ray& cameraRay, const SurfaceHit& firstHit, const Shading& firstShading, Random& rng,
-                                             PathScratch& scratch) const {
-  PathSample out;
-  Ray ray = cameraRay;
-  glm::dvec3 throughput(1.0);
-  double previousBsdfPdf = 0.0;  // solid-angle pdf of the BSDF sample that made `ray`
-  bool previousDelta = true;     // camera rays: nothing else could have found the emitter
-  for (int depth = 0;; ++depth) {
-    SurfaceHit traced;
-    if (depth > 0) {
-      traced = trace(ray);
-      ++scratch.rays;
-    }
-    const SurfaceHit& hit = depth == 0 ? firstHit : traced;
-    // Radiance found by this ray is direct when it reaches the camera from the first surface
-    // (depth 1) or is seen by the camera itself (depth 0).
-    glm::dvec3& bucket = depth <= 1 ? out.direct : out.indirect;
-    if (!hit.hit) {
-      if (environment_) {
-        double pdfLight = 0.0;
-        const glm::dvec3 le = lights_.environmentRadiance(ray.direction, &pdfLight);
-        const double w = previousDelta || !settings_.nextEventEstimation ? 1.0 : powerHeuristic(previousBsdfPdf, pdfLight);
-        bucket += throughput * le * w;
-      }
-      break;
-    }
-    const glm::dvec3 wo = -ray.direction;
-    const Shading s = depth == 0 ? firstShading : shade(hit, wo);
-    if (s.material.emission != glm::dvec3(0.0)) {
-      double w = 1.0;
-      if (!previousDelta && settings_.nextEventEstimation) {
-        const double cosLight = std::abs(glm::dot(hit.geometricNormal, ray.direction));
-        w = powerHeuristic(previousBsdfPdf, lights_.pdfEmissive(s.emissiveWeight, hit.distance, cosLight));
-      }
-      bucket += throughput * s.material.emission * w;
-    }
-    if (depth > settings_.bounces) break;
-    const Frame frame(s.shadingNormal);
-    const Bsdf bsdf(s.material, frame, s.geometricNormal);
-    const glm::dvec3 origin = offsetOrigin(hit.position, s.geometricNormal);
-    glm::dvec3& nextBucket = depth == 0 ? out.direct : out.indirect;  // light reaching this hit
-
-    if (settings_.nextEventEstimation) {
-      // Adds one light's contribution; Monte Carlo samples are weighted against BSDF sampling
-      // (Veach's MIS), delta lights count fully (no other strategy can find them).
-      auto addLight = [&](const std::optional<LightSample>& ls) {
-        if (!ls || !(ls->pdf > 0)) return;
-        const glm::dvec3 f = bsdf.eval(wo, ls->direction);
-        if (f == glm::dvec3(0.0)) return;
-        const double cosine = std::abs(glm::dot(s.shadingNormal, ls->direction));
-        const double tMax = std::isinf(ls->distance) ? 1e30 : ls->distance * (1.0 - 1e-4) - 3e-5;
-        ++scratch.rays;
-        if (rayTracing_->occluded(origin, ls->direction, tMax)) return;
-        const double w = ls->delta ? 1.0 : powerHeuristic(ls->pdf, bsdf.pdf(wo, ls->direction));
-        nextBucket += throughput * f * ls->radiance * (cosine * w / ls->pdf);
-      };
-      // Every punctual light in reach: a sum, no noise (LightSet::punctualInReach).
-      lights_.punctualInReach(hit.position, scratch.reach);
-      ++scratch.shadingPoints;
-      scratch.punctualEvaluated += scratch.reach.size();
-      for (const std::uint32_t l : scratch.reach) addLight(lights_.samplePunctual(l, hit.position));
-      // The environment or an emissive triangle: one Monte Carlo sample. Drawn whether or not
-      // there is anything to choose, so the random stream stays aligned.
-      const double uChoice = rng.uniform();
-      const glm::dvec2 uLight = rng.uniform2();
-      if (!lights_.empty()) addLight(lights_.sample(hit.position, uChoice, uLight));
-    }
-
-    const double uLobe = rng.uniform();
-    const auto bs = bsdf.sample(wo, rng.uniform2(), uLobe);
-    if (!bs) break;
-    throughput *= bs->value * (std::abs(glm::dot(s.shadingNormal, bs->direction)) / bs->pdf);
-    if (depth >= 3) {  // Russian roulette keeps long paths cheap without bias
-      const double survive = std::min(0.95, std::max({throughput.x, throughput.y, throughput.z}));
-      if (rng.uniform() >= survive) break;
-      throughput /= survive;
-    }
-    if (!finite(throughput) || throughput == glm::dvec3(0.0)) break;
-    previousBsdfPdf = bs->pdf;
-    previousDelta = false;
-    ray.origin = origin;
-    ray.direction = bs->direction;
+void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, const Shading& firstShading, std::span<PathState> paths,
+                            PathScratch& scratch) const {
+  for (PathState& p : paths) {
+    p.ray = cameraRay;
+    p.throughput = glm::dvec3(1.0);
+    p.out = PathSample{};
+    p.previousBsdfPdf = 0.0;
+    p.previousDelta = true;
+    p.active = true;
   }
-  if (!finite(out.direct)) out.direct = glm::dvec3(0.0);
-  if (!finite(out.indirect)) out.indirect = glm::dvec3(0.0);
-  return out;
+  const bool lightSample = settings_.nextEventEstimation;
+  for (int depth = 0;; ++depth) {
+    const bool shadesHere = depth <= settings_.bounces;  // a hit at this depth gathers light and bounces
+    // Stage 1: trace; start loading the hit's texture coordinates, the environment pixel of an
+    // escape, and the light tables the light sample will read.
+    bool any = false;
+    for (PathState& p : paths) {
+      if (!p.active) continue;
+      any = true;
+      if (depth > 0) {
+        p.hit = trace(p.ray);
+        ++scratch.rays;
+      }
+      const SurfaceHit& hit = depth == 0 ? firstHit : p.hit;
+      if (!hit.hit) {
+        if (environment_) {
+          p.uv = equirectCoordinates(p.ray.direction);
+          lights_.prefetchEnvironment(p.uv);
+        }
+        continue;
+      }
+      if (depth > 0) prefetchTexCoords(hit);
+      if (lightSample && shadesHere) {
+        p.uChoice = p.rng.uniform();
+        p.uLight = p.rng.uniform2();
+        lights_.prefetchSample(p.uChoice, p.uLight, 0);
+      }
+    }
+    if (!any) break;
+    // Stage 2: what stage 1's loads point to: the texels at the hit, the light's pixel or triangle.
+    for (PathState& p : paths) {
+      const SurfaceHit& hit = depth == 0 ? firstHit : p.hit;
+      if (!p.active || !hit.hit) continue;
+      if (depth > 0) {
+        p.uv = texCoord(hit);
+        prefetchTextures(hit, p.uv);
+      }
+      if (lightSample && shadesHere) lights_.prefetchSample(p.uChoice, p.uLight, 1);
+    }
+    // Stage 3: shade, gather light, bounce.
+    for (PathState& p : paths)
+      if (p.active) p.active = advance(p, depth, depth == 0 ? firstHit : p.hit, depth == 0 ? &firstShading : nullptr, scratch);
+  }
+  for (PathState& p : paths) {
+    if (!finite(p.out.direct)) p.out.direct = glm::dvec3(0.0);
+    if (!finite(p.out.indirect)) p.out.indirect = glm::dvec3(0.0);
+  }
+}
+
+bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const Shading* given, PathScratch& scratch) const {
+  const Ray& ray = p.ray;
+  // Radiance found by this ray is direct when it reaches the camera from the first surface
+  // (depth 1) or is seen by the camera itself (depth 0).
+  glm::dvec3& bucket = depth <= 1 ? p.out.direct : p.out.indirect;
+  if (!hit.hit) {
+    if (environment_) {
+      double pdfLight = 0.0;
+      const glm::dvec3 le = lights_.environmentRadianceAt(p.uv, &pdfLight);
+      const double w = p.previousDelta || !settings_.nextEventEstimation ? 1.0 : powerHeuristic(p.previousBsdfPdf, pdfLight);
+      bucket += p.throughput * le * w;
+    }
+    return false;
+  }
+  const glm::dvec3 wo = -ray.direction;
+  const Shading s = given ? *given : shade(hit, wo, p.uv);
+  if (s.material.emission != glm::dvec3(0.0)) {
+    double w = 1.0;
+    if (!p.previousDelta && settings_.nextEventEstimation) {
+      const double cosLight = std::abs(glm::dot(hit.geometricNormal, ray.direction));
+      w = powerHeuristic(p.previousBsdfPdf, lights_.pdfEmissive(s.emissiveWeight, hit.distance, cosLight));
+    }
+    bucket += p.throughput * s.material.emission * w;
+  }
+  if (depth > settings_.bounces) return false;
+  const Frame frame(s.shadingNormal);
+  const Bsdf bsdf(s.material, frame, s.geometricNormal);
+  const glm::dvec3 origin = offsetOrigin(hit.position, s.geometricNormal);
+  glm::dvec3& nextBucket = depth == 0 ? p.out.direct : p.out.indirect;  // light reaching this hit
+
+  if (settings_.nextEventEstimation) {
+    // Adds one light's contribution; Monte Carlo samples are weighted against BSDF sampling
+    // (Veach's MIS), delta lights count fully (no other strategy can find them).
+    auto addLight = [&](const std::optional<LightSample>& ls) {
+      if (!ls || !(ls->pdf > 0)) return;
+      const glm::dvec3 f = bsdf.eval(wo, ls->direction);
+      if (f == glm::dvec3(0.0)) return;
+      const double cosine = std::abs(glm::dot(s.shadingNormal, ls->direction));
+      const double tMax = std::isinf(ls->distance) ? 1e30 : ls->distance * (1.0 - 1e-4) - 3e-5;
+      ++scratch.rays;
+      if (rayTracing_->occluded(origin, ls->direction, tMax)) return;
+      const double w = ls->delta ? 1.0 : powerHeuristic(ls->pdf, bsdf.pdf(wo, ls->direction));
+      nextBucket += p.throughput * f * ls->radiance * (cosine * w / ls->pdf);
+    };
+    // Every punctual light in reach: a sum, no noise (LightSet::punctualInReach).
+    lights_.punctualInReach(hit.position, scratch.reach);
+    ++scratch.shadingPoints;
+    scratch.punctualEvaluated += scratch.reach.size();
+    for (const std::uint32_t l : scratch.reach) addLight(lights_.samplePunctual(l, hit.position));
+    // The environment or an emissive triangle: one Monte Carlo sample (its random numbers drawn
+    // in the trace stage whether or not there is anything to choose, so the stream stays aligned).
+    if (!lights_.empty()) addLight(lights_.sample(hit.position, p.uChoice, p.uLight));
+  }
+
+  const double uLobe = p.rng.uniform();
+  const auto bs = bsdf.sample(wo, p.rng.uniform2(), uLobe);
+  if (!bs) return false;
+  p.throughput *= bs->value * (std::abs(glm::dot(s.shadingNormal, bs->direction)) / bs->pdf);
+  if (depth >= 3) {  // Russian roulette keeps long paths cheap without bias
+    const double survive = std::min(0.95, std::max({p.throughput.x, p.throughput.y, p.throughput.z}));
+    if (p.rng.uniform() >= survive) return false;
+    p.throughput /= survive;
+  }
+  if (!finite(p.throughput) || p.throughput == glm::dvec3(0.0)) return false;
+  p.previousBsdfPdf = bs->pdf;
+  p.previousDelta = false;
+  p.ray.origin = origin;
+  p.ray.direction = bs->direction;
+  return true;
 }
 
 namespace {
@@ -355,11 +442,16 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
       while (sum.samples < upTo) sum.add(le, glm::dvec3(0.0));
       return;
     }
-    const Shading shading = shade(hit, -ray.direction);
-    for (int sample = sum.samples; sample < upTo; ++sample) {
-      Random rng(settings_.seed, frameIndex, pixel, static_cast<std::uint64_t>(sample));
-      const PathSample ps = tracePath(ray, hit, shading, rng, scratch);
-      sum.add(ps.direct, ps.indirect);
+    const Shading shading = shade(hit, -ray.direction, texCoord(hit));
+    // In batches, each path with the random stream of its sample index, summed in sample order.
+    while (sum.samples < upTo) {
+      const std::size_t batch = static_cast<std::size_t>(std::min(upTo - sum.samples, kBatch));
+      scratch.paths.resize(std::max(scratch.paths.size(), batch));
+      const std::span<PathState> paths(scratch.paths.data(), batch);
+      for (std::size_t k = 0; k < batch; ++k)
+        paths[k].rng = Random(settings_.seed, frameIndex, pixel, static_cast<std::uint64_t>(sum.samples) + k);
+      tracePaths(ray, hit, shading, paths, scratch);
+      for (const PathState& p : paths) sum.add(p.out.direct, p.out.indirect);
     }
   };
 
@@ -376,7 +468,7 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
         ++scratch.rays;
         firstHits[pixel] = hit;
         if (hit.hit) {
-          const Shading s = shade(hit, -ray.direction);
+          const Shading s = shade(hit, -ray.direction, texCoord(hit));
           put3(out.position, pixel, hit.position);
           put3(out.normal, pixel, s.shadingNormal);
           put3(out.albedo, pixel, s.material.baseColor);

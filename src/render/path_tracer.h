@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -88,18 +89,33 @@ class PathTracer {
  private:
   struct Shading;
   PathTracer(const scene::Scene& scene, const RenderSettings& settings);
-  Shading shade(const SurfaceHit& hit, const glm::dvec3& wo) const;
+  // The material at a hit seen from direction wo, at the hit's texture coordinates uv.
+  Shading shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv) const;
   glm::dvec3 emission(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
   glm::dvec2 texCoord(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
+  glm::dvec2 texCoord(const SurfaceHit& hit) const;  // the same, from the vertex indices the hit carries
+  // Memory prefetches of the batched tracer: a hit's vertex texture coordinates, then the texels
+  // its material will read at uv.
+  void prefetchTexCoords(const SurfaceHit& hit) const;
+  void prefetchTextures(const SurfaceHit& hit, glm::dvec2 uv) const;
   bool alphaOpaque(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
   const scene::Material* materialOf(int node, int primitive) const;
   SurfaceHit trace(const Ray& ray) const;
   struct PathSample;
+  struct PathState;
   struct PathScratch;
-  // One path from the camera through the pixel centre, starting at its first hit (already traced
-  // and shaded): its direct and indirect radiance.
-  PathSample tracePath(const Ray& cameraRay, const SurfaceHit& firstHit, const Shading& firstShading, Random& rng,
-                       PathScratch& scratch) const;
+  // A batch of paths from the camera through the pixel centre, all starting at its first hit
+  // (already traced and shaded), each with its own random stream: their direct and indirect
+  // radiance, in paths[k].out. The paths advance together, one bounce at a time, in stages (trace
+  // every path, then shade every path), so that the memory each path's shading reads (texels,
+  // environment pixels, light tables) is prefetched while the other paths trace: one path at a
+  // time spent most of its time waiting on those loads. Each path computes exactly what it would
+  // alone: the same random numbers in the same order, the same arithmetic.
+  void tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, const Shading& firstShading, std::span<PathState> paths,
+                  PathScratch& scratch) const;
+  // One vertex of one path (its hit traced, its prefetches issued): adds what it finds to the
+  // path's radiance and sets up the next ray. false when the path ends.
+  bool advance(PathState& path, int depth, const SurfaceHit& hit, const Shading* given, PathScratch& scratch) const;
 
   const scene::Scene& scene_;
   RenderSettings settings_;

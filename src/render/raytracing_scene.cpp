@@ -271,6 +271,7 @@ SurfaceHit RayTracingScene::intersect(const Ray& ray, double tMin, double tMax) 
   hit.dynamicGeometry = rh.hit.instID[0] != 0;
   hit.geometry = rh.hit.geomID;
   const std::uint32_t i0 = e.indices[3 * rh.hit.primID], i1 = e.indices[3 * rh.hit.primID + 1], i2 = e.indices[3 * rh.hit.primID + 2];
+  hit.vertices = {i0, i1, i2};
   const double u = rh.hit.u, v = rh.hit.v, w = 1.0 - u - v;
   hit.position = w * e.positions[i0] + u * e.positions[i1] + v * e.positions[i2];
   hit.geometricNormal = glm::normalize(glm::cross(e.positions[i1] - e.positions[i0], e.positions[i2] - e.positions[i0]));

@@ -24,6 +24,7 @@ struct SurfaceHit {
   int node = -1;
   int primitive = -1;
   unsigned triangle = 0;
+  std::array<std::uint32_t, 3> vertices{};  // the triangle's vertex indices in its primitive
   bool dynamicGeometry = false;  // which Embree geometry it was (for previousPosition)
   unsigned geometry = 0;
 };

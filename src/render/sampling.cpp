@@ -45,6 +45,14 @@ Distribution1D::Distribution1D(std::span<const double> weights) : weights_(weigh
     if (slot.keep < 1.0 && weights_[slot.alias] <= 0) slot.alias = positive;
 }
 
+// The slot index sampleDiscrete computes, without the clamping of f it does not need.
+void Distribution1D::prefetch(double u) const {
+  if (alias_.empty()) return;
+  const std::size_t i = std::min(static_cast<std::size_t>(std::clamp(u, 0.0, 1.0) * static_cast<double>(alias_.size())), alias_.size() - 1);
+  __builtin_prefetch(&alias_[i]);
+  __builtin_prefetch(&weights_[i]);
+}
+
 std::size_t Distribution1D::sampleDiscrete(double u, double* probability, double* remapped) const {
   const double n = static_cast<double>(alias_.size());
   const double x = std::clamp(u, 0.0, 1.0) * n;
@@ -78,6 +86,11 @@ glm::dvec2 Distribution2D::sampleCell(glm::dvec2 u, std::size_t* cell) const {
   const std::size_t column = columns_[row].sampleDiscrete(u.x, nullptr, &w);
   *cell = row * static_cast<std::size_t>(width_) + column;
   return {(static_cast<double>(column) + w) / width_, (static_cast<double>(row) + v) / height_};
+}
+
+void Distribution2D::prefetch(glm::dvec2 u) const {
+  if (rows_.empty()) return;
+  columns_[rows_.sampleDiscrete(u.y)].prefetch(u.x);
 }
 
 glm::dvec2 Distribution2D::sample(glm::dvec2 u, double* density) const {

@@ -16,6 +16,7 @@ namespace dynbench::render {
 // PCG32 (O'Neill 2014): small state, good statistics, reproducible streams.
 class Random {
  public:
+  Random() = default;
   // One independent stream per (seed, frame, pixel, sample): the image does not depend on which
   // thread renders which pixel.
   Random(std::uint64_t seed, std::uint64_t frame, std::uint64_t pixel, std::uint64_t sample) {
@@ -92,6 +93,8 @@ class Distribution1D {
   // (what is left of u's precision: about 32 - log2(n) bits).
   std::size_t sampleDiscrete(double u, double* probability = nullptr, double* remapped = nullptr) const;
   double probability(std::size_t bin) const { return total_ > 0 ? weights_[bin] / total_ : 0.0; }
+  // Starts loading the table entry sampleDiscrete(u) reads first (its slot and the slot's own bin).
+  void prefetch(double u) const;
 
  private:
   // Slot i of the table: bin i with probability `keep` (of the slot's 1/n), else bin `alias`.
@@ -116,6 +119,8 @@ class Distribution2D {
   // The same point, and the index (row x width + column) of its cell instead of the density.
   glm::dvec2 sampleCell(glm::dvec2 u, std::size_t* cell) const;
   double density(glm::dvec2 point) const;
+  // Starts loading the column table entry that sampleCell(u) reads (the row table is small).
+  void prefetch(glm::dvec2 u) const;
 
  private:
   double cellDensity(std::size_t row, std::size_t column) const;

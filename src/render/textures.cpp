@@ -75,11 +75,10 @@ Texture toTexture(const FloatImage& image, bool srgb) {
 }  // namespace
 
 // In float: texels are float, and a float uv resolves 1/1000 of a texel on a 16k-texel repeat.
-glm::dvec4 Texture::sample(glm::dvec2 uv) const {
+Texture::Footprint Texture::footprint(glm::dvec2 uv) const {
   const float x = static_cast<float>(uv.x) * static_cast<float>(width) - 0.5f;
   const float y = static_cast<float>(uv.y) * static_cast<float>(height) - 0.5f;
   const float fx = std::floor(x), fy = std::floor(y);
-  const float tx = x - fx, ty = y - fy;
   // Repeat: one remainder per axis (uv far outside [0, 1] stays exact as long as it fits a long).
   auto wrap = [](float f, int n) {
     long i = static_cast<long>(f) % n;
@@ -89,14 +88,24 @@ glm::dvec4 Texture::sample(glm::dvec2 uv) const {
   const std::size_t x1 = x0 + 1 == static_cast<std::size_t>(width) ? 0 : x0 + 1;
   const std::size_t y1 = y0 + 1 == static_cast<std::size_t>(height) ? 0 : y0 + 1;
   const auto w = static_cast<std::size_t>(width);
-  const std::size_t i00 = y0 * w + x0, i01 = y0 * w + x1, i10 = y1 * w + x0, i11 = y1 * w + x1;
+  return {{y0 * w + x0, y0 * w + x1, y1 * w + x0, y1 * w + x1}, x - fx, y - fy};
+}
+
+glm::dvec4 Texture::sample(glm::dvec2 uv) const {
+  const Footprint f = footprint(uv);
   auto texel = [&](std::size_t i) {
     if (codes.empty()) return texels[i];
     const auto& k = codes[i];
     return glm::vec4(decodeColour[k[0]], decodeColour[k[1]], decodeColour[k[2]], decodeAlpha[k[3]]);
   };
-  const glm::vec4 a = texel(i00), b = texel(i01), c = texel(i10), d = texel(i11);
+  const glm::vec4 a = texel(f.index[0]), b = texel(f.index[1]), c = texel(f.index[2]), d = texel(f.index[3]);
+  const float tx = f.tx, ty = f.ty;
   return glm::dvec4((1 - ty) * ((1 - tx) * a + tx * b) + ty * ((1 - tx) * c + tx * d));
+}
+
+void Texture::prefetch(glm::dvec2 uv) const {
+  const Footprint f = footprint(uv);
+  for (const std::size_t i : f.index) __builtin_prefetch(codes.empty() ? static_cast<const void*>(&texels[i]) : &codes[i]);
 }
 
 Expected<TextureSet> TextureSet::load(const scene::Scene& scene, std::vector<std::string>& warnings) {
@@ -140,6 +149,10 @@ const Texture* TextureSet::find(int image, bool srgb) const {
   if (image < 0 || static_cast<std::size_t>(image) >= linear_.size()) return nullptr;
   const Texture& t = (srgb ? linear_ : raw_)[static_cast<std::size_t>(image)];
   return t.texels.empty() && t.codes.empty() ? nullptr : &t;
+}
+
+void TextureSet::prefetch(const scene::TextureRef& ref, bool srgb, glm::dvec2 uv) const {
+  if (const Texture* t = find(ref.image, srgb)) t->prefetch(uv);
 }
 
 glm::dvec4 TextureSet::sample(const scene::TextureRef& ref, bool srgb, glm::dvec2 uv, glm::dvec4 fallback) const {

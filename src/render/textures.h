@@ -25,6 +25,16 @@ struct Texture {
   // Bilinear filtering between the four nearest texel centres, repeating at the edges (glTF's
   // default sampler; dynbench does not read sampler objects).
   glm::dvec4 sample(glm::dvec2 uv) const;
+  // Starts loading the texels sample(uv) reads, so that a later sample(uv) does not wait for
+  // memory (the batched path tracer issues these for every path of a batch before shading any).
+  void prefetch(glm::dvec2 uv) const;
+
+ private:
+  struct Footprint {
+    std::size_t index[4];  // texels (x0, y0), (x1, y0), (x0, y1), (x1, y1)
+    float tx, ty;          // bilinear weights of x1 and y1
+  };
+  Footprint footprint(glm::dvec2 uv) const;
 };
 
 class TextureSet {
@@ -37,6 +47,7 @@ class TextureSet {
   // The texture in `ref` sampled at uv; `fallback` when the slot is unused or was skipped.
   glm::dvec4 sample(const scene::TextureRef& ref, bool srgb, glm::dvec2 uv, glm::dvec4 fallback = glm::dvec4(1.0)) const;
   const Texture* find(int image, bool srgb) const;
+  void prefetch(const scene::TextureRef& ref, bool srgb, glm::dvec2 uv) const;
 
  private:
   std::vector<Texture> linear_, raw_;  // per image: sRGB-decoded and as stored (empty when unused)
