@@ -227,6 +227,13 @@ int main(int argc, char** argv) {
     std::printf("path tracer, %d thread(s): %.2f M rays/s (%.2f M rays/s per thread) over %.2f s of frames; whole job %.2f s "
                 "(loading %.2f s)\n",
                 t, raysPerSecond[t - 1] / 1e6, raysPerSecond[t - 1] / t / 1e6, framesSeconds[t - 1], s.seconds, s.loadSeconds);
+    if (t == 1) {
+      // What a ray costs depends on the mix: shadow rays (any hit) per shading point, bounce rays.
+      const double points = static_cast<double>(std::max<std::uint64_t>(1, s.light.shadingPoints));
+      std::printf("  per shading point: %.2f rays, %.2f punctual lights in reach (of %.1f in the frame); %.0f ns of frame time\n",
+                  static_cast<double>(s.rays) / points, static_cast<double>(s.light.punctualEvaluated) / points,
+                  static_cast<double>(s.light.punctualInFrame) / static_cast<double>(list->size()), 1e9 * framesSeconds[0] / points);
+    }
   }
   std::printf("2-thread speedup: %.2fx over the frames, %.2fx over the whole job\n", framesSeconds[0] / framesSeconds[1],
               jobSeconds[0] / jobSeconds[1]);

@@ -87,13 +87,6 @@ void EnvironmentLight::prefetchSampleTable(glm::dvec2 u) const {
   if (height_ > 1) distribution_.prefetch(u);
 }
 
-void EnvironmentLight::prefetchSamplePixel(glm::dvec2 u) const {
-  if (height_ <= 1 || distribution_.empty()) return;
-  std::size_t cell = 0;
-  distribution_.sampleCell(u, &cell);
-  __builtin_prefetch(&pixels_[cell]);
-}
-
 glm::dvec3 EnvironmentLight::radianceAt(glm::dvec2 uv, double* pdf) const {
   const glm::vec4& pixel = pixels_[pixelAt(uv)];
   if (distribution_.empty()) *pdf = 0.0;
@@ -103,6 +96,18 @@ glm::dvec3 EnvironmentLight::radianceAt(glm::dvec2 uv, double* pdf) const {
 }
 
 glm::dvec3 EnvironmentLight::sample(glm::dvec2 u, double* pdf, glm::dvec3* radiance) const {
+  std::size_t pixel = 0;
+  const glm::dvec2 point = samplePoint(u, &pixel);
+  return sampleAt(point, pixel, pdf, radiance);
+}
+
+glm::dvec2 EnvironmentLight::samplePoint(glm::dvec2 u, std::size_t* pixel) const {
+  *pixel = 0;
+  if (distribution_.empty() || height_ == 1) return u;  // nothing to sample, or the sphere uniformly (sampleAt)
+  return distribution_.sampleCell(u, pixel);
+}
+
+glm::dvec3 EnvironmentLight::sampleAt(glm::dvec2 point, std::size_t pixel, double* pdf, glm::dvec3* radiance) const {
   if (distribution_.empty()) {  // a black environment: nothing to sample
     *pdf = 0.0;
     return {0, 1, 0};
@@ -110,18 +115,17 @@ glm::dvec3 EnvironmentLight::sample(glm::dvec2 u, double* pdf, glm::dvec3* radia
   if (height_ == 1) {
     // A single row (constant environment): sample the sphere uniformly instead of in (u, v), so
     // the density stays bounded at the poles.
+    const glm::dvec2 u = point;
     const double z = 1.0 - 2.0 * u.y, r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = 2.0 * kPi * u.x;
     *pdf = 1.0 / (4.0 * kPi);
     const glm::dvec3 d(r * std::cos(phi), z, r * std::sin(phi));
     if (radiance) *radiance = this->radiance(d);
     return d;
   }
-  std::size_t cell = 0;
-  const glm::dvec2 uv = distribution_.sampleCell(u, &cell);
-  const glm::vec4& pixel = pixels_[cell];
-  *pdf = solidAnglePdf(pixel.w, uv.y);
-  if (radiance) *radiance = glm::dvec3(pixel);
-  return equirectDirection(uv.x, uv.y);
+  const glm::vec4& texel = pixels_[pixel];
+  *pdf = solidAnglePdf(texel.w, point.y);
+  if (radiance) *radiance = glm::dvec3(texel);
+  return equirectDirection(point.x, point.y);
 }
 
 double EnvironmentLight::pdf(const glm::dvec3& direction) const {
@@ -261,23 +265,41 @@ std::optional<LightSample> LightSet::samplePunctual(std::size_t light, const glm
 }
 
 std::optional<LightSample> LightSet::sample(const glm::dvec3& point, double uChoice, glm::dvec2 u) const {
-  if (choice_.empty()) return std::nullopt;
-  double choiceProbability = 0.0;
-  const std::size_t pick = choice_.sampleDiscrete(uChoice, &choiceProbability);
-  LightSample s;
-  if (pick == 0) {
-    double pdf = 0.0;
-    s.direction = environment_->sample(u, &pdf, &s.radiance);
-    if (!(pdf > 0)) return std::nullopt;
-    s.distance = std::numeric_limits<double>::infinity();
-    s.pdf = choiceProbability * pdf;
-    return s;
+  return sample(point, choose(uChoice, u));
+}
+
+LightSet::Choice LightSet::choose(double uChoice, glm::dvec2 u) const {
+  Choice c;
+  if (choice_.empty()) return c;
+  if (choice_.sampleDiscrete(uChoice, &c.probability) == 0) {
+    c.kind = Choice::Kind::kEnvironment;
+    c.point = environment_->samplePoint(u, &c.index);
+    environment_->prefetchPixel(c.index);
+    return c;
   }
   // An emissive triangle by area x emissive luminance, then a uniform point on it.
+  c.kind = Choice::Kind::kTriangle;
   double remapped = 0.0, triangleProbability = 0.0;
-  const std::size_t t = triangleChoice_.sampleDiscrete(u.x, &triangleProbability, &remapped);
-  const Triangle& tri = triangles_[t];
-  const glm::dvec2 b = sampleTriangle({remapped, u.y});
+  c.index = triangleChoice_.sampleDiscrete(u.x, &triangleProbability, &remapped);
+  c.probability *= triangleProbability;
+  c.point = {remapped, u.y};
+  __builtin_prefetch(&triangles_[c.index]);
+  return c;
+}
+
+std::optional<LightSample> LightSet::sample(const glm::dvec3& point, const Choice& c) const {
+  LightSample s;
+  if (c.kind == Choice::Kind::kNone) return std::nullopt;
+  if (c.kind == Choice::Kind::kEnvironment) {
+    double pdf = 0.0;
+    s.direction = environment_->sampleAt(c.point, c.index, &pdf, &s.radiance);
+    if (!(pdf > 0)) return std::nullopt;
+    s.distance = std::numeric_limits<double>::infinity();
+    s.pdf = c.probability * pdf;
+    return s;
+  }
+  const Triangle& tri = triangles_[c.index];
+  const glm::dvec2 b = sampleTriangle(c.point);
   const glm::dvec3 p = (1.0 - b.x - b.y) * tri.p0 + b.x * tri.p1 + b.y * tri.p2;
   const glm::dvec3 toLight = p - point;
   const double d2 = glm::dot(toLight, toLight);
@@ -289,7 +311,7 @@ std::optional<LightSample> LightSet::sample(const glm::dvec3& point, double uCho
   const double cosLight = std::abs(glm::dot(cross / (2.0 * area), s.direction));
   if (cosLight <= 1e-12) return std::nullopt;
   s.radiance = emission_(tri.node, tri.primitive, tri.index, b);
-  s.pdf = choiceProbability * triangleProbability * d2 / (area * cosLight);
+  s.pdf = c.probability * d2 / (area * cosLight);
   return s;
 }
 
@@ -306,16 +328,10 @@ glm::dvec3 LightSet::environmentRadianceAt(glm::dvec2 uv, double* pdf) const {
   return le;
 }
 
-void LightSet::prefetchSample(double uChoice, glm::dvec2 u, int stage) const {
+void LightSet::prefetchChoice(double uChoice, glm::dvec2 u) const {
   if (choice_.empty()) return;
-  if (choice_.sampleDiscrete(uChoice) == 0) {  // the same pick sample() makes: a two-entry table
-    if (stage == 0) environment_->prefetchSampleTable(u);
-    else environment_->prefetchSamplePixel(u);
-  } else if (stage == 0) {
-    triangleChoice_.prefetch(u.x);
-  } else {
-    __builtin_prefetch(&triangles_[triangleChoice_.sampleDiscrete(u.x)]);
-  }
+  if (choice_.sampleDiscrete(uChoice) == 0) environment_->prefetchSampleTable(u);  // a two-entry table: cached
+  else triangleChoice_.prefetch(u.x);
 }
 
 // Choice of the triangle ∝ area x weight, then uniform on it: the area cancels, leaving

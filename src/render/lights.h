@@ -37,12 +37,17 @@ class EnvironmentLight {
   // A direction towards the environment with its solid-angle density and, when asked, the
   // radiance from it (the sampled pixel's, without mapping the direction back).
   glm::dvec3 sample(glm::dvec2 u, double* pdf, glm::dvec3* radiance = nullptr) const;
+  // sample() in two steps, so the batched path tracer can prefetch the pixel between them: the
+  // image point and pixel index for u (reads the sampling tables), then the direction, density
+  // and radiance there (reads the pixel).
+  glm::dvec2 samplePoint(glm::dvec2 u, std::size_t* pixel) const;
+  glm::dvec3 sampleAt(glm::dvec2 point, std::size_t pixel, double* pdf, glm::dvec3* radiance = nullptr) const;
   double pdf(const glm::dvec3& direction) const;
   // Memory prefetches for the batched path tracer: the pixel radianceAt(uv) reads; the table
   // entry sample(u) reads first; then (once that entry has arrived) the pixel it picks.
   void prefetchPixel(glm::dvec2 uv) const;
+  void prefetchPixel(std::size_t pixel) const { __builtin_prefetch(&pixels_[pixel]); }
   void prefetchSampleTable(glm::dvec2 u) const;
-  void prefetchSamplePixel(glm::dvec2 u) const;
   // Mean radiance over the sphere (luminance), for choosing between lights.
   double meanLuminance() const { return meanLuminance_; }
 
@@ -104,15 +109,24 @@ class LightSet {
   // The environment or an emissive triangle, picked by estimated power, then a point on it (next
   // event estimation; Monte Carlo, weighted against BSDF sampling by the integrator).
   std::optional<LightSample> sample(const glm::dvec3& point, double uChoice, glm::dvec2 u) const;
+  // The same in two steps: what does not depend on the point (which light, which environment
+  // pixel or triangle; reads the light tables and prefetches the pixel or triangle), then the
+  // sample from the point.
+  struct Choice {
+    enum class Kind { kNone, kEnvironment, kTriangle } kind = Kind::kNone;
+    double probability = 0.0;  // of choosing the light (and for a triangle, that triangle)
+    std::size_t index = 0;     // environment pixel or triangle
+    glm::dvec2 point{0.0};     // environment image point, or the triangle's (remapped u.x, u.y)
+  };
+  Choice choose(double uChoice, glm::dvec2 u) const;
+  std::optional<LightSample> sample(const glm::dvec3& point, const Choice& choice) const;
   // When a BSDF-sampled ray reaches the environment: its radiance and, in *pdf, this strategy's
   // density for MIS (choice x solid-angle density), in one lookup.
   glm::dvec3 environmentRadiance(const glm::dvec3& direction, double* pdf) const;
   // The same at image point uv = equirectCoordinates(direction).
   glm::dvec3 environmentRadianceAt(glm::dvec2 uv, double* pdf) const;
-  // Memory prefetches for the batched path tracer. Stage 0 starts loading the table entries that
-  // sample(point, uChoice, u) reads first; stage 1, issued after stage 0's loads have had time to
-  // arrive, the data those entries point to (the environment pixel or the emissive triangle).
-  void prefetchSample(double uChoice, glm::dvec2 u, int stage) const;
+  // Starts loading the table entries choose(uChoice, u) reads (for the batched path tracer).
+  void prefetchChoice(double uChoice, glm::dvec2 u) const;
   void prefetchEnvironment(glm::dvec2 uv) const {
     if (environment_) environment_->prefetchPixel(uv);
   }

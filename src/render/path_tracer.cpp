@@ -239,6 +239,7 @@ struct PathTracer::PathState {
   // them: nothing else draws between the hit and them) so that their tables can be prefetched.
   double uChoice = 0.0;
   glm::dvec2 uLight{0.0};
+  LightSet::Choice lightChoice;  // from them, in the prefetch stage
   glm::dvec2 uv{0.0};  // the hit's texture coordinates, or the environment image point of an escape
 };
 
@@ -246,6 +247,8 @@ struct PathTracer::PathState {
 struct PathTracer::PathScratch {
   std::vector<std::uint32_t> reach;  // punctual lights in reach of a shading point
   std::vector<PathState> paths;      // a batch
+  std::vector<Ray> rays_;
+  std::vector<SurfaceHit> hits_;
   std::uint64_t rays = 0, shadingPoints = 0, punctualEvaluated = 0;
 };
 
@@ -265,13 +268,20 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
     // Stage 1: trace; start loading the hit's texture coordinates, the environment pixel of an
     // escape, and the light tables the light sample will read.
     bool any = false;
+    if (depth > 0) {
+      scratch.rays_.clear();
+      for (PathState& p : paths)
+        if (p.active) scratch.rays_.push_back(p.ray);
+      scratch.hits_.resize(scratch.rays_.size());
+      rayTracing_->intersect(scratch.rays_, scratch.hits_);
+      std::size_t k = 0;
+      for (PathState& p : paths)
+        if (p.active) p.hit = scratch.hits_[k++];
+      scratch.rays += scratch.rays_.size();
+    }
     for (PathState& p : paths) {
       if (!p.active) continue;
       any = true;
-      if (depth > 0) {
-        p.hit = trace(p.ray);
-        ++scratch.rays;
-      }
       const SurfaceHit& hit = depth == 0 ? firstHit : p.hit;
       if (!hit.hit) {
         if (environment_) {
@@ -284,11 +294,12 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
       if (lightSample && shadesHere) {
         p.uChoice = p.rng.uniform();
         p.uLight = p.rng.uniform2();
-        lights_.prefetchSample(p.uChoice, p.uLight, 0);
+        lights_.prefetchChoice(p.uChoice, p.uLight);
       }
     }
     if (!any) break;
-    // Stage 2: what stage 1's loads point to: the texels at the hit, the light's pixel or triangle.
+    // Stage 2: what stage 1's loads point to: the texels at the hit; the light choice, which
+    // starts loading the environment pixel or triangle it picks.
     for (PathState& p : paths) {
       const SurfaceHit& hit = depth == 0 ? firstHit : p.hit;
       if (!p.active || !hit.hit) continue;
@@ -296,7 +307,7 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
         p.uv = texCoord(hit);
         prefetchTextures(hit, p.uv);
       }
-      if (lightSample && shadesHere) lights_.prefetchSample(p.uChoice, p.uLight, 1);
+      if (lightSample && shadesHere) p.lightChoice = lights_.choose(p.uChoice, p.uLight);
     }
     // Stage 3: shade, gather light, bounce.
     for (PathState& p : paths)
@@ -359,7 +370,7 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const S
     for (const std::uint32_t l : scratch.reach) addLight(lights_.samplePunctual(l, hit.position));
     // The environment or an emissive triangle: one Monte Carlo sample (its random numbers drawn
     // in the trace stage whether or not there is anything to choose, so the stream stays aligned).
-    if (!lights_.empty()) addLight(lights_.sample(hit.position, p.uChoice, p.uLight));
+    if (!lights_.empty()) addLight(lights_.sample(hit.position, p.lightChoice));
   }
 
   const double uLobe = p.rng.uniform();

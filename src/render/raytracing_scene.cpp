@@ -242,9 +242,9 @@ std::array<glm::dvec3, 3> RayTracingScene::trianglePositions(const SurfaceHit& h
 
 const scene::ScenePose& RayTracingScene::pose() const { return impl_->pose; }
 
-SurfaceHit RayTracingScene::intersect(const Ray& ray, double tMin, double tMax) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
+namespace {
+
+RTCRayHit embreeRay(const Ray& ray, double tMin, double tMax) {
   RTCRayHit rh{};
   rh.ray.org_x = static_cast<float>(ray.origin.x);
   rh.ray.org_y = static_cast<float>(ray.origin.y);
@@ -257,10 +257,16 @@ SurfaceHit RayTracingScene::intersect(const Ray& ray, double tMin, double tMax) 
   rh.ray.mask = 0xFFFFFFFF;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(impl_->top, &context, &rh);
+  return rh;
+}
+
+}  // namespace
+
+// The hit record of what Embree found: the scene model's ids and double-precision surface data.
+static SurfaceHit surfaceHit(const RayTracingScene::Impl& impl, const RTCRayHit& rh) {
   SurfaceHit hit;
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
-  const auto& entries = rh.hit.instID[0] == 0 ? impl_->staticEntries : impl_->dynamicEntries;
+  const auto& entries = rh.hit.instID[0] == 0 ? impl.staticEntries : impl.dynamicEntries;
   const Entry& e = entries[rh.hit.geomID];
   hit.hit = true;
   hit.distance = rh.ray.tfar;
@@ -281,6 +287,24 @@ SurfaceHit RayTracingScene::intersect(const Ray& ray, double tMin, double tMax) 
     if (glm::length(n) > 0) hit.shadingNormal = glm::normalize(n);
   }
   return hit;
+}
+
+SurfaceHit RayTracingScene::intersect(const Ray& ray, double tMin, double tMax) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh = embreeRay(ray, tMin, tMax);
+  rtcIntersect1(impl_->top, &context, &rh);
+  return surfaceHit(*impl_, rh);
+}
+
+void RayTracingScene::intersect(std::span<const Ray> rays, std::span<SurfaceHit> hits) const {
+  thread_local std::vector<RTCRayHit> stream;
+  stream.resize(rays.size());
+  for (std::size_t k = 0; k < rays.size(); ++k) stream[k] = embreeRay(rays[k], 0.0, 1e30);
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  rtcIntersect1M(impl_->top, &context, stream.data(), static_cast<unsigned>(stream.size()), sizeof(RTCRayHit));
+  for (std::size_t k = 0; k < rays.size(); ++k) hits[k] = surfaceHit(*impl_, stream[k]);
 }
 
 bool RayTracingScene::occluded(const glm::dvec3& origin, const glm::dvec3& direction, double tMax) const {

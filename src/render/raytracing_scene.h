@@ -6,6 +6,7 @@
 #include <array>
 #include <functional>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "core/error.h"
@@ -66,6 +67,8 @@ class RayTracingScene {
   // The world positions of the hit's triangle at the last update (tangent frames for normal maps).
   std::array<glm::dvec3, 3> trianglePositions(const SurfaceHit& hit) const;  // every node at the last update's time
   SurfaceHit intersect(const Ray& ray, double tMin = 0.0, double tMax = 1e30) const;
+  // Many rays at once, through Embree's stream API: hits[k] is intersect(rays[k]).
+  void intersect(std::span<const Ray> rays, std::span<SurfaceHit> hits) const;
   bool occluded(const glm::dvec3& origin, const glm::dvec3& direction, double tMax) const;
   RayTracingStats stats() const;
 
