@@ -82,9 +82,15 @@ double wrapDegrees(double d) {
 }
 
 glm::dvec3 equirectDirection(double u, double v) {
+  double sinTheta = 0.0;
+  return equirectDirection(u, v, &sinTheta);
+}
+
+glm::dvec3 equirectDirection(double u, double v, double* sinTheta) {
   const double phi = 2.0 * kPi * (u - 0.5);  // azimuth from -Z towards +X
   const double theta = kPi * v;              // polar angle from +Y
-  return {std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi)};
+  *sinTheta = std::sin(theta);
+  return {*sinTheta * std::sin(phi), std::cos(theta), -*sinTheta * std::cos(phi)};
 }
 
 glm::dvec2 equirectCoordinates(const glm::dvec3& d) {

@@ -64,6 +64,8 @@ inline double luminance(const glm::dvec3& rgb) { return 0.2126 * rgb.r + 0.7152 
 // The equirectangular mapping of dataset environments (docs/dataset.md): image point (u, v) in
 // [0, 1]² to a unit direction; u = 0.5 looks down -Z, u grows towards +X; v = 0 is straight up (+Y).
 glm::dvec3 equirectDirection(double u, double v);
+// The same, also giving sin(theta) = sin(pi v) (the mapping's Jacobian needs it).
+glm::dvec3 equirectDirection(double u, double v, double* sinTheta);
 // Its inverse: the image point a unit direction maps to.
 glm::dvec2 equirectCoordinates(const glm::dvec3& direction);
 // Solid angle of pixel row `row` of an equirectangular image of the given size, steradians.

@@ -91,21 +91,33 @@ double Bsdf::pdfLocal(const glm::dvec3& wo, const glm::dvec3& wi, double pSpecul
   return pdf;
 }
 
-glm::dvec3 Bsdf::eval(const glm::dvec3& wo, const glm::dvec3& wi) const {
-  if (glm::dot(wi, ng_) <= 0 || glm::dot(wo, ng_) <= 0) return glm::dvec3(0.0);
-  return evalLocal(frame_.toLocal(wo), frame_.toLocal(wi));
+Bsdf::View Bsdf::view(const glm::dvec3& wo) const {
+  View v;
+  v.wo = wo;
+  v.local = frame_.toLocal(wo);
+  v.specularProbability = specularProbability(v.local);
+  v.above = glm::dot(wo, ng_) > 0;
+  return v;
 }
 
-double Bsdf::pdf(const glm::dvec3& wo, const glm::dvec3& wi) const {
-  if (glm::dot(wi, ng_) <= 0 || glm::dot(wo, ng_) <= 0) return 0.0;
-  const glm::dvec3 o = frame_.toLocal(wo);
-  return pdfLocal(o, frame_.toLocal(wi), specularProbability(o));
+glm::dvec3 Bsdf::eval(const glm::dvec3& wo, const glm::dvec3& wi) const { return eval(view(wo), wi); }
+double Bsdf::pdf(const glm::dvec3& wo, const glm::dvec3& wi) const { return pdf(view(wo), wi); }
+std::optional<BsdfSample> Bsdf::sample(const glm::dvec3& wo, glm::dvec2 u, double uLobe) const { return sample(view(wo), u, uLobe); }
+
+glm::dvec3 Bsdf::eval(const View& v, const glm::dvec3& wi) const {
+  if (glm::dot(wi, ng_) <= 0 || !v.above) return glm::dvec3(0.0);
+  return evalLocal(v.local, frame_.toLocal(wi));
 }
 
-std::optional<BsdfSample> Bsdf::sample(const glm::dvec3& wo, glm::dvec2 u, double uLobe) const {
-  const glm::dvec3 o = frame_.toLocal(wo);
+double Bsdf::pdf(const View& v, const glm::dvec3& wi) const {
+  if (glm::dot(wi, ng_) <= 0 || !v.above) return 0.0;
+  return pdfLocal(v.local, frame_.toLocal(wi), v.specularProbability);
+}
+
+std::optional<BsdfSample> Bsdf::sample(const View& v, glm::dvec2 u, double uLobe) const {
+  const glm::dvec3& o = v.local;
   if (o.z <= 0) return std::nullopt;
-  const double pSpecular = specularProbability(o);
+  const double pSpecular = v.specularProbability;
   glm::dvec3 i;
   if (uLobe < pSpecular) {
     const glm::dvec3 h = sampleGgxVisibleNormal(o, alpha_, u);

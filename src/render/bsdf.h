@@ -41,6 +41,18 @@ class Bsdf {
   // (cosine-weighted); the GGX lobe samples visible normals (Heitz 2018).
   std::optional<BsdfSample> sample(const glm::dvec3& wo, glm::dvec2 u, double uLobe) const;
 
+  // What the three calls above derive from wo alone, derived once: a path vertex evaluates, weighs
+  // and samples with the same wo (same results, less arithmetic).
+  struct View {
+    glm::dvec3 wo, local;
+    double specularProbability = 0.0;
+    bool above = false;  // wo is on the geometric normal's side
+  };
+  View view(const glm::dvec3& wo) const;
+  glm::dvec3 eval(const View& view, const glm::dvec3& wi) const;
+  double pdf(const View& view, const glm::dvec3& wi) const;
+  std::optional<BsdfSample> sample(const View& view, glm::dvec2 u, double uLobe) const;
+
   double alpha() const { return alpha_; }
 
   // Building blocks, in the local frame (n = +Z), exposed for known-answer tests.

@@ -72,10 +72,9 @@ glm::dvec3 EnvironmentLight::radiance(const glm::dvec3& direction) const {
 
 // A density over the image square becomes a solid-angle density through the equirectangular
 // Jacobian: dω = 2π² sin θ du dv.
-double EnvironmentLight::solidAnglePdf(double density, double v) const {
-  const double sinTheta = std::sin(kPi * v);
-  return sinTheta > 0 ? density / (2.0 * kPi * kPi * sinTheta) : 0.0;
-}
+double EnvironmentLight::solidAnglePdf(double density, double v) const { return solidAngleDensity(density, std::sin(kPi * v)); }
+
+double EnvironmentLight::solidAngleDensity(double density, double sinTheta) { return sinTheta > 0 ? density / (2.0 * kPi * kPi * sinTheta) : 0.0; }
 
 glm::dvec3 EnvironmentLight::radiance(const glm::dvec3& direction, double* pdf) const {
   return radianceAt(equirectCoordinates(direction), pdf);
@@ -123,9 +122,11 @@ glm::dvec3 EnvironmentLight::sampleAt(glm::dvec2 point, std::size_t pixel, doubl
     return d;
   }
   const glm::vec4& texel = pixels_[pixel];
-  *pdf = solidAnglePdf(texel.w, point.y);
+  double sinTheta = 0.0;
+  const glm::dvec3 direction = equirectDirection(point.x, point.y, &sinTheta);
+  *pdf = solidAngleDensity(texel.w, sinTheta);
   if (radiance) *radiance = glm::dvec3(texel);
-  return equirectDirection(point.x, point.y);
+  return direction;
 }
 
 double EnvironmentLight::pdf(const glm::dvec3& direction) const {

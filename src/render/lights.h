@@ -62,6 +62,7 @@ class EnvironmentLight {
   std::size_t pixelAt(glm::dvec2 uv) const;
   // Solid-angle density at image point uv of a pixel whose square density is `density`.
   double solidAnglePdf(double density, double v) const;
+  static double solidAngleDensity(double density, double sinTheta);  // the same, given sin(theta) = sin(pi v)
 };
 
 struct LightSample {

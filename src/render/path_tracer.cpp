@@ -346,6 +346,7 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const S
   if (depth > settings_.bounces) return false;
   const Frame frame(s.shadingNormal);
   const Bsdf bsdf(s.material, frame, s.geometricNormal);
+  const Bsdf::View view = bsdf.view(wo);
   const glm::dvec3 origin = offsetOrigin(hit.position, s.geometricNormal);
   glm::dvec3& nextBucket = depth == 0 ? p.out.direct : p.out.indirect;  // light reaching this hit
 
@@ -354,13 +355,13 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const S
     // (Veach's MIS), delta lights count fully (no other strategy can find them).
     auto addLight = [&](const std::optional<LightSample>& ls) {
       if (!ls || !(ls->pdf > 0)) return;
-      const glm::dvec3 f = bsdf.eval(wo, ls->direction);
+      const glm::dvec3 f = bsdf.eval(view, ls->direction);
       if (f == glm::dvec3(0.0)) return;
       const double cosine = std::abs(glm::dot(s.shadingNormal, ls->direction));
       const double tMax = std::isinf(ls->distance) ? 1e30 : ls->distance * (1.0 - 1e-4) - 3e-5;
       ++scratch.rays;
       if (rayTracing_->occluded(origin, ls->direction, tMax)) return;
-      const double w = ls->delta ? 1.0 : powerHeuristic(ls->pdf, bsdf.pdf(wo, ls->direction));
+      const double w = ls->delta ? 1.0 : powerHeuristic(ls->pdf, bsdf.pdf(view, ls->direction));
       nextBucket += p.throughput * f * ls->radiance * (cosine * w / ls->pdf);
     };
     // Every punctual light in reach: a sum, no noise (LightSet::punctualInReach).
@@ -374,7 +375,7 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const S
   }
 
   const double uLobe = p.rng.uniform();
-  const auto bs = bsdf.sample(wo, p.rng.uniform2(), uLobe);
+  const auto bs = bsdf.sample(view, p.rng.uniform2(), uLobe);
   if (!bs) return false;
   p.throughput *= bs->value * (std::abs(glm::dot(s.shadingNormal, bs->direction)) / bs->pdf);
   if (depth >= 3) {  // Russian roulette keeps long paths cheap without bias

@@ -79,9 +79,12 @@ Texture::Footprint Texture::footprint(glm::dvec2 uv) const {
   const float x = static_cast<float>(uv.x) * static_cast<float>(width) - 0.5f;
   const float y = static_cast<float>(uv.y) * static_cast<float>(height) - 0.5f;
   const float fx = std::floor(x), fy = std::floor(y);
-  // Repeat: one remainder per axis (uv far outside [0, 1] stays exact as long as it fits a long).
+  // Repeat: one remainder per axis (uv far outside [0, 1] stays exact as long as it fits a long),
+  // and only when outside the image: a division is a large part of a lookup's arithmetic.
   auto wrap = [](float f, int n) {
-    long i = static_cast<long>(f) % n;
+    long i = static_cast<long>(f);
+    if (i >= 0 && i < n) return static_cast<std::size_t>(i);
+    i %= n;
     return static_cast<std::size_t>(i < 0 ? i + n : i);
   };
   const std::size_t x0 = wrap(fx, width), y0 = wrap(fy, height);
