@@ -465,6 +465,88 @@ TEST(Render, SameSeedSameImageWhateverTheThreads) {
   EXPECT_NE(one, other);
 }
 
+TEST(Render, PathsTracedInBatchesComputeExactlyWhatOnePathAtATimeDoes) {
+  // The batched tracer prefetches, draws the light sample's random numbers early and streams
+  // rays to Embree; none of that may change a bit. A scene that exercises every such step:
+  // textures (base colour, metallic-roughness, an alpha mask), an image environment with a sun,
+  // an emissive quad, a point light, metal and glossy surfaces, and converging pixels.
+  const fs::path dir = test::freshDir("batches");
+  FloatImage checker{16, 16, 4, std::vector<float>(16 * 16 * 4), {}};
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x)
+      for (int c = 0; c < 4; ++c)
+        checker.pixels[static_cast<std::size_t>((y * 16 + x) * 4 + c)] =
+            c == 3 ? ((x / 2 + y) % 5 ? 1.0f : 0.0f) : static_cast<float>(((x / 4 + y / 4) % 2 ? 200 : 40 + 60 * c)) / 255.0f;
+  ASSERT_TRUE(writeImage(dir / "checker.png", checker));
+  FloatImage sky{32, 16, 3, std::vector<float>(32 * 16 * 3, 0.3f), {}};
+  for (int c = 0; c < 3; ++c) sky.pixels[static_cast<std::size_t>((4 * 32 + 9) * 3 + c)] = 400.0f;
+  ASSERT_TRUE(writeImage(dir / "sky.hdr", sky));
+
+  test::GltfBuilder b;
+  b.doc["images"] = json::array({{{"uri", "checker.png"}}});
+  b.doc["textures"] = json::array({{{"source", 0}}});
+  b.doc["materials"].push_back({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}, {"metallicRoughnessTexture", {{"index", 0}}}}},
+                                {"alphaMode", "MASK"}});
+  const int textured = static_cast<int>(b.doc["materials"].size()) - 1;
+  const int metal = addMaterial(b, glm::dvec3(0.9, 0.7, 0.4), 1.0, 0.3, false);
+  const int glossy = addMaterial(b, glm::dvec3(0.2, 0.4, 0.8), 0.0, 0.2, false);
+  const int lamp = addMaterial(b, glm::dvec3(0.0), 0.0, 1.0, true, glm::dvec3(8.0, 6.0, 4.0));
+  const int floor = addMesh(b, {-4, 0, -4, -4, 0, 4, 4, 0, 4, 4, 0, -4}, {0, 1, 2, 0, 2, 3}, textured, {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0});
+  b.doc["meshes"][floor]["primitives"][0]["attributes"]["TEXCOORD_0"] = b.accessor(std::vector<float>{0, 0, 0, 3, 3, 3, 3, 0}, "VEC2");
+  b.node({{"mesh", floor}});
+  b.node({{"mesh", addMesh(b, {-4, -1, -4, 4, -1, -4, 4, -1, 4, -4, -1, 4}, {0, 1, 2, 0, 2, 3}, glossy)}});
+  b.node({{"mesh", addSphere(b, glm::dvec3(-0.8, 0.7, 0.0), 0.7, metal)}});
+  b.node({{"mesh", addSphere(b, glm::dvec3(0.9, 0.5, 0.5), 0.5, glossy)}});
+  b.node({{"mesh", addMesh(b, {-1, 2.5, -2, 1, 2.5, -2, 1, 3.5, -2}, {0, 1, 2}, lamp)}});
+  b.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"type", "point"}, {"intensity", 20.0}}});
+  b.node({{"translation", {1.5, 2.0, 1.5}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  b.doc["extensions"]["DYNBENCH_environment"] = {{"uri", "sky.hdr"}};
+  b.doc["extensionsUsed"] = {"KHR_lights_punctual", "DYNBENCH_environment"};
+  auto loaded = scene::loadScene(b.write(dir, "batches"));
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  const RenderCamera cam = lookCamera({0, 2.5, 5}, {0, -0.5, -1}, 50.0, 24, 16);
+
+  auto render = [&](int batch, bool converge, FrameBuffers* frame = nullptr) {
+    RenderSettings settings;
+    settings.samplesPerPixel = 37;  // a batch of 32 and one of 5
+    settings.bounces = 5;
+    settings.pathBatch = batch;
+    settings.converge = converge;
+    settings.maxSamplesPerPixel = 300;
+    auto t = tracerFor(*loaded, settings);
+    EXPECT_TRUE(t->setTime(0, 0));
+    RenderStatistics statistics;
+    const FrameBuffers f = t->render(2, cam, cam, nullptr, &statistics);
+    if (frame) *frame = f;
+    std::vector<float> all;  // every buffer of the contract, one after another
+    for (const auto& spec : frames::contractBuffers()) all.insert(all.end(), (f.*spec.member).begin(), (f.*spec.member).end());
+    return std::make_pair(all, statistics.rays);
+  };
+  for (const bool converge : {false, true}) {
+    FrameBuffers frame;
+    const auto one = render(1, converge, &frame);
+    for (const int batch : {5, 32}) {
+      const auto batched = render(batch, converge);
+      EXPECT_EQ(batched.first, one.first) << "batch " << batch << (converge ? ", converging" : "");
+      EXPECT_EQ(batched.second, one.second) << "rays traced, batch " << batch;
+    }
+    // Not a comparison of black images: direct and indirect light arrive, some pixels converged
+    // early and others took more samples.
+    double direct = 0, indirect = 0;
+    for (std::size_t i = 0; i < frame.pixelCount(); ++i) {
+      direct += luminance(rgb(frame.direct, i));
+      indirect += luminance(rgb(frame.indirect, i));
+    }
+    EXPECT_GT(direct, 0.1 * static_cast<double>(frame.pixelCount()));
+    EXPECT_GT(indirect, 0.01 * static_cast<double>(frame.pixelCount()));
+    if (converge) EXPECT_LT(*std::min_element(frame.spp.begin(), frame.spp.end()), *std::max_element(frame.spp.begin(), frame.spp.end()));
+  }
+  RenderSettings bad;
+  bad.pathBatch = 0;
+  std::vector<std::string> warnings;
+  EXPECT_FALSE(PathTracer::create(*loaded, bad, warnings));
+}
+
 // Distance from a point to a triangle (Ericson, Real-Time Collision Detection §5.1.5).
 double pointTriangleDistance(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
   const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;

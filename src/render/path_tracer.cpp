@@ -15,9 +15,6 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr int kMinFirstRound = 16;
-// Paths traced together (PathTracer::tracePaths): enough that a path's prefetched loads arrive
-// while the others trace.
-constexpr int kBatch = 32;
 
 // Rays leave a surface from a point pushed off it along the geometric normal, by an amount that
 // grows with the coordinates' magnitude (Embree intersects in single precision).
@@ -46,8 +43,8 @@ PathTracer::~PathTracer() = default;
 
 Expected<std::unique_ptr<PathTracer>> PathTracer::create(const scene::Scene& scene, const RenderSettings& settings,
                                                          std::vector<std::string>& warnings) {
-  if (settings.width <= 0 || settings.height <= 0 || settings.samplesPerPixel <= 0 || settings.bounces < 0)
-    return fail(ErrorCode::kUsage, "render settings: resolution and samples must be positive, bounces non-negative");
+  if (settings.width <= 0 || settings.height <= 0 || settings.samplesPerPixel <= 0 || settings.bounces < 0 || settings.pathBatch <= 0)
+    return fail(ErrorCode::kUsage, "render settings: resolution, samples and path batch must be positive, bounces non-negative");
   std::unique_ptr<PathTracer> tracer(new PathTracer(scene, settings));
   auto textures = TextureSet::load(scene, warnings);
   if (!textures) return std::unexpected(textures.error());
@@ -457,7 +454,7 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
     const Shading shading = shade(hit, -ray.direction, texCoord(hit));
     // In batches, each path with the random stream of its sample index, summed in sample order.
     while (sum.samples < upTo) {
-      const std::size_t batch = static_cast<std::size_t>(std::min(upTo - sum.samples, kBatch));
+      const std::size_t batch = static_cast<std::size_t>(std::min(upTo - sum.samples, settings_.pathBatch));
       scratch.paths.resize(std::max(scratch.paths.size(), batch));
       const std::span<PathState> paths(scratch.paths.data(), batch);
       for (std::size_t k = 0; k < batch; ++k)

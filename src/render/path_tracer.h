@@ -58,6 +58,9 @@ struct RenderSettings {
   // renderer jitters its projection for TAA.
   bool jitter = false;
   double directThresholdFraction = 0.1, indirectThresholdFraction = 0.1;
+  // Paths traced together (PathTracer::tracePaths); 1 traces one path at a time. The image does
+  // not depend on it (tested): only the speed does.
+  int pathBatch = 32;
 };
 
 // One frame's buffers: the feature-buffer contract's frame (frames/feature_frame.h).
