@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
   std::printf("%s: %zu frames, %dx%d\n", argv[1], all.size(), all[0].width, all[0].height);
   std::printf("%-8s %14s %14s %16s   (bytes per pixel; contract = half where frames::Storage allows)\n", "codec", "float32", "contract",
               "contract write");
-  for (const char* codec : {"none", "rle", "zips", "zip", "zip:9", "piz", "b44"}) {
+  for (const char* codec : {"none", "rle", "zips", "zip:1", "zip", "zip:9", "piz", "b44"}) {
     const double full = bytes(true, codec, nullptr), contract = bytes(false, codec, nullptr);
     std::printf("%-8s %14.2f %14.2f %11.1f ms/frame\n", codec, full, contract, 1e3 * writeSeconds / static_cast<double>(all.size()));
   }
