@@ -265,10 +265,6 @@ std::optional<LightSample> LightSet::samplePunctual(std::size_t light, const glm
   return s;
 }
 
-std::optional<LightSample> LightSet::sample(const glm::dvec3& point, double uChoice, glm::dvec2 u) const {
-  return sample(point, choose(uChoice, u));
-}
-
 LightSet::Choice LightSet::choose(double uChoice, glm::dvec2 u) const {
   Choice c;
   if (choice_.empty()) return c;
@@ -314,10 +310,6 @@ std::optional<LightSample> LightSet::sample(const glm::dvec3& point, const Choic
   s.radiance = emission_(tri.node, tri.primitive, tri.index, b);
   s.pdf = c.probability * d2 / (area * cosLight);
   return s;
-}
-
-glm::dvec3 LightSet::environmentRadiance(const glm::dvec3& direction, double* pdf) const {
-  return environmentRadianceAt(equirectCoordinates(direction), pdf);
 }
 
 glm::dvec3 LightSet::environmentRadianceAt(glm::dvec2 uv, double* pdf) const {

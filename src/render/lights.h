@@ -108,11 +108,9 @@ class LightSet {
 
   bool empty() const { return choice_.empty(); }
   // The environment or an emissive triangle, picked by estimated power, then a point on it (next
-  // event estimation; Monte Carlo, weighted against BSDF sampling by the integrator).
-  std::optional<LightSample> sample(const glm::dvec3& point, double uChoice, glm::dvec2 u) const;
-  // The same in two steps: what does not depend on the point (which light, which environment
-  // pixel or triangle; reads the light tables and prefetches the pixel or triangle), then the
-  // sample from the point.
+  // event estimation; Monte Carlo, weighted against BSDF sampling by the integrator), in two
+  // steps: what does not depend on the point (which light, which environment pixel or triangle;
+  // reads the light tables and prefetches the pixel or triangle), then the sample from the point.
   struct Choice {
     enum class Kind { kNone, kEnvironment, kTriangle } kind = Kind::kNone;
     double probability = 0.0;  // of choosing the light (and for a triangle, that triangle)
@@ -122,9 +120,8 @@ class LightSet {
   Choice choose(double uChoice, glm::dvec2 u) const;
   std::optional<LightSample> sample(const glm::dvec3& point, const Choice& choice) const;
   // When a BSDF-sampled ray reaches the environment: its radiance and, in *pdf, this strategy's
-  // density for MIS (choice x solid-angle density), in one lookup.
-  glm::dvec3 environmentRadiance(const glm::dvec3& direction, double* pdf) const;
-  // The same at image point uv = equirectCoordinates(direction).
+  // density for MIS (choice x solid-angle density), in one lookup; uv = equirectCoordinates of
+  // the ray's direction, which the caller has computed.
   glm::dvec3 environmentRadianceAt(glm::dvec2 uv, double* pdf) const;
   // Starts loading the table entries choose(uChoice, u) reads (for the batched path tracer).
   void prefetchChoice(double uChoice, glm::dvec2 u) const;
