@@ -93,7 +93,6 @@ double Bsdf::pdfLocal(const glm::dvec3& wo, const glm::dvec3& wi, double pSpecul
 
 Bsdf::View Bsdf::view(const glm::dvec3& wo) const {
   View v;
-  v.wo = wo;
   v.local = frame_.toLocal(wo);
   v.specularProbability = specularProbability(v.local);
   v.above = glm::dot(wo, ng_) > 0;

@@ -44,7 +44,7 @@ class Bsdf {
   // What the three calls above derive from wo alone, derived once: a path vertex evaluates, weighs
   // and samples with the same wo (same results, less arithmetic).
   struct View {
-    glm::dvec3 wo, local;
+    glm::dvec3 local;  // wo in the shading frame
     double specularProbability = 0.0;
     bool above = false;  // wo is on the geometric normal's side
   };

@@ -71,32 +71,38 @@ Expected<std::unique_ptr<PathTracer>> PathTracer::create(const scene::Scene& sce
   return tracer;
 }
 
-const scene::Material* PathTracer::materialOf(int node, int primitive) const {
+const scene::Primitive& PathTracer::primitiveOf(int node, int primitive) const {
   const auto& n = scene_.nodes[static_cast<std::size_t>(node)];
-  const int m = scene_.meshes[static_cast<std::size_t>(n.mesh)].primitives[static_cast<std::size_t>(primitive)].material;
+  return scene_.meshes[static_cast<std::size_t>(n.mesh)].primitives[static_cast<std::size_t>(primitive)];
+}
+
+const scene::Material* PathTracer::materialOf(int node, int primitive) const {
+  const int m = primitiveOf(node, primitive).material;
   return m >= 0 ? &scene_.materials[static_cast<std::size_t>(m)] : nullptr;
 }
 
-glm::dvec2 PathTracer::texCoord(int node, int primitive, unsigned triangle, glm::dvec2 b) const {
-  const auto& n = scene_.nodes[static_cast<std::size_t>(node)];
-  const auto& prim = scene_.meshes[static_cast<std::size_t>(n.mesh)].primitives[static_cast<std::size_t>(primitive)];
+namespace {
+
+// The texture coordinates at barycentric point b of the triangle with these vertices.
+glm::dvec2 interpolateUv(const scene::Primitive& prim, const std::uint32_t* vertices, glm::dvec2 b) {
   if (prim.uvs.empty()) return glm::dvec2(0.0);
-  const std::uint32_t* idx = &prim.indices[3 * static_cast<std::size_t>(triangle)];
-  return (1.0 - b.x - b.y) * glm::dvec2(prim.uvs[idx[0]]) + b.x * glm::dvec2(prim.uvs[idx[1]]) + b.y * glm::dvec2(prim.uvs[idx[2]]);
+  return (1.0 - b.x - b.y) * glm::dvec2(prim.uvs[vertices[0]]) + b.x * glm::dvec2(prim.uvs[vertices[1]]) +
+         b.y * glm::dvec2(prim.uvs[vertices[2]]);
+}
+
+}  // namespace
+
+glm::dvec2 PathTracer::texCoord(int node, int primitive, unsigned triangle, glm::dvec2 b) const {
+  const scene::Primitive& prim = primitiveOf(node, primitive);
+  return interpolateUv(prim, &prim.indices[3 * static_cast<std::size_t>(triangle)], b);
 }
 
 glm::dvec2 PathTracer::texCoord(const SurfaceHit& hit) const {
-  const auto& n = scene_.nodes[static_cast<std::size_t>(hit.node)];
-  const auto& prim = scene_.meshes[static_cast<std::size_t>(n.mesh)].primitives[static_cast<std::size_t>(hit.primitive)];
-  if (prim.uvs.empty()) return glm::dvec2(0.0);
-  const glm::dvec2 b = hit.barycentric;
-  return (1.0 - b.x - b.y) * glm::dvec2(prim.uvs[hit.vertices[0]]) + b.x * glm::dvec2(prim.uvs[hit.vertices[1]]) +
-         b.y * glm::dvec2(prim.uvs[hit.vertices[2]]);
+  return interpolateUv(primitiveOf(hit.node, hit.primitive), hit.vertices.data(), hit.barycentric);
 }
 
 void PathTracer::prefetchTexCoords(const SurfaceHit& hit) const {
-  const auto& n = scene_.nodes[static_cast<std::size_t>(hit.node)];
-  const auto& prim = scene_.meshes[static_cast<std::size_t>(n.mesh)].primitives[static_cast<std::size_t>(hit.primitive)];
+  const scene::Primitive& prim = primitiveOf(hit.node, hit.primitive);
   if (prim.uvs.empty()) return;
   for (const std::uint32_t v : hit.vertices) __builtin_prefetch(&prim.uvs[v]);
 }
@@ -167,10 +173,9 @@ PathTracer::Shading PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& w
     // Tangent frame from the triangle's uv parameterisation (what glTF implies when a mesh has no
     // TANGENT attribute), then n = T x + B y + N z with (x, y, z) = 2 texel - 1.
     const auto p = rayTracing_->trianglePositions(hit);
-    const auto& node = scene_.nodes[static_cast<std::size_t>(hit.node)];
-    const auto& prim = scene_.meshes[static_cast<std::size_t>(node.mesh)].primitives[static_cast<std::size_t>(hit.primitive)];
+    const scene::Primitive& prim = primitiveOf(hit.node, hit.primitive);
     if (!prim.uvs.empty()) {
-      const std::uint32_t* idx = &prim.indices[3 * static_cast<std::size_t>(hit.triangle)];
+      const std::uint32_t* idx = hit.vertices.data();
       const glm::dvec2 d1 = glm::dvec2(prim.uvs[idx[1]]) - glm::dvec2(prim.uvs[idx[0]]);
       const glm::dvec2 d2 = glm::dvec2(prim.uvs[idx[2]]) - glm::dvec2(prim.uvs[idx[0]]);
       const double det = d1.x * d2.y - d2.x * d1.y;
@@ -244,8 +249,8 @@ struct PathTracer::PathState {
 struct PathTracer::PathScratch {
   std::vector<std::uint32_t> reach;  // punctual lights in reach of a shading point
   std::vector<PathState> paths;      // a batch
-  std::vector<Ray> rays_;
-  std::vector<SurfaceHit> hits_;
+  std::vector<Ray> streamRays;        // the batch's rays still going, and their hits
+  std::vector<SurfaceHit> streamHits;
   std::uint64_t rays = 0, shadingPoints = 0, punctualEvaluated = 0;
 };
 
@@ -266,15 +271,15 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
     // escape, and the light tables the light sample will read.
     bool any = false;
     if (depth > 0) {
-      scratch.rays_.clear();
+      scratch.streamRays.clear();
       for (PathState& p : paths)
-        if (p.active) scratch.rays_.push_back(p.ray);
-      scratch.hits_.resize(scratch.rays_.size());
-      rayTracing_->intersect(scratch.rays_, scratch.hits_);
+        if (p.active) scratch.streamRays.push_back(p.ray);
+      scratch.streamHits.resize(scratch.streamRays.size());
+      rayTracing_->intersect(scratch.streamRays, scratch.streamHits);
       std::size_t k = 0;
       for (PathState& p : paths)
-        if (p.active) p.hit = scratch.hits_[k++];
-      scratch.rays += scratch.rays_.size();
+        if (p.active) p.hit = scratch.streamHits[k++];
+      scratch.rays += scratch.streamRays.size();
     }
     for (PathState& p : paths) {
       if (!p.active) continue;
@@ -368,7 +373,7 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const S
     for (const std::uint32_t l : scratch.reach) addLight(lights_.samplePunctual(l, hit.position));
     // The environment or an emissive triangle: one Monte Carlo sample (its random numbers drawn
     // in the trace stage whether or not there is anything to choose, so the stream stays aligned).
-    if (!lights_.empty()) addLight(lights_.sample(hit.position, p.lightChoice));
+    addLight(lights_.sample(hit.position, p.lightChoice));  // no light to choose: a kNone choice, no sample
   }
 
   const double uLobe = p.rng.uniform();

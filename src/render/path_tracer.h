@@ -102,6 +102,7 @@ class PathTracer {
   void prefetchTexCoords(const SurfaceHit& hit) const;
   void prefetchTextures(const SurfaceHit& hit, glm::dvec2 uv) const;
   bool alphaOpaque(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
+  const scene::Primitive& primitiveOf(int node, int primitive) const;
   const scene::Material* materialOf(int node, int primitive) const;
   SurfaceHit trace(const Ray& ray) const;
   struct PathSample;

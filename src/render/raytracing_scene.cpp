@@ -298,6 +298,7 @@ SurfaceHit RayTracingScene::intersect(const Ray& ray, double tMin, double tMax) 
 }
 
 void RayTracingScene::intersect(std::span<const Ray> rays, std::span<SurfaceHit> hits) const {
+  // Embree's ray records, kept per thread between calls so that a stream does not allocate.
   thread_local std::vector<RTCRayHit> stream;
   stream.resize(rays.size());
   for (std::size_t k = 0; k < rays.size(); ++k) stream[k] = embreeRay(rays[k], 0.0, 1e30);
