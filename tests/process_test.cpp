@@ -1,6 +1,7 @@
 // core/process: the one way dynbench runs other programs.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,32 @@ TEST(Process, StopsTheProgramWhenTheCallerSaysSo) {
   EXPECT_EQ(seen, 1);
   EXPECT_EQ(run->signal, 15);  // SIGTERM, well before the 30 s sleep ends
   EXPECT_EQ(run->tail, "first");
+  EXPECT_TRUE(run->stoppedByCaller);
+}
+
+TEST(Process, AProgramThatFinishesButDoesNotExitIsStoppedWhenAskedWhileSilent) {
+  // Like the Cube 2 client that has written its capture and then hangs in its own shutdown: the
+  // program prints nothing more, so only the periodic question can stop it.
+  bool finished = false;
+  int asked = 0;
+  const auto started = std::chrono::steady_clock::now();
+  auto run = runProcess({.argv = {"sh", "-c", "echo done; exec sleep 30"},
+                         .onLine = [&](std::string_view line) {
+                           finished = finished || line == "done";
+                           return true;
+                         },
+                         .stopIf = [&] { return ++asked >= 3 && finished; }});
+  ASSERT_TRUE(run) << run.error().message;
+  EXPECT_TRUE(run->stoppedByCaller);
+  EXPECT_EQ(run->signal, 15);
+  EXPECT_GE(asked, 3);
+  // Asked about once a second while silent: stopped after seconds, not after the 30 s sleep.
+  EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(20));
+  // A program that exits by itself is not marked as stopped.
+  auto quick = runProcess({.argv = {"sh", "-c", "echo done"}, .stopIf = [] { return false; }});
+  ASSERT_TRUE(quick);
+  EXPECT_FALSE(quick->stoppedByCaller);
+  EXPECT_EQ(quick->exitStatus, 0);
 }
 
 TEST(Process, AProgramThatIsNotThereIsAnError) {

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdio>
 #include <map>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -124,20 +125,28 @@ Expected<Cube2Report> captureCube2(const Cube2Options& o, const Cube2Progress& p
   game.argv.insert(game.argv.end(), {"./" + client->filename().string(), "-q" + fs::absolute(home).string(), "-k" + fs::absolute(o.data).string(),
                                      "-r", "-t0", fmt::format("-w{}", o.width), fmt::format("-h{}", o.height), "-x" + *script});
   std::size_t frames = 0;
+  std::optional<std::chrono::steady_clock::time_point> captureClosed;  // when the client said the capture is complete
   game.onLine = [&](std::string_view line) {
     unsigned long long done = 0, all = 0;
     if (std::sscanf(std::string(line).c_str(), "dynbench-capture: %llu/%llu frames", &done, &all) == 2) {
       frames = static_cast<std::size_t>(done);
       if (progress) progress(frames, total);
     }
+    if (line.starts_with("dynbench-capture: window of ")) captureClosed = std::chrono::steady_clock::now();
     return true;
+  };
+  game.stopIf = [&] {
+    return captureClosed && std::chrono::steady_clock::now() - *captureClosed > std::chrono::duration<double>(kClientExitGrace);
   };
   game.tailBytes = 3000;
   const auto started = std::chrono::steady_clock::now();
   auto run = runProcess(game);
   fs::remove_all(home, ec);
   if (!run) return std::unexpected(run.error());
-  if (!run->succeeded() || frames < total)
+  // A client stopped after closing a complete capture is not a failed capture: checkCapture below
+  // reads the whole of it.
+  const bool stoppedAfterCapture = run->stoppedByCaller && captureClosed && frames >= total;
+  if ((!run->succeeded() && !stoppedAfterCapture) || frames < total)
     return fail(ErrorCode::kExternalTool, "the Cube 2 client stopped after {} of {} frames (status {}); its last output:\n{}", frames, total,
                 run->exitStatus, run->tail);
   auto summary = checkCapture(o.output);
@@ -154,6 +163,7 @@ Expected<Cube2Report> captureCube2(const Cube2Options& o, const Cube2Progress& p
   if (auto ok = writeFileAtomic(o.output / "LICENSES.txt", licences); !ok) return std::unexpected(ok.error());
   Cube2Report report;
   report.frames = frames;
+  report.clientStoppedAfterCapture = stoppedAfterCapture;
   report.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return report;
 }

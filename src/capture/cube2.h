@@ -38,9 +38,15 @@ struct Cube2Options {
   std::filesystem::path data = "/usr/share/games/cube2";  // Debian's cube2-data
 };
 
+// How long the client may take to exit after it has closed a complete capture (s). Its own
+// shutdown (software OpenGL and SDL under Xvfb) has hung for minutes under load, after the
+// capture was complete; it is stopped then, and the capture is checked as usual.
+inline constexpr double kClientExitGrace = 20.0;
+
 struct Cube2Report {
   std::size_t frames = 0;
   double wallSeconds = 0.0;
+  bool clientStoppedAfterCapture = false;  // the client did not exit within kClientExitGrace and was stopped
 };
 
 // (frames recorded, frames total)

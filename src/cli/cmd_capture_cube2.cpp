@@ -19,6 +19,9 @@ Expected<void> runCube2(const capture::Cube2Options& options) {
   auto result = capture::captureCube2(options, report);
   progress.reset();
   if (!result) return std::unexpected(result.error());
+  if (result->clientStoppedAfterCapture)
+    fmt::print(stderr, "dynbench: note: the Cube 2 client closed the capture but did not exit within {:.0f} s; it was stopped\n",
+               capture::kClientExitGrace);
   fmt::print("{}: {} frames ({:.1f} s of game time at {} frames/s) in {:.1f} s; next: dynbench convert {} -o DATASET.gltf\n",
              options.output.string(), result->frames, result->frames / options.fps, options.fps, result->wallSeconds,
              options.output.string());

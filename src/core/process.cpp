@@ -1,6 +1,7 @@
 #include "core/process.h"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -55,13 +56,21 @@ Expected<ProcessResult> runProcess(const ProcessOptions& options) {
 
   ProcessResult result;
   std::string pending;
-  bool stopped = false;
   char buffer[4096];
   auto keep = [&](std::string_view text) {
     result.tail.append(text);
     if (result.tail.size() > options.tailBytes) result.tail.erase(0, result.tail.size() - options.tailBytes);
   };
+  auto stop = [&] {
+    result.stoppedByCaller = true;
+    ::kill(pid, SIGTERM);  // then keep reading until it has gone
+  };
   while (true) {
+    if (!result.stoppedByCaller && options.stopIf && options.stopIf()) stop();
+    pollfd readable{fds[0], POLLIN, 0};
+    const int ready = ::poll(&readable, 1, options.stopIf ? 1000 : -1);
+    if (ready < 0 && errno == EINTR) continue;
+    if (ready == 0) continue;  // quiet for a second: ask stopIf again
     const ssize_t n = ::read(fds[0], buffer, sizeof buffer);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) break;
@@ -69,14 +78,11 @@ Expected<ProcessResult> runProcess(const ProcessOptions& options) {
     if (!options.onLine) continue;
     pending.append(buffer, static_cast<std::size_t>(n));
     for (std::size_t end; (end = pending.find('\n')) != std::string::npos;) {
-      if (!stopped && !options.onLine(std::string_view(pending).substr(0, end))) {
-        stopped = true;
-        ::kill(pid, SIGTERM);  // then keep reading until it has gone
-      }
+      if (!result.stoppedByCaller && !options.onLine(std::string_view(pending).substr(0, end))) stop();
       pending.erase(0, end + 1);
     }
   }
-  if (options.onLine && !stopped && !pending.empty()) options.onLine(pending);
+  if (options.onLine && !result.stoppedByCaller && !pending.empty()) options.onLine(pending);
   ::close(fds[0]);
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {

@@ -22,6 +22,9 @@ struct ProcessOptions {
   // Each output line, without its '\n'; returning false stops the program (SIGTERM), e.g. after
   // the caller failed on what it printed.
   std::function<bool(std::string_view line)> onLine;
+  // Asked about once a second while the program runs (and after each line); returning true stops
+  // it (SIGTERM), e.g. a program that has done its work but does not exit.
+  std::function<bool()> stopIf;
   std::size_t tailBytes = 4000;                                  // output kept for ProcessResult::tail
 };
 
@@ -29,6 +32,7 @@ struct ProcessResult {
   int exitStatus = -1;  // the program's exit status, or -1 when a signal ended it
   int signal = 0;       // the signal that ended it, else 0
   std::string tail;     // the end of its output (stdout and stderr interleaved)
+  bool stoppedByCaller = false;  // onLine returned false or stopIf true, and it was sent SIGTERM
   bool succeeded() const { return exitStatus == 0; }
 };
 

@@ -317,7 +317,8 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
     c.seed = o.seed;
     auto captured = capture::captureCube2(c);
     if (!captured) return std::unexpected(captured.error());
-    log(fmt::format("  {} frames in {:.0f} s", captured->frames, captured->wallSeconds));
+    log(fmt::format("  {} frames in {:.0f} s{}", captured->frames, captured->wallSeconds,
+                    captured->clientStoppedAfterCapture ? " (the client did not exit after closing the capture; stopped)" : ""));
     if (auto ok = writeFileAtomic(key, wanted); !ok) return std::unexpected(ok.error());
   } else {
     log(fmt::format("capture: {} exists, reused", (capture / "Capture.txt").string()));
