@@ -73,8 +73,17 @@ std::vector<std::pair<int, std::string>> queued(const std::string& job) {
 }
 
 void waitUntilGone(const std::string& job) {
+  ASSERT_TRUE(!job.empty() && job.find_first_not_of("0123456789") == std::string::npos) << "'" << job << "' is not a job id";
   for (int i = 0; i < 600 && !queued(job).empty(); ++i) std::this_thread::sleep_for(200ms);
   ASSERT_TRUE(queued(job).empty()) << "job " << job << " still queued after 2 minutes";
+}
+
+// A task's log (which may not exist yet) says its script has started.
+bool hasStarted(const fs::path& log) {
+  std::ifstream in(log);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str().find(" started ") != std::string::npos;
 }
 
 // Every file of `local` is in `slurm` with the same bytes (the job's slurm/ folder aside).
@@ -141,9 +150,13 @@ TEST_F(Slurm, ASignalledTaskRequeuesAndACancelledOneIsReportedAndRerun) {
         const std::string ids = shell("squeue -h -o %F -n dynbench-render | head -n 1");
         if (!ids.empty() && std::isdigit(static_cast<unsigned char>(ids[0]))) job = ids.substr(0, ids.find('\n'));
       }
+      // Running, and its script past `trap` (it logs "started" after it): a signal before that
+      // would end the task instead of requeueing it.
       if (!job.empty())
         for (const auto& [task, state] : queued(job))
-          if (state == "RUNNING" && task != not_) return task;
+          if (state == "RUNNING" && task != not_ &&
+              hasStarted(out / "slurm" / fmt::format("task-{}_{}.log", job, task)))
+            return task;
       std::this_thread::sleep_for(100ms);
     }
     return -1;
@@ -187,9 +200,11 @@ TEST_F(Slurm, ASignalledTaskRequeuesAndACancelledOneIsReportedAndRerun) {
   for (const auto& e : fs::directory_iterator(out))
     if (e.path().extension() == ".exr") EXPECT_TRUE(readImageHeader(e.path())) << e.path();
   // The printed command completes the missing frames.
-  const std::string resubmitted = shell(rerun + " --parsable");
-  ASSERT_FALSE(resubmitted.empty());
-  ASSERT_NO_FATAL_FAILURE(waitUntilGone(resubmitted.substr(0, resubmitted.find_first_of(";\n"))));
+  // sbatch reads its options before the script (anything after it goes to the script), so
+  // --parsable goes first; the wait then has the job id to wait for.
+  const std::string resubmitted = shell("sbatch --parsable" + rerun.substr(std::string("sbatch").size()));
+  const std::string rerunJob = resubmitted.substr(0, resubmitted.find_first_of(";\n"));
+  ASSERT_NO_FATAL_FAILURE(waitUntilGone(rerunJob));
   auto r = dynbench(fmt::format("render {} -o {} {} --threads 2", kOrbit.string(), (dir / "local").string(), options), dir);
   ASSERT_EQ(r.status, 0) << r.err;
   expectSameFrames(dir / "local", out, 12);
