@@ -53,18 +53,27 @@ glm::dvec3 Bsdf::sampleGgxVisibleNormal(const glm::dvec3& wo, double alpha, glm:
   return glm::normalize(glm::dvec3(alpha * nh.x, alpha * nh.y, std::max(1e-9, nh.z)));
 }
 
-glm::dvec3 Bsdf::evalLocal(const glm::dvec3& wo, const glm::dvec3& wi) const {
-  if (wo.z <= 0 || wi.z <= 0) return glm::dvec3(0.0);
+Bsdf::Evaluation Bsdf::evaluateLocal(const View& v, const glm::dvec3& wi) const {
+  const glm::dvec3& wo = v.local;
+  if (wo.z <= 0 || wi.z <= 0) return {};
   const glm::dvec3 h = glm::normalize(wo + wi);
+  const double d = ggxD(h, alpha_);
+  Evaluation e;
   const double vh = std::max(0.0, glm::dot(wo, h));
   const double w = schlickWeight(vh);
   const glm::dvec3 fDielectric = dielectricF0_ + (dielectricF90_ - dielectricF0_) * w;
   const glm::dvec3 fMetal = m_.baseColor + (glm::dvec3(1.0) - m_.baseColor) * w;
-  const double s = ggxD(h, alpha_) * smithG1(wo, alpha_) * smithG1(wi, alpha_) / (4.0 * wo.z * wi.z);
+  const double s = d * v.maskingWo * smithG1(wi, alpha_) / (4.0 * wo.z * wi.z);
   const glm::dvec3 diffuse = (1.0 - maxComponent(fDielectric)) * m_.baseColor / kPi;
   const glm::dvec3 dielectric = diffuse + fDielectric * s;
   const glm::dvec3 metal = fMetal * s;
-  return (1.0 - m_.metallic) * dielectric + m_.metallic * metal;
+  e.value = (1.0 - m_.metallic) * dielectric + m_.metallic * metal;
+  // The pdf: cosine-weighted diffuse, plus the visible-normal density
+  // D_v(h) = G1(wo) max(0, wo.h) D(h) / wo.z times the reflection Jacobian 1 / (4 wo.h).
+  const double pSpecular = v.specularProbability;
+  e.pdf = (1.0 - pSpecular) * wi.z / kPi;
+  if (pSpecular > 0) e.pdf += pSpecular * v.maskingWo * d / (4.0 * wo.z);
+  return e;
 }
 
 // How much of the reflection is specular, estimated with the Fresnel term at n.v.
@@ -80,45 +89,29 @@ double Bsdf::specularProbability(const glm::dvec3& wo) const {
   return std::clamp(specular / (specular + diffuse), 0.05, 0.95);  // both lobes stay reachable
 }
 
-double Bsdf::pdfLocal(const glm::dvec3& wo, const glm::dvec3& wi, double pSpecular) const {
-  if (wo.z <= 0 || wi.z <= 0) return 0.0;
-  double pdf = (1.0 - pSpecular) * wi.z / kPi;
-  if (pSpecular > 0) {
-    const glm::dvec3 h = glm::normalize(wo + wi);
-    // Visible-normal density D_v(h) = G1(wo) max(0, wo.h) D(h) / wo.z; reflection Jacobian 1 / (4 wo.h).
-    pdf += pSpecular * smithG1(wo, alpha_) * ggxD(h, alpha_) / (4.0 * wo.z);
-  }
-  return pdf;
-}
-
 Bsdf::View Bsdf::view(const glm::dvec3& wo) const {
   View v;
   v.local = frame_.toLocal(wo);
   v.specularProbability = specularProbability(v.local);
+  v.maskingWo = smithG1(v.local, alpha_);
   v.above = glm::dot(wo, ng_) > 0;
   return v;
 }
 
-glm::dvec3 Bsdf::eval(const glm::dvec3& wo, const glm::dvec3& wi) const { return eval(view(wo), wi); }
-double Bsdf::pdf(const glm::dvec3& wo, const glm::dvec3& wi) const { return pdf(view(wo), wi); }
+glm::dvec3 Bsdf::eval(const glm::dvec3& wo, const glm::dvec3& wi) const { return evaluate(view(wo), wi).value; }
+double Bsdf::pdf(const glm::dvec3& wo, const glm::dvec3& wi) const { return evaluate(view(wo), wi).pdf; }
 std::optional<BsdfSample> Bsdf::sample(const glm::dvec3& wo, glm::dvec2 u, double uLobe) const { return sample(view(wo), u, uLobe); }
 
-glm::dvec3 Bsdf::eval(const View& v, const glm::dvec3& wi) const {
-  if (glm::dot(wi, ng_) <= 0 || !v.above) return glm::dvec3(0.0);
-  return evalLocal(v.local, frame_.toLocal(wi));
-}
-
-double Bsdf::pdf(const View& v, const glm::dvec3& wi) const {
-  if (glm::dot(wi, ng_) <= 0 || !v.above) return 0.0;
-  return pdfLocal(v.local, frame_.toLocal(wi), v.specularProbability);
+Bsdf::Evaluation Bsdf::evaluate(const View& v, const glm::dvec3& wi) const {
+  if (glm::dot(wi, ng_) <= 0 || !v.above) return {};
+  return evaluateLocal(v, frame_.toLocal(wi));
 }
 
 std::optional<BsdfSample> Bsdf::sample(const View& v, glm::dvec2 u, double uLobe) const {
   const glm::dvec3& o = v.local;
   if (o.z <= 0) return std::nullopt;
-  const double pSpecular = v.specularProbability;
   glm::dvec3 i;
-  if (uLobe < pSpecular) {
+  if (uLobe < v.specularProbability) {
     const glm::dvec3 h = sampleGgxVisibleNormal(o, alpha_, u);
     i = glm::reflect(-o, h);
   } else {
@@ -128,9 +121,10 @@ std::optional<BsdfSample> Bsdf::sample(const View& v, glm::dvec2 u, double uLobe
   BsdfSample s;
   s.direction = frame_.toWorld(i);
   if (glm::dot(s.direction, ng_) <= 0) return std::nullopt;
-  s.pdf = pdfLocal(o, i, pSpecular);
-  if (s.pdf <= 0) return std::nullopt;
-  s.value = evalLocal(o, i);
+  const Evaluation e = evaluateLocal(v, i);
+  if (e.pdf <= 0) return std::nullopt;
+  s.pdf = e.pdf;
+  s.value = e.value;
   return s;
 }
 

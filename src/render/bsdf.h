@@ -46,11 +46,17 @@ class Bsdf {
   struct View {
     glm::dvec3 local;  // wo in the shading frame
     double specularProbability = 0.0;
-    bool above = false;  // wo is on the geometric normal's side
+    double maskingWo = 0.0;  // Smith G1(wo)
+    bool above = false;      // wo is on the geometric normal's side
   };
   View view(const glm::dvec3& wo) const;
-  glm::dvec3 eval(const View& view, const glm::dvec3& wi) const;
-  double pdf(const View& view, const glm::dvec3& wi) const;
+  // f(wo, wi) and the solid-angle pdf of sample() choosing wi, in one pass: they share the half
+  // vector and the GGX terms (a light sample needs both).
+  struct Evaluation {
+    glm::dvec3 value{0.0};
+    double pdf = 0.0;
+  };
+  Evaluation evaluate(const View& view, const glm::dvec3& wi) const;
   std::optional<BsdfSample> sample(const View& view, glm::dvec2 u, double uLobe) const;
 
   double alpha() const { return alpha_; }
@@ -61,8 +67,7 @@ class Bsdf {
   static glm::dvec3 sampleGgxVisibleNormal(const glm::dvec3& wo, double alpha, glm::dvec2 u);
 
  private:
-  glm::dvec3 evalLocal(const glm::dvec3& wo, const glm::dvec3& wi) const;
-  double pdfLocal(const glm::dvec3& wo, const glm::dvec3& wi, double specularProbability) const;
+  Evaluation evaluateLocal(const View& view, const glm::dvec3& wi) const;  // wi in the shading frame
   double specularProbability(const glm::dvec3& woLocal) const;
 
   SurfaceMaterial m_;

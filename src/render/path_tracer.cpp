@@ -245,9 +245,30 @@ struct PathTracer::PathState {
   glm::dvec2 uv{0.0};  // the hit's texture coordinates, or the environment image point of an escape
 };
 
+struct PathTracer::Vertex {
+  Bsdf bsdf;
+  Bsdf::View view;
+  glm::dvec3 origin;  // where the vertex's shadow and bounce rays leave
+};
+
+// A pixel's first hit: the same for every path of its batches (the same hit seen from the same
+// direction), so its shading, BSDF and punctual lights in reach are found once.
+struct PathTracer::FirstVertex {
+  const Shading& shading;
+  Vertex vertex;
+  const std::vector<std::uint32_t>& reach;
+};
+
+PathTracer::Vertex PathTracer::vertexAt(const SurfaceHit& hit, const Shading& s, const glm::dvec3& wo) const {
+  Bsdf bsdf(s.material, Frame(s.shadingNormal), s.geometricNormal);
+  const Bsdf::View view = bsdf.view(wo);
+  return Vertex{bsdf, view, offsetOrigin(hit.position, s.geometricNormal)};
+}
+
 // Per-thread working memory of the path loop, so the per-ray path does not allocate.
 struct PathTracer::PathScratch {
-  std::vector<std::uint32_t> reach;  // punctual lights in reach of a shading point
+  std::vector<std::uint32_t> reach;       // punctual lights in reach of a shading point
+  std::vector<std::uint32_t> firstReach;  // of the pixel's first hit
   std::vector<PathState> paths;      // a batch
   std::vector<Ray> streamRays;        // the batch's rays still going, and their hits
   std::vector<SurfaceHit> streamHits;
@@ -265,6 +286,9 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
     p.active = true;
   }
   const bool lightSample = settings_.nextEventEstimation;
+  scratch.firstReach.clear();
+  if (lightSample) lights_.punctualInReach(firstHit.position, scratch.firstReach);
+  const FirstVertex first{firstShading, vertexAt(firstHit, firstShading, -cameraRay.direction), scratch.firstReach};
   for (int depth = 0;; ++depth) {
     const bool shadesHere = depth <= settings_.bounces;  // a hit at this depth gathers light and bounces
     // Stage 1: trace; start loading the hit's texture coordinates, the environment pixel of an
@@ -313,7 +337,7 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
     }
     // Stage 3: shade, gather light, bounce.
     for (PathState& p : paths)
-      if (p.active) p.active = advance(p, depth, depth == 0 ? firstHit : p.hit, depth == 0 ? &firstShading : nullptr, scratch);
+      if (p.active) p.active = advance(p, depth, depth == 0 ? firstHit : p.hit, depth == 0 ? &first : nullptr, scratch);
   }
   for (PathState& p : paths) {
     if (!finite(p.out.direct)) p.out.direct = glm::dvec3(0.0);
@@ -321,7 +345,7 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
   }
 }
 
-bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const Shading* given, PathScratch& scratch) const {
+bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const FirstVertex* first, PathScratch& scratch) const {
   const Ray& ray = p.ray;
   // Radiance found by this ray is direct when it reaches the camera from the first surface
   // (depth 1) or is seen by the camera itself (depth 0).
@@ -336,7 +360,8 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const S
     return false;
   }
   const glm::dvec3 wo = -ray.direction;
-  const Shading s = given ? *given : shade(hit, wo, p.uv);
+  std::optional<Shading> ownShading;
+  const Shading& s = first ? first->shading : ownShading.emplace(shade(hit, wo, p.uv));
   if (s.material.emission != glm::dvec3(0.0)) {
     double w = 1.0;
     if (!p.previousDelta && settings_.nextEventEstimation) {
@@ -346,10 +371,11 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const S
     bucket += p.throughput * s.material.emission * w;
   }
   if (depth > settings_.bounces) return false;
-  const Frame frame(s.shadingNormal);
-  const Bsdf bsdf(s.material, frame, s.geometricNormal);
-  const Bsdf::View view = bsdf.view(wo);
-  const glm::dvec3 origin = offsetOrigin(hit.position, s.geometricNormal);
+  std::optional<Vertex> ownVertex;
+  const Vertex& vertex = first ? first->vertex : ownVertex.emplace(vertexAt(hit, s, wo));
+  const Bsdf& bsdf = vertex.bsdf;
+  const Bsdf::View& view = vertex.view;
+  const glm::dvec3& origin = vertex.origin;
   glm::dvec3& nextBucket = depth == 0 ? p.out.direct : p.out.indirect;  // light reaching this hit
 
   if (settings_.nextEventEstimation) {
@@ -357,20 +383,22 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const S
     // (Veach's MIS), delta lights count fully (no other strategy can find them).
     auto addLight = [&](const std::optional<LightSample>& ls) {
       if (!ls || !(ls->pdf > 0)) return;
-      const glm::dvec3 f = bsdf.eval(view, ls->direction);
+      const Bsdf::Evaluation e = bsdf.evaluate(view, ls->direction);
+      const glm::dvec3& f = e.value;
       if (f == glm::dvec3(0.0)) return;
       const double cosine = std::abs(glm::dot(s.shadingNormal, ls->direction));
       const double tMax = std::isinf(ls->distance) ? 1e30 : ls->distance * (1.0 - 1e-4) - 3e-5;
       ++scratch.rays;
       if (rayTracing_->occluded(origin, ls->direction, tMax)) return;
-      const double w = ls->delta ? 1.0 : powerHeuristic(ls->pdf, bsdf.pdf(view, ls->direction));
+      const double w = ls->delta ? 1.0 : powerHeuristic(ls->pdf, e.pdf);
       nextBucket += p.throughput * f * ls->radiance * (cosine * w / ls->pdf);
     };
     // Every punctual light in reach: a sum, no noise (LightSet::punctualInReach).
-    lights_.punctualInReach(hit.position, scratch.reach);
+    if (!first) lights_.punctualInReach(hit.position, scratch.reach);
+    const std::vector<std::uint32_t>& reach = first ? first->reach : scratch.reach;
     ++scratch.shadingPoints;
-    scratch.punctualEvaluated += scratch.reach.size();
-    for (const std::uint32_t l : scratch.reach) addLight(lights_.samplePunctual(l, hit.position));
+    scratch.punctualEvaluated += reach.size();
+    for (const std::uint32_t l : reach) addLight(lights_.samplePunctual(l, hit.position));
     // The environment or an emissive triangle: one Monte Carlo sample (its random numbers drawn
     // in the trace stage whether or not there is anything to choose, so the stream stays aligned).
     addLight(lights_.sample(hit.position, p.lightChoice));  // no light to choose: a kNone choice, no sample

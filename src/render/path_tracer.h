@@ -117,9 +117,14 @@ class PathTracer {
   // alone: the same random numbers in the same order, the same arithmetic.
   void tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, const Shading& firstShading, std::span<PathState> paths,
                   PathScratch& scratch) const;
+  struct Vertex;
+  // The BSDF, its view from wo and the rays' origin at a shaded hit.
+  Vertex vertexAt(const SurfaceHit& hit, const Shading& shading, const glm::dvec3& wo) const;
   // One vertex of one path (its hit traced, its prefetches issued): adds what it finds to the
-  // path's radiance and sets up the next ray. false when the path ends.
-  bool advance(PathState& path, int depth, const SurfaceHit& hit, const Shading* given, PathScratch& scratch) const;
+  // path's radiance and sets up the next ray. false when the path ends. At a pixel's first hit,
+  // which every path of the batch shares, `first` holds its shading and vertex, built once.
+  struct FirstVertex;
+  bool advance(PathState& path, int depth, const SurfaceHit& hit, const FirstVertex* first, PathScratch& scratch) const;
 
   const scene::Scene& scene_;
   RenderSettings settings_;
