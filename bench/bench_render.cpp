@@ -1,10 +1,11 @@
 // Render benchmark (run by hand; not part of the test suite):
-//   build/release/bench/bench_render [DATASET] [--frames A:B] [--res WxH] [--spp N] [--bounces N] [--no-cycles]
+//   build/release/bench/bench_render [DATASET] [--frames A:B] [--res WxH] [--spp N] [--bounces N] [--repeat N] [--no-cycles]
 // For the same dataset and frames, in one run:
 //  1. the path tracer's rays per second on one thread and on two, and the 2-thread speedup (over
 //     the frames, and over the whole job with loading);
 //  2. Embree's raw ray throughput on the same scene and camera (bench/raw_rays.h: primary rays
 //     through the render camera, random incoherent rays around it), and the path tracer's share;
+//     1 and 2 are repeated (--repeat, default 3) and summarised as median and range;
 //  3. bytes per pixel of the frames on disk;
 //  4. unless --no-cycles, Cycles (Blender) against the path tracer: each renders twice with two
 //     seeds; wall times, their ratio, each engine's noise (the variance of one render, estimated
@@ -12,10 +13,12 @@
 //     time-to-equal-noise ratio (time x variance is constant as samples grow).
 // Without DATASET it builds a test arena: a floor, walls and 40 pillars (static), 12 moving
 // spheres of mixed materials, 6 point lights and the Preetham sky, seen by a fast-turning camera.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -153,7 +156,7 @@ std::vector<double> radiance(const fs::path& dir, const std::vector<long>& frame
 
 int main(int argc, char** argv) {
   std::string dataset, frames = "0:3", res = "480x270";
-  int spp = 16, bounces = 4;
+  int spp = 16, bounces = 4, repeats = 3;
   bool cycles = true;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -161,6 +164,7 @@ int main(int argc, char** argv) {
     else if (a == "--res" && i + 1 < argc) res = argv[++i];
     else if (a == "--spp" && i + 1 < argc) spp = std::atoi(argv[++i]);
     else if (a == "--bounces" && i + 1 < argc) bounces = std::atoi(argv[++i]);
+    else if (a == "--repeat" && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
     else if (a == "--no-cycles") cycles = false;
     else dataset = a;
   }
@@ -217,47 +221,71 @@ int main(int argc, char** argv) {
     job.settings.samplesPerPixel = savedSpp;
   }
 
-  // 1. The path tracer on one thread and on two.
-  double framesSeconds[2] = {0, 0}, jobSeconds[2] = {0, 0}, raysPerSecond[2] = {0, 0};
-  for (int t = 1; t <= 2; ++t) {
-    const auto s = run("embree", t, 1, work / fmt::format("embree_{}thread", t));
-    framesSeconds[t - 1] = s.seconds - s.loadSeconds;
-    jobSeconds[t - 1] = s.seconds;
-    raysPerSecond[t - 1] = static_cast<double>(s.rays) / framesSeconds[t - 1];
-    std::printf("path tracer, %d thread(s): %.2f M rays/s (%.2f M rays/s per thread) over %.2f s of frames; whole job %.2f s "
-                "(loading %.2f s)\n",
-                t, raysPerSecond[t - 1] / 1e6, raysPerSecond[t - 1] / t / 1e6, framesSeconds[t - 1], s.seconds, s.loadSeconds);
-    if (t == 1) {
-      // What a ray costs depends on the mix: shadow rays (any hit) per shading point, bounce rays.
-      const double points = static_cast<double>(std::max<std::uint64_t>(1, s.light.shadingPoints));
-      std::printf("  per shading point: %.2f rays, %.2f punctual lights in reach (of %.1f in the frame); %.0f ns of frame time\n",
-                  static_cast<double>(s.rays) / points, static_cast<double>(s.light.punctualEvaluated) / points,
-                  static_cast<double>(s.light.punctualInFrame) / static_cast<double>(list->size()), 1e9 * framesSeconds[0] / points);
-    }
+  // Embree's ceiling on the same scene (the first frame's time) and camera.
+  auto rt = render::RayTracingScene::create(*scene);
+  auto node = scene::selectCameraNode(*scene, job.camera);
+  if (!rt || !node) {
+    std::fprintf(stderr, "cannot build the ray-tracing scene or find the camera\n");
+    return 1;
   }
-  std::printf("2-thread speedup: %.2fx over the frames, %.2fx over the whole job\n", framesSeconds[0] / framesSeconds[1],
-              jobSeconds[0] / jobSeconds[1]);
+  const scene::Evaluator evaluator(*scene);
+  auto cameras = render::frameCameras(evaluator, *node, job, list->front());
+  if (!cameras || !(*rt)->update(cameras->time)) {
+    std::fprintf(stderr, "cannot place the scene at the first frame\n");
+    return 1;
+  }
 
-  // 2. Embree's ceiling on the same scene (the first frame's time) and camera.
-  {
-    auto rt = render::RayTracingScene::create(*scene);
-    auto node = scene::selectCameraNode(*scene, job.camera);
-    if (!rt || !node) {
-      std::fprintf(stderr, "cannot build the ray-tracing scene or find the camera\n");
-      return 1;
-    }
-    const scene::Evaluator evaluator(*scene);
-    auto cameras = render::frameCameras(evaluator, *node, job, list->front());
-    if (!cameras || !(*rt)->update(cameras->time)) {
-      std::fprintf(stderr, "cannot place the scene at the first frame\n");
-      return 1;
+  // 1 and 2, `repeats` times: the path tracer on one thread and on two, then Embree's raw rays,
+  // so that each ratio compares measurements taken moments apart; the summary gives the median and
+  // the range, since one run on a shared machine can be off by several per cent.
+  std::vector<double> oneThread, speedup, jobSpeedup, random, primary, shareRandom, sharePrimary;
+  for (int r = 0; r < repeats; ++r) {
+    double framesSeconds[2] = {0, 0}, jobSeconds[2] = {0, 0}, raysPerSecond[2] = {0, 0};
+    for (int t = 1; t <= 2; ++t) {
+      const auto s = run("embree", t, 1, work / fmt::format("embree_{}thread", t));
+      framesSeconds[t - 1] = s.seconds - s.loadSeconds;
+      jobSeconds[t - 1] = s.seconds;
+      raysPerSecond[t - 1] = static_cast<double>(s.rays) / framesSeconds[t - 1];
+      std::printf("[%d/%d] path tracer, %d thread(s): %.2f M rays/s (%.2f M rays/s per thread) over %.2f s of frames; whole job %.2f s "
+                  "(loading %.2f s)\n",
+                  r + 1, repeats, t, raysPerSecond[t - 1] / 1e6, raysPerSecond[t - 1] / t / 1e6, framesSeconds[t - 1], s.seconds,
+                  s.loadSeconds);
+      if (t == 1 && r == 0) {
+        // What a ray costs depends on the mix: shadow rays (any hit) per shading point, bounce rays.
+        const double points = static_cast<double>(std::max<std::uint64_t>(1, s.light.shadingPoints));
+        std::printf("  per shading point: %.2f rays, %.2f punctual lights in reach (of %.1f in the frame); %.0f ns of frame time\n",
+                    static_cast<double>(s.rays) / points, static_cast<double>(s.light.punctualEvaluated) / points,
+                    static_cast<double>(s.light.punctualInFrame) / static_cast<double>(list->size()), 1e9 * framesSeconds[0] / points);
+      }
     }
     const auto raw = bench::measureRawRays(**rt, cameras->camera);
-    std::printf("Embree raw, one thread: primary %.2f M rays/s (%.0f %% hit), random %.2f M rays/s (%.0f %% hit)\n",
-                raw.primaryRaysPerSecond / 1e6, 100 * raw.primaryHitShare, raw.randomRaysPerSecond / 1e6, 100 * raw.randomHitShare);
-    std::printf("path tracer (one thread) / Embree raw: %.0f %% of random-ray, %.0f %% of primary-ray throughput\n",
-                100 * raysPerSecond[0] / raw.randomRaysPerSecond, 100 * raysPerSecond[0] / raw.primaryRaysPerSecond);
+    std::printf("[%d/%d] Embree raw, one thread: primary %.2f M rays/s (%.0f %% hit), random %.2f M rays/s (%.0f %% hit)\n", r + 1,
+                repeats, raw.primaryRaysPerSecond / 1e6, 100 * raw.primaryHitShare, raw.randomRaysPerSecond / 1e6,
+                100 * raw.randomHitShare);
+    oneThread.push_back(raysPerSecond[0] / 1e6);
+    speedup.push_back(framesSeconds[0] / framesSeconds[1]);
+    jobSpeedup.push_back(jobSeconds[0] / jobSeconds[1]);
+    random.push_back(raw.randomRaysPerSecond / 1e6);
+    primary.push_back(raw.primaryRaysPerSecond / 1e6);
+    shareRandom.push_back(100 * raysPerSecond[0] / raw.randomRaysPerSecond);
+    sharePrimary.push_back(100 * raysPerSecond[0] / raw.primaryRaysPerSecond);
   }
+  // "median (min-max)" of a figure over the repeats.
+  auto spread = [](std::vector<double> v, const char* format) {
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    const double median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    return fmt::format(fmt::runtime(format), median) + " (" + fmt::format(fmt::runtime(format), v.front()) + "-" +
+           fmt::format(fmt::runtime(format), v.back()) + ")";
+  };
+  std::printf("summary over %d run(s), median (min-max):\n", repeats);
+  std::printf("  path tracer, one thread: %s M rays/s\n", spread(oneThread, "{:.2f}").c_str());
+  std::printf("  2-thread speedup: %sx over the frames, %sx over the whole job\n", spread(speedup, "{:.2f}").c_str(),
+              spread(jobSpeedup, "{:.2f}").c_str());
+  std::printf("  Embree raw, one thread: random %s M rays/s, primary %s M rays/s\n", spread(random, "{:.2f}").c_str(),
+              spread(primary, "{:.2f}").c_str());
+  std::printf("  path tracer (one thread) / Embree raw: %s %% of random-ray, %s %% of primary-ray throughput\n",
+              spread(shareRandom, "{:.1f}").c_str(), spread(sharePrimary, "{:.1f}").c_str());
 
   // 3. Bytes per pixel on disk.
   {
