@@ -202,7 +202,8 @@ TEST_F(Slurm, ASignalledTaskRequeuesAndACancelledOneIsReportedAndRerun) {
   // The printed command completes the missing frames.
   // sbatch reads its options before the script (anything after it goes to the script), so
   // --parsable goes first; the wait then has the job id to wait for.
-  const std::string resubmitted = shell("sbatch --parsable" + rerun.substr(std::string("sbatch").size()));
+  const std::string resubmitted =
+      shell(fmt::format("sbatch --parsable --array={} {}", cancelled, (out / "slurm" / "render.sbatch").string()));
   const std::string rerunJob = resubmitted.substr(0, resubmitted.find_first_of(";\n"));
   ASSERT_NO_FATAL_FAILURE(waitUntilGone(rerunJob));
   auto r = dynbench(fmt::format("render {} -o {} {} --threads 2", kOrbit.string(), (dir / "local").string(), options), dir);
