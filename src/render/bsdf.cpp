@@ -44,9 +44,10 @@ glm::dvec3 Bsdf::sampleGgxVisibleNormal(const glm::dvec3& wo, double alpha, glm:
   const double lensq = vh.x * vh.x + vh.y * vh.y;
   const glm::dvec3 t1 = lensq > 0 ? glm::dvec3(-vh.y, vh.x, 0) / std::sqrt(lensq) : glm::dvec3(1, 0, 0);
   const glm::dvec3 t2 = glm::cross(vh, t1);
-  const double r = std::sqrt(u.x), phi = 2.0 * kPi * u.y;
-  const double p1 = r * std::cos(phi);
-  double p2 = r * std::sin(phi);
+  const double r = std::sqrt(u.x);
+  const SinCos phi = sinCosSingle(2.0 * kPi * u.y);
+  const double p1 = r * phi.cos;
+  double p2 = r * phi.sin;
   const double s = 0.5 * (1.0 + vh.z);
   p2 = (1.0 - s) * std::sqrt(std::max(0.0, 1.0 - p1 * p1)) + s * p2;
   const glm::dvec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;

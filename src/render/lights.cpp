@@ -82,9 +82,6 @@ glm::dvec3 EnvironmentLight::radiance(const glm::dvec3& direction, double* pdf) 
 
 void EnvironmentLight::prefetchPixel(glm::dvec2 uv) const { __builtin_prefetch(&pixels_[pixelAt(uv)]); }
 
-void EnvironmentLight::prefetchSampleTable(glm::dvec2 u) const {
-  if (height_ > 1) distribution_.prefetch(u);
-}
 
 glm::dvec3 EnvironmentLight::radianceAt(glm::dvec2 uv, double* pdf) const {
   const glm::vec4& pixel = pixels_[pixelAt(uv)];
@@ -100,10 +97,17 @@ glm::dvec3 EnvironmentLight::sample(glm::dvec2 u, double* pdf, glm::dvec3* radia
   return sampleAt(point, pixel, pdf, radiance);
 }
 
-glm::dvec2 EnvironmentLight::samplePoint(glm::dvec2 u, std::size_t* pixel) const {
+Distribution2D::RowSample EnvironmentLight::sampleRow(glm::dvec2 u) const {
+  if (distribution_.empty() || height_ == 1) return {};
+  const Distribution2D::RowSample row = distribution_.sampleRow(u.y);
+  distribution_.prefetchColumn(row, u.x);
+  return row;
+}
+
+glm::dvec2 EnvironmentLight::samplePoint(const Distribution2D::RowSample& row, glm::dvec2 u, std::size_t* pixel) const {
   *pixel = 0;
   if (distribution_.empty() || height_ == 1) return u;  // nothing to sample, or the sphere uniformly (sampleAt)
-  return distribution_.sampleCell(u, pixel);
+  return distribution_.sampleColumn(row, u.x, pixel);
 }
 
 glm::dvec3 EnvironmentLight::sampleAt(glm::dvec2 point, std::size_t pixel, double* pdf, glm::dvec3* radiance) const {
@@ -115,15 +119,16 @@ glm::dvec3 EnvironmentLight::sampleAt(glm::dvec2 point, std::size_t pixel, doubl
     // A single row (constant environment): sample the sphere uniformly instead of in (u, v), so
     // the density stays bounded at the poles.
     const glm::dvec2 u = point;
-    const double z = 1.0 - 2.0 * u.y, r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = 2.0 * kPi * u.x;
+    const double z = 1.0 - 2.0 * u.y, r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const SinCos phi = sinCosSingle(2.0 * kPi * u.x);
     *pdf = 1.0 / (4.0 * kPi);
-    const glm::dvec3 d(r * std::cos(phi), z, r * std::sin(phi));
+    const glm::dvec3 d(r * phi.cos, z, r * phi.sin);
     if (radiance) *radiance = this->radiance(d);
     return d;
   }
   const glm::vec4& texel = pixels_[pixel];
   double sinTheta = 0.0;
-  const glm::dvec3 direction = equirectDirection(point.x, point.y, &sinTheta);
+  const glm::dvec3 direction = equirectDirectionForSampling(point.x, point.y, &sinTheta);
   *pdf = solidAngleDensity(texel.w, sinTheta);
   if (radiance) *radiance = glm::dvec3(texel);
   return direction;
@@ -266,22 +271,37 @@ std::optional<LightSample> LightSet::samplePunctual(std::size_t light, const glm
 }
 
 LightSet::Choice LightSet::choose(double uChoice, glm::dvec2 u) const {
+  Choice c = startChoice(uChoice, u);
+  finishChoice(c);
+  return c;
+}
+
+LightSet::Choice LightSet::startChoice(double uChoice, glm::dvec2 u) const {
   Choice c;
   if (choice_.empty()) return c;
+  c.u = u;
   if (choice_.sampleDiscrete(uChoice, &c.probability) == 0) {
     c.kind = Choice::Kind::kEnvironment;
-    c.point = environment_->samplePoint(u, &c.index);
-    environment_->prefetchPixel(c.index);
-    return c;
+    c.row = environment_->sampleRow(u);
+  } else {
+    c.kind = Choice::Kind::kTriangle;
+    triangleChoice_.prefetch(u.x);
   }
-  // An emissive triangle by area x emissive luminance, then a uniform point on it.
-  c.kind = Choice::Kind::kTriangle;
-  double remapped = 0.0, triangleProbability = 0.0;
-  c.index = triangleChoice_.sampleDiscrete(u.x, &triangleProbability, &remapped);
-  c.probability *= triangleProbability;
-  c.point = {remapped, u.y};
-  __builtin_prefetch(&triangles_[c.index]);
   return c;
+}
+
+void LightSet::finishChoice(Choice& c) const {
+  if (c.kind == Choice::Kind::kEnvironment) {
+    c.point = environment_->samplePoint(c.row, c.u, &c.index);
+    environment_->prefetchPixel(c.index);
+  } else if (c.kind == Choice::Kind::kTriangle) {
+    // An emissive triangle by area x emissive luminance, then a uniform point on it.
+    double remapped = 0.0, triangleProbability = 0.0;
+    c.index = triangleChoice_.sampleDiscrete(c.u.x, &triangleProbability, &remapped);
+    c.probability *= triangleProbability;
+    c.point = {remapped, c.u.y};
+    __builtin_prefetch(&triangles_[c.index]);
+  }
 }
 
 std::optional<LightSample> LightSet::sample(const glm::dvec3& point, const Choice& c) const {
@@ -319,12 +339,6 @@ glm::dvec3 LightSet::environmentRadianceAt(glm::dvec2 uv, double* pdf) const {
   const glm::dvec3 le = environment_->radianceAt(uv, &p);
   if (environmentChoice_ > 0) *pdf = environmentChoice_ * p;
   return le;
-}
-
-void LightSet::prefetchChoice(double uChoice, glm::dvec2 u) const {
-  if (choice_.empty()) return;
-  if (choice_.sampleDiscrete(uChoice) == 0) environment_->prefetchSampleTable(u);  // a two-entry table: cached
-  else triangleChoice_.prefetch(u.x);
 }
 
 // Choice of the triangle ∝ area x weight, then uniform on it: the area cancels, leaving

@@ -37,17 +37,19 @@ class EnvironmentLight {
   // A direction towards the environment with its solid-angle density and, when asked, the
   // radiance from it (the sampled pixel's, without mapping the direction back).
   glm::dvec3 sample(glm::dvec2 u, double* pdf, glm::dvec3* radiance = nullptr) const;
-  // sample() in two steps, so the batched path tracer can prefetch the pixel between them: the
-  // image point and pixel index for u (reads the sampling tables), then the direction, density
-  // and radiance there (reads the pixel).
-  glm::dvec2 samplePoint(glm::dvec2 u, std::size_t* pixel) const;
+  // sample() in steps, so the batched path tracer can prefetch between them: the image point and
+  // pixel index for u (reads the sampling tables), then the direction, density and radiance there
+  // (reads the pixel). The first step itself splits in two: the row (starting to load the column
+  // table entry the point is read from), then the point.
+  glm::dvec2 samplePoint(glm::dvec2 u, std::size_t* pixel) const { return samplePoint(sampleRow(u), u, pixel); }
+  Distribution2D::RowSample sampleRow(glm::dvec2 u) const;
+  glm::dvec2 samplePoint(const Distribution2D::RowSample& row, glm::dvec2 u, std::size_t* pixel) const;
   glm::dvec3 sampleAt(glm::dvec2 point, std::size_t pixel, double* pdf, glm::dvec3* radiance = nullptr) const;
   double pdf(const glm::dvec3& direction) const;
-  // Memory prefetches for the batched path tracer: the pixel radianceAt(uv) reads; the table
-  // entry sample(u) reads first; then (once that entry has arrived) the pixel it picks.
+  // Memory prefetches for the batched path tracer: the pixel radianceAt(uv) reads; the pixel a
+  // sample picked.
   void prefetchPixel(glm::dvec2 uv) const;
   void prefetchPixel(std::size_t pixel) const { __builtin_prefetch(&pixels_[pixel]); }
-  void prefetchSampleTable(glm::dvec2 u) const;
   // Mean radiance over the sphere (luminance), for choosing between lights.
   double meanLuminance() const { return meanLuminance_; }
 
@@ -116,15 +118,21 @@ class LightSet {
     double probability = 0.0;  // of choosing the light (and for a triangle, that triangle)
     std::size_t index = 0;     // environment pixel or triangle
     glm::dvec2 point{0.0};     // environment image point, or the triangle's (remapped u.x, u.y)
+    // Between startChoice and finishChoice: the random numbers, and the environment's row.
+    glm::dvec2 u{0.0};
+    Distribution2D::RowSample row;
   };
   Choice choose(double uChoice, glm::dvec2 u) const;
+  // choose() in two steps, for the batched path tracer: which light and (for the environment)
+  // which row, from tables small enough to stay cached, starting to load the table entry the
+  // second step reads; then the pixel or triangle, starting to load it. Each table is read once.
+  Choice startChoice(double uChoice, glm::dvec2 u) const;
+  void finishChoice(Choice& choice) const;
   std::optional<LightSample> sample(const glm::dvec3& point, const Choice& choice) const;
   // When a BSDF-sampled ray reaches the environment: its radiance and, in *pdf, this strategy's
   // density for MIS (choice x solid-angle density), in one lookup; uv = equirectCoordinates of
   // the ray's direction, which the caller has computed.
   glm::dvec3 environmentRadianceAt(glm::dvec2 uv, double* pdf) const;
-  // Starts loading the table entries choose(uChoice, u) reads (for the batched path tracer).
-  void prefetchChoice(double uChoice, glm::dvec2 u) const;
   void prefetchEnvironment(glm::dvec2 uv) const {
     if (environment_) environment_->prefetchPixel(uv);
   }

@@ -237,11 +237,10 @@ struct PathTracer::PathState {
   double previousBsdfPdf = 0.0;  // solid-angle pdf of the BSDF sample that made `ray`
   bool previousDelta = true;     // camera rays: nothing else could have found the emitter
   bool active = true;
-  // The light sample's random numbers, drawn in the trace stage (in the order the path draws
-  // them: nothing else draws between the hit and them) so that their tables can be prefetched.
-  double uChoice = 0.0;
-  glm::dvec2 uLight{0.0};
-  LightSet::Choice lightChoice;  // from them, in the prefetch stage
+  // The light sample, started in the trace stage (its random numbers drawn in the order the path
+  // draws them: nothing else draws between the hit and them) so that the table entry it reads
+  // next is loading; finished in the prefetch stage.
+  LightSet::Choice lightChoice;
   glm::dvec2 uv{0.0};  // the hit's texture coordinates, or the environment image point of an escape
 };
 
@@ -318,9 +317,9 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
       }
       if (depth > 0) prefetchTexCoords(hit);
       if (lightSample && shadesHere) {
-        p.uChoice = p.rng.uniform();
-        p.uLight = p.rng.uniform2();
-        lights_.prefetchChoice(p.uChoice, p.uLight);
+        const double uChoice = p.rng.uniform();
+        const glm::dvec2 uLight = p.rng.uniform2();
+        p.lightChoice = lights_.startChoice(uChoice, uLight);
       }
     }
     if (!any) break;
@@ -333,7 +332,7 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
         p.uv = texCoord(hit);
         prefetchTextures(hit, p.uv);
       }
-      if (lightSample && shadesHere) p.lightChoice = lights_.choose(p.uChoice, p.uLight);
+      if (lightSample && shadesHere) lights_.finishChoice(p.lightChoice);
     }
     // Stage 3: shade, gather light, bounce.
     for (PathState& p : paths)

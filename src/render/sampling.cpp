@@ -80,18 +80,20 @@ Distribution2D::Distribution2D(std::span<const double> weights, int width, int h
   if (rows_.empty()) columns_.clear();
 }
 
-glm::dvec2 Distribution2D::sampleCell(glm::dvec2 u, std::size_t* cell) const {
-  double v = 0, w = 0;
-  const std::size_t row = rows_.sampleDiscrete(u.y, nullptr, &v);
-  const std::size_t column = columns_[row].sampleDiscrete(u.x, nullptr, &w);
-  *cell = row * static_cast<std::size_t>(width_) + column;
-  return {(static_cast<double>(column) + w) / width_, (static_cast<double>(row) + v) / height_};
+Distribution2D::RowSample Distribution2D::sampleRow(double uy) const {
+  RowSample r;
+  r.row = rows_.sampleDiscrete(uy, nullptr, &r.v);
+  return r;
 }
 
-void Distribution2D::prefetch(glm::dvec2 u) const {
-  if (rows_.empty()) return;
-  columns_[rows_.sampleDiscrete(u.y)].prefetch(u.x);
+glm::dvec2 Distribution2D::sampleColumn(const RowSample& row, double ux, std::size_t* cell) const {
+  double w = 0;
+  const std::size_t column = columns_[row.row].sampleDiscrete(ux, nullptr, &w);
+  *cell = row.row * static_cast<std::size_t>(width_) + column;
+  return {(static_cast<double>(column) + w) / width_, (static_cast<double>(row.row) + row.v) / height_};
 }
+
+glm::dvec2 Distribution2D::sampleCell(glm::dvec2 u, std::size_t* cell) const { return sampleColumn(sampleRow(u.y), u.x, cell); }
 
 glm::dvec2 Distribution2D::sample(glm::dvec2 u, double* density) const {
   std::size_t cell = 0;

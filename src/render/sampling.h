@@ -67,8 +67,9 @@ struct Frame {
 
 // Cosine-weighted direction about +Z (Malley's method); pdf = cos(theta) / pi.
 inline glm::dvec3 sampleCosineHemisphere(glm::dvec2 u) {
-  const double r = std::sqrt(u.x), phi = 2.0 * kPi * u.y;
-  return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0, 1.0 - u.x))};
+  const double r = std::sqrt(u.x);
+  const SinCos phi = sinCosSingle(2.0 * kPi * u.y);
+  return {r * phi.cos, r * phi.sin, std::sqrt(std::max(0.0, 1.0 - u.x))};
 }
 
 // Uniform point on a triangle, as barycentric weights of vertices 1 and 2 (Heitz 2019's
@@ -119,8 +120,16 @@ class Distribution2D {
   // The same point, and the index (row x width + column) of its cell instead of the density.
   glm::dvec2 sampleCell(glm::dvec2 u, std::size_t* cell) const;
   double density(glm::dvec2 point) const;
-  // Starts loading the column table entry that sampleCell(u) reads (the row table is small).
-  void prefetch(glm::dvec2 u) const;
+  // sampleCell in two steps, so that a batched caller can load the column table entry between
+  // them: the row (from the row table, which is small and stays cached) with what is left of
+  // u.y, then the column. sampleColumn(sampleRow(u.y), u.x, cell) is sampleCell(u, cell).
+  struct RowSample {
+    std::size_t row = 0;
+    double v = 0.0;  // uniform in [0, 1) within the row
+  };
+  RowSample sampleRow(double uy) const;
+  void prefetchColumn(const RowSample& row, double ux) const { columns_[row.row].prefetch(ux); }
+  glm::dvec2 sampleColumn(const RowSample& row, double ux, std::size_t* cell) const;
 
  private:
   double cellDensity(std::size_t row, std::size_t column) const;
