@@ -100,9 +100,17 @@ glm::dvec3 equirectDirectionForSampling(double u, double v, double* sinTheta) {
 }
 
 glm::dvec2 equirectCoordinates(const glm::dvec3& d) {
+  double sinTheta = 0.0;
+  return equirectCoordinates(d, &sinTheta);
+}
+
+glm::dvec2 equirectCoordinates(const glm::dvec3& d, double* sinTheta) {
   const double phi = std::atan2(d.x, -d.z);
   // atan2 rather than acos(d.y): acos loses half the digits near the poles.
-  const double theta = std::atan2(std::sqrt(d.x * d.x + d.z * d.z), d.y);
+  const double horizontal = std::sqrt(d.x * d.x + d.z * d.z);
+  const double theta = std::atan2(horizontal, d.y);
+  const double length = std::sqrt(horizontal * horizontal + d.y * d.y);
+  *sinTheta = length > 0 ? horizontal / length : 0.0;
   return {phi / (2.0 * kPi) + 0.5, theta / kPi};
 }
 

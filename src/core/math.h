@@ -86,6 +86,8 @@ glm::dvec3 equirectDirection(double u, double v, double* sinTheta);
 glm::dvec3 equirectDirectionForSampling(double u, double v, double* sinTheta);
 // Its inverse: the image point a unit direction maps to.
 glm::dvec2 equirectCoordinates(const glm::dvec3& direction);
+// The same, also giving sin(theta) = sin(pi v), from the direction itself (no sine to compute).
+glm::dvec2 equirectCoordinates(const glm::dvec3& direction, double* sinTheta);
 // Solid angle of pixel row `row` of an equirectangular image of the given size, steradians.
 double equirectPixelSolidAngle(int row, int width, int height);
 

@@ -72,22 +72,22 @@ glm::dvec3 EnvironmentLight::radiance(const glm::dvec3& direction) const {
 
 // A density over the image square becomes a solid-angle density through the equirectangular
 // Jacobian: dω = 2π² sin θ du dv.
-double EnvironmentLight::solidAnglePdf(double density, double v) const { return solidAngleDensity(density, std::sin(kPi * v)); }
-
 double EnvironmentLight::solidAngleDensity(double density, double sinTheta) { return sinTheta > 0 ? density / (2.0 * kPi * kPi * sinTheta) : 0.0; }
 
 glm::dvec3 EnvironmentLight::radiance(const glm::dvec3& direction, double* pdf) const {
-  return radianceAt(equirectCoordinates(direction), pdf);
+  double sinTheta = 0.0;
+  const glm::dvec2 uv = equirectCoordinates(direction, &sinTheta);
+  return radianceAt(uv, sinTheta, pdf);
 }
 
 void EnvironmentLight::prefetchPixel(glm::dvec2 uv) const { __builtin_prefetch(&pixels_[pixelAt(uv)]); }
 
 
-glm::dvec3 EnvironmentLight::radianceAt(glm::dvec2 uv, double* pdf) const {
+glm::dvec3 EnvironmentLight::radianceAt(glm::dvec2 uv, double sinTheta, double* pdf) const {
   const glm::vec4& pixel = pixels_[pixelAt(uv)];
   if (distribution_.empty()) *pdf = 0.0;
   else if (height_ == 1) *pdf = 1.0 / (4.0 * kPi);
-  else *pdf = solidAnglePdf(pixel.w, uv.y);
+  else *pdf = solidAngleDensity(pixel.w, sinTheta);
   return glm::dvec3(pixel);
 }
 
@@ -332,11 +332,11 @@ std::optional<LightSample> LightSet::sample(const glm::dvec3& point, const Choic
   return s;
 }
 
-glm::dvec3 LightSet::environmentRadianceAt(glm::dvec2 uv, double* pdf) const {
+glm::dvec3 LightSet::environmentRadianceAt(glm::dvec2 uv, double sinTheta, double* pdf) const {
   *pdf = 0.0;
   if (!environment_) return glm::dvec3(0.0);
   double p = 0.0;
-  const glm::dvec3 le = environment_->radianceAt(uv, &p);
+  const glm::dvec3 le = environment_->radianceAt(uv, sinTheta, &p);
   if (environmentChoice_ > 0) *pdf = environmentChoice_ * p;
   return le;
 }

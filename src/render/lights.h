@@ -32,8 +32,8 @@ class EnvironmentLight {
   glm::dvec3 radiance(const glm::dvec3& direction) const;
   // Radiance and solid-angle density in one lookup (a path that escapes needs both).
   glm::dvec3 radiance(const glm::dvec3& direction, double* pdf) const;
-  // The same at image point uv = equirectCoordinates(direction), computed by the caller.
-  glm::dvec3 radianceAt(glm::dvec2 uv, double* pdf) const;
+  // The same at image point uv = equirectCoordinates(direction, &sinTheta), computed by the caller.
+  glm::dvec3 radianceAt(glm::dvec2 uv, double sinTheta, double* pdf) const;
   // A direction towards the environment with its solid-angle density and, when asked, the
   // radiance from it (the sampled pixel's, without mapping the direction back).
   glm::dvec3 sample(glm::dvec2 u, double* pdf, glm::dvec3* radiance = nullptr) const;
@@ -62,9 +62,9 @@ class EnvironmentLight {
   double meanLuminance_ = 0.0;
 
   std::size_t pixelAt(glm::dvec2 uv) const;
-  // Solid-angle density at image point uv of a pixel whose square density is `density`.
-  double solidAnglePdf(double density, double v) const;
-  static double solidAngleDensity(double density, double sinTheta);  // the same, given sin(theta) = sin(pi v)
+  // Solid-angle density at polar angle theta (sinTheta = sin(pi v)) of a pixel whose density
+  // over the image square is `density`.
+  static double solidAngleDensity(double density, double sinTheta);
 };
 
 struct LightSample {
@@ -131,8 +131,8 @@ class LightSet {
   std::optional<LightSample> sample(const glm::dvec3& point, const Choice& choice) const;
   // When a BSDF-sampled ray reaches the environment: its radiance and, in *pdf, this strategy's
   // density for MIS (choice x solid-angle density), in one lookup; uv = equirectCoordinates of
-  // the ray's direction, which the caller has computed.
-  glm::dvec3 environmentRadianceAt(glm::dvec2 uv, double* pdf) const;
+  // the ray's direction, with its sinTheta, which the caller has computed.
+  glm::dvec3 environmentRadianceAt(glm::dvec2 uv, double sinTheta, double* pdf) const;
   void prefetchEnvironment(glm::dvec2 uv) const {
     if (environment_) environment_->prefetchPixel(uv);
   }

@@ -231,7 +231,7 @@ struct PathTracer::PathSample {
 struct PathTracer::PathState {
   Random rng;
   Ray ray;
-  SurfaceHit hit;  // of `ray` (depth > 0)
+  std::size_t streamIndex = 0;  // where the hit of `ray` is in the batch's stream (depth > 0)
   glm::dvec3 throughput{1.0};
   PathSample out;
   double previousBsdfPdf = 0.0;  // solid-angle pdf of the BSDF sample that made `ray`
@@ -242,6 +242,7 @@ struct PathTracer::PathState {
   // next is loading; finished in the prefetch stage.
   LightSet::Choice lightChoice;
   glm::dvec2 uv{0.0};  // the hit's texture coordinates, or the environment image point of an escape
+  double escapeSinTheta = 0.0;  // sin(theta) of an escape's direction (the environment's Jacobian)
 };
 
 struct PathTracer::Vertex {
@@ -301,16 +302,18 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
       rayTracing_->intersect(scratch.streamRays, scratch.streamHits);
       std::size_t k = 0;
       for (PathState& p : paths)
-        if (p.active) p.hit = scratch.streamHits[k++];
+        if (p.active) p.streamIndex = k++;
       scratch.rays += scratch.streamRays.size();
     }
+    // The hits are read where the stream left them (a hit record is 150 bytes: not copied).
+    auto hitOf = [&](const PathState& p) -> const SurfaceHit& { return depth == 0 ? firstHit : scratch.streamHits[p.streamIndex]; };
     for (PathState& p : paths) {
       if (!p.active) continue;
       any = true;
-      const SurfaceHit& hit = depth == 0 ? firstHit : p.hit;
+      const SurfaceHit& hit = hitOf(p);
       if (!hit.hit) {
         if (environment_) {
-          p.uv = equirectCoordinates(p.ray.direction);
+          p.uv = equirectCoordinates(p.ray.direction, &p.escapeSinTheta);
           lights_.prefetchEnvironment(p.uv);
         }
         continue;
@@ -326,8 +329,9 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
     // Stage 2: what stage 1's loads point to: the texels at the hit; the light choice, which
     // starts loading the environment pixel or triangle it picks.
     for (PathState& p : paths) {
-      const SurfaceHit& hit = depth == 0 ? firstHit : p.hit;
-      if (!p.active || !hit.hit) continue;
+      if (!p.active) continue;
+      const SurfaceHit& hit = hitOf(p);
+      if (!hit.hit) continue;
       if (depth > 0) {
         p.uv = texCoord(hit);
         prefetchTextures(hit, p.uv);
@@ -336,7 +340,7 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
     }
     // Stage 3: shade, gather light, bounce.
     for (PathState& p : paths)
-      if (p.active) p.active = advance(p, depth, depth == 0 ? firstHit : p.hit, depth == 0 ? &first : nullptr, scratch);
+      if (p.active) p.active = advance(p, depth, hitOf(p), depth == 0 ? &first : nullptr, scratch);
   }
   for (PathState& p : paths) {
     if (!finite(p.out.direct)) p.out.direct = glm::dvec3(0.0);
@@ -352,7 +356,7 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const F
   if (!hit.hit) {
     if (environment_) {
       double pdfLight = 0.0;
-      const glm::dvec3 le = lights_.environmentRadianceAt(p.uv, &pdfLight);
+      const glm::dvec3 le = lights_.environmentRadianceAt(p.uv, p.escapeSinTheta, &pdfLight);
       const double w = p.previousDelta || !settings_.nextEventEstimation ? 1.0 : powerHeuristic(p.previousBsdfPdf, pdfLight);
       bucket += p.throughput * le * w;
     }
