@@ -143,7 +143,7 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
     engineHelp += fmt::format(" {} ({}){}", b.name, b.description, &b == &render::renderBackends().back() ? "" : ";");
   }
   cmd->add_option("--engine", o->job.engine, engineHelp)->check(CLI::IsMember(engines));
-  cmd->add_option("--threads", o->job.threads, "Threads (0: all cores)")->check(nonNegative());
+  cmd->add_option("--threads", o->job.threads, "Threads for loading, rendering and writing frames (0: all cores)")->check(nonNegative());
   cmd->add_option("--blender", o->job.blender, "Blender executable for --engine cycles");
   cmd->add_option("--env-constant", o->envConstant, "Light with a constant environment of radiance L or R,G,B instead of the dataset's");
   cmd->add_flag("--no-environment", o->noEnvironment, "No image-based light (black background)");

@@ -19,11 +19,13 @@ using WriteFn = int (*)(const char*, const char*, int, int, int, const float*, c
                         std::size_t);
 using ReadFn = int (*)(const char*, int*, int*, int*, float**, char*, std::size_t, char*, std::size_t, char*, std::size_t);
 using FreeFn = void (*)(float*);
+using SetThreadsFn = void (*)(int);
 
 struct Module {
   WriteFn write = nullptr;
   ReadFn read = nullptr;
   FreeFn free = nullptr;
+  SetThreadsFn setThreads = nullptr;
   std::string error;
 };
 
@@ -45,7 +47,8 @@ const Module& module() {
       m.write = reinterpret_cast<WriteFn>(::dlsym(handle, "dynbench_image_write_v2"));
       m.read = reinterpret_cast<ReadFn>(::dlsym(handle, "dynbench_image_read_v2"));
       m.free = reinterpret_cast<FreeFn>(::dlsym(handle, "dynbench_image_free"));
-      if (m.write && m.read && m.free) return;
+      m.setThreads = reinterpret_cast<SetThreadsFn>(::dlsym(handle, "dynbench_image_set_threads"));
+      if (m.write && m.read && m.free && m.setThreads) return;
       tried += fmt::format("\n  {}: not a dynbench image module", c.string());
     }
     m.error = "cannot load the image module (libdynbench_image.so, OpenImageIO); tried:" + tried;
@@ -103,6 +106,11 @@ Expected<FloatImage> read(const fs::path& path, bool pixelsToo) {
 }
 
 }  // namespace
+
+void setImageThreads(int threads) {
+  // Without the module nothing reads or writes images, and the first read or write says why.
+  if (const Module& m = module(); m.setThreads) m.setThreads(threads);
+}
 
 Expected<FloatImage> readImageHeader(const fs::path& path) { return read(path, false); }
 Expected<FloatImage> readImage(const fs::path& path) { return read(path, true); }

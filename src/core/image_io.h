@@ -31,4 +31,10 @@ Expected<FloatImage> readImage(const std::filesystem::path& path);
 // Width, height and channels from the header only.
 Expected<FloatImage> readImageHeader(const std::filesystem::path& path);
 
+// The threads image reading and writing may use, process-wide: OpenImageIO's own pool and
+// OpenEXR's compression pool, which otherwise each start one thread per hardware core whatever
+// the caller's thread budget. 1: the calling thread does all the work; 0: the libraries'
+// default (every core).
+void setImageThreads(int threads);
+
 }  // namespace dynbench

@@ -94,4 +94,11 @@ int dynbench_image_read_v2(const char* path, int* width, int* height, int* chann
 
 void dynbench_image_free(float* pixels) { std::free(pixels); }
 
+// OpenImageIO's pool and its OpenEXR compression pool (OpenImageIO's convention for the latter:
+// 0 is every core, -1 none, so that the calling thread compresses).
+void dynbench_image_set_threads(int threads) {
+  OIIO::attribute("threads", threads);
+  OIIO::attribute("exr_threads", threads == 1 ? -1 : threads);
+}
+
 }  // extern "C"

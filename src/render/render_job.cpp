@@ -8,6 +8,7 @@
 #include <tbb/global_control.h>
 
 #include "core/files.h"
+#include "core/image_io.h"
 #include "render/backend.h"
 #include "scene/queries.h"
 #include "frames/frame_io.h"
@@ -146,9 +147,11 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
     requests.push_back({f, std::move(*cameras)});
   }
   const auto started = std::chrono::steady_clock::now();
-  // --threads holds for the whole job: loading (textures decode in parallel) and rendering.
+  // --threads holds for the whole job: loading (textures decode in parallel), rendering and
+  // writing (OpenEXR compresses a frame's blocks on its own pool, one thread per core unless told).
   std::optional<tbb::global_control> limit;
   if (job.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(job.threads));
+  setImageThreads(job.threads);  // the frames' ZIP compression too
   auto renderer = (*backend)->create({scene, job, *cameraNode, summary.warnings});
   if (!renderer) return std::unexpected(renderer.error());
   summary.loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
