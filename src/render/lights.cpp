@@ -82,7 +82,6 @@ glm::dvec3 EnvironmentLight::radiance(const glm::dvec3& direction, double* pdf) 
 
 void EnvironmentLight::prefetchPixel(glm::dvec2 uv) const { __builtin_prefetch(&pixels_[pixelAt(uv)]); }
 
-
 glm::dvec3 EnvironmentLight::radianceAt(glm::dvec2 uv, double sinTheta, double* pdf) const {
   const glm::vec4& pixel = pixels_[pixelAt(uv)];
   if (distribution_.empty()) *pdf = 0.0;
@@ -93,7 +92,7 @@ glm::dvec3 EnvironmentLight::radianceAt(glm::dvec2 uv, double sinTheta, double* 
 
 glm::dvec3 EnvironmentLight::sample(glm::dvec2 u, double* pdf, glm::dvec3* radiance) const {
   std::size_t pixel = 0;
-  const glm::dvec2 point = samplePoint(u, &pixel);
+  const glm::dvec2 point = samplePoint(sampleRow(u), u, &pixel);
   return sampleAt(point, pixel, pdf, radiance);
 }
 
@@ -268,12 +267,6 @@ std::optional<LightSample> LightSet::samplePunctual(std::size_t light, const glm
   if (attenuation <= 0) return std::nullopt;
   s.radiance = l.intensity * attenuation;
   return s;
-}
-
-LightSet::Choice LightSet::choose(double uChoice, glm::dvec2 u) const {
-  Choice c = startChoice(uChoice, u);
-  finishChoice(c);
-  return c;
 }
 
 LightSet::Choice LightSet::startChoice(double uChoice, glm::dvec2 u) const {

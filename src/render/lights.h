@@ -41,7 +41,6 @@ class EnvironmentLight {
   // pixel index for u (reads the sampling tables), then the direction, density and radiance there
   // (reads the pixel). The first step itself splits in two: the row (starting to load the column
   // table entry the point is read from), then the point.
-  glm::dvec2 samplePoint(glm::dvec2 u, std::size_t* pixel) const { return samplePoint(sampleRow(u), u, pixel); }
   Distribution2D::RowSample sampleRow(glm::dvec2 u) const;
   glm::dvec2 samplePoint(const Distribution2D::RowSample& row, glm::dvec2 u, std::size_t* pixel) const;
   glm::dvec3 sampleAt(glm::dvec2 point, std::size_t pixel, double* pdf, glm::dvec3* radiance = nullptr) const;
@@ -122,8 +121,7 @@ class LightSet {
     glm::dvec2 u{0.0};
     Distribution2D::RowSample row;
   };
-  Choice choose(double uChoice, glm::dvec2 u) const;
-  // choose() in two steps, for the batched path tracer: which light and (for the environment)
+  // Choosing takes two steps, for the batched path tracer: which light and (for the environment)
   // which row, from tables small enough to stay cached, starting to load the table entry the
   // second step reads; then the pixel or triangle, starting to load it. Each table is read once.
   Choice startChoice(double uChoice, glm::dvec2 u) const;

@@ -291,8 +291,8 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
   const FirstVertex first{firstShading, vertexAt(firstHit, firstShading, -cameraRay.direction), scratch.firstReach};
   for (int depth = 0;; ++depth) {
     const bool shadesHere = depth <= settings_.bounces;  // a hit at this depth gathers light and bounces
-    // Stage 1: trace; start loading the hit's texture coordinates, the environment pixel of an
-    // escape, and the light tables the light sample will read.
+    // Stage 1: trace; start loading the hit's texture coordinates and the environment pixel of an
+    // escape; start the light choice (which loads the table entry stage 2 reads).
     bool any = false;
     if (depth > 0) {
       scratch.streamRays.clear();
@@ -476,7 +476,8 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
   tbb::enumerable_thread_specific<PathScratch> scratches;
   const glm::dvec2 jitter = settings_.jitter ? frames::jitterOffset(static_cast<long>(frameIndex)) : glm::dvec2(0.0);
 
-  auto samplePixel = [&](std::size_t pixel, int upTo, PathScratch& scratch) {
+  // `known`: the first hit's shading when the caller has it already (the first round's buffers).
+  auto samplePixel = [&](std::size_t pixel, int upTo, PathScratch& scratch, const Shading* known = nullptr) {
     const int px = static_cast<int>(pixel % static_cast<std::size_t>(width)), py = static_cast<int>(pixel / static_cast<std::size_t>(width));
     const Ray ray = camera.ray(px + 0.5 + jitter.x, py + 0.5 + jitter.y);
     const SurfaceHit& hit = firstHits[pixel];
@@ -487,7 +488,8 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
       while (sum.samples < upTo) sum.add(le, glm::dvec3(0.0));
       return;
     }
-    const Shading shading = shade(hit, -ray.direction, texCoord(hit));
+    std::optional<Shading> own;
+    const Shading& shading = known ? *known : own.emplace(shade(hit, -ray.direction, texCoord(hit)));
     // In batches, each path with the random stream of its sample index, summed in sample order.
     while (sum.samples < upTo) {
       const std::size_t batch = static_cast<std::size_t>(std::min(upTo - sum.samples, settings_.pathBatch));
@@ -512,8 +514,9 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
         const SurfaceHit hit = trace(ray);
         ++scratch.rays;
         firstHits[pixel] = hit;
+        std::optional<Shading> shading;
         if (hit.hit) {
-          const Shading s = shade(hit, -ray.direction, texCoord(hit));
+          const Shading& s = shading.emplace(shade(hit, -ray.direction, texCoord(hit)));
           put3(out.position, pixel, hit.position);
           put3(out.normal, pixel, s.shadingNormal);
           put3(out.albedo, pixel, s.material.baseColor);
@@ -526,7 +529,7 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
           out.motion[2 * pixel] = static_cast<float>(target.x - (px + 0.5 + jitter.x));
           out.motion[2 * pixel + 1] = static_cast<float>(target.y - (py + 0.5 + jitter.y));
         }
-        samplePixel(pixel, firstRound, scratch);
+        samplePixel(pixel, firstRound, scratch, shading ? &*shading : nullptr);
       }
       if (rowsDone && !settings_.converge) rowsDone->fetch_add(1, std::memory_order_relaxed);
     }

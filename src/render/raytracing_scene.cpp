@@ -223,7 +223,7 @@ glm::dvec3 RayTracingScene::previousPosition(const SurfaceHit& hit) const {
   if (!hit.hit || !hit.dynamicGeometry) return hit.position;
   const Entry& e = impl_->dynamicEntries[hit.geometry];
   if (!e.previousValid) return hit.position;
-  const std::uint32_t* idx = &e.indices[3 * hit.triangle];
+  const auto& idx = hit.vertices;
   const double u = hit.barycentric.x, v = hit.barycentric.y;
   return (1.0 - u - v) * e.previousPositions[idx[0]] + u * e.previousPositions[idx[1]] + v * e.previousPositions[idx[2]];
 }
@@ -236,7 +236,7 @@ void RayTracingScene::forEachPrimitive(const std::function<void(const PrimitiveV
 
 std::array<glm::dvec3, 3> RayTracingScene::trianglePositions(const SurfaceHit& hit) const {
   const Entry& e = (hit.dynamicGeometry ? impl_->dynamicEntries : impl_->staticEntries)[hit.geometry];
-  const std::uint32_t* idx = &e.indices[3 * hit.triangle];
+  const auto& idx = hit.vertices;
   return {e.positions[idx[0]], e.positions[idx[1]], e.positions[idx[2]]};
 }
 
