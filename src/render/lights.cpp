@@ -269,9 +269,10 @@ std::optional<LightSample> LightSet::samplePunctual(std::size_t light, const glm
   return s;
 }
 
-LightSet::Choice LightSet::startChoice(double uChoice, glm::dvec2 u) const {
-  Choice c;
-  if (choice_.empty()) return c;
+void LightSet::startChoice(double uChoice, glm::dvec2 u, Choice& c) const {
+  c.kind = Choice::Kind::kNone;
+  c.probability = 0.0;
+  if (choice_.empty()) return;
   c.u = u;
   if (choice_.sampleDiscrete(uChoice, &c.probability) == 0) {
     c.kind = Choice::Kind::kEnvironment;
@@ -280,7 +281,6 @@ LightSet::Choice LightSet::startChoice(double uChoice, glm::dvec2 u) const {
     c.kind = Choice::Kind::kTriangle;
     triangleChoice_.prefetch(u.x);
   }
-  return c;
 }
 
 void LightSet::finishChoice(Choice& c) const {

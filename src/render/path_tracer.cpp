@@ -298,8 +298,9 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
       scratch.streamRays.clear();
       for (PathState& p : paths)
         if (p.active) scratch.streamRays.push_back(p.ray);
-      scratch.streamHits.resize(scratch.streamRays.size());
-      rayTracing_->intersect(scratch.streamRays, scratch.streamHits);
+      // Grown, never shrunk: growing again after a shrink would value-initialise the hit records.
+      if (scratch.streamHits.size() < scratch.streamRays.size()) scratch.streamHits.resize(scratch.streamRays.size());
+      rayTracing_->intersect(scratch.streamRays, std::span(scratch.streamHits).first(scratch.streamRays.size()));
       std::size_t k = 0;
       for (PathState& p : paths)
         if (p.active) p.streamIndex = k++;
@@ -322,7 +323,7 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
       if (lightSample && shadesHere) {
         const double uChoice = p.rng.uniform();
         const glm::dvec2 uLight = p.rng.uniform2();
-        p.lightChoice = lights_.startChoice(uChoice, uLight);
+        lights_.startChoice(uChoice, uLight, p.lightChoice);
       }
     }
     if (!any) break;

@@ -244,28 +244,35 @@ const scene::ScenePose& RayTracingScene::pose() const { return impl_->pose; }
 
 namespace {
 
-RTCRayHit embreeRay(const Ray& ray, double tMin, double tMax) {
-  RTCRayHit rh{};
+// Written field by field into the record Embree reads, not built on the stack and copied: GCC
+// copies such a temporary with 16-byte loads of 4-byte stores just made, a store-forwarding stall
+// per load (perf put a quarter of the hit bookkeeping's time on those copies).
+void setEmbreeRay(RTCRayHit& rh, const Ray& ray, double tMin, double tMax) {
   rh.ray.org_x = static_cast<float>(ray.origin.x);
   rh.ray.org_y = static_cast<float>(ray.origin.y);
   rh.ray.org_z = static_cast<float>(ray.origin.z);
+  rh.ray.tnear = static_cast<float>(tMin);
   rh.ray.dir_x = static_cast<float>(ray.direction.x);
   rh.ray.dir_y = static_cast<float>(ray.direction.y);
   rh.ray.dir_z = static_cast<float>(ray.direction.z);
-  rh.ray.tnear = static_cast<float>(tMin);
+  rh.ray.time = 0.0f;
   rh.ray.tfar = static_cast<float>(std::min(tMax, 1e30));
   rh.ray.mask = 0xFFFFFFFF;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  return rh;
 }
 
 }  // namespace
 
-// The hit record of what Embree found: the scene model's ids and double-precision surface data.
-static SurfaceHit surfaceHit(const RayTracingScene::Impl& impl, const RTCRayHit& rh) {
-  SurfaceHit hit;
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
+// The hit record of what Embree found: the scene model's ids and double-precision surface data,
+// written in place (see setEmbreeRay).
+static void setSurfaceHit(SurfaceHit& hit, const RayTracingScene::Impl& impl, const RTCRayHit& rh) {
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+    hit = SurfaceHit{};
+    return;
+  }
   const auto& entries = rh.hit.instID[0] == 0 ? impl.staticEntries : impl.dynamicEntries;
   const Entry& e = entries[rh.hit.geomID];
   hit.hit = true;
@@ -286,22 +293,24 @@ static SurfaceHit surfaceHit(const RayTracingScene::Impl& impl, const RTCRayHit&
     const glm::dvec3 n = w * e.normals[i0] + u * e.normals[i1] + v * e.normals[i2];
     if (glm::length(n) > 0) hit.shadingNormal = glm::normalize(n);
   }
-  return hit;
 }
 
 SurfaceHit RayTracingScene::intersect(const Ray& ray, double tMin, double tMax) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  RTCRayHit rh = embreeRay(ray, tMin, tMax);
+  RTCRayHit rh;
+  setEmbreeRay(rh, ray, tMin, tMax);
   rtcIntersect1(impl_->top, &context, &rh);
-  return surfaceHit(*impl_, rh);
+  SurfaceHit hit;
+  setSurfaceHit(hit, *impl_, rh);
+  return hit;
 }
 
 void RayTracingScene::intersect(std::span<const Ray> rays, std::span<SurfaceHit> hits) const {
   // Embree's ray records, kept per thread between calls so that a stream does not allocate.
   thread_local std::vector<RTCRayHit> stream;
   stream.resize(rays.size());
-  for (std::size_t k = 0; k < rays.size(); ++k) stream[k] = embreeRay(rays[k], 0.0, 1e30);
+  for (std::size_t k = 0; k < rays.size(); ++k) setEmbreeRay(stream[k], rays[k], 0.0, 1e30);
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   rtcIntersect1M(impl_->top, &context, stream.data(), static_cast<unsigned>(stream.size()), sizeof(RTCRayHit));
@@ -321,7 +330,7 @@ void RayTracingScene::intersect(std::span<const Ray> rays, std::span<SurfaceHit>
       if (!e.normals.empty()) __builtin_prefetch(&e.normals[v]);
     }
   }
-  for (std::size_t k = 0; k < rays.size(); ++k) hits[k] = surfaceHit(*impl_, stream[k]);
+  for (std::size_t k = 0; k < rays.size(); ++k) setSurfaceHit(hits[k], *impl_, stream[k]);
 }
 
 bool RayTracingScene::occluded(const glm::dvec3& origin, const glm::dvec3& direction, double tMax) const {
