@@ -101,16 +101,20 @@ Bsdf::View Bsdf::view(const glm::dvec3& wo) const {
 
 glm::dvec3 Bsdf::eval(const glm::dvec3& wo, const glm::dvec3& wi) const { return evaluate(view(wo), wi).value; }
 double Bsdf::pdf(const glm::dvec3& wo, const glm::dvec3& wi) const { return evaluate(view(wo), wi).pdf; }
-std::optional<BsdfSample> Bsdf::sample(const glm::dvec3& wo, glm::dvec2 u, double uLobe) const { return sample(view(wo), u, uLobe); }
+std::optional<BsdfSample> Bsdf::sample(const glm::dvec3& wo, glm::dvec2 u, double uLobe) const {
+  BsdfSample s;
+  if (!sample(view(wo), u, uLobe, s)) return std::nullopt;
+  return s;
+}
 
 Bsdf::Evaluation Bsdf::evaluate(const View& v, const glm::dvec3& wi) const {
   if (glm::dot(wi, ng_) <= 0 || !v.above) return {};
   return evaluateLocal(v, frame_.toLocal(wi));
 }
 
-std::optional<BsdfSample> Bsdf::sample(const View& v, glm::dvec2 u, double uLobe) const {
+bool Bsdf::sample(const View& v, glm::dvec2 u, double uLobe, BsdfSample& s) const {
   const glm::dvec3& o = v.local;
-  if (o.z <= 0) return std::nullopt;
+  if (o.z <= 0) return false;
   glm::dvec3 i;
   if (uLobe < v.specularProbability) {
     const glm::dvec3 h = sampleGgxVisibleNormal(o, alpha_, u);
@@ -118,15 +122,14 @@ std::optional<BsdfSample> Bsdf::sample(const View& v, glm::dvec2 u, double uLobe
   } else {
     i = sampleCosineHemisphere(u);
   }
-  if (i.z <= 0) return std::nullopt;
-  BsdfSample s;
+  if (i.z <= 0) return false;
   s.direction = frame_.toWorld(i);
-  if (glm::dot(s.direction, ng_) <= 0) return std::nullopt;
+  if (glm::dot(s.direction, ng_) <= 0) return false;
   const Evaluation e = evaluateLocal(v, i);
-  if (e.pdf <= 0) return std::nullopt;
+  if (e.pdf <= 0) return false;
   s.pdf = e.pdf;
   s.value = e.value;
-  return s;
+  return true;
 }
 
 }  // namespace dynbench::render

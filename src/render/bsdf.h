@@ -57,7 +57,9 @@ class Bsdf {
     double pdf = 0.0;
   };
   Evaluation evaluate(const View& view, const glm::dvec3& wi) const;
-  std::optional<BsdfSample> sample(const View& view, glm::dvec2 u, double uLobe) const;
+  // sample() from a view, into `out`; false where sample() gives nothing. (Written in place: the
+  // optional, returned, cost GCC a copy whose loads waited on the stores just made.)
+  bool sample(const View& view, glm::dvec2 u, double uLobe, BsdfSample& out) const;
 
   double alpha() const { return alpha_; }
 

@@ -297,32 +297,32 @@ void LightSet::finishChoice(Choice& c) const {
   }
 }
 
-std::optional<LightSample> LightSet::sample(const glm::dvec3& point, const Choice& c) const {
-  LightSample s;
-  if (c.kind == Choice::Kind::kNone) return std::nullopt;
+bool LightSet::sample(const glm::dvec3& point, const Choice& c, LightSample& s) const {
+  s.delta = false;
+  if (c.kind == Choice::Kind::kNone) return false;
   if (c.kind == Choice::Kind::kEnvironment) {
     double pdf = 0.0;
     s.direction = environment_->sampleAt(c.point, c.index, &pdf, &s.radiance);
-    if (!(pdf > 0)) return std::nullopt;
+    if (!(pdf > 0)) return false;
     s.distance = std::numeric_limits<double>::infinity();
     s.pdf = c.probability * pdf;
-    return s;
+    return true;
   }
   const Triangle& tri = triangles_[c.index];
   const glm::dvec2 b = sampleTriangle(c.point);
   const glm::dvec3 p = (1.0 - b.x - b.y) * tri.p0 + b.x * tri.p1 + b.y * tri.p2;
   const glm::dvec3 toLight = p - point;
   const double d2 = glm::dot(toLight, toLight);
-  if (!(d2 > 0)) return std::nullopt;
+  if (!(d2 > 0)) return false;
   s.distance = std::sqrt(d2);
   s.direction = toLight / s.distance;
   const glm::dvec3 cross = glm::cross(tri.p1 - tri.p0, tri.p2 - tri.p0);
   const double area = 0.5 * glm::length(cross);
   const double cosLight = std::abs(glm::dot(cross / (2.0 * area), s.direction));
-  if (cosLight <= 1e-12) return std::nullopt;
+  if (cosLight <= 1e-12) return false;
   s.radiance = emission_(tri.node, tri.primitive, tri.index, b);
   s.pdf = c.probability * d2 / (area * cosLight);
-  return s;
+  return true;
 }
 
 glm::dvec3 LightSet::environmentRadianceAt(glm::dvec2 uv, double sinTheta, double* pdf) const {

@@ -128,7 +128,9 @@ class LightSet {
   // stores just made (perf: an eighth of the batch loop's own time on one such copy).
   void startChoice(double uChoice, glm::dvec2 u, Choice& choice) const;
   void finishChoice(Choice& choice) const;
-  std::optional<LightSample> sample(const glm::dvec3& point, const Choice& choice) const;
+  // The sample from `point`, into `sample` (every field; written in place, as startChoice's
+  // choice); false where there is none.
+  bool sample(const glm::dvec3& point, const Choice& choice, LightSample& sample) const;
   // When a BSDF-sampled ray reaches the environment: its radiance and, in *pdf, this strategy's
   // density for MIS (choice x solid-angle density), in one lookup; uv = equirectCoordinates of
   // the ray's direction, with its sinTheta, which the caller has computed.

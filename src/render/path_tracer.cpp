@@ -137,11 +137,19 @@ glm::dvec3 PathTracer::emission(int node, int primitive, unsigned triangle, glm:
 
 PathTracer::Shading PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv) const {
   Shading s;
+  shade(hit, wo, uv, s);
+  return s;
+}
+
+void PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, Shading& s) const {
   const scene::Material* m = materialOf(hit.node, hit.primitive);
-  // glTF's default material when a primitive has none: white, metallic 1, roughness 1 (§3.9.6).
   SurfaceMaterial& mat = s.material;
-  mat.metallic = 1.0;
-  if (m) {
+  if (!m) {
+    // glTF's default material when a primitive has none: white, metallic 1, roughness 1 (§3.9.6).
+    mat = SurfaceMaterial{};
+    mat.metallic = 1.0;
+    s.emissiveWeight = 0.0;
+  } else {
     glm::dvec4 base(m->baseColorFactor);
     if (m->baseColorTexture.image >= 0) base *= textures_.sample(m->baseColorTexture, true, uv);
     mat.baseColor = glm::dvec3(base);
@@ -196,7 +204,6 @@ PathTracer::Shading PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& w
   // just in front (a common fix; pbrt and Cycles do similar).
   if (glm::dot(n, wo) < 1e-4) n = glm::normalize(n - wo * (glm::dot(n, wo) - 1e-4));
   s.shadingNormal = n;
-  return s;
 }
 
 SurfaceHit PathTracer::trace(const Ray& ray) const { return rayTracing_->intersect(ray); }
@@ -245,7 +252,13 @@ struct PathTracer::PathState {
   double escapeSinTheta = 0.0;  // sin(theta) of an escape's direction (the environment's Jacobian)
 };
 
+// The BSDF, its view from wo and the rays' origin at a shaded hit. Built where it is kept
+// (std::optional::emplace, not a returned copy: GCC's copy of these 300 bytes was a rep movs).
 struct PathTracer::Vertex {
+  Vertex(const SurfaceHit& hit, const Shading& s, const glm::dvec3& wo)
+      : bsdf(s.material, Frame(s.shadingNormal), s.geometricNormal),
+        view(bsdf.view(wo)),
+        origin(offsetOrigin(hit.position, s.geometricNormal)) {}
   Bsdf bsdf;
   Bsdf::View view;
   glm::dvec3 origin;  // where the vertex's shadow and bounce rays leave
@@ -259,14 +272,13 @@ struct PathTracer::FirstVertex {
   const std::vector<std::uint32_t>& reach;
 };
 
-PathTracer::Vertex PathTracer::vertexAt(const SurfaceHit& hit, const Shading& s, const glm::dvec3& wo) const {
-  Bsdf bsdf(s.material, Frame(s.shadingNormal), s.geometricNormal);
-  const Bsdf::View view = bsdf.view(wo);
-  return Vertex{bsdf, view, offsetOrigin(hit.position, s.geometricNormal)};
-}
-
 // Per-thread working memory of the path loop, so the per-ray path does not allocate.
 struct PathTracer::PathScratch {
+  // What advance computes at a path vertex, written in place (returned by value, GCC zeroed and
+  // copied them, with loads that waited on the stores just made).
+  Shading shading;
+  LightSample lightSample;
+  BsdfSample bsdfSample;
   std::vector<std::uint32_t> reach;       // punctual lights in reach of a shading point
   std::vector<std::uint32_t> firstReach;  // of the pixel's first hit
   std::vector<PathState> paths;      // a batch
@@ -288,7 +300,7 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
   const bool lightSample = settings_.nextEventEstimation;
   scratch.firstReach.clear();
   if (lightSample) lights_.punctualInReach(firstHit.position, scratch.firstReach);
-  const FirstVertex first{firstShading, vertexAt(firstHit, firstShading, -cameraRay.direction), scratch.firstReach};
+  const FirstVertex first{firstShading, Vertex(firstHit, firstShading, -cameraRay.direction), scratch.firstReach};
   for (int depth = 0;; ++depth) {
     const bool shadesHere = depth <= settings_.bounces;  // a hit at this depth gathers light and bounces
     // Stage 1: trace; start loading the hit's texture coordinates and the environment pixel of an
@@ -364,8 +376,9 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const F
     return false;
   }
   const glm::dvec3 wo = -ray.direction;
-  std::optional<Shading> ownShading;
-  const Shading& s = first ? first->shading : ownShading.emplace(shade(hit, wo, p.uv));
+  // The hit's shading, written in place (scratch.shading: returned, GCC zeroed and copied it).
+  if (!first) shade(hit, wo, p.uv, scratch.shading);
+  const Shading& s = first ? first->shading : scratch.shading;
   if (s.material.emission != glm::dvec3(0.0)) {
     double w = 1.0;
     if (!p.previousDelta && settings_.nextEventEstimation) {
@@ -375,8 +388,15 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const F
     bucket += p.throughput * s.material.emission * w;
   }
   if (depth > settings_.bounces) return false;
-  std::optional<Vertex> ownVertex;
-  const Vertex& vertex = first ? first->vertex : ownVertex.emplace(vertexAt(hit, s, wo));
+  if (first) return scatter(p, depth, hit, s, first->vertex, first->reach, scratch);
+  // Every punctual light in reach: a sum, no noise (LightSet::punctualInReach).
+  if (settings_.nextEventEstimation) lights_.punctualInReach(hit.position, scratch.reach);
+  const Vertex vertex(hit, s, wo);
+  return scatter(p, depth, hit, s, vertex, scratch.reach, scratch);
+}
+
+bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const Shading& s, const Vertex& vertex,
+                         const std::vector<std::uint32_t>& reach, PathScratch& scratch) const {
   const Bsdf& bsdf = vertex.bsdf;
   const Bsdf::View& view = vertex.view;
   const glm::dvec3& origin = vertex.origin;
@@ -385,7 +405,7 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const F
   if (settings_.nextEventEstimation) {
     // Adds one light's contribution; Monte Carlo samples are weighted against BSDF sampling
     // (Veach's MIS), delta lights count fully (no other strategy can find them).
-    auto addLight = [&](const std::optional<LightSample>& ls) {
+    auto addLight = [&](const LightSample* ls) {
       if (!ls || !(ls->pdf > 0)) return;
       const Bsdf::Evaluation e = bsdf.evaluate(view, ls->direction);
       const glm::dvec3& f = e.value;
@@ -397,31 +417,33 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const F
       const double w = ls->delta ? 1.0 : powerHeuristic(ls->pdf, e.pdf);
       nextBucket += p.throughput * f * ls->radiance * (cosine * w / ls->pdf);
     };
-    // Every punctual light in reach: a sum, no noise (LightSet::punctualInReach).
-    if (!first) lights_.punctualInReach(hit.position, scratch.reach);
-    const std::vector<std::uint32_t>& reach = first ? first->reach : scratch.reach;
     ++scratch.shadingPoints;
     scratch.punctualEvaluated += reach.size();
-    for (const std::uint32_t l : reach) addLight(lights_.samplePunctual(l, hit.position));
+    for (const std::uint32_t l : reach) {
+      const std::optional<LightSample> punctual = lights_.samplePunctual(l, hit.position);
+      addLight(punctual ? &*punctual : nullptr);
+    }
     // The environment or an emissive triangle: one Monte Carlo sample (its random numbers drawn
     // in the trace stage whether or not there is anything to choose, so the stream stays aligned).
-    addLight(lights_.sample(hit.position, p.lightChoice));  // no light to choose: a kNone choice, no sample
+    // No light to choose: a kNone choice, no sample.
+    LightSample& sampled = scratch.lightSample;
+    if (lights_.sample(hit.position, p.lightChoice, sampled)) addLight(&sampled);
   }
 
   const double uLobe = p.rng.uniform();
-  const auto bs = bsdf.sample(view, p.rng.uniform2(), uLobe);
-  if (!bs) return false;
-  p.throughput *= bs->value * (std::abs(glm::dot(s.shadingNormal, bs->direction)) / bs->pdf);
+  BsdfSample& bs = scratch.bsdfSample;
+  if (!bsdf.sample(view, p.rng.uniform2(), uLobe, bs)) return false;
+  p.throughput *= bs.value * (std::abs(glm::dot(s.shadingNormal, bs.direction)) / bs.pdf);
   if (depth >= 3) {  // Russian roulette keeps long paths cheap without bias
     const double survive = std::min(0.95, std::max({p.throughput.x, p.throughput.y, p.throughput.z}));
     if (p.rng.uniform() >= survive) return false;
     p.throughput /= survive;
   }
   if (!finite(p.throughput) || p.throughput == glm::dvec3(0.0)) return false;
-  p.previousBsdfPdf = bs->pdf;
+  p.previousBsdfPdf = bs.pdf;
   p.previousDelta = false;
   p.ray.origin = origin;
-  p.ray.direction = bs->direction;
+  p.ray.direction = bs.direction;
   return true;
 }
 

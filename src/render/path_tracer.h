@@ -94,6 +94,7 @@ class PathTracer {
   PathTracer(const scene::Scene& scene, const RenderSettings& settings);
   // The material at a hit seen from direction wo, at the hit's texture coordinates uv.
   Shading shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv) const;
+  void shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, Shading& shading) const;  // every field written
   glm::dvec3 emission(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
   glm::dvec2 texCoord(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
   glm::dvec2 texCoord(const SurfaceHit& hit) const;  // the same, from the vertex indices the hit carries
@@ -117,14 +118,16 @@ class PathTracer {
   // alone: the same random numbers in the same order, the same arithmetic.
   void tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, const Shading& firstShading, std::span<PathState> paths,
                   PathScratch& scratch) const;
-  struct Vertex;
-  // The BSDF, its view from wo and the rays' origin at a shaded hit.
-  Vertex vertexAt(const SurfaceHit& hit, const Shading& shading, const glm::dvec3& wo) const;
+  struct Vertex;  // the BSDF, its view from wo and the rays' origin at a shaded hit
   // One vertex of one path (its hit traced, its prefetches issued): adds what it finds to the
   // path's radiance and sets up the next ray. false when the path ends. At a pixel's first hit,
   // which every path of the batch shares, `first` holds its shading and vertex, built once.
   struct FirstVertex;
   bool advance(PathState& path, int depth, const SurfaceHit& hit, const FirstVertex* first, PathScratch& scratch) const;
+  // advance below the hit's emission: light from the lights (next event estimation: the punctual
+  // lights in `reach`, then the path's light choice) and the bounce.
+  bool scatter(PathState& path, int depth, const SurfaceHit& hit, const Shading& shading, const Vertex& vertex,
+               const std::vector<std::uint32_t>& reach, PathScratch& scratch) const;
 
   const scene::Scene& scene_;
   RenderSettings settings_;
