@@ -47,7 +47,10 @@ Texture toTexture(const FloatImage& image, bool srgb) {
   auto codeOf = [&](float v, std::uint8_t& code) {
     const float scaled = v * 255.0f;
     if (!(scaled >= -0.25f && scaled <= 255.25f)) return false;
-    code = static_cast<std::uint8_t>(std::lround(scaled));
+    // Round to nearest by truncation (scaled + 0.5 > 0 here): a call to lround per channel was
+    // 40 % of a one-frame job's instructions. Ties do not matter: a code within 1e-3 of `scaled`
+    // is the nearest whichever way halves round.
+    code = static_cast<std::uint8_t>(scaled + 0.5f);
     if (std::abs(scaled - code) > 1e-3f) return false;
     if (!seen[code]) {
       seen[code] = true;
