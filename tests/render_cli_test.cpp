@@ -85,6 +85,23 @@ TEST(RenderCli, WritesTheContractAndResumes) {
     EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
 }
 
+// Frames are written while the next one renders: a frame that cannot be written still stops the
+// job with its file named, the frames before it complete and none after it.
+TEST(RenderCli, AFrameThatCannotBeWrittenStopsTheJob) {
+  const auto dir = test::freshDir("render_write_fails");
+  const fs::path out = dir / "frames";
+  // Frame 2's image path is a folder with a file in it: the image cannot be renamed over it.
+  fs::create_directories(out / "frame_00002.exr");
+  ASSERT_TRUE(writeFileAtomic(out / "frame_00002.exr" / "keep", "x"));
+  const auto r = dynbench(fmt::format("render {} -o {} --res 32x18 --spp 2 --frames 0:6:2", kOrbit.string(), out.string()), dir);
+  EXPECT_EQ(r.status, 3);  // kIo
+  EXPECT_NE(r.err.find("frame_00002.exr: cannot move finished file into place: Is a directory"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(out / "frame_00000.json"));
+  EXPECT_TRUE(fs::is_regular_file(out / "frame_00000.exr"));
+  for (const char* name : {"frame_00002.json", "frame_00004.exr", "frame_00004.json", "frame_00006.exr", "frame_00006.json"})
+    EXPECT_FALSE(fs::exists(out / name)) << name;
+}
+
 TEST(RenderCli, JitterOffsetsEachFramesSamplesByTheHaltonSequence) {
   // Halton (2, 3) at index 1 + (frame mod 8), minus 0.5: by hand, index 1 = (1/2, 1/3),
   // index 2 = (1/4, 2/3), index 8 = (1/16, 8/9).

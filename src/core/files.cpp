@@ -35,7 +35,8 @@ Expected<void> commitTemporary(const std::filesystem::path& temporary,
   std::error_code ec;
   std::filesystem::rename(temporary, path, ec);
   if (ec) {
-    std::filesystem::remove(temporary, ec);
+    std::error_code ignored;  // not `ec`: the reason reported is the rename's
+    std::filesystem::remove(temporary, ignored);
     return fail(ErrorCode::kIo, "{}: cannot move finished file into place: {}", path.string(),
                 ec.message());
   }

@@ -20,7 +20,8 @@ struct FrameRequest {
   FrameCameras cameras;
 };
 
-// Receives each finished frame, in request order; an error stops the backend.
+// Receives each finished frame, in request order, one call at a time; an error stops the backend.
+// It may be called from another thread, while the next frame renders and reports its rows.
 using FrameSink = std::function<Expected<void>(frames::FeatureFrame&&)>;
 // (request index, rows of that frame finished): for progress; may be called from another thread.
 using RowProgress = std::function<void(std::size_t, int)>;

@@ -4,6 +4,8 @@
 #include <optional>
 #include <thread>
 
+#include <tbb/task_group.h>
+
 #include "render/backend.h"
 #include "render/path_tracer.h"
 
@@ -16,9 +18,22 @@ class EmbreeBackend final : public RenderBackend {
 
   Expected<void> render(const std::vector<FrameRequest>& requests, const FrameSink& done, const RowProgress& rows) override {
     const int height = tracer_->settings().height;
+    // Each frame is written while the next one renders (a TBB task, so --threads still bounds
+    // the cores in use): written in turn, the write, the BVH update and the light tables of each
+    // frame boundary ran on one core while the others waited.
+    tbb::task_group writing;
+    FrameBuffers written;  // the frame the write task holds
+    Expected<void> writeResult;
+    auto finishWriting = [&]() -> Expected<void> {
+      writing.wait();
+      return writeResult;
+    };
     for (std::size_t i = 0; i < requests.size(); ++i) {
       const FrameRequest& request = requests[i];
-      if (auto ok = tracer_->setTime(request.cameras.time, request.cameras.previousTime); !ok) return ok;
+      if (auto ok = tracer_->setTime(request.cameras.time, request.cameras.previousTime); !ok) {
+        (void)finishWriting();
+        return ok;
+      }
       std::atomic<int> rowsDone{0};
       RenderStatistics stats;
       FrameBuffers buffers;
@@ -46,9 +61,11 @@ class EmbreeBackend final : public RenderBackend {
       buffers.time = request.cameras.time;
       buffers.camera = request.cameras.camera.frameCamera();
       if (tracer_->settings().jitter) buffers.camera.jitter = frames::jitterOffset(request.frame);
-      if (auto ok = done(std::move(buffers)); !ok) return ok;
+      if (auto ok = finishWriting(); !ok) return ok;  // the frame before, in request order
+      written = std::move(buffers);
+      writing.run([&] { writeResult = done(std::move(written)); });
     }
-    return {};
+    return finishWriting();
   }
 
   RenderStatistics statistics() const override { return statistics_; }

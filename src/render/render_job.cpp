@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <chrono>
+#include <mutex>
 #include <thread>
 #include <set>
 
@@ -159,11 +160,19 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
   // Around every backend alike: frames written through the contract module, progress in rows.
   const std::size_t height = static_cast<std::size_t>(job.settings.height);
   const std::size_t rowsTotal = requests.size() * height;
+  // A backend may write a frame while the next one reports its rows (backend.h): one lock for the
+  // progress reports and the summary.
+  std::mutex reporting;
   RowProgress rows;
-  if (progress) rows = [&](std::size_t i, int done) { progress(i * height + static_cast<std::size_t>(done), rowsTotal, i, requests.size()); };
+  if (progress)
+    rows = [&](std::size_t i, int done) {
+      const std::lock_guard lock(reporting);
+      progress(i * height + static_cast<std::size_t>(done), rowsTotal, i, requests.size());
+    };
   const FrameSink write = [&](frames::FeatureFrame&& frame) -> Expected<void> {
     frame.cut = cuts.contains(frame.frame);  // the sidecar's `cut`: temporal methods and discard reset here
     if (auto ok = frames::writeFrame(job.output, frame, record, {.float32 = job.float32}); !ok) return ok;
+    const std::lock_guard lock(reporting);
     summary.rendered.push_back(frame.frame);
     if (frame.sampling) {
       summary.cappedPixels += frame.sampling->cappedPixels;
