@@ -76,9 +76,10 @@ const scene::Primitive& PathTracer::primitiveOf(int node, int primitive) const {
   return scene_.meshes[static_cast<std::size_t>(n.mesh)].primitives[static_cast<std::size_t>(primitive)];
 }
 
-const scene::Material* PathTracer::materialOf(int node, int primitive) const {
-  const int m = primitiveOf(node, primitive).material;
-  return m >= 0 ? &scene_.materials[static_cast<std::size_t>(m)] : nullptr;
+const scene::Material* PathTracer::materialOf(int node, int primitive) const { return materialOf(primitiveOf(node, primitive)); }
+
+const scene::Material* PathTracer::materialOf(const scene::Primitive& primitive) const {
+  return primitive.material >= 0 ? &scene_.materials[static_cast<std::size_t>(primitive.material)] : nullptr;
 }
 
 namespace {
@@ -98,17 +99,17 @@ glm::dvec2 PathTracer::texCoord(int node, int primitive, unsigned triangle, glm:
 }
 
 glm::dvec2 PathTracer::texCoord(const SurfaceHit& hit) const {
-  return interpolateUv(primitiveOf(hit.node, hit.primitive), hit.vertices.data(), hit.barycentric);
+  return interpolateUv(*hit.source, hit.vertices.data(), hit.barycentric);
 }
 
 void PathTracer::prefetchTexCoords(const SurfaceHit& hit) const {
-  const scene::Primitive& prim = primitiveOf(hit.node, hit.primitive);
+  const scene::Primitive& prim = *hit.source;
   if (prim.uvs.empty()) return;
   for (const std::uint32_t v : hit.vertices) __builtin_prefetch(&prim.uvs[v]);
 }
 
 void PathTracer::prefetchTextures(const SurfaceHit& hit, glm::dvec2 uv) const {
-  const scene::Material* m = materialOf(hit.node, hit.primitive);
+  const scene::Material* m = materialOf(*hit.source);
   if (!m) return;
   textures_.prefetch(m->baseColorTexture, true, uv);
   if (m->workflow == scene::MaterialWorkflow::kMetallicRoughness) textures_.prefetch(m->metallicRoughnessTexture, false, uv);
@@ -142,7 +143,7 @@ PathTracer::Shading PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& w
 }
 
 void PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, Shading& s) const {
-  const scene::Material* m = materialOf(hit.node, hit.primitive);
+  const scene::Material* m = materialOf(*hit.source);
   SurfaceMaterial& mat = s.material;
   if (!m) {
     // glTF's default material when a primitive has none: white, metallic 1, roughness 1 (§3.9.6).
@@ -169,7 +170,9 @@ void PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 u
     mat.specular = m->specularFactor;
     mat.specularColor = glm::dvec3(m->specularColorFactor);
     s.emissiveWeight = LightSet::emissiveWeight(glm::dvec3(m->emissiveFactor));
-    mat.emission = emission(hit.node, hit.primitive, hit.triangle, hit.barycentric);
+    // (The factor tested here first: most materials emit nothing, and emission() looks the
+    // material up again.)
+    mat.emission = m->emissiveFactor == glm::vec3(0.0f) ? glm::dvec3(0.0) : emission(hit.node, hit.primitive, hit.triangle, hit.barycentric);
   }
   // Both sides of a surface are shaded alike: the normals are turned towards the viewer. When a
   // mesh's winding contradicts its vertex normals, the vertex normals say which side is which.
@@ -181,7 +184,7 @@ void PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 u
     // Tangent frame from the triangle's uv parameterisation (what glTF implies when a mesh has no
     // TANGENT attribute), then n = T x + B y + N z with (x, y, z) = 2 texel - 1.
     const auto p = rayTracing_->trianglePositions(hit);
-    const scene::Primitive& prim = primitiveOf(hit.node, hit.primitive);
+    const scene::Primitive& prim = *hit.source;
     if (!prim.uvs.empty()) {
       const std::uint32_t* idx = hit.vertices.data();
       const glm::dvec2 d1 = glm::dvec2(prim.uvs[idx[1]]) - glm::dvec2(prim.uvs[idx[0]]);

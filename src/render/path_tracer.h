@@ -105,6 +105,7 @@ class PathTracer {
   bool alphaOpaque(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
   const scene::Primitive& primitiveOf(int node, int primitive) const;
   const scene::Material* materialOf(int node, int primitive) const;
+  const scene::Material* materialOf(const scene::Primitive& primitive) const;
   SurfaceHit trace(const Ray& ray) const;
   struct PathSample;
   struct PathState;

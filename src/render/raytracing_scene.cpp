@@ -17,6 +17,7 @@ void onEmbreeError(void* user, RTCError, const char* message) { *static_cast<std
 struct Entry {  // what an Embree geometry is in the scene model
   int node = -1;
   int primitive = -1;
+  const scene::Primitive* source = nullptr;  // the scene model's primitive (SurfaceHit::source)
   RTCGeometry geometry = nullptr;  // dynamic entries keep theirs to update it every frame
   bool enabled = true;
   bool previousValid = false;  // previousPositions hold the update before the last one
@@ -115,6 +116,7 @@ struct RayTracingScene::Impl {
     const auto& prim = scene->meshes[static_cast<std::size_t>(scene->nodes[static_cast<std::size_t>(node)].mesh)]
                            .primitives[static_cast<std::size_t>(primitive)];
     e.indices = prim.indices;
+    e.source = &prim;
     return e;
   }
 };
@@ -279,6 +281,7 @@ static void setSurfaceHit(SurfaceHit& hit, const RayTracingScene::Impl& impl, co
   hit.distance = rh.ray.tfar;
   hit.node = e.node;
   hit.primitive = e.primitive;
+  hit.source = e.source;
   hit.triangle = rh.hit.primID;
   hit.barycentric = {rh.hit.u, rh.hit.v};
   hit.dynamicGeometry = rh.hit.instID[0] != 0;

@@ -24,6 +24,9 @@ struct SurfaceHit {
   glm::dvec2 barycentric{0.0};      // (u, v) of Embree: p = (1 - u - v) p0 + u p1 + v p2
   int node = -1;
   int primitive = -1;
+  // scene.meshes[scene.nodes[node].mesh].primitives[primitive], resolved once per hit: the
+  // shading reads its texture coordinates and material several times.
+  const scene::Primitive* source = nullptr;
   unsigned triangle = 0;
   std::array<std::uint32_t, 3> vertices{};  // the triangle's vertex indices in its primitive
   bool dynamicGeometry = false;  // which Embree geometry it was (for previousPosition)
