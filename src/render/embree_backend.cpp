@@ -1,6 +1,7 @@
 // `--engine embree`: dynbench's path tracer (path_tracer.h) as a render backend.
 #include <atomic>
 #include <chrono>
+#include <future>
 #include <optional>
 #include <thread>
 
@@ -17,10 +18,9 @@ class EmbreeBackend final : public RenderBackend {
   explicit EmbreeBackend(std::unique_ptr<PathTracer> tracer) : tracer_(std::move(tracer)) {}
 
   Expected<void> render(const std::vector<FrameRequest>& requests, const FrameSink& done, const RowProgress& rows) override {
-    const int height = tracer_->settings().height;
     // Each frame is written while the next one renders (a TBB task, so --threads still bounds
-    // the cores in use): written in turn, the write, the BVH update and the light tables of each
-    // frame boundary ran on one core while the others waited.
+    // the cores in use): written in turn, one core compressed the EXR at each frame boundary while
+    // the others had no rows left.
     tbb::task_group writing;
     FrameBuffers written;  // the frame the write task holds
     Expected<void> writeResult;
@@ -42,12 +42,15 @@ class EmbreeBackend final : public RenderBackend {
                                   &stats);
       };
       if (rows) {
-        // The frame renders on a worker thread while this one reports its rows.
-        std::thread worker(renderFrame);
-        while (rowsDone.load() < height) {
-          rows(i, rowsDone.load());
-          std::this_thread::sleep_for(std::chrono::milliseconds(100));
-        }
+        // The frame renders on a worker thread while this one reports its rows, every 100 ms
+        // until the frame ends. (It used to sleep 100 ms between reports whatever happened: every
+        // frame then ended with both cores idle for 50 ms on average, 11 % of a 2-thread frame
+        // of the colos segment at 320x180.)
+        std::packaged_task<void()> task(renderFrame);
+        const std::future<void> finished = task.get_future();
+        std::thread worker(std::move(task));
+        do rows(i, rowsDone.load());
+        while (finished.wait_for(std::chrono::milliseconds(100)) != std::future_status::ready);
         worker.join();
       } else {
         renderFrame();
