@@ -255,8 +255,9 @@ struct PathTracer::PathState {
   double escapeSinTheta = 0.0;  // sin(theta) of an escape's direction (the environment's Jacobian)
 };
 
-// The BSDF, its view from wo and the rays' origin at a shaded hit. Built where it is kept
-// (std::optional::emplace, not a returned copy: GCC's copy of these 300 bytes was a rep movs).
+// The BSDF, its view from wo and the rays' origin at a shaded hit. Constructed where it is kept
+// (a local of advance, or the pixel's FirstVertex), not returned and copied: GCC copied these
+// 300 bytes with rep movs.
 struct PathTracer::Vertex {
   Vertex(const SurfaceHit& hit, const Shading& s, const glm::dvec3& wo)
       : bsdf(s.material, Frame(s.shadingNormal), s.geometricNormal),
