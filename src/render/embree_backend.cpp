@@ -2,7 +2,6 @@
 #include <atomic>
 #include <chrono>
 #include <future>
-#include <optional>
 #include <thread>
 
 #include <tbb/task_group.h>

@@ -237,20 +237,19 @@ void LightSet::punctualInReach(const glm::dvec3& point, std::vector<std::uint32_
   reach.insert(reach.end(), everywhere_.begin(), everywhere_.end());
 }
 
-std::optional<LightSample> LightSet::samplePunctual(std::size_t light, const glm::dvec3& point) const {
+bool LightSet::samplePunctual(std::size_t light, const glm::dvec3& point, LightSample& s) const {
   const Punctual& l = punctual_[light];
-  LightSample s;
   s.delta = true;
   s.pdf = 1.0;
   if (l.type == scene::Light::Type::kDirectional) {
     s.direction = -l.direction;
     s.distance = std::numeric_limits<double>::infinity();
     s.radiance = l.intensity;
-    return s;
+    return true;
   }
   const glm::dvec3 toLight = l.position - point;
   const double d2 = glm::dot(toLight, toLight);
-  if (!(d2 > 0)) return std::nullopt;
+  if (!(d2 > 0)) return false;
   s.distance = std::sqrt(d2);
   s.direction = toLight / s.distance;
   double attenuation = 1.0 / d2;
@@ -264,9 +263,9 @@ std::optional<LightSample> LightSet::samplePunctual(std::size_t light, const glm
     const double a = std::clamp((cd - l.cosOuter) * scale, 0.0, 1.0);
     attenuation *= a * a;
   }
-  if (attenuation <= 0) return std::nullopt;
+  if (attenuation <= 0) return false;
   s.radiance = l.intensity * attenuation;
-  return s;
+  return true;
 }
 
 void LightSet::startChoice(double uChoice, glm::dvec2 u, Choice& c) const {

@@ -100,7 +100,8 @@ class LightSet {
   // lights whose sphere of influence (KHR `range`, or the cut-off radius) contains the point (found
   // through a BVH over the spheres), and lights with neither.
   void punctualInReach(const glm::dvec3& point, std::vector<std::uint32_t>& reach) const;
-  std::optional<LightSample> samplePunctual(std::size_t light, const glm::dvec3& point) const;
+  // Light `light` at `point`, into `sample` (every field, as sample() below); false where it gives none.
+  bool samplePunctual(std::size_t light, const glm::dvec3& point, LightSample& sample) const;
   std::size_t punctualCount() const { return punctual_.size(); }
   // The cut-off in use (0: none) and the most irradiance it can drop at any point (N x epsilon,
   // per colour channel).

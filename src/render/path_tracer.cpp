@@ -130,9 +130,14 @@ bool PathTracer::alphaOpaque(int node, int primitive, unsigned triangle, glm::dv
 glm::dvec3 PathTracer::emission(int node, int primitive, unsigned triangle, glm::dvec2 b) const {
   const scene::Material* m = materialOf(node, primitive);
   if (!m) return glm::dvec3(0.0);
-  glm::dvec3 e(m->emissiveFactor);
-  if (e == glm::dvec3(0.0)) return e;
-  if (m->emissiveTexture.image >= 0) e *= glm::dvec3(textures_.sample(m->emissiveTexture, true, texCoord(node, primitive, triangle, b)));
+  // The texture coordinates only where the texture is read.
+  if (m->emissiveFactor == glm::vec3(0.0f) || m->emissiveTexture.image < 0) return glm::dvec3(m->emissiveFactor);
+  return emission(*m, texCoord(node, primitive, triangle, b));
+}
+
+glm::dvec3 PathTracer::emission(const scene::Material& m, glm::dvec2 uv) const {
+  glm::dvec3 e(m.emissiveFactor);
+  if (e != glm::dvec3(0.0) && m.emissiveTexture.image >= 0) e *= glm::dvec3(textures_.sample(m.emissiveTexture, true, uv));
   return e;
 }
 
@@ -170,9 +175,7 @@ void PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 u
     mat.specular = m->specularFactor;
     mat.specularColor = glm::dvec3(m->specularColorFactor);
     s.emissiveWeight = LightSet::emissiveWeight(glm::dvec3(m->emissiveFactor));
-    // (The factor tested here first: most materials emit nothing, and emission() looks the
-    // material up again.)
-    mat.emission = m->emissiveFactor == glm::vec3(0.0f) ? glm::dvec3(0.0) : emission(hit.node, hit.primitive, hit.triangle, hit.barycentric);
+    mat.emission = emission(*m, uv);
   }
   // Both sides of a surface are shaded alike: the normals are turned towards the viewer. When a
   // mesh's winding contradicts its vertex normals, the vertex normals say which side is which.
@@ -409,29 +412,27 @@ bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const S
   if (settings_.nextEventEstimation) {
     // Adds one light's contribution; Monte Carlo samples are weighted against BSDF sampling
     // (Veach's MIS), delta lights count fully (no other strategy can find them).
-    auto addLight = [&](const LightSample* ls) {
-      if (!ls || !(ls->pdf > 0)) return;
-      const Bsdf::Evaluation e = bsdf.evaluate(view, ls->direction);
+    auto addLight = [&](const LightSample& ls) {
+      if (!(ls.pdf > 0)) return;
+      const Bsdf::Evaluation e = bsdf.evaluate(view, ls.direction);
       const glm::dvec3& f = e.value;
       if (f == glm::dvec3(0.0)) return;
-      const double cosine = std::abs(glm::dot(s.shadingNormal, ls->direction));
-      const double tMax = std::isinf(ls->distance) ? 1e30 : ls->distance * (1.0 - 1e-4) - 3e-5;
+      const double cosine = std::abs(glm::dot(s.shadingNormal, ls.direction));
+      const double tMax = std::isinf(ls.distance) ? 1e30 : ls.distance * (1.0 - 1e-4) - 3e-5;
       ++scratch.rays;
-      if (rayTracing_->occluded(origin, ls->direction, tMax)) return;
-      const double w = ls->delta ? 1.0 : powerHeuristic(ls->pdf, e.pdf);
-      nextBucket += p.throughput * f * ls->radiance * (cosine * w / ls->pdf);
+      if (rayTracing_->occluded(origin, ls.direction, tMax)) return;
+      const double w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, e.pdf);
+      nextBucket += p.throughput * f * ls.radiance * (cosine * w / ls.pdf);
     };
     ++scratch.shadingPoints;
     scratch.punctualEvaluated += reach.size();
-    for (const std::uint32_t l : reach) {
-      const std::optional<LightSample> punctual = lights_.samplePunctual(l, hit.position);
-      addLight(punctual ? &*punctual : nullptr);
-    }
+    LightSample& sampled = scratch.lightSample;
+    for (const std::uint32_t l : reach)
+      if (lights_.samplePunctual(l, hit.position, sampled)) addLight(sampled);
     // The environment or an emissive triangle: one Monte Carlo sample (its random numbers drawn
     // in the trace stage whether or not there is anything to choose, so the stream stays aligned).
     // No light to choose: a kNone choice, no sample.
-    LightSample& sampled = scratch.lightSample;
-    if (lights_.sample(hit.position, p.lightChoice, sampled)) addLight(&sampled);
+    if (lights_.sample(hit.position, p.lightChoice, sampled)) addLight(sampled);
   }
 
   const double uLobe = p.rng.uniform();

@@ -96,6 +96,7 @@ class PathTracer {
   Shading shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv) const;
   void shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, Shading& shading) const;  // every field written
   glm::dvec3 emission(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
+  glm::dvec3 emission(const scene::Material& material, glm::dvec2 uv) const;  // the same, at texture coordinates uv
   glm::dvec2 texCoord(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
   glm::dvec2 texCoord(const SurfaceHit& hit) const;  // the same, from the vertex indices the hit carries
   // Memory prefetches of the batched tracer: a hit's vertex texture coordinates, then the texels
