@@ -9,7 +9,7 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   # libraries
   nlohmann-json3-dev libassimp-dev libglm-dev libopenimageio-dev
-  libembree-dev libtbb-dev
+  libembree-dev libtbb-dev libhwy-dev
   libcli11-dev libfmt-dev libspdlog-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev googletest libbenchmark-dev zlib1g-dev

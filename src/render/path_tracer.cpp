@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/math.h"
+#include "render/bsdf_batch.h"
 
 namespace dynbench::render {
 namespace {
@@ -256,6 +257,12 @@ struct PathTracer::PathState {
   LightSet::Choice lightChoice;
   glm::dvec2 uv{0.0};  // the hit's texture coordinates, or the environment image point of an escape
   double escapeSinTheta = 0.0;  // sin(theta) of an escape's direction (the environment's Jacobian)
+  // Between the shading and the bounce of stage 3: the path's lane of the batch's BSDFs, its light
+  // sample (evaluated in that lane when `lightEvaluated`) and where its rays leave.
+  std::size_t lane = 0;
+  LightSample lightSample;
+  bool lightEvaluated = false;
+  glm::dvec3 origin{0.0}, shadingNormal{0.0};
 };
 
 // The BSDF, its view from wo and the rays' origin at a shaded hit. Constructed where it is kept
@@ -286,6 +293,7 @@ struct PathTracer::PathScratch {
   Shading shading;
   LightSample lightSample;
   BsdfSample bsdfSample;
+  BsdfBatch bsdfs;  // the BSDFs of a stage's shading points, evaluated and sampled together
   std::vector<std::uint32_t> reach;       // punctual lights in reach of a shading point
   std::vector<std::uint32_t> firstReach;  // of the pixel's first hit
   std::vector<PathState> paths;      // a batch
@@ -308,6 +316,7 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
   scratch.firstReach.clear();
   if (lightSample) lights_.punctualInReach(firstHit.position, scratch.firstReach);
   const FirstVertex first{firstShading, Vertex(firstHit, firstShading, -cameraRay.direction), scratch.firstReach};
+  scratch.bsdfs.reserve(paths.size());
   for (int depth = 0;; ++depth) {
     const bool shadesHere = depth <= settings_.bounces;  // a hit at this depth gathers light and bounces
     // Stage 1: trace; start loading the hit's texture coordinates and the environment pixel of an
@@ -358,9 +367,15 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
       }
       if (lightSample && shadesHere) lights_.finishChoice(p.lightChoice);
     }
-    // Stage 3: shade, gather light, bounce.
+    // Stage 3: shade and gather the punctual lights, path by path, each path's BSDF going into a
+    // lane of the batch; evaluate the light samples and sample the bounces of all the lanes at
+    // once (BsdfBatch); then each path's light sample (its shadow ray) and its bounce.
+    std::size_t lanes = 0;
     for (PathState& p : paths)
-      if (p.active) p.active = advance(p, depth, hitOf(p), depth == 0 ? &first : nullptr, scratch);
+      if (p.active) p.active = advance(p, depth, hitOf(p), depth == 0 ? &first : nullptr, scratch, lanes);
+    if (lanes > 0) scratch.bsdfs.run(lanes);
+    for (PathState& p : paths)
+      if (p.active) p.active = bounce(p, depth, scratch);
   }
   for (PathState& p : paths) {
     if (!finite(p.out.direct)) p.out.direct = glm::dvec3(0.0);
@@ -368,7 +383,8 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
   }
 }
 
-bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const FirstVertex* first, PathScratch& scratch) const {
+bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const FirstVertex* first, PathScratch& scratch,
+                         std::size_t& lanes) const {
   const Ray& ray = p.ray;
   // Radiance found by this ray is direct when it reaches the camera from the first surface
   // (depth 1) or is seen by the camera itself (depth 0).
@@ -395,50 +411,61 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const F
     bucket += p.throughput * s.material.emission * w;
   }
   if (depth > settings_.bounces) return false;
-  if (first) return scatter(p, depth, hit, s, first->vertex, first->reach, scratch);
+  if (first) return scatter(p, depth, hit, s, first->vertex, first->reach, scratch, lanes);
   // Every punctual light in reach: a sum, no noise (LightSet::punctualInReach).
   if (settings_.nextEventEstimation) lights_.punctualInReach(hit.position, scratch.reach);
   const Vertex vertex(hit, s, wo);
-  return scatter(p, depth, hit, s, vertex, scratch.reach, scratch);
+  return scatter(p, depth, hit, s, vertex, scratch.reach, scratch, lanes);
 }
 
 bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const Shading& s, const Vertex& vertex,
-                         const std::vector<std::uint32_t>& reach, PathScratch& scratch) const {
-  const Bsdf& bsdf = vertex.bsdf;
-  const Bsdf::View& view = vertex.view;
-  const glm::dvec3& origin = vertex.origin;
-  glm::dvec3& nextBucket = depth == 0 ? p.out.direct : p.out.indirect;  // light reaching this hit
-
+                         const std::vector<std::uint32_t>& reach, PathScratch& scratch, std::size_t& lanes) const {
+  p.origin = vertex.origin;
+  p.shadingNormal = s.shadingNormal;
+  p.lightEvaluated = false;
+  p.lane = lanes++;
+  BsdfBatch& bsdfs = scratch.bsdfs;
+  bsdfs.set(p.lane, vertex.bsdf, vertex.view);
   if (settings_.nextEventEstimation) {
-    // Adds one light's contribution; Monte Carlo samples are weighted against BSDF sampling
-    // (Veach's MIS), delta lights count fully (no other strategy can find them).
-    auto addLight = [&](const LightSample& ls) {
-      if (!(ls.pdf > 0)) return;
-      const Bsdf::Evaluation e = bsdf.evaluate(view, ls.direction);
-      const glm::dvec3& f = e.value;
-      if (f == glm::dvec3(0.0)) return;
-      const double cosine = std::abs(glm::dot(s.shadingNormal, ls.direction));
-      const double tMax = std::isinf(ls.distance) ? 1e30 : ls.distance * (1.0 - 1e-4) - 3e-5;
-      ++scratch.rays;
-      if (rayTracing_->occluded(origin, ls.direction, tMax)) return;
-      const double w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, e.pdf);
-      nextBucket += p.throughput * f * ls.radiance * (cosine * w / ls.pdf);
-    };
     ++scratch.shadingPoints;
     scratch.punctualEvaluated += reach.size();
-    LightSample& sampled = scratch.lightSample;
+    // Every punctual light in reach, here, with the scalar BSDF (there are seldom any).
+    LightSample& punctual = scratch.lightSample;
     for (const std::uint32_t l : reach)
-      if (lights_.samplePunctual(l, hit.position, sampled)) addLight(sampled);
+      if (lights_.samplePunctual(l, hit.position, punctual) && punctual.pdf > 0)
+        addLight(p, depth, punctual, vertex.bsdf.evaluate(vertex.view, punctual.direction), scratch);
     // The environment or an emissive triangle: one Monte Carlo sample (its random numbers drawn
-    // in the trace stage whether or not there is anything to choose, so the stream stays aligned).
-    // No light to choose: a kNone choice, no sample.
-    if (lights_.sample(hit.position, p.lightChoice, sampled)) addLight(sampled);
+    // in the trace stage whether or not there is anything to choose, so the stream stays aligned),
+    // evaluated in the path's lane. No light to choose: a kNone choice, no sample.
+    p.lightEvaluated = lights_.sample(hit.position, p.lightChoice, p.lightSample) && p.lightSample.pdf > 0;
   }
-
+  if (p.lightEvaluated) bsdfs.setEvaluation(p.lane, p.lightSample.direction);
+  else bsdfs.clearEvaluation(p.lane);
   const double uLobe = p.rng.uniform();
+  bsdfs.setSample(p.lane, p.rng.uniform2(), uLobe);
+  return true;
+}
+
+// Adds one light's contribution to the light reaching the path's vertex: Monte Carlo samples are
+// weighted against BSDF sampling (Veach's MIS), delta lights count fully (no other strategy can
+// find them).
+void PathTracer::addLight(PathState& p, int depth, const LightSample& ls, const Bsdf::Evaluation& e, PathScratch& scratch) const {
+  const glm::dvec3& f = e.value;
+  if (f == glm::dvec3(0.0)) return;
+  const double cosine = std::abs(glm::dot(p.shadingNormal, ls.direction));
+  const double tMax = std::isinf(ls.distance) ? 1e30 : ls.distance * (1.0 - 1e-4) - 3e-5;
+  ++scratch.rays;
+  if (rayTracing_->occluded(p.origin, ls.direction, tMax)) return;
+  const double w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, e.pdf);
+  glm::dvec3& bucket = depth == 0 ? p.out.direct : p.out.indirect;  // light reaching this hit
+  bucket += p.throughput * f * ls.radiance * (cosine * w / ls.pdf);
+}
+
+bool PathTracer::bounce(PathState& p, int depth, PathScratch& scratch) const {
+  if (p.lightEvaluated) addLight(p, depth, p.lightSample, scratch.bsdfs.evaluation(p.lane), scratch);
   BsdfSample& bs = scratch.bsdfSample;
-  if (!bsdf.sample(view, p.rng.uniform2(), uLobe, bs)) return false;
-  p.throughput *= bs.value * (std::abs(glm::dot(s.shadingNormal, bs.direction)) / bs.pdf);
+  if (!scratch.bsdfs.sample(p.lane, bs)) return false;
+  p.throughput *= bs.value * (std::abs(glm::dot(p.shadingNormal, bs.direction)) / bs.pdf);
   if (depth >= 3) {  // Russian roulette keeps long paths cheap without bias
     const double survive = std::min(0.95, std::max({p.throughput.x, p.throughput.y, p.throughput.z}));
     if (p.rng.uniform() >= survive) return false;
@@ -447,7 +474,7 @@ bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const S
   if (!finite(p.throughput) || p.throughput == glm::dvec3(0.0)) return false;
   p.previousBsdfPdf = bs.pdf;
   p.previousDelta = false;
-  p.ray.origin = origin;
+  p.ray.origin = p.origin;
   p.ray.direction = bs.direction;
   return true;
 }

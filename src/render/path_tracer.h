@@ -121,15 +121,22 @@ class PathTracer {
   void tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, const Shading& firstShading, std::span<PathState> paths,
                   PathScratch& scratch) const;
   struct Vertex;  // the BSDF, its view from wo and the rays' origin at a shaded hit
-  // One vertex of one path (its hit traced, its prefetches issued): adds what it finds to the
-  // path's radiance and sets up the next ray. false when the path ends. At a pixel's first hit,
+  // One vertex of one path (its hit traced, its prefetches issued), first half: adds the hit's
+  // emission and its punctual lights to the path's radiance, takes its light sample and puts its
+  // BSDF, the light sample's direction and the bounce's random numbers into lane `lanes` of the
+  // batch's BSDFs (then counts the lane). false when the path ends here. At a pixel's first hit,
   // which every path of the batch shares, `first` holds its shading and vertex, built once.
   struct FirstVertex;
-  bool advance(PathState& path, int depth, const SurfaceHit& hit, const FirstVertex* first, PathScratch& scratch) const;
-  // advance below the hit's emission: light from the lights (next event estimation: the punctual
-  // lights in `reach`, then the path's light choice) and the bounce.
+  bool advance(PathState& path, int depth, const SurfaceHit& hit, const FirstVertex* first, PathScratch& scratch,
+               std::size_t& lanes) const;
+  // advance below the hit's emission: the punctual lights in `reach`, the light sample and the lane.
   bool scatter(PathState& path, int depth, const SurfaceHit& hit, const Shading& shading, const Vertex& vertex,
-               const std::vector<std::uint32_t>& reach, PathScratch& scratch) const;
+               const std::vector<std::uint32_t>& reach, PathScratch& scratch, std::size_t& lanes) const;
+  // Second half, once the batch's BSDFs are evaluated and sampled: the light sample's contribution
+  // (its shadow ray) and the bounce (the next ray, Russian roulette). false when the path ends.
+  bool bounce(PathState& path, int depth, PathScratch& scratch) const;
+  // A light's contribution at the path's vertex, given the BSDF's value and pdf towards it.
+  void addLight(PathState& path, int depth, const LightSample& light, const Bsdf::Evaluation& evaluation, PathScratch& scratch) const;
 
   const scene::Scene& scene_;
   RenderSettings settings_;
