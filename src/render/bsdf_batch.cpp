@@ -20,19 +20,19 @@ struct Vec3 {
   V x, y, z;
 };
 
-V dot(const Vec3& a, const Vec3& b) { return hn::Add(hn::Add(hn::Mul(a.x, b.x), hn::Mul(a.y, b.y)), hn::Mul(a.z, b.z)); }
-Vec3 scale(const Vec3& a, V s) { return {hn::Mul(a.x, s), hn::Mul(a.y, s), hn::Mul(a.z, s)}; }
-Vec3 add(const Vec3& a, const Vec3& b) { return {hn::Add(a.x, b.x), hn::Add(a.y, b.y), hn::Add(a.z, b.z)}; }
+HWY_INLINE V dot(const Vec3& a, const Vec3& b) { return hn::Add(hn::Add(hn::Mul(a.x, b.x), hn::Mul(a.y, b.y)), hn::Mul(a.z, b.z)); }
+HWY_INLINE Vec3 scale(const Vec3& a, V s) { return {hn::Mul(a.x, s), hn::Mul(a.y, s), hn::Mul(a.z, s)}; }
+HWY_INLINE Vec3 add(const Vec3& a, const Vec3& b) { return {hn::Add(a.x, b.x), hn::Add(a.y, b.y), hn::Add(a.z, b.z)}; }
 // glm::normalize: v x (1 / sqrt(v.v)).
-Vec3 normalize(D d, const Vec3& v) { return scale(v, hn::Div(hn::Set(d, 1.0), hn::Sqrt(dot(v, v)))); }
-Vec3 select(M m, const Vec3& a, const Vec3& b) { return {hn::IfThenElse(m, a.x, b.x), hn::IfThenElse(m, a.y, b.y), hn::IfThenElse(m, a.z, b.z)}; }
+HWY_INLINE Vec3 normalize(D d, const Vec3& v) { return scale(v, hn::Div(hn::Set(d, 1.0), hn::Sqrt(dot(v, v)))); }
+HWY_INLINE Vec3 select(M m, const Vec3& a, const Vec3& b) { return {hn::IfThenElse(m, a.x, b.x), hn::IfThenElse(m, a.y, b.y), hn::IfThenElse(m, a.z, b.z)}; }
 
 // One vector of lanes of the batch's arrays.
 struct Lanes {
   const double* data;
   std::size_t capacity, offset;
-  V load(D d, std::size_t field) const { return hn::LoadU(d, data + field * capacity + offset); }
-  Vec3 load3(D d, std::size_t first) const { return {load(d, first), load(d, first + 1), load(d, first + 2)}; }
+  HWY_INLINE V load(D d, std::size_t field) const { return hn::LoadU(d, data + field * capacity + offset); }
+  HWY_INLINE Vec3 load3(D d, std::size_t first) const { return {load(d, first), load(d, first + 1), load(d, first + 2)}; }
 };
 
 struct Material {
@@ -49,7 +49,7 @@ struct Evaluation {
 
 // Bsdf::evaluateLocal (bsdf.cpp has the equations), for lanes where wo.z > 0 and wi.z > 0 (the
 // caller masks the others).
-Evaluation evaluateLocal(D d, const Material& m, const Vec3& wi) {
+HWY_INLINE Evaluation evaluateLocal(D d, const Material& m, const Vec3& wi) {
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0), pi = hn::Set(d, 3.14159265358979323846);
   const Vec3 h = normalize(d, add(m.wo, wi));
   // GGX D(h) = a2 / (pi (h.z^2 (a2 - 1) + 1)^2), 0 where h.z <= 0.
@@ -84,7 +84,7 @@ Evaluation evaluateLocal(D d, const Material& m, const Vec3& wi) {
   return e;
 }
 
-void store(D d, V v, double* data, std::size_t capacity, std::size_t field, std::size_t offset) {
+HWY_INLINE void store(D d, V v, double* data, std::size_t capacity, std::size_t field, std::size_t offset) {
   hn::StoreU(v, d, data + field * capacity + offset);
 }
 
