@@ -47,6 +47,48 @@ struct Evaluation {
   V pdf;
 };
 
+// Schlick's weight (1 - cosine)^5, the cosine clamped to [0, 1].
+HWY_INLINE V schlickWeight(D d, V cosine) {
+  const V c = hn::Min(hn::Max(hn::Sub(hn::Set(d, 1.0), cosine), hn::Zero(d)), hn::Set(d, 1.0));
+  const V c2 = hn::Mul(c, c);
+  return hn::Mul(hn::Mul(c2, c2), c);
+}
+
+HWY_INLINE Vec3 dielectricFresnel(D d, const Material& m, V w) {
+  (void)d;
+  return {hn::Add(m.f0.x, hn::Mul(hn::Sub(m.f90, m.f0.x), w)), hn::Add(m.f0.y, hn::Mul(hn::Sub(m.f90, m.f0.y), w)),
+          hn::Add(m.f0.z, hn::Mul(hn::Sub(m.f90, m.f0.z), w))};
+}
+
+HWY_INLINE Vec3 metalFresnel(D d, const Material& m, V w) {
+  const V one = hn::Set(d, 1.0);
+  return {hn::Add(m.base.x, hn::Mul(hn::Sub(one, m.base.x), w)), hn::Add(m.base.y, hn::Mul(hn::Sub(one, m.base.y), w)),
+          hn::Add(m.base.z, hn::Mul(hn::Sub(one, m.base.z), w))};
+}
+
+HWY_INLINE V luminance(D d, const Vec3& rgb) {  // core/math.h's Rec. 709 weights
+  return hn::Add(hn::Add(hn::Mul(hn::Set(d, 0.2126), rgb.x), hn::Mul(hn::Set(d, 0.7152), rgb.y)), hn::Mul(hn::Set(d, 0.0722), rgb.z));
+}
+
+// Bsdf::specularProbability: the specular share of the reflection by the Fresnel term at n.wo,
+// clamped to [0.05, 0.95] where both lobes reflect.
+HWY_INLINE V specularProbability(D d, const Material& m) {
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
+  const V w = schlickWeight(d, m.wo.z);
+  const Vec3 fDielectric = dielectricFresnel(d, m, w), fMetal = metalFresnel(d, m, w);
+  const V dielectricWeight = hn::Sub(one, m.metallic);
+  const V specular = luminance(d, {hn::Add(hn::Mul(dielectricWeight, fDielectric.x), hn::Mul(m.metallic, fMetal.x)),
+                                   hn::Add(hn::Mul(dielectricWeight, fDielectric.y), hn::Mul(m.metallic, fMetal.y)),
+                                   hn::Add(hn::Mul(dielectricWeight, fDielectric.z), hn::Mul(m.metallic, fMetal.z))});
+  const V diffuse = hn::Mul(hn::Mul(dielectricWeight, hn::Sub(one, hn::Max(fDielectric.x, hn::Max(fDielectric.y, fDielectric.z)))),
+                            luminance(d, m.base));
+  const V sum = hn::Add(specular, diffuse);
+  V p = hn::Min(hn::Max(hn::Div(specular, sum), hn::Set(d, 0.05)), hn::Set(d, 0.95));
+  p = hn::IfThenElse(hn::Le(diffuse, zero), one, p);
+  p = hn::IfThenElse(hn::Le(specular, zero), zero, p);
+  return hn::IfThenElse(hn::Le(sum, zero), hn::Set(d, 0.5), p);
+}
+
 // Bsdf::evaluateLocal (bsdf.cpp has the equations), for lanes where wo.z > 0 and wi.z > 0 (the
 // caller masks the others).
 HWY_INLINE Evaluation evaluateLocal(D d, const Material& m, const Vec3& wi) {
@@ -56,15 +98,8 @@ HWY_INLINE Evaluation evaluateLocal(D d, const Material& m, const Vec3& wi) {
   const V a2 = hn::Mul(m.alpha, m.alpha);
   const V denominator = hn::Add(hn::Mul(hn::Mul(h.z, h.z), hn::Sub(a2, one)), one);
   const V ggx = hn::IfThenElseZero(hn::Gt(h.z, zero), hn::Div(a2, hn::Mul(pi, hn::Mul(denominator, denominator))));
-  // Schlick's weight (1 - v.h)^5.
-  const V vh = hn::Max(zero, dot(m.wo, h));
-  const V c = hn::Min(hn::Max(hn::Sub(one, vh), zero), one);
-  const V c2 = hn::Mul(c, c);
-  const V w = hn::Mul(hn::Mul(c2, c2), c);
-  const Vec3 fDielectric{hn::Add(m.f0.x, hn::Mul(hn::Sub(m.f90, m.f0.x), w)), hn::Add(m.f0.y, hn::Mul(hn::Sub(m.f90, m.f0.y), w)),
-                         hn::Add(m.f0.z, hn::Mul(hn::Sub(m.f90, m.f0.z), w))};
-  const Vec3 fMetal{hn::Add(m.base.x, hn::Mul(hn::Sub(one, m.base.x), w)), hn::Add(m.base.y, hn::Mul(hn::Sub(one, m.base.y), w)),
-                    hn::Add(m.base.z, hn::Mul(hn::Sub(one, m.base.z), w))};
+  const V w = schlickWeight(d, hn::Max(zero, dot(m.wo, h)));
+  const Vec3 fDielectric = dielectricFresnel(d, m, w), fMetal = metalFresnel(d, m, w);
   // Smith G1(wi) = 2 c / (c + sqrt(a2 + (1 - a2) c^2)), c = wi.z > 0.
   const V g1 = hn::Div(hn::Mul(hn::Set(d, 2.0), wi.z), hn::Add(wi.z, hn::Sqrt(hn::Add(a2, hn::Mul(hn::Sub(one, a2), hn::Mul(wi.z, wi.z))))));
   const V s = hn::Div(hn::Mul(hn::Mul(ggx, m.maskingWo), g1), hn::Mul(hn::Mul(hn::Set(d, 4.0), m.wo.z), wi.z));
@@ -94,26 +129,41 @@ void RunBsdfBatch(double* data, std::size_t capacity, std::size_t count) {
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
   for (std::size_t offset = 0; offset < count; offset += n) {
     const Lanes in{data, capacity, offset};
+    // The Bsdf constructor: the shading frame (Duff et al. 2017, Frame in sampling.h), alpha and
+    // the dielectric Fresnel terms.
     Material m;
-    m.t = in.load3(d, BsdfBatch::kTx);
-    m.b = in.load3(d, BsdfBatch::kBx);
     m.n = in.load3(d, BsdfBatch::kNx);
+    const V sign = hn::CopySign(one, m.n.z);
+    const V a = hn::Div(hn::Set(d, -1.0), hn::Add(sign, m.n.z));
+    const V c = hn::Mul(hn::Mul(m.n.x, m.n.y), a);
+    m.t = {hn::Add(one, hn::Mul(hn::Mul(hn::Mul(sign, m.n.x), m.n.x), a)), hn::Mul(sign, c), hn::Neg(hn::Mul(sign, m.n.x))};
+    m.b = {c, hn::Add(sign, hn::Mul(hn::Mul(m.n.y, m.n.y), a)), hn::Neg(m.n.y)};
     m.g = in.load3(d, BsdfBatch::kGx);
     m.base = in.load3(d, BsdfBatch::kBaseR);
-    m.f0 = in.load3(d, BsdfBatch::kF0R);
     m.metallic = in.load(d, BsdfBatch::kMetallic);
-    m.alpha = in.load(d, BsdfBatch::kAlpha);
-    m.f90 = in.load(d, BsdfBatch::kF90);
-    m.wo = in.load3(d, BsdfBatch::kWoX);
-    m.specularProbability = in.load(d, BsdfBatch::kSpecularProbability);
-    m.maskingWo = in.load(d, BsdfBatch::kMaskingWo);
+    const V roughness = hn::Min(hn::Max(in.load(d, BsdfBatch::kRoughness), zero), one);
+    m.alpha = hn::Max(hn::Mul(roughness, roughness), hn::Set(d, 2e-3));
+    m.f90 = in.load(d, BsdfBatch::kSpecular);
+    const V f0Scale = hn::Set(d, 0.04);
+    const Vec3 specularColor = in.load3(d, BsdfBatch::kSpecularR);
+    m.f0 = {hn::Mul(hn::Min(hn::Mul(f0Scale, specularColor.x), one), m.f90), hn::Mul(hn::Min(hn::Mul(f0Scale, specularColor.y), one), m.f90),
+            hn::Mul(hn::Min(hn::Mul(f0Scale, specularColor.z), one), m.f90)};
+    // Bsdf::view: wo in the shading frame, the lobe choice and Smith G1(wo).
+    const Vec3 woWorld = in.load3(d, BsdfBatch::kWoX);
+    m.wo = {dot(woWorld, m.t), dot(woWorld, m.b), dot(woWorld, m.n)};
+    m.specularProbability = specularProbability(d, m);
+    const V a2 = hn::Mul(m.alpha, m.alpha);
+    const V cosWo = hn::Abs(m.wo.z);
+    m.maskingWo = hn::IfThenElseZero(hn::Gt(cosWo, zero), hn::Div(hn::Mul(hn::Set(d, 2.0), cosWo),
+                                                                    hn::Add(cosWo, hn::Sqrt(hn::Add(a2, hn::Mul(hn::Sub(one, a2), hn::Mul(cosWo, cosWo)))))));
+    const M above = hn::Gt(dot(woWorld, m.g), zero);
     const M woAbove = hn::Gt(m.wo.z, zero);
     auto toLocal = [&](const Vec3& v) { return Vec3{dot(v, m.t), dot(v, m.b), dot(v, m.n)}; };
 
     // Bsdf::evaluate: none below the geometric surface on either side.
     const Vec3 wiWorld = in.load3(d, BsdfBatch::kWiX);
     const Vec3 wi = toLocal(wiWorld);
-    const M evaluated = hn::And(hn::And(hn::Gt(in.load(d, BsdfBatch::kEvaluate), zero), hn::Gt(in.load(d, BsdfBatch::kAbove), zero)),
+    const M evaluated = hn::And(hn::And(hn::Gt(in.load(d, BsdfBatch::kEvaluate), zero), above),
                                 hn::And(hn::And(hn::Gt(dot(wiWorld, m.g), zero), woAbove), hn::Gt(wi.z, zero)));
     const Evaluation light = evaluateLocal(d, m, wi);
     store(d, hn::IfThenElseZero(evaluated, light.value.x), data, capacity, BsdfBatch::kValueR, offset);
@@ -184,18 +234,18 @@ void BsdfBatch::reserve(std::size_t lanes) {
   capacity_ = rounded;
 }
 
-void BsdfBatch::set(std::size_t lane, const Bsdf& bsdf, const Bsdf::View& view) {
-  const glm::dvec3* vectors[] = {&bsdf.frame_.t, &bsdf.frame_.b, &bsdf.frame_.n, &bsdf.ng_, &bsdf.m_.baseColor};
-  for (std::size_t v = 0; v < 5; ++v)
-    for (int c = 0; c < 3; ++c) at(static_cast<Field>(kTx + 3 * v + static_cast<std::size_t>(c)), lane) = (*vectors[v])[c];
-  at(kMetallic, lane) = bsdf.m_.metallic;
-  at(kAlpha, lane) = bsdf.alpha_;
-  for (int c = 0; c < 3; ++c) at(static_cast<Field>(kF0R + static_cast<std::size_t>(c)), lane) = bsdf.dielectricF0_[c];
-  at(kF90, lane) = bsdf.dielectricF90_;
-  for (int c = 0; c < 3; ++c) at(static_cast<Field>(kWoX + static_cast<std::size_t>(c)), lane) = view.local[c];
-  at(kSpecularProbability, lane) = view.specularProbability;
-  at(kMaskingWo, lane) = view.maskingWo;
-  at(kAbove, lane) = view.above ? 1.0 : 0.0;
+void BsdfBatch::set(std::size_t lane, const SurfaceMaterial& material, const glm::dvec3& shadingNormal, const glm::dvec3& geometricNormal,
+                    const glm::dvec3& wo) {
+  const glm::dvec3* vectors[] = {&shadingNormal, &geometricNormal, &material.baseColor};
+  for (std::size_t v = 0; v < 3; ++v)
+    for (int c = 0; c < 3; ++c) at(static_cast<Field>(kNx + 3 * v + static_cast<std::size_t>(c)), lane) = (*vectors[v])[c];
+  at(kMetallic, lane) = material.metallic;
+  at(kRoughness, lane) = material.roughness;
+  at(kSpecular, lane) = material.specular;
+  for (int c = 0; c < 3; ++c) {
+    at(static_cast<Field>(kSpecularR + static_cast<std::size_t>(c)), lane) = material.specularColor[c];
+    at(static_cast<Field>(kWoX + static_cast<std::size_t>(c)), lane) = wo[c];
+  }
 }
 
 void BsdfBatch::setEvaluation(std::size_t lane, const glm::dvec3& wi) {

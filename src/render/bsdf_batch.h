@@ -25,9 +25,11 @@ class BsdfBatch {
   void reserve(std::size_t lanes);
   std::size_t capacity() const { return capacity_; }
 
-  // Lane `lane`: the vertex's BSDF seen from its view; the direction whose value and pdf to
-  // evaluate (Bsdf::evaluate), if any; and the random numbers of the sample (Bsdf::sample).
-  void set(std::size_t lane, const Bsdf& bsdf, const Bsdf::View& view);
+  // Lane `lane`: the vertex's BSDF, Bsdf(material, Frame(shadingNormal), geometricNormal), seen
+  // from wo (Bsdf::view; the kernel builds both); the direction whose value and pdf to evaluate
+  // (Bsdf::evaluate), if any; and the random numbers of the sample (Bsdf::sample).
+  void set(std::size_t lane, const SurfaceMaterial& material, const glm::dvec3& shadingNormal, const glm::dvec3& geometricNormal,
+           const glm::dvec3& wo);
   void setEvaluation(std::size_t lane, const glm::dvec3& wi);
   void clearEvaluation(std::size_t lane);
   void setSample(std::size_t lane, glm::dvec2 u, double uLobe);
@@ -42,11 +44,11 @@ class BsdfBatch {
 
   // The arrays, one per quantity, each `capacity` lanes long (structure of arrays).
   enum Field : std::size_t {
-    kTx, kTy, kTz, kBx, kBy, kBz, kNx, kNy, kNz,  // shading frame
-    kGx, kGy, kGz,                                // geometric normal
-    kBaseR, kBaseG, kBaseB, kMetallic, kAlpha,    // material
-    kF0R, kF0G, kF0B, kF90,                       // dielectric Fresnel at 0 and 90 degrees
-    kWoX, kWoY, kWoZ, kSpecularProbability, kMaskingWo, kAbove,  // the view (wo in the shading frame)
+    kNx, kNy, kNz,                                 // shading normal
+    kGx, kGy, kGz,                                 // geometric normal
+    kBaseR, kBaseG, kBaseB, kMetallic, kRoughness, kSpecular,  // material
+    kSpecularR, kSpecularG, kSpecularB,            // KHR_materials_specular's colour
+    kWoX, kWoY, kWoZ,                              // towards the viewer (world)
     kWiX, kWiY, kWiZ, kEvaluate,                  // direction to evaluate (world), and whether to
     kU1, kU2, kULobe,                             // the sample's random numbers
     kValueR, kValueG, kValueB, kPdf,              // evaluation out

@@ -265,24 +265,11 @@ struct PathTracer::PathState {
   glm::dvec3 origin{0.0}, shadingNormal{0.0};
 };
 
-// The BSDF, its view from wo and the rays' origin at a shaded hit. Constructed where it is kept
-// (a local of advance, or the pixel's FirstVertex), not returned and copied: GCC copied these
-// 300 bytes with rep movs.
-struct PathTracer::Vertex {
-  Vertex(const SurfaceHit& hit, const Shading& s, const glm::dvec3& wo)
-      : bsdf(s.material, Frame(s.shadingNormal), s.geometricNormal),
-        view(bsdf.view(wo)),
-        origin(offsetOrigin(hit.position, s.geometricNormal)) {}
-  Bsdf bsdf;
-  Bsdf::View view;
-  glm::dvec3 origin;  // where the vertex's shadow and bounce rays leave
-};
-
 // A pixel's first hit: the same for every path of its batches (the same hit seen from the same
-// direction), so its shading, BSDF and punctual lights in reach are found once.
+// direction), so its shading, ray origin and punctual lights in reach are found once.
 struct PathTracer::FirstVertex {
   const Shading& shading;
-  Vertex vertex;
+  glm::dvec3 origin;
   const std::vector<std::uint32_t>& reach;
 };
 
@@ -315,7 +302,7 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
   const bool lightSample = settings_.nextEventEstimation;
   scratch.firstReach.clear();
   if (lightSample) lights_.punctualInReach(firstHit.position, scratch.firstReach);
-  const FirstVertex first{firstShading, Vertex(firstHit, firstShading, -cameraRay.direction), scratch.firstReach};
+  const FirstVertex first{firstShading, offsetOrigin(firstHit.position, firstShading.geometricNormal), scratch.firstReach};
   scratch.bsdfs.reserve(paths.size());
   for (int depth = 0;; ++depth) {
     const bool shadesHere = depth <= settings_.bounces;  // a hit at this depth gathers light and bounces
@@ -411,29 +398,33 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const F
     bucket += p.throughput * s.material.emission * w;
   }
   if (depth > settings_.bounces) return false;
-  if (first) return scatter(p, depth, hit, s, first->vertex, first->reach, scratch, lanes);
+  if (first) return scatter(p, depth, hit, s, first->origin, first->reach, scratch, lanes);
   // Every punctual light in reach: a sum, no noise (LightSet::punctualInReach).
   if (settings_.nextEventEstimation) lights_.punctualInReach(hit.position, scratch.reach);
-  const Vertex vertex(hit, s, wo);
-  return scatter(p, depth, hit, s, vertex, scratch.reach, scratch, lanes);
+  return scatter(p, depth, hit, s, offsetOrigin(hit.position, s.geometricNormal), scratch.reach, scratch, lanes);
 }
 
-bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const Shading& s, const Vertex& vertex,
+bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const Shading& s, const glm::dvec3& origin,
                          const std::vector<std::uint32_t>& reach, PathScratch& scratch, std::size_t& lanes) const {
-  p.origin = vertex.origin;
+  p.origin = origin;
   p.shadingNormal = s.shadingNormal;
   p.lightEvaluated = false;
   p.lane = lanes++;
   BsdfBatch& bsdfs = scratch.bsdfs;
-  bsdfs.set(p.lane, vertex.bsdf, vertex.view);
+  const glm::dvec3 wo = -p.ray.direction;
+  bsdfs.set(p.lane, s.material, s.shadingNormal, s.geometricNormal, wo);
   if (settings_.nextEventEstimation) {
     ++scratch.shadingPoints;
     scratch.punctualEvaluated += reach.size();
     // Every punctual light in reach, here, with the scalar BSDF (there are seldom any).
-    LightSample& punctual = scratch.lightSample;
-    for (const std::uint32_t l : reach)
-      if (lights_.samplePunctual(l, hit.position, punctual) && punctual.pdf > 0)
-        addLight(p, depth, punctual, vertex.bsdf.evaluate(vertex.view, punctual.direction), scratch);
+    if (!reach.empty()) {
+      const Bsdf bsdf(s.material, Frame(s.shadingNormal), s.geometricNormal);
+      const Bsdf::View view = bsdf.view(wo);
+      LightSample& punctual = scratch.lightSample;
+      for (const std::uint32_t l : reach)
+        if (lights_.samplePunctual(l, hit.position, punctual) && punctual.pdf > 0)
+          addLight(p, depth, punctual, bsdf.evaluate(view, punctual.direction), scratch);
+    }
     // The environment or an emissive triangle: one Monte Carlo sample (its random numbers drawn
     // in the trace stage whether or not there is anything to choose, so the stream stays aligned),
     // evaluated in the path's lane. No light to choose: a kNone choice, no sample.

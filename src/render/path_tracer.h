@@ -120,7 +120,6 @@ class PathTracer {
   // alone: the same random numbers in the same order, the same arithmetic.
   void tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, const Shading& firstShading, std::span<PathState> paths,
                   PathScratch& scratch) const;
-  struct Vertex;  // the BSDF, its view from wo and the rays' origin at a shaded hit
   // One vertex of one path (its hit traced, its prefetches issued), first half: adds the hit's
   // emission and its punctual lights to the path's radiance, takes its light sample and puts its
   // BSDF, the light sample's direction and the bounce's random numbers into lane `lanes` of the
@@ -129,8 +128,9 @@ class PathTracer {
   struct FirstVertex;
   bool advance(PathState& path, int depth, const SurfaceHit& hit, const FirstVertex* first, PathScratch& scratch,
                std::size_t& lanes) const;
-  // advance below the hit's emission: the punctual lights in `reach`, the light sample and the lane.
-  bool scatter(PathState& path, int depth, const SurfaceHit& hit, const Shading& shading, const Vertex& vertex,
+  // advance below the hit's emission: the punctual lights in `reach`, the light sample and the
+  // lane; the vertex's rays leave from `origin`.
+  bool scatter(PathState& path, int depth, const SurfaceHit& hit, const Shading& shading, const glm::dvec3& origin,
                const std::vector<std::uint32_t>& reach, PathScratch& scratch, std::size_t& lanes) const;
   // Second half, once the batch's BSDFs are evaluated and sampled: the light sample's contribution
   // (its shadow ray) and the bounce (the next ray, Russian roulette). false when the path ends.
