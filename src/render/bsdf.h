@@ -69,7 +69,6 @@ class Bsdf {
   static glm::dvec3 sampleGgxVisibleNormal(const glm::dvec3& wo, double alpha, glm::dvec2 u);
 
  private:
-  friend class BsdfBatch;  // the same BSDF, several vertices per instruction (bsdf_batch.h)
   Evaluation evaluateLocal(const View& view, const glm::dvec3& wi) const;  // wi in the shading frame
   double specularProbability(const glm::dvec3& woLocal) const;
 

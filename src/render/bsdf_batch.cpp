@@ -27,12 +27,18 @@ HWY_INLINE Vec3 add(const Vec3& a, const Vec3& b) { return {hn::Add(a.x, b.x), h
 HWY_INLINE Vec3 normalize(D d, const Vec3& v) { return scale(v, hn::Div(hn::Set(d, 1.0), hn::Sqrt(dot(v, v)))); }
 HWY_INLINE Vec3 select(M m, const Vec3& a, const Vec3& b) { return {hn::IfThenElse(m, a.x, b.x), hn::IfThenElse(m, a.y, b.y), hn::IfThenElse(m, a.z, b.z)}; }
 
-// One vector of lanes of the batch's arrays.
+// One vector of lanes of the batch's arrays (a Vec3 is three consecutive fields).
 struct Lanes {
-  const double* data;
+  double* data;
   std::size_t capacity, offset;
   HWY_INLINE V load(D d, std::size_t field) const { return hn::LoadU(d, data + field * capacity + offset); }
   HWY_INLINE Vec3 load3(D d, std::size_t first) const { return {load(d, first), load(d, first + 1), load(d, first + 2)}; }
+  HWY_INLINE void store(D d, std::size_t field, V v) const { hn::StoreU(v, d, data + field * capacity + offset); }
+  HWY_INLINE void store3(D d, std::size_t first, const Vec3& v) const {
+    store(d, first, v.x);
+    store(d, first + 1, v.y);
+    store(d, first + 2, v.z);
+  }
 };
 
 struct Material {
@@ -54,8 +60,7 @@ HWY_INLINE V schlickWeight(D d, V cosine) {
   return hn::Mul(hn::Mul(c2, c2), c);
 }
 
-HWY_INLINE Vec3 dielectricFresnel(D d, const Material& m, V w) {
-  (void)d;
+HWY_INLINE Vec3 dielectricFresnel(const Material& m, V w) {
   return {hn::Add(m.f0.x, hn::Mul(hn::Sub(m.f90, m.f0.x), w)), hn::Add(m.f0.y, hn::Mul(hn::Sub(m.f90, m.f0.y), w)),
           hn::Add(m.f0.z, hn::Mul(hn::Sub(m.f90, m.f0.z), w))};
 }
@@ -75,7 +80,7 @@ HWY_INLINE V luminance(D d, const Vec3& rgb) {  // core/math.h's Rec. 709 weight
 HWY_INLINE V specularProbability(D d, const Material& m) {
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
   const V w = schlickWeight(d, m.wo.z);
-  const Vec3 fDielectric = dielectricFresnel(d, m, w), fMetal = metalFresnel(d, m, w);
+  const Vec3 fDielectric = dielectricFresnel(m, w), fMetal = metalFresnel(d, m, w);
   const V dielectricWeight = hn::Sub(one, m.metallic);
   const V specular = luminance(d, {hn::Add(hn::Mul(dielectricWeight, fDielectric.x), hn::Mul(m.metallic, fMetal.x)),
                                    hn::Add(hn::Mul(dielectricWeight, fDielectric.y), hn::Mul(m.metallic, fMetal.y)),
@@ -89,6 +94,12 @@ HWY_INLINE V specularProbability(D d, const Material& m) {
   return hn::IfThenElse(hn::Le(sum, zero), hn::Set(d, 0.5), p);
 }
 
+// Smith G1 = 2 c / (c + sqrt(a2 + (1 - a2) c^2)) of a direction with cosine c > 0 (a2 = alpha^2).
+HWY_INLINE V smithG1(D d, V c, V a2) {
+  const V one = hn::Set(d, 1.0);
+  return hn::Div(hn::Mul(hn::Set(d, 2.0), c), hn::Add(c, hn::Sqrt(hn::Add(a2, hn::Mul(hn::Sub(one, a2), hn::Mul(c, c))))));
+}
+
 // Bsdf::evaluateLocal (bsdf.cpp has the equations), for lanes where wo.z > 0 and wi.z > 0 (the
 // caller masks the others).
 HWY_INLINE Evaluation evaluateLocal(D d, const Material& m, const Vec3& wi) {
@@ -99,10 +110,8 @@ HWY_INLINE Evaluation evaluateLocal(D d, const Material& m, const Vec3& wi) {
   const V denominator = hn::Add(hn::Mul(hn::Mul(h.z, h.z), hn::Sub(a2, one)), one);
   const V ggx = hn::IfThenElseZero(hn::Gt(h.z, zero), hn::Div(a2, hn::Mul(pi, hn::Mul(denominator, denominator))));
   const V w = schlickWeight(d, hn::Max(zero, dot(m.wo, h)));
-  const Vec3 fDielectric = dielectricFresnel(d, m, w), fMetal = metalFresnel(d, m, w);
-  // Smith G1(wi) = 2 c / (c + sqrt(a2 + (1 - a2) c^2)), c = wi.z > 0.
-  const V g1 = hn::Div(hn::Mul(hn::Set(d, 2.0), wi.z), hn::Add(wi.z, hn::Sqrt(hn::Add(a2, hn::Mul(hn::Sub(one, a2), hn::Mul(wi.z, wi.z))))));
-  const V s = hn::Div(hn::Mul(hn::Mul(ggx, m.maskingWo), g1), hn::Mul(hn::Mul(hn::Set(d, 4.0), m.wo.z), wi.z));
+  const Vec3 fDielectric = dielectricFresnel(m, w), fMetal = metalFresnel(d, m, w);
+  const V s = hn::Div(hn::Mul(hn::Mul(ggx, m.maskingWo), smithG1(d, wi.z, a2)), hn::Mul(hn::Mul(hn::Set(d, 4.0), m.wo.z), wi.z));
   const V diffuseScale = hn::Div(hn::Sub(one, hn::Max(fDielectric.x, hn::Max(fDielectric.y, fDielectric.z))), pi);
   const V dielectricWeight = hn::Sub(one, m.metallic);
   auto channel = [&](V base, V fd, V fm) {
@@ -117,10 +126,6 @@ HWY_INLINE Evaluation evaluateLocal(D d, const Material& m, const Vec3& wi) {
   e.pdf = hn::Add(hn::Div(hn::Mul(hn::Sub(one, m.specularProbability), wi.z), pi),
                   hn::IfThenElseZero(hn::Gt(m.specularProbability, zero), specular));
   return e;
-}
-
-HWY_INLINE void store(D d, V v, double* data, std::size_t capacity, std::size_t field, std::size_t offset) {
-  hn::StoreU(v, d, data + field * capacity + offset);
 }
 
 void RunBsdfBatch(double* data, std::size_t capacity, std::size_t count) {
@@ -148,17 +153,15 @@ void RunBsdfBatch(double* data, std::size_t capacity, std::size_t count) {
     const Vec3 specularColor = in.load3(d, BsdfBatch::kSpecularR);
     m.f0 = {hn::Mul(hn::Min(hn::Mul(f0Scale, specularColor.x), one), m.f90), hn::Mul(hn::Min(hn::Mul(f0Scale, specularColor.y), one), m.f90),
             hn::Mul(hn::Min(hn::Mul(f0Scale, specularColor.z), one), m.f90)};
-    // Bsdf::view: wo in the shading frame, the lobe choice and Smith G1(wo).
+    auto toLocal = [&](const Vec3& v) { return Vec3{dot(v, m.t), dot(v, m.b), dot(v, m.n)}; };
+    // Bsdf::view: wo in the shading frame, the lobe choice and Smith G1(wo) (0 at |wo.z| = 0).
     const Vec3 woWorld = in.load3(d, BsdfBatch::kWoX);
-    m.wo = {dot(woWorld, m.t), dot(woWorld, m.b), dot(woWorld, m.n)};
+    m.wo = toLocal(woWorld);
     m.specularProbability = specularProbability(d, m);
-    const V a2 = hn::Mul(m.alpha, m.alpha);
     const V cosWo = hn::Abs(m.wo.z);
-    m.maskingWo = hn::IfThenElseZero(hn::Gt(cosWo, zero), hn::Div(hn::Mul(hn::Set(d, 2.0), cosWo),
-                                                                    hn::Add(cosWo, hn::Sqrt(hn::Add(a2, hn::Mul(hn::Sub(one, a2), hn::Mul(cosWo, cosWo)))))));
+    m.maskingWo = hn::IfThenElseZero(hn::Gt(cosWo, zero), smithG1(d, cosWo, hn::Mul(m.alpha, m.alpha)));
     const M above = hn::Gt(dot(woWorld, m.g), zero);
     const M woAbove = hn::Gt(m.wo.z, zero);
-    auto toLocal = [&](const Vec3& v) { return Vec3{dot(v, m.t), dot(v, m.b), dot(v, m.n)}; };
 
     // Bsdf::evaluate: none below the geometric surface on either side.
     const Vec3 wiWorld = in.load3(d, BsdfBatch::kWiX);
@@ -166,10 +169,9 @@ void RunBsdfBatch(double* data, std::size_t capacity, std::size_t count) {
     const M evaluated = hn::And(hn::And(hn::Gt(in.load(d, BsdfBatch::kEvaluate), zero), above),
                                 hn::And(hn::And(hn::Gt(dot(wiWorld, m.g), zero), woAbove), hn::Gt(wi.z, zero)));
     const Evaluation light = evaluateLocal(d, m, wi);
-    store(d, hn::IfThenElseZero(evaluated, light.value.x), data, capacity, BsdfBatch::kValueR, offset);
-    store(d, hn::IfThenElseZero(evaluated, light.value.y), data, capacity, BsdfBatch::kValueG, offset);
-    store(d, hn::IfThenElseZero(evaluated, light.value.z), data, capacity, BsdfBatch::kValueB, offset);
-    store(d, hn::IfThenElseZero(evaluated, light.pdf), data, capacity, BsdfBatch::kPdf, offset);
+    in.store3(d, BsdfBatch::kValueR,
+              {hn::IfThenElseZero(evaluated, light.value.x), hn::IfThenElseZero(evaluated, light.value.y), hn::IfThenElseZero(evaluated, light.value.z)});
+    in.store(d, BsdfBatch::kPdf, hn::IfThenElseZero(evaluated, light.pdf));
 
     // Bsdf::sample. Both lobes' directions come from r = sqrt(u1) and the angle 2 pi u2.
     const V u1 = in.load(d, BsdfBatch::kU1);
@@ -201,13 +203,9 @@ void RunBsdfBatch(double* data, std::size_t capacity, std::size_t count) {
     const Vec3 direction = add(add(scale(m.t, i.x), scale(m.b, i.y)), scale(m.n, i.z));
     const Evaluation e = evaluateLocal(d, m, i);
     const M sampled = hn::And(hn::And(woAbove, hn::Gt(i.z, zero)), hn::And(hn::Gt(dot(direction, m.g), zero), hn::Gt(e.pdf, zero)));
-    store(d, direction.x, data, capacity, BsdfBatch::kDirX, offset);
-    store(d, direction.y, data, capacity, BsdfBatch::kDirY, offset);
-    store(d, direction.z, data, capacity, BsdfBatch::kDirZ, offset);
-    store(d, e.value.x, data, capacity, BsdfBatch::kSampleR, offset);
-    store(d, e.value.y, data, capacity, BsdfBatch::kSampleG, offset);
-    store(d, e.value.z, data, capacity, BsdfBatch::kSampleB, offset);
-    store(d, hn::IfThenElseZero(sampled, e.pdf), data, capacity, BsdfBatch::kSamplePdf, offset);
+    in.store3(d, BsdfBatch::kDirX, direction);
+    in.store3(d, BsdfBatch::kSampleR, e.value);
+    in.store(d, BsdfBatch::kSamplePdf, hn::IfThenElseZero(sampled, e.pdf));
   }
 }
 
@@ -226,11 +224,8 @@ void BsdfBatch::reserve(std::size_t lanes) {
   constexpr std::size_t kVector = 16;
   const std::size_t rounded = (lanes + kVector - 1) / kVector * kVector;
   if (rounded <= capacity_) return;
-  // Fields are laid out capacity apart: copy each into the larger layout.
-  std::vector<double> grown(kFieldCount * rounded, 0.0);
-  for (std::size_t f = 0; f < kFieldCount; ++f)
-    std::copy_n(data_.begin() + static_cast<std::ptrdiff_t>(f * capacity_), capacity_, grown.begin() + static_cast<std::ptrdiff_t>(f * rounded));
-  data_ = std::move(grown);
+  // Nothing to keep: a batch's lanes are set before each run.
+  data_.assign(kFieldCount * rounded, 0.0);
   capacity_ = rounded;
 }
 

@@ -21,7 +21,8 @@ namespace dynbench::render {
 
 class BsdfBatch {
  public:
-  // Room for `lanes` vertices (rounded up to whole vectors, the padding lanes finite).
+  // Room for `lanes` vertices, rounded up to whole vectors (the kernel computes the padding lanes
+  // too; their results are never read). Growing discards the lanes' contents.
   void reserve(std::size_t lanes);
   std::size_t capacity() const { return capacity_; }
 

@@ -124,7 +124,8 @@ class PathTracer {
   // emission and its punctual lights to the path's radiance, takes its light sample and puts its
   // BSDF, the light sample's direction and the bounce's random numbers into lane `lanes` of the
   // batch's BSDFs (then counts the lane). false when the path ends here. At a pixel's first hit,
-  // which every path of the batch shares, `first` holds its shading and vertex, built once.
+  // which every path of the batch shares, `first` holds its shading, ray origin and punctual lights
+  // in reach, found once.
   struct FirstVertex;
   bool advance(PathState& path, int depth, const SurfaceHit& hit, const FirstVertex* first, PathScratch& scratch,
                std::size_t& lanes) const;
