@@ -693,6 +693,32 @@ TEST(Sampling, Distribution2DDensityMatchesItsSamples) {
   }
 }
 
+TEST(Sampling, Distribution2DNeverPicksARowOrCellOfNoWeight) {
+  // A 4 x 3 grid whose middle row has no usable weight (zero, negative, NaN, infinity) and whose
+  // other rows each have one empty cell: the rows' column tables share one array, and a row the
+  // row table cannot pick keeps default slots; no sample may land in it or in an empty cell.
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  const std::vector<double> weights{1, 0, 2, 3, 0, -1, nan, inf, 4, 4, 0, 8};
+  const Distribution2D d(weights, 4, 3);
+  const std::vector<double> used{1, 0, 2, 3, 0, 0, 0, 0, 4, 4, 0, 8};  // as the distribution reads them
+  const double mean = 22.0 / 12;
+  Random rng(7, 0, 0, 0);
+  std::vector<int> counts(12, 0);
+  const int n = 220000;
+  for (int i = 0; i < n; ++i) {
+    std::size_t cell = 0;
+    const glm::dvec2 p = d.sampleCell(rng.uniform2(), &cell);
+    ASSERT_EQ(cell, static_cast<std::size_t>(p.y * 3) * 4 + static_cast<std::size_t>(p.x * 4));
+    ASSERT_GT(used[cell], 0.0) << "cell " << cell;
+    ++counts[cell];
+  }
+  for (std::size_t k = 0; k < 12; ++k) {
+    EXPECT_NEAR(d.density({(k % 4 + 0.5) / 4, (k / 4 + 0.5) / 3}), used[k] / mean, 1e-12) << k;
+    const double expected = n * used[k] / 22.0;
+    EXPECT_NEAR(counts[k], expected, 5 * std::sqrt(expected) + 1e-9) << k;
+  }
+}
+
 TEST(Sampling, GgxIsNormalisedAndItsSamplingPdfIntegratesToOne) {
   for (double alpha : {0.05, 0.3, 1.0}) {
     // Projected-area normalisation: integral of D(h) cos(theta_h) over the hemisphere = 1.

@@ -80,7 +80,7 @@ glm::dvec3 EnvironmentLight::radiance(const glm::dvec3& direction, double* pdf) 
   return radianceAt(uv, sinTheta, pdf);
 }
 
-void EnvironmentLight::prefetchPixel(glm::dvec2 uv) const { __builtin_prefetch(&pixels_[pixelAt(uv)]); }
+void EnvironmentLight::prefetchPixel(glm::dvec2 uv) const { prefetchLine(&pixels_[pixelAt(uv)]); }
 
 glm::dvec3 EnvironmentLight::radianceAt(glm::dvec2 uv, double sinTheta, double* pdf) const {
   const glm::vec4& pixel = pixels_[pixelAt(uv)];
@@ -292,7 +292,7 @@ void LightSet::finishChoice(Choice& c) const {
     c.index = triangleChoice_.sampleDiscrete(c.u.x, &triangleProbability, &remapped);
     c.probability *= triangleProbability;
     c.point = {remapped, c.u.y};
-    __builtin_prefetch(&triangles_[c.index]);
+    prefetchLine(&triangles_[c.index]);
   }
 }
 

@@ -48,7 +48,7 @@ class EnvironmentLight {
   // Memory prefetches for the batched path tracer: the pixel radianceAt(uv) reads; the pixel a
   // sample picked.
   void prefetchPixel(glm::dvec2 uv) const;
-  void prefetchPixel(std::size_t pixel) const { __builtin_prefetch(&pixels_[pixel]); }
+  void prefetchPixel(std::size_t pixel) const { prefetchLine(&pixels_[pixel]); }
   // Mean radiance over the sphere (luminance), for choosing between lights.
   double meanLuminance() const { return meanLuminance_; }
 

@@ -10,6 +10,7 @@
 
 #include "core/math.h"
 #include "render/bsdf_batch.h"
+#include "render/prefetch.h"
 
 namespace dynbench::render {
 namespace {
@@ -106,7 +107,7 @@ glm::dvec2 PathTracer::texCoord(const SurfaceHit& hit) const {
 void PathTracer::prefetchTexCoords(const SurfaceHit& hit) const {
   const scene::Primitive& prim = *hit.source;
   if (prim.uvs.empty()) return;
-  for (const std::uint32_t v : hit.vertices) __builtin_prefetch(&prim.uvs[v]);
+  for (const std::uint32_t v : hit.vertices) prefetchLine(&prim.uvs[v]);
 }
 
 void PathTracer::prefetchTextures(const SurfaceHit& hit, glm::dvec2 uv) const {

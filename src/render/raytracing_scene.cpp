@@ -6,6 +6,7 @@
 
 #include <embree3/rtcore.h>
 
+#include "render/prefetch.h"
 #include "scene/queries.h"
 
 namespace dynbench::render {
@@ -323,14 +324,14 @@ void RayTracingScene::intersect(std::span<const Ray> rays, std::span<SurfaceHit>
     return (rh.hit.instID[0] == 0 ? impl_->staticEntries : impl_->dynamicEntries)[rh.hit.geomID];
   };
   for (const RTCRayHit& rh : stream)
-    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) __builtin_prefetch(&entryOf(rh).indices[3 * rh.hit.primID]);
+    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) prefetchLine(&entryOf(rh).indices[3 * rh.hit.primID]);
   for (const RTCRayHit& rh : stream) {
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
     const Entry& e = entryOf(rh);
     for (int c = 0; c < 3; ++c) {
       const std::uint32_t v = e.indices[3 * rh.hit.primID + static_cast<unsigned>(c)];
-      __builtin_prefetch(&e.positions[v]);
-      if (!e.normals.empty()) __builtin_prefetch(&e.normals[v]);
+      prefetchLine(&e.positions[v]);
+      if (!e.normals.empty()) prefetchLine(&e.normals[v]);
     }
   }
   for (std::size_t k = 0; k < rays.size(); ++k) setSurfaceHit(hits[k], *impl_, stream[k]);

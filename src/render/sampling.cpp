@@ -4,28 +4,28 @@
 
 namespace dynbench::render {
 
-Distribution1D::Distribution1D(std::span<const double> weights) : weights_(weights.begin(), weights.end()) {
-  total_ = 0.0;
-  for (auto& w : weights_) {
-    w = std::isfinite(w) ? std::max(0.0, w) : 0.0;
-    total_ += w;
-  }
-  const std::size_t n = weights_.size();
-  if (n == 0 || !(total_ > 0.0)) return;
+namespace {
+
+// A weight as the distributions use it: non-finite and negative weights are 0.
+double usable(double w) { return std::isfinite(w) ? std::max(0.0, w) : 0.0; }
+
+}  // namespace
+
+void buildAliasTable(std::span<const double> weights, double total, std::span<AliasSlot> slots) {
+  const std::size_t n = weights.size();
   // Vose's construction: slots under their share (< 1 in units of total / n) are topped up by
   // slots over it, one donor per slot.
-  alias_.resize(n);
   std::vector<double> scaled(n);
   std::vector<std::uint32_t> small, large;
   for (std::size_t i = 0; i < n; ++i) {
-    scaled[i] = weights_[i] * static_cast<double>(n) / total_;
+    scaled[i] = weights[i] * static_cast<double>(n) / total;
     (scaled[i] < 1.0 ? small : large).push_back(static_cast<std::uint32_t>(i));
   }
   while (!small.empty() && !large.empty()) {
     const std::uint32_t s = small.back(), l = large.back();
     small.pop_back();
-    alias_[s].keep = scaled[s];
-    alias_[s].alias = l;
+    slots[s].keep = scaled[s];
+    slots[s].alias = l;
     scaled[l] -= 1.0 - scaled[s];
     if (scaled[l] < 1.0) {
       large.pop_back();
@@ -35,32 +35,22 @@ Distribution1D::Distribution1D(std::span<const double> weights) : weights_(weigh
   // What is left is a full slot up to rounding; a bin of weight 0 never is, but stays unpickable.
   for (const auto& rest : {small, large})
     for (const std::uint32_t i : rest) {
-      alias_[i].keep = weights_[i] > 0 ? 1.0 : 0.0;
-      alias_[i].alias = i;
+      slots[i].keep = weights[i] > 0 ? 1.0 : 0.0;
+      slots[i].alias = i;
     }
   std::uint32_t positive = 0;
   for (std::uint32_t i = 0; i < n; ++i)
-    if (weights_[i] > 0) positive = i;
-  for (auto& slot : alias_)
-    if (slot.keep < 1.0 && weights_[slot.alias] <= 0) slot.alias = positive;
+    if (weights[i] > 0) positive = i;
+  for (auto& slot : slots)
+    if (slot.keep < 1.0 && weights[slot.alias] <= 0) slot.alias = positive;
 }
 
-// The slot index sampleDiscrete computes, without the clamping of f it does not need.
-void Distribution1D::prefetch(double u) const {
-  if (alias_.empty()) return;
-  const std::size_t i = std::min(static_cast<std::size_t>(std::clamp(u, 0.0, 1.0) * static_cast<double>(alias_.size())), alias_.size() - 1);
-  __builtin_prefetch(&alias_[i]);
-  __builtin_prefetch(&weights_[i]);
-}
-
-std::size_t Distribution1D::sampleDiscrete(double u, double* probability, double* remapped) const {
-  const double n = static_cast<double>(alias_.size());
-  const double x = std::clamp(u, 0.0, 1.0) * n;
-  const std::size_t i = std::min(static_cast<std::size_t>(x), alias_.size() - 1);
+std::size_t sampleAlias(std::span<const AliasSlot> slots, double u, double* remapped) {
+  const double x = std::clamp(u, 0.0, 1.0) * static_cast<double>(slots.size());
+  const std::size_t i = std::min(static_cast<std::size_t>(x), slots.size() - 1);
   const double f = std::min(x - static_cast<double>(i), 1.0);
-  const Slot& slot = alias_[i];
+  const AliasSlot& slot = slots[i];
   const bool keep = f < slot.keep;
-  if (probability) *probability = this->probability(keep ? i : slot.alias);
   if (remapped) {
     const double r = keep ? f / slot.keep : (f - slot.keep) / (1.0 - slot.keep);
     *remapped = std::clamp(r, 0.0, 0x1.fffffffffffffp-1);
@@ -68,16 +58,50 @@ std::size_t Distribution1D::sampleDiscrete(double u, double* probability, double
   return keep ? i : slot.alias;
 }
 
-Distribution2D::Distribution2D(std::span<const double> weights, int width, int height) : width_(width), height_(height) {
+Distribution1D::Distribution1D(std::span<const double> weights) : weights_(weights.begin(), weights.end()) {
+  total_ = 0.0;
+  for (auto& w : weights_) {
+    w = usable(w);
+    total_ += w;
+  }
+  if (weights_.empty() || !(total_ > 0.0)) return;
+  alias_.resize(weights_.size());
+  buildAliasTable(weights_, total_, alias_);
+}
+
+// The slot sampleDiscrete reads, and the weight of the slot's own bin.
+void Distribution1D::prefetch(double u) const {
+  if (alias_.empty()) return;
+  const AliasSlot& slot = aliasSlotFor(alias_, u);
+  prefetchLine(&slot);
+  prefetchLine(&weights_[static_cast<std::size_t>(&slot - alias_.data())]);
+}
+
+std::size_t Distribution1D::sampleDiscrete(double u, double* probability, double* remapped) const {
+  const std::size_t bin = sampleAlias(alias_, u, remapped);
+  if (probability) *probability = this->probability(bin);
+  return bin;
+}
+
+Distribution2D::Distribution2D(std::span<const double> weights, int width, int height)
+    : width_(width), height_(height), weights_(weights.begin(), weights.end()) {
+  const auto w = static_cast<std::size_t>(width);
   std::vector<double> rowSums(static_cast<std::size_t>(height), 0.0);
-  columns_.reserve(static_cast<std::size_t>(height));
-  for (int y = 0; y < height; ++y) {
-    const auto row = weights.subspan(static_cast<std::size_t>(y) * static_cast<std::size_t>(width), static_cast<std::size_t>(width));
-    columns_.emplace_back(row);
-    rowSums[static_cast<std::size_t>(y)] = columns_.back().total();
+  columnSlots_.resize(weights_.size());
+  for (std::size_t y = 0; y < rowSums.size(); ++y) {
+    const std::span<double> row = std::span(weights_).subspan(y * w, w);
+    for (double& v : row) {
+      v = usable(v);
+      rowSums[y] += v;
+    }
+    // A row of weight 0 keeps default slots: the row table never picks it.
+    if (rowSums[y] > 0.0) buildAliasTable(row, rowSums[y], std::span(columnSlots_).subspan(y * w, w));
   }
   rows_ = Distribution1D(rowSums);
-  if (rows_.empty()) columns_.clear();
+  if (rows_.empty()) {
+    weights_.clear();
+    columnSlots_.clear();
+  }
 }
 
 Distribution2D::RowSample Distribution2D::sampleRow(double uy) const {
@@ -88,7 +112,7 @@ Distribution2D::RowSample Distribution2D::sampleRow(double uy) const {
 
 glm::dvec2 Distribution2D::sampleColumn(const RowSample& row, double ux, std::size_t* cell) const {
   double w = 0;
-  const std::size_t column = columns_[row.row].sampleDiscrete(ux, nullptr, &w);
+  const std::size_t column = sampleAlias(columnsOf(row.row), ux, &w);
   *cell = row.row * static_cast<std::size_t>(width_) + column;
   return {(static_cast<double>(column) + w) / width_, (static_cast<double>(row.row) + row.v) / height_};
 }
@@ -102,8 +126,11 @@ glm::dvec2 Distribution2D::sample(glm::dvec2 u, double* density) const {
   return point;
 }
 
+// P(row) x P(column | row), per unit area of [0, 1)^2.
 double Distribution2D::cellDensity(std::size_t row, std::size_t column) const {
-  return rows_.probability(row) * columns_[row].probability(column) * width_ * height_;
+  const double rowTotal = rows_.weights()[row];
+  const double columnProbability = rowTotal > 0 ? weights_[row * static_cast<std::size_t>(width_) + column] / rowTotal : 0.0;
+  return rows_.probability(row) * columnProbability * width_ * height_;
 }
 
 double Distribution2D::density(glm::dvec2 point) const {

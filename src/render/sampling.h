@@ -2,6 +2,7 @@
 // Random numbers and sampling routines of the path tracer. Written here rather than taken from a
 // library because each is a few lines and must be bit-for-bit deterministic per pixel and sample
 // whatever the thread schedule (pbrt-v4 keeps the same routines in its own util/sampling.h).
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -10,6 +11,7 @@
 #include <glm/glm.hpp>
 
 #include "core/math.h"  // luminance
+#include "render/prefetch.h"
 
 namespace dynbench::render {
 
@@ -79,10 +81,26 @@ inline glm::dvec2 sampleTriangle(glm::dvec2 u) {
   return {s * (1.0 - u.y), s * u.y};
 }
 
+// Walker's alias table (Walker 1977; Vose 1991's construction) over n bins: slot i holds bin i
+// with probability `keep` (of the slot's 1/n), else bin `alias`. A sample reads one slot instead of
+// a binary search whose every step misses the cache on an environment map's rows (it was the path
+// tracer's largest cost in `perf`). pbrt-v4's AliasTable is the same idea.
+struct AliasSlot {
+  double keep = 1.0;
+  std::uint32_t alias = 0;
+};
+// The table of `weights` (finite, non-negative, summing to total > 0) into `slots` (as many).
+void buildAliasTable(std::span<const double> weights, double total, std::span<AliasSlot> slots);
+// The slot of `slots` that sampleAlias(slots, u) reads: prefetch it.
+inline const AliasSlot& aliasSlotFor(std::span<const AliasSlot> slots, double u) {
+  return slots[std::min(static_cast<std::size_t>(std::clamp(u, 0.0, 1.0) * static_cast<double>(slots.size())), slots.size() - 1)];
+}
+// A bin for u in [0, 1); `remapped` (optional) is uniform in [0, 1) given the bin (what is left of
+// u's precision: about 32 - log2(n) bits).
+std::size_t sampleAlias(std::span<const AliasSlot> slots, double u, double* remapped);
+
 // A piecewise-constant 1D distribution over n bins of [0, 1) (pbrt's PiecewiseConstant1D), sampled
-// in constant time through an alias table (Walker 1977; Vose 1991's construction): one table entry
-// per sample instead of a binary search whose every step misses the cache on an environment map's
-// rows (it was the path tracer's largest cost in `perf`). pbrt-v4's AliasTable is the same idea.
+// in constant time through an alias table.
 class Distribution1D {
  public:
   Distribution1D() = default;
@@ -90,26 +108,24 @@ class Distribution1D {
   bool empty() const { return alias_.empty() || total_ <= 0.0; }
   double total() const { return total_; }  // sum of the weights
   std::size_t size() const { return weights_.size(); }
-  // A bin picked with probability weight / total; `remapped` is uniform in [0, 1) given the bin
-  // (what is left of u's precision: about 32 - log2(n) bits).
+  std::span<const double> weights() const { return weights_; }  // as used: non-finite and negative weights are 0
+  // A bin picked with probability weight / total; `remapped` as sampleAlias's.
   std::size_t sampleDiscrete(double u, double* probability = nullptr, double* remapped = nullptr) const;
   double probability(std::size_t bin) const { return total_ > 0 ? weights_[bin] / total_ : 0.0; }
   // Starts loading the table entry sampleDiscrete(u) reads first (its slot and the slot's own bin).
   void prefetch(double u) const;
 
  private:
-  // Slot i of the table: bin i with probability `keep` (of the slot's 1/n), else bin `alias`.
-  struct Slot {
-    double keep = 1.0;
-    std::uint32_t alias = 0;
-  };
   std::vector<double> weights_;
-  std::vector<Slot> alias_;
+  std::vector<AliasSlot> alias_;
   double total_ = 0.0;
 };
 
 // A piecewise-constant 2D distribution over a width x height grid of [0, 1)^2: rows by their
-// sums, then a column within the row. Samples a pixel of an environment map by its weight.
+// sums, then a column within the row. Samples a pixel of an environment map by its weight. The
+// rows' column tables are one array (row-major), so the slot a column sample reads has an address
+// computed from the row alone: with a table per row, finding that table's memory was itself a
+// cache miss that the prefetch of its slot had to wait for (perf: 2 % of a render).
 class Distribution2D {
  public:
   Distribution2D() = default;
@@ -128,15 +144,19 @@ class Distribution2D {
     double v = 0.0;  // uniform in [0, 1) within the row
   };
   RowSample sampleRow(double uy) const;
-  void prefetchColumn(const RowSample& row, double ux) const { columns_[row.row].prefetch(ux); }
+  void prefetchColumn(const RowSample& row, double ux) const { prefetchLine(&aliasSlotFor(columnsOf(row.row), ux)); }
   glm::dvec2 sampleColumn(const RowSample& row, double ux, std::size_t* cell) const;
 
  private:
   double cellDensity(std::size_t row, std::size_t column) const;
+  std::span<const AliasSlot> columnsOf(std::size_t row) const {
+    return std::span(columnSlots_).subspan(row * static_cast<std::size_t>(width_), static_cast<std::size_t>(width_));
+  }
 
   int width_ = 0, height_ = 0;
-  Distribution1D rows_;
-  std::vector<Distribution1D> columns_;
+  Distribution1D rows_;          // by row sums
+  std::vector<double> weights_;  // per cell, as used (non-finite and negative weights are 0)
+  std::vector<AliasSlot> columnSlots_;  // per row, the alias table of its columns
 };
 
 // The power heuristic with beta = 2 (Veach 1997, eq. 9.13): weight of a sample of strategy f.

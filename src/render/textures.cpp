@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/image_io.h"
+#include "render/prefetch.h"
 
 namespace dynbench::render {
 namespace {
@@ -111,7 +112,7 @@ glm::dvec4 Texture::sample(glm::dvec2 uv) const {
 
 void Texture::prefetch(glm::dvec2 uv) const {
   const Footprint f = footprint(uv);
-  for (const std::size_t i : f.index) __builtin_prefetch(codes.empty() ? static_cast<const void*>(&texels[i]) : &codes[i]);
+  for (const std::size_t i : f.index) prefetchLine(codes.empty() ? static_cast<const void*>(&texels[i]) : &codes[i]);
 }
 
 Expected<TextureSet> TextureSet::load(const scene::Scene& scene, std::vector<std::string>& warnings) {
