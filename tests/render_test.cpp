@@ -13,6 +13,7 @@
 #include "gltf_builder.h"
 #include "render/bsdf.h"
 #include "render/bsdf_batch.h"
+#include "render/equirect_batch.h"
 #include "render/lights.h"
 #include "render/path_tracer.h"
 #include "scene/evaluate.h"
@@ -879,6 +880,90 @@ TEST(BsdfBatch, ALaneDoesNotDependOnTheOtherLanes) {
   EXPECT_EQ(a.value, b.value);
   EXPECT_EQ(a.pdf, b.pdf);
   EXPECT_GT(a.pdf, 0.0);
+}
+
+TEST(EquirectBatch, EveryLaneMapsAsTheScalarMappingDoes) {
+  // 37 lanes (not a whole number of vectors) at a time: random image points and directions, then
+  // the awkward ones: the poles, the seam at u = 0 / 1 (phi = +-pi), the axes, signed zeros (which
+  // pick the side of the seam in std::atan2), and directions that are not of unit length.
+  Random rng(11, 0, 0, 0);
+  std::vector<glm::dvec2> points;
+  std::vector<glm::dvec3> directions;
+  for (int i = 0; i < 3700; ++i) {
+    points.push_back(rng.uniform2());
+    const double z = 1 - 2 * rng.uniform(), phi = 2 * kPi * rng.uniform(), r = std::sqrt(std::max(0.0, 1 - z * z));
+    directions.push_back(glm::dvec3(r * std::cos(phi), z, r * std::sin(phi)) * (i % 3 == 0 ? 3.5 : 1.0));
+  }
+  for (const glm::dvec2 p : {glm::dvec2(0, 0), glm::dvec2(1, 1), glm::dvec2(0.5, 0), glm::dvec2(0.5, 1), glm::dvec2(0, 0.5),
+                             glm::dvec2(1, 0.5), glm::dvec2(0.25, 0.5), glm::dvec2(0.75, 0.25)})
+    points.push_back(p);
+  for (const double a : {0.0, -0.0, 1.0, -1.0})
+    for (const double b : {0.0, -0.0, 1.0, -1.0})
+      for (const double c : {0.0, -0.0, 1e-300, -2.0})
+        if (a != 0 || b != 0 || c != 0) directions.push_back({a, b, c});
+  EquirectBatch batch;
+  batch.reserve(37);
+  double worstDirection = 0, worstPoint = 0;
+  for (std::size_t first = 0; first < points.size(); first += 37) {
+    const std::size_t count = std::min<std::size_t>(37, points.size() - first);
+    for (std::size_t k = 0; k < count; ++k) batch.setPoint(k, points[first + k]);
+    batch.directions(count);
+    for (std::size_t k = 0; k < count; ++k) {
+      const glm::dvec2 p = points[first + k];
+      double sinTheta = 0, expectedSinTheta = 0;
+      const glm::dvec3 expected = equirectDirection(p.x, p.y, &expectedSinTheta);
+      const glm::dvec3 got = batch.direction(k, &sinTheta);
+      worstDirection = std::max({worstDirection, glm::length(got - expected), std::abs(sinTheta - expectedSinTheta)});
+      ASSERT_LT(glm::length(got - expected), 1e-14) << p.x << "," << p.y;
+      ASSERT_NEAR(sinTheta, expectedSinTheta, 1e-14) << p.x << "," << p.y;
+    }
+  }
+  for (std::size_t first = 0; first < directions.size(); first += 37) {
+    const std::size_t count = std::min<std::size_t>(37, directions.size() - first);
+    for (std::size_t k = 0; k < count; ++k) batch.setDirection(k, directions[first + k]);
+    batch.coordinates(count);
+    for (std::size_t k = 0; k < count; ++k) {
+      const glm::dvec3 d = directions[first + k];
+      double sinTheta = 0, expectedSinTheta = 0;
+      const glm::dvec2 expected = equirectCoordinates(d, &expectedSinTheta);
+      const glm::dvec2 got = batch.point(k, &sinTheta);
+      worstPoint = std::max({worstPoint, glm::length(got - expected), std::abs(sinTheta - expectedSinTheta)});
+      ASSERT_LT(glm::length(got - expected), 1e-14) << d.x << "," << d.y << "," << d.z << " (signs " << std::signbit(d.x) << std::signbit(d.z) << ")";
+      ASSERT_NEAR(sinTheta, expectedSinTheta, 1e-15) << d.x << "," << d.y << "," << d.z;
+    }
+  }
+  std::printf("largest difference from the scalar mapping: %.2g (directions), %.2g (image points)\n", worstDirection, worstPoint);
+}
+
+TEST(EquirectBatch, ALaneDoesNotDependOnTheOtherLanes) {
+  EquirectBatch alone, crowded;
+  alone.reserve(1);
+  crowded.reserve(20);
+  const glm::dvec2 point(0.3, 0.7);
+  const glm::dvec3 direction = glm::normalize(glm::dvec3(-0.2, 0.5, 0.9));
+  alone.setPoint(0, point);
+  alone.setDirection(0, direction);
+  for (std::size_t k = 0; k < 20; ++k) {
+    crowded.setPoint(k, {0.05 * static_cast<double>(k), 0.9});
+    crowded.setDirection(k, {0, -1, 0.1 * static_cast<double>(k)});
+  }
+  crowded.setPoint(13, point);
+  crowded.setDirection(13, direction);
+  // Directions first: they overwrite the direction fields, so set those again before coordinates.
+  alone.directions(1);
+  crowded.directions(20);
+  double a = 0, b = 0;
+  EXPECT_EQ(alone.direction(0, &a), crowded.direction(13, &b));
+  EXPECT_EQ(a, b);
+  alone.setDirection(0, direction);
+  crowded.setDirection(13, direction);
+  for (std::size_t k = 0; k < 20; ++k)
+    if (k != 13) crowded.setDirection(k, {0, -1, 0.1 * static_cast<double>(k)});
+  alone.coordinates(1);
+  crowded.coordinates(20);
+  EXPECT_EQ(alone.point(0, &a), crowded.point(13, &b));
+  EXPECT_EQ(a, b);
+  EXPECT_GT(a, 0.0);
 }
 
 TEST(Sampling, EnvironmentPdfMatchesItsSamples) {

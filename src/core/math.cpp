@@ -93,12 +93,6 @@ glm::dvec3 equirectDirection(double u, double v, double* sinTheta) {
   return {*sinTheta * std::sin(phi), std::cos(theta), -*sinTheta * std::cos(phi)};
 }
 
-glm::dvec3 equirectDirectionForSampling(double u, double v, double* sinTheta) {
-  const SinCos phi = sinCosSingle(2.0 * kPi * (u - 0.5)), theta = sinCosSingle(kPi * v);
-  *sinTheta = theta.sin;
-  return {theta.sin * phi.sin, theta.cos, -theta.sin * phi.cos};
-}
-
 glm::dvec2 equirectCoordinates(const glm::dvec3& d) {
   double sinTheta = 0.0;
   return equirectCoordinates(d, &sinTheta);

@@ -66,8 +66,9 @@ inline double luminance(const glm::dvec3& rgb) { return 0.2126 * rgb.r + 0.7152 
 // sin and cos of an angle, computed in single precision and widened. For Monte Carlo sampling
 // only: a sampled direction is off by at most ~3e-7 rad (the float rounding of the angle), far
 // below a pixel of any image here, and the sample's density is computed from the direction
-// produced, so nothing is biased. glibc's sincosf takes about 8 ns here against 18 ns for sincos,
-// and the path tracer calls it two to three times per shading point.
+// produced, so nothing is biased. glibc's sincosf takes about 8 ns here against 18 ns for sincos.
+// (The batched path tracer's own sines and cosines are Highway's, in double precision:
+// render/bsdf_batch.h, render/equirect_batch.h.)
 struct SinCos {
   double sin = 0.0, cos = 1.0;
 };
@@ -81,9 +82,6 @@ inline SinCos sinCosSingle(double angle) {
 glm::dvec3 equirectDirection(double u, double v);
 // The same, also giving sin(theta) = sin(pi v) (the mapping's Jacobian needs it).
 glm::dvec3 equirectDirection(double u, double v, double* sinTheta);
-// The same with single-precision trigonometry (sinCosSingle): for sampling an environment, where
-// the direction and its density come from the same sin and cos; not for mapping pixels.
-glm::dvec3 equirectDirectionForSampling(double u, double v, double* sinTheta);
 // Its inverse: the image point a unit direction maps to.
 glm::dvec2 equirectCoordinates(const glm::dvec3& direction);
 // The same, also giving sin(theta) = sin(pi v), from the direction itself (no sine to compute).

@@ -219,16 +219,6 @@ namespace dynbench::render {
 
 HWY_EXPORT(RunBsdfBatch);
 
-void BsdfBatch::reserve(std::size_t lanes) {
-  // Whole vectors of any x86 target (AVX-512: 8 doubles), so the kernel never reads past the end.
-  constexpr std::size_t kVector = 16;
-  const std::size_t rounded = (lanes + kVector - 1) / kVector * kVector;
-  if (rounded <= capacity_) return;
-  // Nothing to keep: a batch's lanes are set before each run.
-  data_.assign(kFieldCount * rounded, 0.0);
-  capacity_ = rounded;
-}
-
 void BsdfBatch::set(std::size_t lane, const SurfaceMaterial& material, const glm::dvec3& shadingNormal, const glm::dvec3& geometricNormal,
                     const glm::dvec3& wo) {
   const glm::dvec3* vectors[] = {&shadingNormal, &geometricNormal, &material.baseColor};
@@ -270,7 +260,7 @@ bool BsdfBatch::sample(std::size_t lane, BsdfSample& out) const {
   return true;
 }
 
-void BsdfBatch::run(std::size_t count) { HWY_DYNAMIC_DISPATCH(RunBsdfBatch)(data_.data(), capacity_, std::min(count, capacity_)); }
+void BsdfBatch::run(std::size_t count) { HWY_DYNAMIC_DISPATCH(RunBsdfBatch)(lanes_.data(), capacity(), std::min(count, capacity())); }
 
 }  // namespace dynbench::render
 #endif

@@ -11,20 +11,19 @@
 // bit for bit (render_test.cpp: `BsdfBatch.*`). Lanes are independent: a lane's result does not
 // depend on the other lanes or on how many there are.
 #include <cstddef>
-#include <vector>
 
 #include <glm/glm.hpp>
 
 #include "render/bsdf.h"
+#include "render/lane_arrays.h"
 
 namespace dynbench::render {
 
 class BsdfBatch {
  public:
-  // Room for `lanes` vertices, rounded up to whole vectors (the kernel computes the padding lanes
-  // too; their results are never read). Growing discards the lanes' contents.
-  void reserve(std::size_t lanes);
-  std::size_t capacity() const { return capacity_; }
+  // Room for `lanes` vertices (LaneArrays). Growing discards the lanes' contents.
+  void reserve(std::size_t lanes) { lanes_.reserve(lanes); }
+  std::size_t capacity() const { return lanes_.capacity(); }
 
   // Lane `lane`: the vertex's BSDF, Bsdf(material, Frame(shadingNormal), geometricNormal), seen
   // from wo (Bsdf::view; the kernel builds both); the direction whose value and pdf to evaluate
@@ -58,10 +57,9 @@ class BsdfBatch {
   };
 
  private:
-  double& at(Field f, std::size_t lane) { return data_[f * capacity_ + lane]; }
-  double at(Field f, std::size_t lane) const { return data_[f * capacity_ + lane]; }
-  std::size_t capacity_ = 0;
-  std::vector<double> data_;
+  double& at(Field f, std::size_t lane) { return lanes_.at(f, lane); }
+  double at(Field f, std::size_t lane) const { return lanes_.at(f, lane); }
+  LaneArrays<kFieldCount> lanes_;
 };
 
 }  // namespace dynbench::render

@@ -8,6 +8,7 @@
 
 #include "core/image_io.h"
 #include "core/math.h"
+#include "render/equirect_batch.h"
 
 namespace dynbench::render {
 
@@ -125,9 +126,14 @@ glm::dvec3 EnvironmentLight::sampleAt(glm::dvec2 point, std::size_t pixel, doubl
     if (radiance) *radiance = this->radiance(d);
     return d;
   }
-  const glm::vec4& texel = pixels_[pixel];
   double sinTheta = 0.0;
-  const glm::dvec3 direction = equirectDirectionForSampling(point.x, point.y, &sinTheta);
+  const glm::dvec3 direction = equirectDirection(point.x, point.y, &sinTheta);
+  return sampleMapped(direction, sinTheta, pixel, pdf, radiance);
+}
+
+glm::dvec3 EnvironmentLight::sampleMapped(const glm::dvec3& direction, double sinTheta, std::size_t pixel, double* pdf,
+                                          glm::dvec3* radiance) const {
+  const glm::vec4& texel = pixels_[pixel];
   *pdf = solidAngleDensity(texel.w, sinTheta);
   if (radiance) *radiance = glm::dvec3(texel);
   return direction;
@@ -283,6 +289,7 @@ void LightSet::startChoice(double uChoice, glm::dvec2 u, Choice& c) const {
 }
 
 void LightSet::finishChoice(Choice& c) const {
+  c.mapped = false;
   if (c.kind == Choice::Kind::kEnvironment) {
     c.point = environment_->samplePoint(c.row, c.u, &c.index);
     environment_->prefetchPixel(c.index);
@@ -296,12 +303,29 @@ void LightSet::finishChoice(Choice& c) const {
   }
 }
 
+void LightSet::mapDirections(std::span<Choice* const> choices, EquirectBatch& scratch) const {
+  if (!environment_ || !environment_->mapsImagePoints()) return;
+  std::size_t lanes = 0;
+  scratch.reserve(choices.size());
+  for (const Choice* c : choices)
+    if (c->kind == Choice::Kind::kEnvironment) scratch.setPoint(lanes++, c->point);
+  if (lanes == 0) return;
+  scratch.directions(lanes);
+  std::size_t lane = 0;
+  for (Choice* c : choices)
+    if (c->kind == Choice::Kind::kEnvironment) {
+      c->direction = scratch.direction(lane++, &c->sinTheta);
+      c->mapped = true;
+    }
+}
+
 bool LightSet::sample(const glm::dvec3& point, const Choice& c, LightSample& s) const {
   s.delta = false;
   if (c.kind == Choice::Kind::kNone) return false;
   if (c.kind == Choice::Kind::kEnvironment) {
     double pdf = 0.0;
-    s.direction = environment_->sampleAt(c.point, c.index, &pdf, &s.radiance);
+    s.direction = c.mapped ? environment_->sampleMapped(c.direction, c.sinTheta, c.index, &pdf, &s.radiance)
+                           : environment_->sampleAt(c.point, c.index, &pdf, &s.radiance);
     if (!(pdf > 0)) return false;
     s.distance = std::numeric_limits<double>::infinity();
     s.pdf = c.probability * pdf;

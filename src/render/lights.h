@@ -9,6 +9,7 @@
 // texture) as radiance. docs/feature-buffers.md repeats this.
 #include <functional>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -19,6 +20,8 @@
 #include "scene/scene.h"
 
 namespace dynbench::render {
+
+class EquirectBatch;
 
 // An equirectangular environment (core/math.h's mapping), importance-sampled by pixel luminance
 // times the pixel's solid angle. Radiance is looked up at the nearest pixel, so the sampled
@@ -44,6 +47,13 @@ class EnvironmentLight {
   Distribution2D::RowSample sampleRow(glm::dvec2 u) const;
   glm::dvec2 samplePoint(const Distribution2D::RowSample& row, glm::dvec2 u, std::size_t* pixel) const;
   glm::dvec3 sampleAt(glm::dvec2 point, std::size_t pixel, double* pdf, glm::dvec3* radiance = nullptr) const;
+  // Whether sampleAt's direction is the image point's (equirectDirection): then a caller that has
+  // mapped the point itself (EquirectBatch, for many at once) finishes with sampleMapped. Not for
+  // a constant environment, which samples the sphere uniformly instead.
+  bool mapsImagePoints() const { return !distribution_.empty() && height_ > 1; }
+  // sampleAt's density and radiance for a point already mapped to `direction` (unit) with
+  // sin(theta) = sinTheta; returns the direction.
+  glm::dvec3 sampleMapped(const glm::dvec3& direction, double sinTheta, std::size_t pixel, double* pdf, glm::dvec3* radiance = nullptr) const;
   double pdf(const glm::dvec3& direction) const;
   // Memory prefetches for the batched path tracer: the pixel radianceAt(uv) reads; the pixel a
   // sample picked.
@@ -121,6 +131,10 @@ class LightSet {
     // Between startChoice and finishChoice: the random numbers, and the environment's row.
     glm::dvec2 u{0.0};
     Distribution2D::RowSample row;
+    // An environment choice's direction and sin(theta), when mapDirections has mapped `point`.
+    glm::dvec3 direction{0.0};
+    double sinTheta = 0.0;
+    bool mapped = false;
   };
   // Choosing takes two steps, for the batched path tracer: which light and (for the environment)
   // which row, from tables small enough to stay cached, starting to load the table entry the
@@ -129,6 +143,10 @@ class LightSet {
   // stores just made (perf: an eighth of the batch loop's own time on one such copy).
   void startChoice(double uChoice, glm::dvec2 u, Choice& choice) const;
   void finishChoice(Choice& choice) const;
+  // Optionally, after finishChoice: the directions of a batch's environment choices (any others are
+  // left as they are), mapped several per SIMD instruction in `scratch`. sample() maps a choice
+  // this has not.
+  void mapDirections(std::span<Choice* const> choices, EquirectBatch& scratch) const;
   // The sample from `point`, into `sample` (every field; written in place, as startChoice's
   // choice); false where there is none.
   bool sample(const glm::dvec3& point, const Choice& choice, LightSample& sample) const;

@@ -10,6 +10,7 @@
 
 #include "core/math.h"
 #include "render/bsdf_batch.h"
+#include "render/equirect_batch.h"
 #include "render/prefetch.h"
 
 namespace dynbench::render {
@@ -282,6 +283,8 @@ struct PathTracer::PathScratch {
   LightSample lightSample;
   BsdfSample bsdfSample;
   BsdfBatch bsdfs;  // the BSDFs of a stage's shading points, evaluated and sampled together
+  EquirectBatch equirect;  // escapes' directions mapped to environment image points, together
+  std::vector<LightSet::Choice*> choices;  // a stage's light choices, their directions mapped together
   std::vector<std::uint32_t> reach;       // punctual lights in reach of a shading point
   std::vector<std::uint32_t> firstReach;  // of the pixel's first hit
   std::vector<PathState> paths;      // a batch
@@ -305,6 +308,7 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
   if (lightSample) lights_.punctualInReach(firstHit.position, scratch.firstReach);
   const FirstVertex first{firstShading, offsetOrigin(firstHit.position, firstShading.geometricNormal), scratch.firstReach};
   scratch.bsdfs.reserve(paths.size());
+  scratch.equirect.reserve(paths.size());
   for (int depth = 0;; ++depth) {
     const bool shadesHere = depth <= settings_.bounces;  // a hit at this depth gathers light and bounces
     // Stage 1: trace; start loading the hit's texture coordinates and the environment pixel of an
@@ -324,15 +328,14 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
     }
     // The hits are read where the stream left them (a hit record is 150 bytes: not copied).
     auto hitOf = [&](const PathState& p) -> const SurfaceHit& { return depth == 0 ? firstHit : scratch.streamHits[p.streamIndex]; };
+    auto escaped = [&](const PathState& p) { return p.active && !hitOf(p).hit && environment_; };
+    std::size_t escapes = 0;
     for (PathState& p : paths) {
       if (!p.active) continue;
       any = true;
       const SurfaceHit& hit = hitOf(p);
       if (!hit.hit) {
-        if (environment_) {
-          p.uv = equirectCoordinates(p.ray.direction, &p.escapeSinTheta);
-          lights_.prefetchEnvironment(p.uv);
-        }
+        if (environment_) scratch.equirect.setDirection(escapes++, p.ray.direction);
         continue;
       }
       if (depth > 0) prefetchTexCoords(hit);
@@ -343,8 +346,20 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
       }
     }
     if (!any) break;
+    // The escapes' environment image points, all at once; start loading their pixels.
+    if (escapes > 0) {
+      scratch.equirect.coordinates(escapes);
+      std::size_t lane = 0;
+      for (PathState& p : paths)
+        if (escaped(p)) {
+          p.uv = scratch.equirect.point(lane++, &p.escapeSinTheta);
+          lights_.prefetchEnvironment(p.uv);
+        }
+    }
     // Stage 2: what stage 1's loads point to: the texels at the hit; the light choice, which
-    // starts loading the environment pixel or triangle it picks.
+    // starts loading the environment pixel or triangle it picks. Then the directions of the
+    // environment choices, all at once.
+    scratch.choices.clear();
     for (PathState& p : paths) {
       if (!p.active) continue;
       const SurfaceHit& hit = hitOf(p);
@@ -353,8 +368,12 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
         p.uv = texCoord(hit);
         prefetchTextures(hit, p.uv);
       }
-      if (lightSample && shadesHere) lights_.finishChoice(p.lightChoice);
+      if (lightSample && shadesHere) {
+        lights_.finishChoice(p.lightChoice);
+        scratch.choices.push_back(&p.lightChoice);
+      }
     }
+    lights_.mapDirections(scratch.choices, scratch.equirect);
     // Stage 3: shade and gather the punctual lights, path by path, each path's BSDF going into a
     // lane of the batch; evaluate the light samples and sample the bounces of all the lanes at
     // once (BsdfBatch); then each path's light sample (its shadow ray) and its bounce.
