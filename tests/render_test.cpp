@@ -510,7 +510,9 @@ TEST(Render, PathsTracedInBatchesComputeExactlyWhatOnePathAtATimeDoes) {
 
   auto render = [&](int batch, bool converge, FrameBuffers* frame = nullptr) {
     RenderSettings settings;
-    settings.samplesPerPixel = 37;  // a batch of 32 and one of 5
+    // 37 samples: batches of 32, 64 or 100 paths span two or three pixels, starting and ending
+    // inside them; in converging rounds, several pixels' next samples share batches.
+    settings.samplesPerPixel = 37;
     settings.bounces = 5;
     settings.pathBatch = batch;
     settings.converge = converge;
@@ -527,7 +529,7 @@ TEST(Render, PathsTracedInBatchesComputeExactlyWhatOnePathAtATimeDoes) {
   for (const bool converge : {false, true}) {
     FrameBuffers frame;
     const auto one = render(1, converge, &frame);
-    for (const int batch : {5, 32}) {
+    for (const int batch : {5, 32, 64, 100}) {
       const auto batched = render(batch, converge);
       EXPECT_EQ(batched.first, one.first) << "batch " << batch << (converge ? ", converging" : "");
       EXPECT_EQ(batched.second, one.second) << "rays traced, batch " << batch;

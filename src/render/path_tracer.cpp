@@ -245,6 +245,7 @@ struct PathTracer::PathSample {
 
 // One path of a batch between its stages.
 struct PathTracer::PathState {
+  const FirstVertex* first = nullptr;  // its pixel's camera ray and first hit
   Random rng;
   Ray ray;
   std::size_t streamIndex = 0;  // where the hit of `ray` is in the batch's stream (depth > 0)
@@ -267,12 +268,18 @@ struct PathTracer::PathState {
   glm::dvec3 origin{0.0}, shadingNormal{0.0};
 };
 
-// A pixel's first hit: the same for every path of its batches (the same hit seen from the same
-// direction), so its shading, ray origin and punctual lights in reach are found once.
+// A pixel whose paths wait in the thread's queue (PathScratch::queue): its camera ray and first
+// hit, the same for every path of the pixel (the same hit seen from the same direction), so its
+// shading, ray origin and punctual lights in reach are found once; and its samples still to be
+// traced, [next, upTo).
 struct PathTracer::FirstVertex {
-  const Shading& shading;
-  glm::dvec3 origin;
-  const std::vector<std::uint32_t>& reach;
+  std::size_t pixel = 0;
+  Ray ray;
+  const SurfaceHit* hit = nullptr;
+  Shading shading;
+  glm::dvec3 origin{0.0};
+  std::vector<std::uint32_t> reach;
+  int next = 0, upTo = 0;
 };
 
 // Per-thread working memory of the path loop, so the per-ray path does not allocate.
@@ -286,17 +293,19 @@ struct PathTracer::PathScratch {
   EquirectBatch equirect;  // escapes' directions mapped to environment image points, together
   std::vector<LightSet::Choice*> choices;  // a stage's light choices, their directions mapped together
   std::vector<std::uint32_t> reach;       // punctual lights in reach of a shading point
-  std::vector<std::uint32_t> firstReach;  // of the pixel's first hit
-  std::vector<PathState> paths;      // a batch
+  // Pixels whose paths are still to be traced: entries [queueHead, queueEnd) of `queue`, which
+  // keeps its entries (and their reach vectors' memory) for the next pixels.
+  std::vector<FirstVertex> queue;
+  std::size_t queueHead = 0, queueEnd = 0;
+  std::vector<PathState> paths;   // a batch
   std::vector<Ray> streamRays;        // the batch's rays still going, and their hits
   std::vector<SurfaceHit> streamHits;
   std::uint64_t rays = 0, shadingPoints = 0, punctualEvaluated = 0;
 };
 
-void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, const Shading& firstShading, std::span<PathState> paths,
-                            PathScratch& scratch) const {
+void PathTracer::tracePaths(std::span<PathState> paths, PathScratch& scratch) const {
   for (PathState& p : paths) {
-    p.ray = cameraRay;
+    p.ray = p.first->ray;
     p.throughput = glm::dvec3(1.0);
     p.out = PathSample{};
     p.previousBsdfPdf = 0.0;
@@ -304,9 +313,6 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
     p.active = true;
   }
   const bool lightSample = settings_.nextEventEstimation;
-  scratch.firstReach.clear();
-  if (lightSample) lights_.punctualInReach(firstHit.position, scratch.firstReach);
-  const FirstVertex first{firstShading, offsetOrigin(firstHit.position, firstShading.geometricNormal), scratch.firstReach};
   scratch.bsdfs.reserve(paths.size());
   scratch.equirect.reserve(paths.size());
   for (int depth = 0;; ++depth) {
@@ -327,7 +333,7 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
       scratch.rays += scratch.streamRays.size();
     }
     // The hits are read where the stream left them (a hit record is 150 bytes: not copied).
-    auto hitOf = [&](const PathState& p) -> const SurfaceHit& { return depth == 0 ? firstHit : scratch.streamHits[p.streamIndex]; };
+    auto hitOf = [&](const PathState& p) -> const SurfaceHit& { return depth == 0 ? *p.first->hit : scratch.streamHits[p.streamIndex]; };
     auto escaped = [&](const PathState& p) { return p.active && !hitOf(p).hit && environment_; };
     std::size_t escapes = 0;
     for (PathState& p : paths) {
@@ -379,7 +385,7 @@ void PathTracer::tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, co
     // once (BsdfBatch); then each path's light sample (its shadow ray) and its bounce.
     std::size_t lanes = 0;
     for (PathState& p : paths)
-      if (p.active) p.active = advance(p, depth, hitOf(p), depth == 0 ? &first : nullptr, scratch, lanes);
+      if (p.active) p.active = advance(p, depth, hitOf(p), depth == 0 ? p.first : nullptr, scratch, lanes);
     if (lanes > 0) scratch.bsdfs.run(lanes);
     for (PathState& p : paths)
       if (p.active) p.active = bounce(p, depth, scratch);
@@ -542,8 +548,10 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
   tbb::enumerable_thread_specific<PathScratch> scratches;
   const glm::dvec2 jitter = settings_.jitter ? frames::jitterOffset(static_cast<long>(frameIndex)) : glm::dvec2(0.0);
 
-  // `known`: the first hit's shading when the caller has it already (the first round's buffers).
-  auto samplePixel = [&](std::size_t pixel, int upTo, PathScratch& scratch, const Shading* known = nullptr) {
+  // A pixel's samples up to `upTo`: one environment lookup where the camera ray escapes, else its
+  // paths queued in the thread's scratch (`known`: the first hit's shading when the caller has it
+  // already, the first round's buffers). flush traces them.
+  auto enqueue = [&](std::size_t pixel, int upTo, PathScratch& scratch, const Shading* known = nullptr) {
     const int px = static_cast<int>(pixel % static_cast<std::size_t>(width)), py = static_cast<int>(pixel / static_cast<std::size_t>(width));
     const Ray ray = camera.ray(px + 0.5 + jitter.x, py + 0.5 + jitter.y);
     const SurfaceHit& hit = firstHits[pixel];
@@ -554,17 +562,48 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
       while (sum.samples < upTo) sum.add(le, glm::dvec3(0.0));
       return;
     }
-    std::optional<Shading> own;
-    const Shading& shading = known ? *known : own.emplace(shade(hit, -ray.direction, texCoord(hit)));
-    // In batches, each path with the random stream of its sample index, summed in sample order.
-    while (sum.samples < upTo) {
-      const std::size_t batch = static_cast<std::size_t>(std::min(upTo - sum.samples, settings_.pathBatch));
+    if (sum.samples >= upTo) return;
+    if (scratch.queueEnd == scratch.queue.size()) scratch.queue.emplace_back();
+    FirstVertex& v = scratch.queue[scratch.queueEnd++];
+    v.pixel = pixel;
+    v.ray = ray;
+    v.hit = &hit;
+    if (known) v.shading = *known;
+    else shade(hit, -ray.direction, texCoord(hit), v.shading);
+    v.origin = offsetOrigin(hit.position, v.shading.geometricNormal);
+    v.reach.clear();
+    if (settings_.nextEventEstimation) lights_.punctualInReach(hit.position, v.reach);
+    v.next = sum.samples;
+    v.upTo = upTo;
+  };
+  // Traces the queued paths in batches of pathBatch, in queue order, each path with the random
+  // stream of its pixel and sample index, and sums them per pixel in sample order; a batch may
+  // span several pixels (at 16 spp one pixel filled half a batch, and a shorter batch hides less of
+  // the memory latency and fills fewer SIMD lanes). `all`: also the last, partial batch. Each path
+  // computes what it would alone, so the image does not depend on how pixels share batches.
+  auto flush = [&](PathScratch& scratch, bool all) {
+    auto& queue = scratch.queue;
+    const auto batchSize = static_cast<std::size_t>(settings_.pathBatch);
+    while (true) {
+      std::size_t waiting = 0;
+      for (std::size_t q = scratch.queueHead; q < scratch.queueEnd && waiting < batchSize; ++q)
+        waiting += static_cast<std::size_t>(queue[q].upTo - queue[q].next);
+      if (waiting == 0 || (waiting < batchSize && !all)) break;
+      const std::size_t batch = std::min(waiting, batchSize);
       scratch.paths.resize(std::max(scratch.paths.size(), batch));
       const std::span<PathState> paths(scratch.paths.data(), batch);
-      for (std::size_t k = 0; k < batch; ++k)
-        paths[k].rng = Random(settings_.seed, frameIndex, pixel, static_cast<std::uint64_t>(sum.samples) + k);
-      tracePaths(ray, hit, shading, paths, scratch);
-      for (const PathState& p : paths) sum.add(p.out.direct, p.out.indirect);
+      std::size_t n = 0;
+      for (std::size_t q = scratch.queueHead; n < batch; ++q) {
+        FirstVertex& v = queue[q];
+        for (; v.next < v.upTo && n < batch; ++v.next, ++n) {
+          paths[n].first = &v;
+          paths[n].rng = Random(settings_.seed, frameIndex, v.pixel, static_cast<std::uint64_t>(v.next));
+        }
+      }
+      tracePaths(paths, scratch);
+      for (const PathState& p : paths) sums[p.first->pixel].add(p.out.direct, p.out.indirect);
+      while (scratch.queueHead < scratch.queueEnd && queue[scratch.queueHead].next == queue[scratch.queueHead].upTo) ++scratch.queueHead;
+      if (scratch.queueHead == scratch.queueEnd) scratch.queueHead = scratch.queueEnd = 0;
     }
   };
 
@@ -595,8 +634,10 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
           out.motion[2 * pixel] = static_cast<float>(target.x - (px + 0.5 + jitter.x));
           out.motion[2 * pixel + 1] = static_cast<float>(target.y - (py + 0.5 + jitter.y));
         }
-        samplePixel(pixel, firstRound, scratch, shading ? &*shading : nullptr);
+        enqueue(pixel, firstRound, scratch, shading ? &*shading : nullptr);
+        flush(scratch, false);
       }
+      flush(scratch, true);
       if (rowsDone && !settings_.converge) rowsDone->fetch_add(1, std::memory_order_relaxed);
     }
   });
@@ -631,17 +672,23 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
     std::atomic<std::size_t> pixelsDone{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pixels, 8), [&](const tbb::blocked_range<std::size_t>& run) {
       PathScratch& scratch = scratches.local();
-      for (std::size_t pixel = run.begin(); pixel < run.end(); ++pixel) {
-        PixelSums& sum = sums[pixel];
-        while (sum.samples < cap) {
-          auto ratio = [](double variance, double targetSq) {
-            if (variance <= 0) return 0.0;
-            return targetSq > 0 ? variance / targetSq : std::numeric_limits<double>::infinity();
-          };
+      auto ratio = [](double variance, double targetSq) {
+        if (variance <= 0) return 0.0;
+        return targetSq > 0 ? variance / targetSq : std::numeric_limits<double>::infinity();
+      };
+      // In rounds: every pixel of the run that has not converged queues its next samples, then
+      // they are traced together. A pixel's counts depend on its own sums alone.
+      for (bool queued = true; queued;) {
+        queued = false;
+        for (std::size_t pixel = run.begin(); pixel < run.end(); ++pixel) {
+          const PixelSums& sum = sums[pixel];
+          if (sum.samples >= cap) continue;
           const double r = std::max(ratio(sum.directVariance(), directTargetSq), ratio(sum.indirectVariance(), indirectTargetSq));
-          if (r <= 1.0) break;
-          samplePixel(pixel, nextSampleCount(sum.samples, r, firstRound, cap), scratch);
+          if (r <= 1.0) continue;
+          enqueue(pixel, nextSampleCount(sum.samples, r, firstRound, cap), scratch);
+          queued = true;
         }
+        flush(scratch, true);
       }
       const std::size_t done = pixelsDone.fetch_add(run.size(), std::memory_order_relaxed) + run.size();
       // Whole rows' worth, for progress; the last run's store below makes it `height` exactly.

@@ -60,7 +60,7 @@ struct RenderSettings {
   double directThresholdFraction = 0.1, indirectThresholdFraction = 0.1;
   // Paths traced together (PathTracer::tracePaths); 1 traces one path at a time. The image does
   // not depend on it (tested): only the speed does.
-  int pathBatch = 32;
+  int pathBatch = 64;
 };
 
 // One frame's buffers: the feature-buffer contract's frame (frames/feature_frame.h).
@@ -111,21 +111,21 @@ class PathTracer {
   struct PathSample;
   struct PathState;
   struct PathScratch;
-  // A batch of paths from the camera through the pixel centre, all starting at its first hit
-  // (already traced and shaded), each with its own random stream: their direct and indirect
-  // radiance, in paths[k].out. The paths advance together, one bounce at a time, in stages (trace
-  // every path, then shade every path), so that the memory each path's shading reads (texels,
-  // environment pixels, light tables) is prefetched while the other paths trace: one path at a
-  // time spent most of its time waiting on those loads. Each path computes exactly what it would
-  // alone: the same random numbers in the same order, the same arithmetic.
-  void tracePaths(const Ray& cameraRay, const SurfaceHit& firstHit, const Shading& firstShading, std::span<PathState> paths,
-                  PathScratch& scratch) const;
+  // A batch of paths, each from the camera through its pixel's centre and starting at that
+  // pixel's first hit (already traced and shaded: PathState::first), each with its own random
+  // stream: their direct and indirect radiance, in paths[k].out. A batch may hold the paths of
+  // several pixels. The paths advance together, one bounce at a time, in stages (trace every path,
+  // then shade every path), so that the memory each path's shading reads (texels, environment
+  // pixels, light tables) is prefetched while the other paths trace: one path at a time spent
+  // most of its time waiting on those loads. Each path computes exactly what it would alone: the
+  // same random numbers in the same order, the same arithmetic.
+  void tracePaths(std::span<PathState> paths, PathScratch& scratch) const;
   // One vertex of one path (its hit traced, its prefetches issued), first half: adds the hit's
   // emission and its punctual lights to the path's radiance, takes its light sample and puts its
   // BSDF, the light sample's direction and the bounce's random numbers into lane `lanes` of the
   // batch's BSDFs (then counts the lane). false when the path ends here. At a pixel's first hit,
-  // which every path of the batch shares, `first` holds its shading, ray origin and punctual lights
-  // in reach, found once.
+  // which every path of the pixel shares, `first` holds its shading, ray origin and punctual
+  // lights in reach, found once.
   struct FirstVertex;
   bool advance(PathState& path, int depth, const SurfaceHit& hit, const FirstVertex* first, PathScratch& scratch,
                std::size_t& lanes) const;
