@@ -548,12 +548,15 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
   tbb::enumerable_thread_specific<PathScratch> scratches;
   const glm::dvec2 jitter = settings_.jitter ? frames::jitterOffset(static_cast<long>(frameIndex)) : glm::dvec2(0.0);
 
-  // A pixel's samples up to `upTo`: one environment lookup where the camera ray escapes, else its
-  // paths queued in the thread's scratch (`known`: the first hit's shading when the caller has it
-  // already, the first round's buffers). flush traces them.
-  auto enqueue = [&](std::size_t pixel, int upTo, PathScratch& scratch, const Shading* known = nullptr) {
+  // The ray through a pixel's (jittered) centre.
+  auto pixelRay = [&](std::size_t pixel) {
     const int px = static_cast<int>(pixel % static_cast<std::size_t>(width)), py = static_cast<int>(pixel / static_cast<std::size_t>(width));
-    const Ray ray = camera.ray(px + 0.5 + jitter.x, py + 0.5 + jitter.y);
+    return camera.ray(px + 0.5 + jitter.x, py + 0.5 + jitter.y);
+  };
+  // A pixel's samples up to `upTo`: one environment lookup where its camera ray `ray` escapes, else
+  // its paths queued in the thread's scratch (`known`: the first hit's shading when the caller has
+  // it already, the first round's buffers). flush traces them.
+  auto enqueue = [&](std::size_t pixel, const Ray& ray, int upTo, PathScratch& scratch, const Shading* known = nullptr) {
     const SurfaceHit& hit = firstHits[pixel];
     PixelSums& sum = sums[pixel];
     if (!hit.hit) {
@@ -615,7 +618,7 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
     for (int py = rows.begin(); py < rows.end(); ++py) {
       for (int px = 0; px < width; ++px) {
         const std::size_t pixel = static_cast<std::size_t>(py) * static_cast<std::size_t>(width) + static_cast<std::size_t>(px);
-        const Ray ray = camera.ray(px + 0.5 + jitter.x, py + 0.5 + jitter.y);
+        const Ray ray = pixelRay(pixel);
         const SurfaceHit hit = trace(ray);
         ++scratch.rays;
         firstHits[pixel] = hit;
@@ -634,7 +637,7 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
           out.motion[2 * pixel] = static_cast<float>(target.x - (px + 0.5 + jitter.x));
           out.motion[2 * pixel + 1] = static_cast<float>(target.y - (py + 0.5 + jitter.y));
         }
-        enqueue(pixel, firstRound, scratch, shading ? &*shading : nullptr);
+        enqueue(pixel, ray, firstRound, scratch, shading ? &*shading : nullptr);
         flush(scratch, false);
       }
       flush(scratch, true);
@@ -685,7 +688,7 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
           if (sum.samples >= cap) continue;
           const double r = std::max(ratio(sum.directVariance(), directTargetSq), ratio(sum.indirectVariance(), indirectTargetSq));
           if (r <= 1.0) continue;
-          enqueue(pixel, nextSampleCount(sum.samples, r, firstRound, cap), scratch);
+          enqueue(pixel, pixelRay(pixel), nextSampleCount(sum.samples, r, firstRound, cap), scratch);
           queued = true;
         }
         flush(scratch, true);
