@@ -82,7 +82,7 @@ std::uintmax_t writeCapture(const fs::path& dir, double gigabytes) {
       if ((f / 30 + p) % 7 != 0) check(dbc_model(s, props[p], "prop", dq(f * 0.02 * p, {p * 1.0, 2, 5})));
     if (f % 20 < 3) {
       const float at[] = {0, 3, float(f * 0.1)}, rgb[] = {1, 0.6f, 0.2f};
-      check(dbc_light(s, 100000 + f / 20, at, rgb, DBC_LIGHT_POINT, 1, "flash"));
+      check(dbc_light(s, 100000 + f / 20, at, rgb, 24.0f, DBC_FALLOFF_QUADRATIC, DBC_LIGHT_POINT, 1, "flash"));
     }
     check(dbc_frame_end(s));
     if (f % 1000 == 999 && fs::file_size(dir / "Capture.txt") >= target) break;

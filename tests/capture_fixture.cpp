@@ -57,11 +57,11 @@ Ids recordFrames(dbc_session* s, int frames) {
     EXPECT_EQ(dbc_joints(s, ids.arm, "chars/arm", 2, pose), DBC_OK) << dbc_last_error();
     if (f < 4 || f > 6) EXPECT_EQ(dbc_model(s, ids.crate, "mapmodel/crate:1", crateModelPose(f)), DBC_OK);
     const float lampAt[] = {0, 5, 0}, white[] = {1, 1, 1}, orange[] = {1, 0.5f, 0};
-    EXPECT_EQ(dbc_light(s, ids.lamp, lampAt, white, DBC_LIGHT_POINT, 0, nullptr), DBC_OK);
+    EXPECT_EQ(dbc_light(s, ids.lamp, lampAt, white, 40.0f, DBC_FALLOFF_LINEAR, DBC_LIGHT_POINT, 0, nullptr), DBC_OK);
     if (f == 2 || f == 3) {
       const float at[] = {0.5f, 1.5f, static_cast<float>(f)};
       const float fading[] = {orange[0] / 2, orange[1] / 2, orange[2] / 2};  // the flash fades to half in frame 3
-      EXPECT_EQ(dbc_light(s, ids.flash, at, f == 2 ? orange : fading, DBC_LIGHT_POINT, 1, "flash"), DBC_OK);
+      EXPECT_EQ(dbc_light(s, ids.flash, at, f == 2 ? orange : fading, 0.0f, DBC_FALLOFF_QUADRATIC, DBC_LIGHT_POINT, 1, "flash"), DBC_OK);
     }
     EXPECT_EQ(dbc_frame_end(s), DBC_OK) << dbc_last_error();
   }

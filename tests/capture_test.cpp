@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include <gtest/gtest.h>
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "capture/check.h"
@@ -227,7 +228,7 @@ fs::path handCapture(const std::string& name, const std::string& capture) {
   return dir;
 }
 
-const std::string kHeader = "dynbench-capture:1\ns:hand\n";
+const std::string kHeader = "dynbench-capture:2\ns:hand\n";
 const std::string kGoodFrame = "f:1:0\nt:1:0:0:0:0:0:0\nm:2:0:0:0:1:0:0:0:0:chars/arm\n"
                                "j:2:2:0:0:0:1:0:0:0:0:0:0:0:1:0:0:0:0:chars/arm\ne:1\n";
 
@@ -302,10 +303,42 @@ TEST(BadCapture, TruncatedLastFrameIsAWarning) {
 }
 
 TEST(BadCapture, OrderAndVersion) {
-  expectCaptureError(handCapture("bad_version", "dynbench-capture:9\n"), ErrorCode::kParse, {"Capture.txt:1:", "version line"});
+  expectCaptureError(handCapture("bad_version", "dynbench-capture:9\n"), ErrorCode::kParse, {"Capture.txt:1:", "version 9 is not supported"});
+  expectCaptureError(handCapture("bad_version_header", "capture\n"), ErrorCode::kParse, {"Capture.txt:1:", "expected the version line"});
+  // A version 1 capture (before the lights' range and the signed normals) is named as such.
+  expectCaptureError(handCapture("old_version", "dynbench-capture:1\ns:hand\n" + kGoodFrame), ErrorCode::kParse,
+                     {"Capture.txt:1:", "version 1 is not supported", "reads version 2", "capture again"});
   expectCaptureError(handCapture("bad_order", kHeader + "f:2:0\ne:2\nf:1:1\ne:1\n"), ErrorCode::kInvalidData,
                      {"Capture.txt:5:", "frame numbers must increase"});
   expectCaptureError(handCapture("bad_nested", kHeader + "f:1:0\nf:2:0\n"), ErrorCode::kInvalidData, {"Capture.txt:4:", "before frame 1"});
+}
+
+TEST(BadCapture, LightRangeFalloffAndMapLighting) {
+  const std::string light = "f:1:0\nl:5:0:1:0:1:0.5:0.25:{}:{}:point:0:none\ne:1\n";
+  auto good = checkCapture(handCapture("light_range", kHeader + "L:1:2:2:0.8:0.8:0.7:0.1:0.1:0.1:0.4:0.4:0.5\n" + fmt::format(fmt::runtime(light), 40, "linear")));
+  ASSERT_TRUE(good) << good.error().message;
+  auto reader = CaptureReader::open(handCapture("light_range_read", kHeader + "L:1:2:2:0.8:0.8:0.7:0.1:0.1:0.1:0.4:0.4:0.5\n" +
+                                                                         fmt::format(fmt::runtime(light), 40, "quadratic")));
+  ASSERT_TRUE(reader) << reader.error().message;
+  ASSERT_TRUE((*reader)->settings().lighting);
+  const MapLighting& m = *(*reader)->settings().lighting;
+  EXPECT_NEAR(m.sunDirection.y, 2.0 / 3.0, 1e-12);  // normalised
+  EXPECT_EQ(m.sun, glm::dvec3(0.8, 0.8, 0.7));
+  EXPECT_EQ(m.sky, glm::dvec3(0.4, 0.4, 0.5));
+  CaptureFrame frame;
+  ASSERT_TRUE((*reader)->next(frame));
+  ASSERT_EQ(frame.lights.size(), 1u);
+  EXPECT_EQ(frame.lights[0].range, 40.0);
+  EXPECT_EQ(frame.lights[0].falloff, LightFalloff::kQuadratic);
+  expectCaptureError(handCapture("bad_falloff", kHeader + fmt::format(fmt::runtime(light), 40, "cubic")), ErrorCode::kInvalidData,
+                     {"Capture.txt:4:", "light falloff 'cubic'"});
+  expectCaptureError(handCapture("bad_falloff_none", kHeader + fmt::format(fmt::runtime(light), 40, "none")), ErrorCode::kInvalidData,
+                     {"Capture.txt:4:", "falloff exactly when it has a range"});
+  expectCaptureError(handCapture("bad_range", kHeader + fmt::format(fmt::runtime(light), -1, "linear")), ErrorCode::kInvalidData,
+                     {"Capture.txt:4:", "range must be 0 (none) or positive"});
+  expectCaptureError(handCapture("bad_lighting", kHeader + "L:0:0:0:1:1:1:0:0:0:0:0:0\n"), ErrorCode::kInvalidData,
+                     {"Capture.txt:3:", "a sun needs a direction"});
+  expectCaptureError(handCapture("bad_lighting_fields", kHeader + "L:0:1:0:1:1:1\n"), ErrorCode::kParse, {"Capture.txt:3:", "needs 12 fields"});
 }
 
 TEST(BadCapture, BrokenModelMeshFile) {

@@ -289,8 +289,18 @@ TEST(Convert, LightRules) {
   const auto j = readJson(c.dataset);
   const auto& lights = j["extensions"]["KHR_lights_punctual"]["lights"];
   ASSERT_EQ(lights.size(), 2u);
-  // Lamp: white (1, 1, 1) at 100 cd per unit; flash: orange (1, 0.5, 0) amplified x4.
-  EXPECT_DOUBLE_EQ(lights[0]["intensity"].get<double>(), 100.0);
+  // Lamp: white (1, 1, 1) with a range of 40 units and a linear falloff: the flux of the engine's
+  // light, I = E_u x 40^2 x 5/48, with E_u (lux of the engine's full light) the sky dome's
+  // horizontal illuminance, as the fixture's capture has no map lighting. Flash: orange (1, 0.5, 0)
+  // without a range, 100 cd per unit, amplified x4.
+  const auto& calibration = j["extensions"]["DYNBENCH_environment"]["light_calibration"];
+  EXPECT_EQ(calibration["source"], "sky dome = full light");
+  const double lux = calibration["lux_per_unit"].get<double>();
+  EXPECT_GT(lux, 5000.0);  // a clear sky's dome gives a horizontal surface some 10 klux
+  EXPECT_LT(lux, 50000.0);
+  EXPECT_NEAR(lights[0]["intensity"].get<double>(), lux * 1600.0 * 5.0 / 48.0, 1e-9 * lux * 1600.0);
+  EXPECT_EQ(lights[0]["range"], 40.0);
+  EXPECT_FALSE(lights[1].contains("range"));
   EXPECT_DOUBLE_EQ(lights[1]["intensity"].get<double>(), 400.0);
   EXPECT_EQ(lights[1]["color"], nlohmann::json({1.0, 0.5, 0.0}));
 
@@ -298,6 +308,7 @@ TEST(Convert, LightRules) {
   std::ofstream(rules) << R"({"candela_per_unit": 10, "types": {"flash": {"ring_lights": 6, "ring_radius_m": 2}}})";
   auto parsed = readLightRules(rules);
   ASSERT_TRUE(parsed) << parsed.error().message;
+  Expected<LightRules> bad = parsed;
   ConvertOptions options;
   options.lightRules = *parsed;
   const auto k = readJson(convertFixture("convert_lights_ring", options).dataset);
@@ -312,11 +323,23 @@ TEST(Convert, LightRules) {
     }
   EXPECT_EQ(ringNodes, 6);
 
-  std::ofstream(rules) << R"({"types": {"flash": {"extra_frames": -1}}})";
-  auto bad = readLightRules(rules);
+  // lux_per_unit set by hand: the lamp's candela follow from it alone.
+  std::ofstream(rules, std::ios::trunc) << R"({"lux_per_unit": 3})";
+  parsed = readLightRules(rules);
+  ASSERT_TRUE(parsed) << parsed.error().message;
+  options.lightRules = *parsed;
+  const auto byHand = readJson(convertFixture("convert_lights_lux", options).dataset);
+  EXPECT_NEAR(byHand["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"].get<double>(), 500.0, 1e-9);
+  std::ofstream(rules, std::ios::trunc) << R"({"lux_per_unit": 0})";
+  bad = readLightRules(rules);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("/lux_per_unit"), std::string::npos) << bad.error().message;
+
+  std::ofstream(rules, std::ios::trunc) << R"({"types": {"flash": {"extra_frames": -1}}})";
+  bad = readLightRules(rules);
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.error().message.find("/types/flash/extra_frames"), std::string::npos) << bad.error().message;
-  std::ofstream(rules) << R"({"typo": 1})";
+  std::ofstream(rules, std::ios::trunc) << R"({"typo": 1})";
   bad = readLightRules(rules);
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.error().message.find("/typo"), std::string::npos) << bad.error().message;
@@ -332,7 +355,7 @@ TEST(Convert, NegativeLightColoursBecomeZero) {
   for (int f = 0; f < 2; ++f) {
     ASSERT_EQ(dbc_frame_begin(s, static_cast<uint64_t>(f), f / 60.0), DBC_OK);
     ASSERT_EQ(dbc_camera(s, camera, origin, 0, 0, 0), DBC_OK);
-    ASSERT_EQ(dbc_light(s, lamp, origin, rgb, DBC_LIGHT_POINT, 1, "explosion"), DBC_OK);
+    ASSERT_EQ(dbc_light(s, lamp, origin, rgb, 0.0f, DBC_FALLOFF_LINEAR, DBC_LIGHT_POINT, 1, "explosion"), DBC_OK);
     ASSERT_EQ(dbc_frame_end(s), DBC_OK);
   }
   ASSERT_EQ(dbc_close(s), DBC_OK);
@@ -349,6 +372,53 @@ TEST(Convert, NegativeLightColoursBecomeZero) {
   const std::string validation = validate(dir / "out" / "neg.gltf", status);
   EXPECT_EQ(status, 0) << validation;
   EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
+}
+
+TEST(Convert, TheMapsSunPlacesTheSkysSunAndCalibratesTheLights) {
+  // A map lit by a sun of engine colour 0.5 from elevation 30 degrees: the generated sky's sun
+  // stands there, and a light of colour 1 and radius R gets I = (E_sun / 0.5) x R^2 x k, k = 1/6
+  // for a quadratic falloff. A map without a sun gets a sky without a sun disc.
+  for (const bool sun : {true, false}) {
+    const fs::path dir = freshDir(sun ? "convert_map_sun" : "convert_map_no_sun");
+    dbc_session* s = nullptr;
+    ASSERT_EQ(dbc_open((dir / "capture").c_str(), "test", &s), DBC_OK);
+    const float towardsSun[3] = {0.0f, 0.5f, -static_cast<float>(std::sqrt(3.0) / 2)};  // elevation 30, azimuth 0
+    const float sunColour[3] = {0.5f, 0.5f, 0.4f}, none[3] = {0, 0, 0}, ambient[3] = {0.1f, 0.1f, 0.1f}, skyLight[3] = {0.4f, 0.4f, 0.4f};
+    ASSERT_EQ(dbc_set_lighting(s, towardsSun, sun ? sunColour : none, ambient, skyLight), DBC_OK) << dbc_last_error();
+    const uint64_t camera = dbc_new_id(s), lamp = dbc_new_id(s);
+    const float origin[3] = {0, 0, 0}, white[3] = {1, 1, 1};
+    ASSERT_EQ(dbc_frame_begin(s, 0, 0.0), DBC_OK);
+    ASSERT_EQ(dbc_camera(s, camera, origin, 0, 0, 0), DBC_OK);
+    ASSERT_EQ(dbc_light(s, lamp, origin, white, 20.0f, DBC_FALLOFF_QUADRATIC, DBC_LIGHT_POINT, 0, "none"), DBC_OK);
+    ASSERT_EQ(dbc_frame_end(s), DBC_OK);
+    ASSERT_EQ(dbc_close(s), DBC_OK);
+    ConvertOptions options;
+    options.capture = dir / "capture";
+    options.output = dir / "out" / "map.gltf";
+    auto report = convertCapture(options);
+    ASSERT_TRUE(report) << report.error().message;
+    const auto j = readJson(options.output);
+    const auto& env = j["extensions"]["DYNBENCH_environment"];
+    const double intensity = j["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"].get<double>();
+    if (sun) {
+      EXPECT_NEAR(env["sky"]["sun_elevation_degrees"].get<double>(), 30.0, 1e-4);
+      EXPECT_NEAR(env["sky"]["sun_azimuth_degrees"].get<double>(), 0.0, 1e-4);
+      const double sunLux = env["sky"]["sun_illuminance_lux"].get<double>();
+      EXPECT_GT(sunLux, 50000.0);
+      EXPECT_EQ(env["light_calibration"]["source"], "map sun");
+      EXPECT_NEAR(intensity, sunLux / 0.5 * 400.0 / 6.0, 1e-3 * intensity);
+    } else {
+      EXPECT_EQ(env["sky"]["sun_disc"], false);
+      EXPECT_EQ(env["sky"]["sun_illuminance_lux"], 0.0);
+      EXPECT_EQ(env["light_calibration"]["source"], "map sky light");
+      const double dome = env["light_calibration"]["sky_dome_lux"].get<double>();
+      EXPECT_NEAR(intensity, dome / 0.4 * 400.0 / 6.0, 1e-3 * intensity);
+    }
+    int status = 0;
+    const std::string validation = validate(options.output, status);
+    EXPECT_EQ(status, 0) << validation;
+    EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
+  }
 }
 
 TEST(Convert, TruncatedCaptureKeepsCompleteFrames) {

@@ -139,7 +139,7 @@ TEST(Frames, EachBufferIsStoredAtTheContractsPrecision) {
 TEST(Frames, TheSamplingSummaryRoundTrips) {
   const fs::path dir = freshDir("frames_sampling");
   FeatureFrame written = patterned(4, 2);
-  written.sampling = frames::SamplingSummary{true, 0.25, 1.5, 0.75, 16, 4096, 123.5, 3, 0.01, 2.5};
+  written.sampling = frames::SamplingSummary{true, 0.25, 1.5, 0.75, 16, 4096, 123.5, 3, 4};
   ASSERT_TRUE(writeFrame(dir, written, {{"engine", "test"}}));
   auto entries = listFrames(dir);
   ASSERT_TRUE(entries);
@@ -155,8 +155,7 @@ TEST(Frames, TheSamplingSummaryRoundTrips) {
   EXPECT_EQ(s.maxSamples, 4096);
   EXPECT_EQ(s.meanSamples, 123.5);
   EXPECT_EQ(s.cappedPixels, 3);
-  EXPECT_EQ(s.lightCutoff, 0.01);
-  EXPECT_EQ(s.droppedIrradianceBound, 2.5);
+  EXPECT_EQ(s.lightsPerPoint, 4);
   // A malformed value is named by its JSON pointer.
   auto j = nlohmann::json::parse(test::slurp(frameSidecarPath(dir, 7)));
   j["sampling"]["mean_spp"] = "many";

@@ -191,7 +191,7 @@ TEST(Render, PointLightOverDiffusePlaneGivesTheAnalyticRadianceWithoutNoise) {
 
 TEST(Render, ThousandLightsOfWhichTenReachGiveTheImageOfTheTen) {
   // Ten point lights with a range over the plane, and 990 whose range ends before the plane: the
-  // light hierarchy must find the ten (and only those) and the image must be the ten's alone.
+  // light tree must find the ten (and only those) and the image must be the ten's alone.
   const PlaneScene one = pointLightOverPlane();
   auto build = [&](int outOfReach) {
     test::GltfBuilder b;
@@ -213,6 +213,7 @@ TEST(Render, ThousandLightsOfWhichTenReachGiveTheImageOfTheTen) {
   const scene::Scene ten = build(0), thousand = build(990);
   RenderSettings settings;
   settings.samplesPerPixel = 1;
+  settings.lightsPerPoint = 16;  // at least the ten: the tree then selects each with probability 1
   settings.useEnvironment = false;
   auto a = tracerFor(ten, settings), c = tracerFor(thousand, settings);
   ASSERT_TRUE(a && c);
@@ -262,48 +263,86 @@ TEST(Render, ALightSwitchedOffByNodeVisibilityContributesNothing) {
   EXPECT_GT(litSum, 0.0);  // the same light, visible, does light the plane
 }
 
-TEST(Render, LightCutOffDropsNoMoreThanItsBound) {
-  // 200 unranged lights spread far over the plane, one bright one near it; an environment sets the
-  // automatic cut-off. The cut image differs from the exact one (cut-off 0) by at most the
-  // documented bound (albedo / pi x dropped irradiance), and some lights are in fact cut.
+// A closed room (inward-facing walls, floor and ceiling of half size `half`, centred on the origin).
+void addRoom(test::GltfBuilder& b, double half, int material) {
+  const auto h = static_cast<float>(half);
+  auto quad = [&](std::vector<float> corners, glm::vec3 n) {
+    b.node({{"mesh", addMesh(b, corners, {0, 1, 2, 0, 2, 3}, material, {n.x, n.y, n.z, n.x, n.y, n.z, n.x, n.y, n.z, n.x, n.y, n.z})}});
+  };
+  quad({-h, -h, -h, h, -h, -h, h, -h, h, -h, -h, h}, {0, 1, 0});    // floor
+  quad({-h, h, -h, -h, h, h, h, h, h, h, h, -h}, {0, -1, 0});       // ceiling
+  quad({-h, -h, -h, -h, -h, h, -h, h, h, -h, h, -h}, {1, 0, 0});    // x = -h
+  quad({h, -h, -h, h, h, -h, h, h, h, h, -h, h}, {-1, 0, 0});       // x = +h
+  quad({-h, -h, -h, -h, h, -h, h, h, -h, h, -h, -h}, {0, 0, 1});    // z = -h
+  quad({-h, -h, h, h, -h, h, h, h, h, -h, h, h}, {0, 0, -1});       // z = +h
+}
+
+TEST(Render, ARoomLitByAHundredPointLightsRendersAsEvaluatingEveryLight) {
+  // 100 point lights of varied intensity and colour, half of them with a range, in a closed room:
+  // the light tree (4 lights per shading point) must render, within its noise, the image of
+  // evaluating every light at every point (lightsPerPoint 0, without the tree; exact for direct
+  // light), direct and indirect; and it must evaluate far fewer lights to do it.
   test::GltfBuilder b;
-  const double albedo = 0.5;
-  const int grey = addMaterial(b, glm::dvec3(albedo), 0.0, 1.0, true);
-  b.node({{"name", "plane"}, {"mesh", addPlane(b, 3.0, 0.0, grey)}});
+  const int wall = addMaterial(b, {0.7, 0.6, 0.5}, 0.0, 0.7, false);
+  addRoom(b, 5.0, wall);
+  b.node({{"mesh", addSphere(b, {0.5, -3.5, 0.5}, 1.5, wall, 12, 24)}});
   auto& lights = b.doc["extensions"]["KHR_lights_punctual"]["lights"];
-  lights.push_back({{"type", "point"}, {"intensity", 50.0}});
-  b.node({{"translation", {0.0, 1.0, 0.0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
-  for (int k = 1; k <= 200; ++k) {
-    lights.push_back({{"type", "point"}, {"intensity", 2.0}});
-    b.node({{"translation", {std::cos(k) * 60.0, 5.0 + k * 0.2, std::sin(k) * 60.0}}, {"extensions", {{"KHR_lights_punctual", {{"light", k}}}}}});
+  for (int k = 0; k < 100; ++k) {
+    json light = {{"type", "point"}, {"intensity", 2.0 + 3.0 * (k % 7)}, {"color", {0.5 + 0.5 * (k % 2), 1.0, 0.4 + 0.2 * (k % 4)}}};
+    if (k % 2) light["range"] = 2.0 + 0.05 * k;
+    lights.push_back(light);
+    const double a = 2.4 * k, r = 1.0 + 3.5 * ((k * 37) % 100) / 100.0;
+    b.node({{"translation", {r * std::cos(a), -4.5 + 0.09 * k, r * std::sin(a)}}, {"extensions", {{"KHR_lights_punctual", {{"light", k}}}}}});
   }
-  b.doc["extensionsUsed"] = {"KHR_lights_punctual", "KHR_materials_specular"};
-  const scene::Scene s = load(b, "cutoff");
-  RenderSettings exact, cut;
-  exact.samplesPerPixel = cut.samplesPerPixel = 1;
-  exact.bounces = cut.bounces = 0;
-  exact.useEnvironment = cut.useEnvironment = false;
-  exact.lightCutoff = 0.0;
-  cut.lightCutoff = 1e-3;  // lux: lights beyond sqrt(2 / 1e-3) = 44.7 units are skipped
-  auto te = tracerFor(s, exact), tc = tracerFor(s, cut);
-  ASSERT_TRUE(te && tc);
+  b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  const scene::Scene s = load(b, "hundred_lights");
+  const RenderCamera cam = lookCamera({0, 3.5, 4.5}, {0, -0.6, -1}, 80.0, 48, 32);
+  RenderSettings tree, every;
+  tree.samplesPerPixel = every.samplesPerPixel = 64;
+  tree.bounces = every.bounces = 1;
+  tree.useEnvironment = every.useEnvironment = false;
+  tree.lightsPerPoint = 4;
+  every.lightsPerPoint = 0;
+  every.seed = 2;
+  auto tt = tracerFor(s, tree), te = tracerFor(s, every);
+  ASSERT_TRUE(tt && te);
+  ASSERT_TRUE(tt->setTime(0, 0));
   ASSERT_TRUE(te->setTime(0, 0));
-  ASSERT_TRUE(tc->setTime(0, 0));
-  const RenderCamera cam = lookCamera({0, 4, 0}, {0, -1, 0}, 60.0, 40, 30);
-  RenderStatistics se, sc;
-  const FrameBuffers fe = te->render(0, cam, cam, nullptr, &se), fc = tc->render(0, cam, cam, nullptr, &sc);
-  ASSERT_TRUE(fc.sampling);
-  const double bound = albedo / kPi * fc.sampling->droppedIrradianceBound;
-  EXPECT_NEAR(fc.sampling->droppedIrradianceBound, 201 * 1e-3, 1e-12);
-  double largest = 0;
-  for (std::size_t i = 0; i < fe.hit.size(); ++i) {
-    const double dropped = fe.direct[3 * i] - fc.direct[3 * i];
-    EXPECT_GE(dropped, -1e-6 * fe.direct[3 * i]);
-    EXPECT_LE(dropped, bound);
-    largest = std::max(largest, dropped);
+  RenderStatistics st, se;
+  const FrameBuffers ft = tt->render(0, cam, cam, nullptr, &st), fe = te->render(0, cam, cam, nullptr, &se);
+  for (const bool direct : {true, false}) {
+    const auto& bt = direct ? ft.direct : ft.indirect;
+    const auto& be = direct ? fe.direct : fe.indirect;
+    const auto& vt = direct ? ft.directVariance : ft.indirectVariance;
+    const auto& ve = direct ? fe.directVariance : fe.indirectVariance;
+    double worst = 0, sumT = 0, sumE = 0;
+    for (int by = 0; by < 32; by += 8)
+      for (int bx = 0; bx < 48; bx += 8) {
+        double a = 0, c = 0, var = 0;
+        for (int y = by; y < by + 8; ++y)
+          for (int x = bx; x < bx + 8; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y * 48 + x);
+            a += luminance(rgb(bt, i));
+            c += luminance(rgb(be, i));
+            var += vt[i] + ve[i];
+          }
+        ASSERT_GT(c, 0.0) << "every block of the room is lit";
+        const double z = std::abs(a - c) / std::sqrt(var);
+        worst = std::max(worst, z);
+        EXPECT_LT(z, 5.0) << (direct ? "direct" : "indirect") << " block " << bx << "," << by << ": " << a / 64 << " vs " << c / 64;
+        sumT += a;
+        sumE += c;
+      }
+    std::printf("%s: worst block z = %.2f, mean tree / every = %.4f\n", direct ? "direct" : "indirect", worst, sumT / sumE);
   }
-  EXPECT_GT(largest, 0.0);                                     // something was cut
-  EXPECT_LT(sc.punctualEvaluated, se.punctualEvaluated / 2);  // and that saved work
+  // Every light is evaluated exactly without the tree: its direct light has no noise at all.
+  for (std::size_t i = 0; i < fe.directVariance.size(); ++i) {
+    const double l = luminance(rgb(fe.direct, i));
+    EXPECT_LE(fe.directVariance[i], 1e-12 * l * l + 1e-30) << "pixel " << i;  // rounding of the sums alone
+  }
+  ASSERT_GT(st.shadingPoints, 0u);
+  EXPECT_LE(st.punctualEvaluated, 4 * st.shadingPoints);
+  EXPECT_GT(static_cast<double>(se.punctualEvaluated) / static_cast<double>(se.shadingPoints), 30.0);
 }
 
 TEST(Render, SpotLightConeAndRangeWindow) {

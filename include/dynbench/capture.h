@@ -46,6 +46,9 @@ typedef struct dbc_dual_quat {
 } dbc_dual_quat;
 
 typedef enum dbc_light_type { DBC_LIGHT_POINT = 0, DBC_LIGHT_SPOT = 1, DBC_LIGHT_DIRECTIONAL = 2 } dbc_light_type;
+/* How a light with a range fades to nothing at it, as the engine draws it: colour x (1 - d/range)
+ * (LINEAR: Cube 2's lightmaps) or colour x (1 - (d/range)^2) (QUADRATIC: Cube 2's dynamic lights). */
+typedef enum dbc_light_falloff { DBC_FALLOFF_LINEAR = 0, DBC_FALLOFF_QUADRATIC = 1 } dbc_light_falloff;
 
 /* One mesh of a model. Arrays hold vertex_count elements of the given width; normals, uvs,
  * joints and weights may be NULL. joints/weights: 4 per vertex, unused influences have weight 0
@@ -77,6 +80,13 @@ int dbc_set_data_root(dbc_session* session, const char* path);
 int dbc_set_metres_per_unit(dbc_session* session, float metres);
 int dbc_set_map(dbc_session* session, const char* map_name, const float offset[3]);
 int dbc_set_camera_settings(dbc_session* session, float aspect, float yfov_degrees, float znear, float zfar);
+/* The map's own lighting, in the light colours' units (1: the engine's full light, as a light of
+ * colour 1 gives a surface beside it): sun_direction points towards the sun (need not be unit;
+ * sun_rgb all 0 when the map has no sun), ambient_rgb the light every surface gets at least, and
+ * sky_rgb what a surface open to the whole sky gets (0 when the engine has no sky light). The
+ * converter calibrates the dataset's sky against the lights with it (docs/dataset.md). */
+int dbc_set_lighting(dbc_session* session, const float sun_direction[3], const float sun_rgb[3], const float ambient_rgb[3],
+                     const float sky_rgb[3]);
 
 /* Models (outside frames). A model is recorded once; dbc_has_model tells whether it already is. */
 int dbc_has_model(const dbc_session* session, const char* model_path);
@@ -102,8 +112,12 @@ int dbc_static_model(dbc_session* session, uint64_t id, const char* model_path, 
 int dbc_model(dbc_session* session, uint64_t id, const char* model_path, dbc_dual_quat pose);
 int dbc_joints(dbc_session* session, uint64_t id, const char* model_path, size_t joint_count,
                const dbc_dual_quat* joints);
-int dbc_light(dbc_session* session, uint64_t id, const float position[3], const float rgb[3], dbc_light_type type,
-              int dynamic, const char* model_type);
+/* A light. rgb: its colour as the engine has it (1: the engine's full light); range: the distance
+ * (capture units) at which the engine's light falls to nothing (its radius), with `falloff` on
+ * the way; 0 when it has none (the converter then keeps the inverse square without a window, and
+ * falloff is ignored). */
+int dbc_light(dbc_session* session, uint64_t id, const float position[3], const float rgb[3], float range,
+              dbc_light_falloff falloff, dbc_light_type type, int dynamic, const char* model_type);
 /* Writes the end-of-frame record and flushes: the frame is complete on disk. */
 int dbc_frame_end(dbc_session* session);
 

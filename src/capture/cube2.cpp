@@ -116,6 +116,15 @@ Expected<Cube2Report> captureCube2(const Cube2Options& o, const Cube2Progress& p
                       {"DYNBENCH_CAPTURE_WARMUP", fmt::format("{}", o.warmup)},
                       {"DYNBENCH_CAPTURE_SECONDS", fmt::format("{}", o.seconds)},
                       {"DYNBENCH_CAPTURE_FOLLOW_AUTO", o.follow == "auto" ? "1" : "0"}};
+  if (!o.gameFrames.empty()) {
+    std::string list;
+    for (const long k : o.gameFrames) {
+      if (k < 0 || static_cast<std::size_t>(k) >= total)
+        return fail(ErrorCode::kUsage, "--game-frames: frame {} is outside the capture's frames 0 to {}", k, total - 1);
+      list += (list.empty() ? "" : ",") + std::to_string(k);
+    }
+    game.environment.emplace_back("DYNBENCH_CAPTURE_GAME_FRAMES", list);
+  }
   game.argv = {"timeout", fmt::format("{}", timeout)};
   // xvfb-run -a searches upwards from -n for a free display; two runs starting together from the
   // same number can race for it, so each starts from its own (by process id).

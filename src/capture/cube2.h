@@ -28,6 +28,9 @@ struct Cube2Options {
   double seconds = 30.0;         // recorded game time
   double fps = 60.0;             // fixed clock
   unsigned seed = 1;
+  // Recorded frames (0-based) whose image the game keeps beside the capture, in game/: its colour
+  // (PPM) and view depth (PFM), for `dynbench fidelity` (docs/fidelity.md). The HUD is hidden then.
+  std::vector<long> gameFrames;
   // auto: the first bot, then the next whenever the followed one dies; one: the first bot for the
   // whole capture (its respawns are cuts); or a client number (bots are 128, 129, ...)
   std::string follow = "auto";

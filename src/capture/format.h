@@ -8,7 +8,9 @@
 
 namespace dynbench::capture {
 
-inline constexpr std::string_view kCaptureVersionLine = "dynbench-capture:1";
+// Version 2 (this one) added the lights' range and the map's lighting (`L`); captures of version 1
+// also predate the adapters' signed normals, so they are refused, not converted.
+inline constexpr std::string_view kCaptureVersionLine = "dynbench-capture:2";
 inline constexpr std::string_view kModelMeshVersionLine = "dynbench-modelmesh:1";
 inline constexpr std::string_view kCaptureFile = "Capture.txt";
 inline constexpr std::string_view kModelsFolder = "models";

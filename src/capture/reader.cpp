@@ -304,8 +304,14 @@ Expected<std::unique_ptr<CaptureReader>> CaptureReader::open(const fs::path& dir
     reader->impl_ = std::make_unique<Impl>(capture);
     Impl& impl = *reader->impl_;
     bool complete = true;
-    if (!impl.source.next(impl.text, complete) || impl.text != kCaptureVersionLine)
+    if (!impl.source.next(impl.text, complete) || impl.text != kCaptureVersionLine) {
+      if (impl.text.starts_with("dynbench-capture:"))
+        return fail(ErrorCode::kParse,
+                    "{}:1: capture format version {} is not supported; this dynbench reads version {} (version 1 captures lack the "
+                    "lights' range and predate the signed normals: capture again)",
+                    impl.file, impl.text.substr(17), kCaptureVersionLine.substr(17));
       return fail(ErrorCode::kParse, "{}:1: expected the version line '{}'", impl.file, kCaptureVersionLine);
+    }
     while (impl.source.next(impl.text, complete)) {
       if (isComment(impl.text)) continue;
       const Line l(impl.file, impl.source.number(), impl.text);
@@ -335,11 +341,25 @@ Expected<std::unique_ptr<CaptureReader>> CaptureReader::open(const fs::path& dir
         reader->settings_.mapName = l.text(4);
       } else if (token == "C") {
         reader->settings_.camera = cameraSettings(l);
+      } else if (token == "L") {
+        l.expectFields(12, "sun_x:sun_y:sun_z:sun_r:sun_g:sun_b:ambient_r:ambient_g:ambient_b:sky_r:sky_g:sky_b");
+        MapLighting m;
+        const glm::dvec3 direction{l.real(1, "sun_x"), l.real(2, "sun_y"), l.real(3, "sun_z")};
+        m.sun = {l.real(4, "sun_r"), l.real(5, "sun_g"), l.real(6, "sun_b")};
+        m.ambient = {l.real(7, "ambient_r"), l.real(8, "ambient_g"), l.real(9, "ambient_b")};
+        m.sky = {l.real(10, "sky_r"), l.real(11, "sky_g"), l.real(12, "sky_b")};
+        for (const glm::dvec3& c : {m.sun, m.ambient, m.sky})
+          if (c.r < 0 || c.g < 0 || c.b < 0) l.fail("lighting colours must not be negative");
+        if (m.hasSun()) {
+          if (!(glm::length(direction) > 0)) l.fail("a sun needs a direction");
+          m.sunDirection = glm::normalize(direction);
+        }
+        reader->settings_.lighting = m;
       } else if (token == "z") {
         l.expectFields(1, "frame_count");
         reader->closed_ = true;
       } else {
-        l.fail(fmt::format("unknown or misplaced record '{}' before the first frame; expected s, d, k, u, C or f", token), ErrorCode::kParse);
+        l.fail(fmt::format("unknown or misplaced record '{}' before the first frame; expected s, d, k, u, C, L or f", token), ErrorCode::kParse);
       }
     }
   } catch (const Failure& f) {
@@ -470,20 +490,27 @@ Expected<bool> CaptureReader::next(CaptureFrame& frame) {
         for (std::size_t k = 0; k < count; ++k) r.joints.push_back(l.dualQuat(3 + 8 * k));
         frame.joints.push_back(std::move(r));
       } else if (token == "l") {
-        l.expectFields(10, "id:x:y:z:r:g:b:type:dynamic:model_type");
+        l.expectFields(12, "id:x:y:z:r:g:b:range:falloff:type:dynamic:model_type");
         LightRecord r;
         r.id = l.integer<std::uint64_t>(1, "id");
         r.position = {l.real(2, "x"), l.real(3, "y"), l.real(4, "z")};
         r.color = {l.real(5, "r"), l.real(6, "g"), l.real(7, "b")};
-        const std::string type = l.text(8);
+        r.range = l.real(8, "range");
+        if (r.range < 0) l.fail("a light's range must be 0 (none) or positive");
+        const std::string falloff = l.text(9);
+        if (falloff == "linear") r.falloff = LightFalloff::kLinear;
+        else if (falloff == "quadratic") r.falloff = LightFalloff::kQuadratic;
+        else if (falloff != "none") l.fail(fmt::format("light falloff '{}'; expected none, linear or quadratic", falloff));
+        if ((r.range > 0) != (r.falloff != LightFalloff::kNone)) l.fail("a light has a falloff exactly when it has a range");
+        const std::string type = l.text(10);
         if (type == "point") r.type = LightType::kPoint;
         else if (type == "spot") r.type = LightType::kSpot;
         else if (type == "directional") r.type = LightType::kDirectional;
         else l.fail(fmt::format("light type '{}'; expected point, spot or directional", type));
-        const int dynamic = l.integer<int>(9, "dynamic");
+        const int dynamic = l.integer<int>(11, "dynamic");
         if (dynamic != 0 && dynamic != 1) l.fail("the dynamic flag must be 0 or 1");
         r.dynamic = dynamic == 1;
-        r.modelType = l.text(10);
+        r.modelType = l.text(12);
         claim(r.id, Kind::kLight, -1);
         frame.lights.push_back(std::move(r));
       } else if (token == "C") {

@@ -49,14 +49,24 @@ struct CameraSettings {
   double aspect = 0, yfovDegrees = 0, znear = 0, zfar = 0;
 };
 
+// The map's own lighting (`L`), in the light colours' units (1: the engine's full light).
+struct MapLighting {
+  glm::dvec3 sunDirection{0.0, 1.0, 0.0};  // towards the sun, unit
+  glm::dvec3 sun{0.0}, ambient{0.0}, sky{0.0};
+  bool hasSun() const { return sun.r > 0 || sun.g > 0 || sun.b > 0; }
+};
+
 struct CaptureSettings {
   std::string source, dataRoot, mapName;
   glm::dvec3 mapOffset{0.0};
   double metresPerUnit = 1.0;
   std::optional<CameraSettings> camera;  // as set before the first frame
+  std::optional<MapLighting> lighting;   // the `L` record
 };
 
 enum class LightType { kPoint, kSpot, kDirectional };
+// How the engine's light fades to nothing at its range: colour x (1 - d/range) or x (1 - (d/range)^2).
+enum class LightFalloff { kNone, kLinear, kQuadratic };
 
 struct CameraRecord {
   std::uint64_t id = 0;
@@ -85,6 +95,8 @@ struct LightRecord {
   std::uint64_t id = 0;
   glm::dvec3 position{0.0};
   glm::dvec3 color{0.0};
+  double range = 0.0;  // capture units where the engine's light ends; 0: none
+  LightFalloff falloff = LightFalloff::kNone;
   LightType type = LightType::kPoint;
   bool dynamic = false;
   std::string modelType;  // "none", "flash", "bouncer", "rocket", ...

@@ -153,6 +153,22 @@ int dbc_set_map(dbc_session* s, const char* map_name, const float offset[3]) {
   return s->writeRecord(line + ":" + escapeField(map_name));
 }
 
+int dbc_set_lighting(dbc_session* s, const float sunDirection[3], const float sunRgb[3], const float ambientRgb[3], const float skyRgb[3]) {
+  if (!s || !sunDirection || !sunRgb || !ambientRgb || !skyRgb) return error(DBC_ERROR_ARGUMENT, "dbc_set_lighting: NULL argument");
+  if (s->inFrame) return error(DBC_ERROR_ORDER, "dbc_set_lighting inside a frame");
+  const std::initializer_list<float> values = {sunDirection[0], sunDirection[1], sunDirection[2], sunRgb[0], sunRgb[1], sunRgb[2],
+                                               ambientRgb[0], ambientRgb[1], ambientRgb[2], skyRgb[0], skyRgb[1], skyRgb[2]};
+  if (!finite(values)) return error(DBC_ERROR_ARGUMENT, "dbc_set_lighting: a value is not finite");
+  for (std::size_t k = 3; k < values.size(); ++k)
+    if (values.begin()[k] < 0) return error(DBC_ERROR_ARGUMENT, "dbc_set_lighting: colours must not be negative");
+  const bool sun = sunRgb[0] > 0 || sunRgb[1] > 0 || sunRgb[2] > 0;
+  if (sun && !(sunDirection[0] != 0 || sunDirection[1] != 0 || sunDirection[2] != 0))
+    return error(DBC_ERROR_ARGUMENT, "dbc_set_lighting: a sun needs a direction");
+  std::string line = "L";
+  for (float v : values) appendFloat(line, v);
+  return s->writeRecord(line);
+}
+
 int dbc_set_camera_settings(dbc_session* s, float aspect, float yfov_degrees, float znear, float zfar) {
   if (!s) return error(DBC_ERROR_ARGUMENT, "dbc_set_camera_settings: session is NULL");
   if (!finite({aspect, yfov_degrees, znear, zfar}) || !(aspect > 0) || !(yfov_degrees > 0 && yfov_degrees < 180) ||
@@ -335,20 +351,24 @@ int dbc_joints(dbc_session* s, uint64_t id, const char* model_path, size_t joint
   return s->writeRecord(line + ":" + escapeField(model_path));
 }
 
-int dbc_light(dbc_session* s, uint64_t id, const float p[3], const float rgb[3], dbc_light_type type, int dynamic,
-              const char* model_type) {
+int dbc_light(dbc_session* s, uint64_t id, const float p[3], const float rgb[3], float range, dbc_light_falloff falloff,
+              dbc_light_type type, int dynamic, const char* model_type) {
   if (!s || !p || !rgb) return error(DBC_ERROR_ARGUMENT, "dbc_light: NULL argument");
   if (int rc = s->requireFrame("dbc_light"); rc != DBC_OK) return rc;
-  if (!finite({p[0], p[1], p[2], rgb[0], rgb[1], rgb[2]})) return error(DBC_ERROR_ARGUMENT, fmt::format("light {}: a value is not finite", id));
+  if (!finite({p[0], p[1], p[2], rgb[0], rgb[1], rgb[2], range})) return error(DBC_ERROR_ARGUMENT, fmt::format("light {}: a value is not finite", id));
+  if (range < 0) return error(DBC_ERROR_ARGUMENT, fmt::format("light {}: range must be 0 (none) or positive (got {})", id, range));
+  if (falloff != DBC_FALLOFF_LINEAR && falloff != DBC_FALLOFF_QUADRATIC)
+    return error(DBC_ERROR_ARGUMENT, fmt::format("light {}: unknown falloff {}", id, static_cast<int>(falloff)));
   if (type != DBC_LIGHT_POINT && type != DBC_LIGHT_SPOT && type != DBC_LIGHT_DIRECTIONAL)
     return error(DBC_ERROR_ARGUMENT, fmt::format("light {}: unknown type {}", id, static_cast<int>(type)));
   if (!dynamic && s->capturables.contains(id)) return DBC_OK;  // static: the first record holds for good
   const std::string kindText = model_type && *model_type ? model_type : "none";
   if (int rc = s->claim(id, Kind::kLight, ""); rc != DBC_OK) return rc;
   std::string line = fmt::format("l:{}", id);
-  for (float v : {p[0], p[1], p[2], rgb[0], rgb[1], rgb[2]}) appendFloat(line, v);
+  for (float v : {p[0], p[1], p[2], rgb[0], rgb[1], rgb[2], range}) appendFloat(line, v);
   static const char* typeNames[] = {"point", "spot", "directional"};
-  return s->writeRecord(line + fmt::format(":{}:{}:{}", typeNames[type], dynamic ? 1 : 0, escapeField(kindText)));
+  const char* falloffName = !(range > 0) ? "none" : falloff == DBC_FALLOFF_LINEAR ? "linear" : "quadratic";
+  return s->writeRecord(line + fmt::format(":{}:{}:{}:{}", falloffName, typeNames[type], dynamic ? 1 : 0, escapeField(kindText)));
 }
 
 int dbc_frame_end(dbc_session* s) {

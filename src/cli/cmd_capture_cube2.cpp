@@ -88,6 +88,10 @@ void addCaptureCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--seconds", o->seconds, "Game seconds recorded")->check(positive());
   cmd->add_option("--fps", o->fps, "Fixed clock, frames per game second")->check(between(1e-3, capture::kMaxFps));
   cmd->add_option("--seed", o->seed, "Seed of every random choice");
+  cmd->add_option("--game-frames", o->gameFrames,
+                  "Recorded frames (0-based, comma-separated) whose own image the game keeps in DIR/game/ (colour and view depth; "
+                  "the HUD is hidden) for dynbench fidelity")
+      ->delimiter(',');
   cmd->add_option("--follow", o->follow, "auto (a bot, then the next whenever the followed one dies, as a spectator would), one (the first bot throughout; its respawns are camera cuts) or a bot's client number (128, 129, ...)");
   cmd->add_option("--warmup", o->warmup, "Game seconds after the map loads before recording (the bots join and the camera follows by 1.5)")
       ->check(between(capture::kMinWarmup, 3600.0));

@@ -13,6 +13,7 @@ namespace {
 struct ConvertCliOptions {
   std::string capture, output, visibility = "both", lightRules, dataRoot, environment;
   convert::SkyParameters sky;
+  bool sunGiven = false;  // --sun-elevation or --sun-azimuth: not the map's sun
   bool glb = false;
 };
 
@@ -36,6 +37,7 @@ Expected<void> runConvert(const ConvertCliOptions& cli) {
   if (!cli.dataRoot.empty()) options.dataRoot = cli.dataRoot;
   if (!cli.environment.empty()) options.environment = cli.environment;
   options.sky = cli.sky;
+  options.sunFromCapture = !cli.sunGiven;
   std::optional<Progress> progress;
   int shownPass = 0;
   options.onProgress = [&](int pass, std::size_t frames, std::size_t total) {
@@ -74,13 +76,16 @@ void addConvertCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--light-rules", options->lightRules, "JSON file overriding the light rules (docs/dataset.md)");
   cmd->add_option("--env", options->environment,
                   "Equirectangular .hdr/.exr environment copied beside the dataset (without it: a generated daylight sky)");
-  cmd->add_option("--sun-elevation", options->sky.sunElevationDegrees, "Generated sky: sun elevation, degrees")
+  cmd->add_option("--sun-elevation", options->sky.sunElevationDegrees, "Generated sky: sun elevation, degrees (default: the map's sun from the capture, else 45)")
       ->check(between(0.0, 90.0));
-  cmd->add_option("--sun-azimuth", options->sky.sunAzimuthDegrees, "Generated sky: sun azimuth from -Z towards +X, degrees");
+  cmd->add_option("--sun-azimuth", options->sky.sunAzimuthDegrees, "Generated sky: sun azimuth from -Z towards +X, degrees (default: the map's sun, else 135)");
   cmd->add_option("--turbidity", options->sky.turbidity, "Generated sky: turbidity, from clear to hazy")
       ->check(between(convert::kTurbidityRange.first, convert::kTurbidityRange.second));
   cmd->add_option("--data-root", options->dataRoot, "Where texture names are resolved (empty: the capture's data root)");
-  cmd->callback([options, &run] { run = [options] { return runConvert(*options); }; });
+  cmd->callback([options, cmd, &run] {
+    options->sunGiven = cmd->count("--sun-elevation") + cmd->count("--sun-azimuth") > 0;
+    run = [options] { return runConvert(*options); };
+  });
 }
 
 }  // namespace dynbench::cli

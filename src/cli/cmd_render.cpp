@@ -158,10 +158,11 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--max-spp", o->job.settings.maxSamplesPerPixel, "With --converge: samples per pixel at most")->check(positive());
   cmd->add_flag("--float32", o->job.float32,
                 "Store every channel as 32-bit float (default: half where docs/feature-buffers.md allows it, about half the disk)");
-  cmd->add_option("--light-cutoff", o->job.settings.lightCutoff,
-                  "Irradiance below which a point or spot light without a range is skipped (0: never; default: automatic, at most "
-                  "0.1% of the environment's mean irradiance dropped in all; docs/feature-buffers.md)")
-      ->check(nonNegative());
+  cmd->add_option("--lights-per-point", o->job.settings.lightsPerPoint,
+                  "Point and spot lights evaluated per shading point at most, chosen by the light tree (unbiased; exact where no "
+                  "more can reach the point; 0: every light, slow; docs/feature-buffers.md)")
+      ->check(CLI::Range(0, 64))
+      ->capture_default_str();
   addSlurmOptions(cmd, o->slurm, o->slurmOptions, "DIR/slurm/render.sbatch, one task per --frames-per-task frames", true);
   cmd->callback([o, &run] { run = [o] { return runRender(*o); }; });
 }

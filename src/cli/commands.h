@@ -37,6 +37,9 @@ void addReportCommand(CLI::App& app, CommandRun& run);
 // Registers `capture cube2`.
 void addCaptureCommand(CLI::App& app, CommandRun& run);
 
+// Registers `fidelity`.
+void addFidelityCommand(CLI::App& app, CommandRun& run);
+
 // Registers `compare`.
 void addCompareCommand(CLI::App& app, CommandRun& run);
 

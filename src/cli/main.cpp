@@ -59,6 +59,7 @@ int main(int argc, char** argv) {
   cli::addReportCommand(app, run);
   cli::addCaptureCommand(app, run);
   cli::addCompareCommand(app, run);
+  cli::addFidelityCommand(app, run);
   cli::addEvaluateCommand(app, run);
   cli::addDemoCommand(app, run);
 

@@ -17,6 +17,7 @@ ConvertReport Converter::run() {
   if (ec) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: cannot create folder: {}", outDir_.string(), ec.message())}};
 
   passOne();
+  calibrateLighting();
   if (times_.empty()) throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: the capture has no complete frame", options_.capture.string())}};
   binPath_ = temporarySibling(outDir_ / (stem_ + ".bin"));
   try {

@@ -29,6 +29,9 @@ struct ConvertOptions {
   // Environment lighting: the user's equirectangular .hdr/.exr, or else the generated sky.
   std::optional<std::filesystem::path> environment;
   SkyParameters sky;
+  // The generated sky's sun from the capture's map lighting (`L`: its direction, or no sun disc
+  // when the map has none); false when the user chose the sun (--sun-elevation, --sun-azimuth).
+  bool sunFromCapture = true;
   // Progress: pass (1 or 2), frames done in it, frames in all (0 in pass 1: not known yet).
   std::function<void(int, std::size_t, std::size_t)> onProgress;
 };

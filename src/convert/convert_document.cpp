@@ -119,6 +119,12 @@ void Converter::buildDocument() {
       lightChannel(input, accessor(view, 0, kFloat, t.span(), "VEC3"), t.lightDefinition, "color");
       region(t.span(), 4, t.intensityOffset, view);
       lightChannel(input, accessor(view, 0, kFloat, t.span(), "SCALAR"), t.lightDefinition, "intensity");
+      // A light whose engine radius changes (an explosion grows): its range is animated too. A
+      // light without a range keeps none (the falloff the engine gives it is fixed by the first).
+      if (t.light.range > 0) {
+        region(t.span(), 4, t.rangeOffset, view);
+        lightChannel(input, accessor(view, 0, kFloat, t.span(), "SCALAR"), t.lightDefinition, "range");
+      }
     }
     if (t.hasVisibilityChannel() && ((nodeVisibility && t.kind != Kind::kCamera) || scaleVisibility)) {
       region(t.visibilityKeys, 4, t.visTimeOffset, view);

@@ -47,15 +47,17 @@ json Converter::environment() {
     if (ec) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: cannot copy the environment: {}", target.string(), ec.message())}};
     ext["source"] = options_.environment->filename().string();
   } else {
-    const SkyImage sky = preethamSky(options_.sky);
+    const SkyImage& sky = *sky_;
     target = outDir_ / (stem_ + "_sky.hdr");
     if (auto ok = writeImage(target, FloatImage{sky.width, sky.height, 3, sky.rgb, {}, {}, {}}); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
     ext["source"] = "dynbench Preetham sky";
-    ext["sky"] = {{"model", "Preetham 1999 + ESRA sun"}, {"turbidity", options_.sky.turbidity},
-                  {"sun_elevation_degrees", options_.sky.sunElevationDegrees}, {"sun_azimuth_degrees", options_.sky.sunAzimuthDegrees},
+    ext["sky"] = {{"model", skyParameters_.sunDisc ? "Preetham 1999 + ESRA sun" : "Preetham 1999, no sun disc"},
+                  {"turbidity", skyParameters_.turbidity}, {"sun_disc", skyParameters_.sunDisc},
+                  {"sun_elevation_degrees", skyParameters_.sunElevationDegrees}, {"sun_azimuth_degrees", skyParameters_.sunAzimuthDegrees},
                   {"sun_direction", vec(sky.sunDirection)}, {"sun_illuminance_lux", sky.sunIlluminanceLux},
                   {"zenith_luminance_cd_m2", sky.zenithLuminance}};
   }
+  ext["light_calibration"] = calibration_;  // how the lights' candela relate to this sky (docs/dataset.md)
   report_.written.push_back(target);
   ext["uri"] = uriPath(target.filename().string());
   return ext;

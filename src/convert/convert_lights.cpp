@@ -2,23 +2,84 @@
 
 namespace dynbench::convert::detail {
 
-std::pair<glm::dvec3, double> Converter::lightColorIntensity(const glm::dvec3& capturedColor, const std::string& modelType,
-                                                            double share) const {
+namespace {
+// Flux-matching factors k in I = E_u c R^2 k (docs/dataset.md, "Lights"). Within its range R the
+// engine's light of colour c gives a surface facing it E_u c f(d/R) (E_u: lux of the engine's full
+// light), with f(x) = 1 - x (linear) or 1 - x^2 (quadratic); its flux is the integral of that over
+// spheres, 4 pi E_u c R^3 (1/3 - 1/4) = pi E_u c R^3 / 3 (linear) or 4 pi E_u c R^3 (1/3 - 1/5)
+// = 8 pi E_u c R^3 / 15 (quadratic). A KHR_lights_punctual light of intensity I with range R
+// gives I (1 - (d/R)^4) / d^2, flux 4 pi I (R - R/5) = 16 pi I R / 5. Equal fluxes:
+// k = 5/48 (linear), 1/6 (quadratic).
+double fluxFactor(LightFalloff falloff) { return falloff == LightFalloff::kQuadratic ? 1.0 / 6.0 : 5.0 / 48.0; }
+}  // namespace
+
+void Converter::calibrateLighting() {
+  const auto& lighting = reader_->settings().lighting;
+  skyParameters_ = options_.sky;
+  if (options_.sunFromCapture && lighting) {
+    if (lighting->hasSun()) {
+      const auto [elevation, azimuth] = sunAngles(lighting->sunDirection);
+      skyParameters_.sunElevationDegrees = std::clamp(elevation, 0.0, 90.0);
+      skyParameters_.sunAzimuthDegrees = azimuth;
+    } else {
+      skyParameters_.sunDisc = false;  // the engine lights this map without a sun
+    }
+  }
+  if (!options_.environment) sky_ = preethamSky(skyParameters_);
+  calibration_ = json::object();
+  if (options_.lightRules.luxPerUnit) {
+    luxPerUnit_ = *options_.lightRules.luxPerUnit;
+    calibration_["source"] = "light rules (lux_per_unit)";
+  } else if (sky_ && lighting && lighting->hasSun()) {
+    // The map's sun and its lights are in the same units: the engine's sun of colour s gives a
+    // surface facing it s, the sky's sun its direct normal illuminance.
+    const double sun = std::max({lighting->sun.r, lighting->sun.g, lighting->sun.b});
+    luxPerUnit_ = sky_->sunIlluminanceLux / sun;
+    calibration_ = {{"source", "map sun"}, {"engine_sun", sun}, {"sky_sun_lux", sky_->sunIlluminanceLux}};
+  } else {
+    // No sun: the sky dome's illuminance on an open horizontal surface is the engine's sky light
+    // (what such a surface gets from it), or, without one, the engine's full light.
+    double dome = 0.0;
+    if (sky_) {
+      dome = horizontalIlluminance(sky_->rgb, sky_->width, sky_->height, skyParameters_.sunDisc ? sky_->sunDirection : glm::dvec3(0.0),
+                                   skyParameters_.sunDisc ? radians(2.0) : 0.0);
+    } else {
+      auto image = readImage(*options_.environment);
+      if (!image || image->channels < 3)
+        throw Failure{Error{ErrorCode::kInvalidData, fmt::format("--env {}: cannot read it as an RGB image", options_.environment->string())}};
+      std::vector<float> rgb(static_cast<std::size_t>(image->width) * image->height * 3);
+      for (std::size_t i = 0; i < rgb.size() / 3; ++i)
+        for (int c = 0; c < 3; ++c) rgb[3 * i + c] = image->pixels[i * static_cast<std::size_t>(image->channels) + c];
+      dome = horizontalIlluminance(rgb, image->width, image->height);
+    }
+    double skyLight = 1.0;
+    if (lighting && std::max({lighting->sky.r, lighting->sky.g, lighting->sky.b}) > std::max({lighting->ambient.r, lighting->ambient.g, lighting->ambient.b}))
+      skyLight = std::max({lighting->sky.r, lighting->sky.g, lighting->sky.b});
+    luxPerUnit_ = dome / skyLight;
+    calibration_ = {{"source", skyLight == 1.0 ? "sky dome = full light" : "map sky light"}, {"engine_sky_light", skyLight}, {"sky_dome_lux", dome}};
+  }
+  calibration_["lux_per_unit"] = luxPerUnit_;
+}
+
+std::pair<glm::dvec3, double> Converter::lightColorIntensity(const glm::dvec3& capturedColor, double range, LightFalloff falloff,
+                                                            const std::string& modelType, double share) const {
   // Engines have negative lights that darken (Cube 2 does); glTF lights only add light, and
   // KHR_lights_punctual colours are in [0, 1]: negative channels become 0.
   const glm::dvec3 captured = glm::max(capturedColor, glm::dvec3(0.0));
   const double peak = std::max({captured.r, captured.g, captured.b});
   const LightRule& rule = options_.lightRules.rule(modelType);
   const glm::dvec3 color = peak > 0 ? captured / peak : glm::dvec3(1.0);
-  return {color, options_.lightRules.candelaPerUnit * peak * rule.intensityScale * share};
+  const double candela = range > 0 ? luxPerUnit_ * range * range * fluxFactor(falloff) : options_.lightRules.candelaPerUnit;
+  return {color, candela * peak * rule.intensityScale * share};
 }
 
 int Converter::lightDefinition(const LightRecord& l, double share) {
-  const auto [color, intensity] = lightColorIntensity(l.color, l.modelType, share);
+  const auto [color, intensity] = lightColorIntensity(l.color, l.range, l.falloff, l.modelType, share);
   json light = {{"type", l.type == LightType::kSpot ? "spot" : l.type == LightType::kDirectional ? "directional" : "point"},
                 {"color", vec(color)},
                 {"intensity", intensity},
                 {"name", l.modelType}};
+  if (l.range > 0 && l.type != LightType::kDirectional) light["range"] = l.range;
   if (l.type == LightType::kSpot) light["spot"] = {{"outerConeAngle", 0.7853981633974483}};
   lights_.push_back(light);
   ++report_.lights;

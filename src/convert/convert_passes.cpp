@@ -60,7 +60,7 @@ void Converter::scanFrame(const CaptureFrame& frame, std::size_t i, Key&& key) {
     if (!t.appeared) {
       t.light = l;
       t.extraFrames = options_.lightRules.rule(l.modelType).extraFrames;
-    } else if (l.color != t.light.color) {
+    } else if (l.color != t.light.color || l.range != t.light.range) {
       t.colorVaries = true;
     }
     if (l.dynamic) present(t, i, key);
@@ -118,6 +118,7 @@ void Converter::passTwo() {
     if (t.scaleOffset) t.scale = RegionWriter(bin_, t.scaleOffset);
     if (t.colorOffset) t.color = RegionWriter(bin_, t.colorOffset);
     if (t.intensityOffset) t.intensity = RegionWriter(bin_, t.intensityOffset);
+    if (t.rangeOffset) t.range = RegionWriter(bin_, t.rangeOffset);
     for (auto o : t.jointTranslationOffsets) t.jointTranslation.emplace_back(bin_, o);
     for (auto o : t.jointRotationOffsets) t.jointRotation.emplace_back(bin_, o);
   }
@@ -155,6 +156,7 @@ void Converter::passTwo() {
       if (!l.dynamic) continue;
       t.heldTranslation = l.position;
       t.heldColor = l.color;
+      t.heldRange = l.range;
       if (!t.appeared) active.push_back(&t);
     }
     for (const auto& j : frame.joints) {
@@ -184,9 +186,10 @@ void Converter::passTwo() {
                                                                          static_cast<float>(t->heldTranslation.y),
                                                                          static_cast<float>(t->heldTranslation.z)});
       if (t->colorOffset) {
-        const auto [color, intensity] = lightColorIntensity(t->heldColor, t->light.modelType, t->lightShare);
+        const auto [color, intensity] = lightColorIntensity(t->heldColor, t->heldRange, t->light.falloff, t->light.modelType, t->lightShare);
         t->color.put(std::array<float, 3>{static_cast<float>(color.r), static_cast<float>(color.g), static_cast<float>(color.b)});
         t->intensity.put(static_cast<float>(intensity));
+        if (t->rangeOffset) t->range.put(static_cast<float>(t->heldRange));
       }
       if (t->rotationOffset) {
         t->heldRotation = nearest(t->lastRotation, t->heldRotation);
@@ -209,7 +212,7 @@ void Converter::passTwo() {
     if (options_.onProgress) options_.onProgress(2, i + 1, times_.size());
   }
   for (auto& [id, t] : tracks_) {
-    for (RegionWriter* w : {&t.translation, &t.rotation, &t.visTime, &t.visValue, &t.scale, &t.color, &t.intensity}) w->flush();
+    for (RegionWriter* w : {&t.translation, &t.rotation, &t.visTime, &t.visValue, &t.scale, &t.color, &t.intensity, &t.range}) w->flush();
     for (auto& w : t.jointTranslation) w.flush();
     for (auto& w : t.jointRotation) w.flush();
   }

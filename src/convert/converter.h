@@ -48,7 +48,7 @@ struct Track {
   // Static records and light properties (from the first record).
   DualQuaternion staticPose;
   LightRecord light;
-  bool colorVaries = false;  // a dynamic light whose captured colour changes: colour and intensity are animated
+  bool colorVaries = false;  // a dynamic light whose captured colour or range changes: colour, intensity (and range) are animated
   int lightDefinition = -1;  // its KHR_lights_punctual light
   double lightShare = 1.0;   // its share of the captured light (1/6 for each of a ring's lights)
   struct Cut {
@@ -61,11 +61,12 @@ struct Track {
   std::uint64_t translationOffset = 0, rotationOffset = 0, visTimeOffset = 0, visValueOffset = 0, scaleOffset = 0;
   std::vector<std::uint64_t> jointTranslationOffsets, jointRotationOffsets;
   // Pass 2.
-  std::uint64_t colorOffset = 0, intensityOffset = 0;
-  RegionWriter translation, rotation, visTime, visValue, scale, color, intensity;
+  std::uint64_t colorOffset = 0, intensityOffset = 0, rangeOffset = 0;
+  RegionWriter translation, rotation, visTime, visValue, scale, color, intensity, range;
   std::vector<RegionWriter> jointTranslation, jointRotation;
   glm::dvec3 heldTranslation{0.0};
   glm::dvec3 heldColor{0.0};
+  double heldRange = 0.0;
   glm::dquat heldRotation{1, 0, 0, 0};
   std::vector<glm::dvec3> heldJointTranslation;
   std::vector<glm::dquat> heldJointRotation;
@@ -168,8 +169,14 @@ class Converter {
   void buildMeshes();
 
   // KHR_lights_punctual colour (the captured colour over its largest channel) and intensity of a
-  // captured colour under the light rules; `share` divides it between a ring's lights.
-  std::pair<glm::dvec3, double> lightColorIntensity(const glm::dvec3& captured, const std::string& modelType, double share) const;
+  // captured light under the light rules; `share` divides it between a ring's lights. A light with
+  // a range gets the flux the engine's falloff gives within it (docs/dataset.md, "Lights").
+  std::pair<glm::dvec3, double> lightColorIntensity(const glm::dvec3& captured, double range, LightFalloff falloff,
+                                                    const std::string& modelType, double share) const;
+
+  // The generated sky (when there is no --env) and the illuminance of the engine's full light,
+  // from the map's lighting: computed before any light is written.
+  void calibrateLighting();
 
   int lightDefinition(const LightRecord& l, double share);
 
@@ -216,6 +223,10 @@ class Converter {
   int timesView_ = -1;
   bool cameraChanged_ = false, usesVisibility_ = false, usesAnimationPointer_ = false;
   ConvertReport report_;
+  std::optional<SkyImage> sky_;  // the generated sky
+  SkyParameters skyParameters_;
+  double luxPerUnit_ = 0.0;      // lux of a captured colour of 1 at a light with a range
+  json calibration_;             // how luxPerUnit_ was found, for the dataset's extras
 };
 
 }  // namespace dynbench::convert::detail

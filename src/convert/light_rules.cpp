@@ -43,11 +43,17 @@ Expected<LightRules> readLightRules(const std::filesystem::path& file) {
     return v.get<double>();
   };
   for (const auto& [key, value] : j.items())
-    if (key != "candela_per_unit" && key != "types")
-      return fail(ErrorCode::kInvalidData, "{}: /{}: unknown key; expected candela_per_unit or types", name, key);
+    if (key != "candela_per_unit" && key != "lux_per_unit" && key != "types")
+      return fail(ErrorCode::kInvalidData, "{}: /{}: unknown key; expected candela_per_unit, lux_per_unit or types", name, key);
   auto candela = number(j, "candela_per_unit", "", rules.candelaPerUnit, 0.0);
   if (!candela) return std::unexpected(candela.error());
   rules.candelaPerUnit = *candela;
+  if (j.contains("lux_per_unit")) {
+    auto lux = number(j, "lux_per_unit", "", 0.0, 0.0);
+    if (!lux) return std::unexpected(lux.error());
+    if (!(*lux > 0)) return fail(ErrorCode::kInvalidData, "{}: /lux_per_unit: expected a positive number", file.string());
+    rules.luxPerUnit = *lux;
+  }
   if (j.contains("types")) {
     if (!j["types"].is_object()) return fail(ErrorCode::kInvalidData, "{}: /types: expected an object", name);
     for (const auto& [type, r] : j["types"].items()) {

@@ -3,6 +3,7 @@
 // Defaults are documented in docs/dataset.md; `--light-rules FILE` (JSON) overrides them.
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "core/error.h"
@@ -20,6 +21,10 @@ struct LightRules {
   // Candela of a captured colour whose largest channel is 1. Captured colours are linear RGB; the
   // light's glTF colour is the captured colour divided by its largest channel.
   double candelaPerUnit = 100.0;
+  // Lights with a range (an engine's radius): illuminance, lux, of the engine's full light (a
+  // captured colour of 1 at the light). Unset: calibrated against the dataset's sky from the map's
+  // lighting (docs/dataset.md, "Lights").
+  std::optional<double> luxPerUnit;
   std::map<std::string, LightRule> byModelType;  // "flash", "bouncer", "rocket", ...
   const LightRule& rule(const std::string& modelType) const;
 };

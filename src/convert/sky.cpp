@@ -87,7 +87,8 @@ SkyImage preethamSky(const SkyParameters& p) {
   const double rayleigh = 1.0 / (6.6296 + 1.7513 * airMass - 0.1202 * airMass * airMass + 0.0065 * std::pow(airMass, 3) -
                                  0.00013 * std::pow(airMass, 4));
   const double directNormal = 1361.0 * std::exp(-0.8662 * T * airMass * rayleigh);  // W/m²
-  sky.sunIlluminanceLux = directNormal * 93.0;
+  sky.sunIlluminanceLux = p.sunDisc ? directNormal * 93.0 : 0.0;
+  if (!p.sunDisc) return sky;
   const double pixelAngle = kPi / sky.height;
   const double radius = std::max(radians(0.2665), 1.5 * pixelAngle);
   double solidAngle = 0.0;
@@ -107,6 +108,29 @@ SkyImage preethamSky(const SkyParameters& p) {
       for (int c = 0; c < 3; ++c) sky.rgb[i * 3 + static_cast<std::size_t>(c)] += radiance;
   }
   return sky;
+}
+
+double horizontalIlluminance(const std::vector<float>& rgb, int width, int height, glm::dvec3 excludeDirection, double excludeRadians) {
+  double e = 0.0;
+  const double cosExclude = std::cos(excludeRadians);
+  const bool exclude = glm::length(excludeDirection) > 0;
+  for (int row = 0; row < height; ++row) {
+    const double solidAngle = equirectPixelSolidAngle(row, width, height);
+    for (int col = 0; col < width; ++col) {
+      const glm::dvec3 d = equirectDirection((col + 0.5) / width, (row + 0.5) / height);
+      if (d.y <= 0) continue;
+      if (exclude && glm::dot(d, glm::normalize(excludeDirection)) >= cosExclude) continue;
+      const std::size_t i = (static_cast<std::size_t>(row) * width + col) * 3;
+      e += luminance(glm::dvec3(rgb[i], rgb[i + 1], rgb[i + 2])) * d.y * solidAngle;
+    }
+  }
+  return e;
+}
+
+std::pair<double, double> sunAngles(const glm::dvec3& towardsSun) {
+  const glm::dvec3 d = glm::normalize(towardsSun);
+  // d = (cos e sin a, sin e, -cos e cos a): the inverse of preethamSky's sun direction.
+  return {degrees(std::asin(std::clamp(d.y, -1.0, 1.0))), degrees(std::atan2(d.x, -d.z))};
 }
 
 }  // namespace dynbench::convert

@@ -25,6 +25,7 @@ struct SkyParameters {
   double sunElevationDegrees = 45.0;  // above the horizon
   double sunAzimuthDegrees = 135.0;   // from -Z (the image centre) towards +X
   int width = 1024;                   // equirectangular: height = width / 2
+  bool sunDisc = true;                // false: the sky dome alone (a map the engine lights without a sun)
 };
 
 struct SkyImage {
@@ -36,6 +37,15 @@ struct SkyImage {
 };
 
 SkyImage preethamSky(const SkyParameters& parameters);
+
+// Illuminance (lux) of a horizontal surface open to the whole upper hemisphere of an
+// equirectangular image (luminance x cos(theta) x solid angle, summed over the pixels above the
+// horizon), with the pixels within `excludeRadians` of `excludeDirection` left out (a sun disc).
+double horizontalIlluminance(const std::vector<float>& rgb, int width, int height, glm::dvec3 excludeDirection = glm::dvec3(0.0),
+                             double excludeRadians = 0.0);
+
+// Elevation and azimuth (degrees, SkyParameters' convention) of a direction towards the sun.
+std::pair<double, double> sunAngles(const glm::dvec3& towardsSun);
 
 // The equirectangular mapping (equirectDirection, equirectPixelSolidAngle) is in core/math.h:
 // the renderer reads the same images.

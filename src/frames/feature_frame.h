@@ -40,8 +40,7 @@ struct SamplingSummary {
   int minSamples = 0, maxSamples = 0;  // samples per pixel, smallest and largest in the frame
   double meanSamples = 0.0;
   long cappedPixels = 0;               // pixels that reached --max-spp before their target
-  double lightCutoff = 0.0;            // irradiance cut-off of lights without a range (0: none)
-  double droppedIrradianceBound = 0.0;  // the most irradiance the cut-off drops at any point
+  int lightsPerPoint = 0;              // point and spot lights evaluated per shading point at most (0: all)
 };
 
 // One frame's buffers: row 0 at the top, channels of a buffer interleaved per pixel. A buffer the

@@ -89,8 +89,7 @@ json samplingJson(const SamplingSummary& s) {
           {"max_spp", s.maxSamples},
           {"mean_spp", s.meanSamples},
           {"capped_pixels", s.cappedPixels},
-          {"light_cutoff", s.lightCutoff},
-          {"dropped_irradiance_bound", s.droppedIrradianceBound}};
+          {"lights_per_point", s.lightsPerPoint}};
 }
 
 namespace {
@@ -104,13 +103,12 @@ Expected<SamplingSummary> readSampling(const json& j, const fs::path& path) {
     s.adaptive = o["adaptive"].get<bool>();
   }
   for (auto [key, target] : {std::pair{"tolerance", &s.tolerance}, {"direct_target", &s.directTarget}, {"indirect_target", &s.indirectTarget},
-                             {"mean_spp", &s.meanSamples}, {"light_cutoff", &s.lightCutoff},
-                             {"dropped_irradiance_bound", &s.droppedIrradianceBound}}) {
+                             {"mean_spp", &s.meanSamples}}) {
     auto v = numberAt(j, path, std::string("/sampling/") + key, 0.0);
     if (!v) return std::unexpected(v.error());
     *target = *v;
   }
-  for (auto [key, target] : {std::pair{"min_spp", &s.minSamples}, {"max_spp", &s.maxSamples}}) {
+  for (auto [key, target] : {std::pair{"min_spp", &s.minSamples}, {"max_spp", &s.maxSamples}, {"lights_per_point", &s.lightsPerPoint}}) {
     auto v = numberAt(j, path, std::string("/sampling/") + key, 0.0);
     if (!v) return std::unexpected(v.error());
     *target = static_cast<int>(*v);

@@ -296,7 +296,7 @@ std::vector<std::string> renderArguments(const render::RenderJob& job) {
   if (s.jitter) a.push_back("--jitter");
   if (s.converge)
     a.insert(a.end(), {"--converge", "--tolerance", fmt::format("{:.17g}", s.tolerance), "--max-spp", std::to_string(s.maxSamplesPerPixel)});
-  if (s.lightCutoff) a.insert(a.end(), {"--light-cutoff", fmt::format("{:.17g}", *s.lightCutoff)});
+  a.insert(a.end(), {"--lights-per-point", std::to_string(s.lightsPerPoint)});
   if (job.float32) a.push_back("--float32");
   return a;
 }

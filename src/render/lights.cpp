@@ -146,10 +146,10 @@ double EnvironmentLight::pdf(const glm::dvec3& direction) const {
 }
 
 Expected<void> LightSet::build(const scene::Scene& scene, const RayTracingScene& rayTracing, const EnvironmentLight* environment,
-                               double sceneRadius, EmissionFunction emission, std::optional<double> cutoff) {
+                               double sceneRadius, EmissionFunction emission) {
   punctual_.clear();
-  everywhere_.clear();
-  sphereLight_.clear();
+  directional_.clear();
+  treeLight_.clear();
   triangles_.clear();
   environment_ = environment;
   emission_ = std::move(emission);
@@ -173,34 +173,19 @@ Expected<void> LightSet::build(const scene::Scene& scene, const RayTracingScene&
     punctual_.push_back(p);
   }
 
-  // Spheres of influence: KHR's range (the window is 0 beyond it: exact), else the distance where
-  // the brightest channel's I / d^2 falls to the cut-off.
-  std::size_t unranged = 0;
-  for (const auto& p : punctual_)
-    if (p.type != scene::Light::Type::kDirectional && !(p.range > 0)) ++unranged;
-  const double environmentIrradiance = environment_ ? kPi * environment_->meanLuminance() : 0.0;
-  cutoff_ = cutoff ? std::max(0.0, *cutoff) : unranged > 0 ? kAutoCutoffShare * environmentIrradiance / static_cast<double>(unranged) : 0.0;
-  culledByCutoff_ = 0;
-  std::vector<glm::dvec4> spheres;
+  // Directional lights light every point; point and spot lights go into the light tree, which
+  // bounds their positions, power and range.
+  std::vector<LightTree::Light> treeLights;
   for (std::size_t i = 0; i < punctual_.size(); ++i) {
     const Punctual& p = punctual_[i];
-    double radius = std::numeric_limits<double>::infinity();
-    if (p.type != scene::Light::Type::kDirectional) {
-      if (p.range > 0) {
-        radius = p.range;
-      } else if (cutoff_ > 0) {
-        radius = std::sqrt(std::max({p.intensity.x, p.intensity.y, p.intensity.z}) / cutoff_);
-        ++culledByCutoff_;
-      }
+    if (p.type == scene::Light::Type::kDirectional) {
+      directional_.push_back(static_cast<std::uint32_t>(i));
+      continue;
     }
-    if (std::isfinite(radius)) {
-      spheres.emplace_back(p.position, radius);
-      sphereLight_.push_back(static_cast<std::uint32_t>(i));
-    } else {
-      everywhere_.push_back(static_cast<std::uint32_t>(i));
-    }
+    treeLights.push_back({p.position, std::max(luminance(p.intensity), 1e-30), p.range});
+    treeLight_.push_back(static_cast<std::uint32_t>(i));
   }
-  if (auto ok = spheres_.build(spheres); !ok) return ok;
+  tree_.build(treeLights);
 
   std::vector<double> weights;
   const double disc = kPi * sceneRadius * sceneRadius;  // area a distant light's power crosses
@@ -237,10 +222,24 @@ Expected<void> LightSet::build(const scene::Scene& scene, const RayTracingScene&
   return {};
 }
 
-void LightSet::punctualInReach(const glm::dvec3& point, std::vector<std::uint32_t>& reach) const {
-  spheres_.query(point, reach);
-  for (auto& k : reach) k = sphereLight_[k];
-  reach.insert(reach.end(), everywhere_.begin(), everywhere_.end());
+void LightSet::selectPunctual(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights,
+                              std::vector<LightTree::Selected>& selected) const {
+  if (maxLights > 0) {
+    tree_.select(point, normal, u, maxLights, selected);
+    for (auto& s : selected) s.light = treeLight_[s.light];
+  } else {
+    // Every light that can reach the point, each with probability 1, found without the tree:
+    // a light whose range ends before the point, or that is behind the surface, gives nothing.
+    selected.clear();
+    for (const std::uint32_t l : treeLight_) {
+      const Punctual& p = punctual_[l];
+      const glm::dvec3 toLight = p.position - point;
+      if (glm::dot(toLight, normal) <= 0) continue;
+      if (p.range > 0 && std::isfinite(p.range) && glm::dot(toLight, toLight) >= p.range * p.range) continue;
+      selected.push_back({l, 1.0});
+    }
+  }
+  for (const std::uint32_t l : directional_) selected.push_back({l, 1.0});
 }
 
 bool LightSet::samplePunctual(std::size_t light, const glm::dvec3& point, LightSample& s) const {

@@ -15,6 +15,7 @@
 #include <glm/glm.hpp>
 
 #include "core/error.h"
+#include "render/light_tree.h"
 #include "render/raytracing_scene.h"
 #include "render/sampling.h"
 #include "scene/scene.h"
@@ -87,36 +88,29 @@ struct LightSample {
 // Emission of an emissive surface at a point of a triangle (the integrator evaluates the material).
 using EmissionFunction = std::function<glm::dvec3(int node, int primitive, unsigned triangle, glm::dvec2 barycentric)>;
 
-// The relative error the automatic light cut-off admits: lights without a `range` are skipped where
-// their irradiance is below epsilon = kAutoCutoffShare x E_env / N, with E_env = pi x the environment's
-// mean radiance (what a surface open to a uniform sky of that mean receives) and N the frame's
-// punctual lights without a range; all of them together then drop less than kAutoCutoffShare x E_env
-// at any point. docs/feature-buffers.md states the rule.
-inline constexpr double kAutoCutoffShare = 1e-3;
-
 class LightSet {
  public:
   // Gathers the frame's lights: punctual lights at their nodes' world transforms (from the
   // ray-tracing scene's pose; hidden nodes are off), every visible emissive triangle, and the
-  // environment. `sceneRadius` sizes the power estimate of environment light. `cutoff`: the
-  // irradiance below which a point or spot light without a range is skipped (nullopt: automatic,
-  // kAutoCutoffShare; 0: never).
+  // environment. `sceneRadius` sizes the power estimate of environment light.
   [[nodiscard]] Expected<void> build(const scene::Scene& scene, const RayTracingScene& rayTracing, const EnvironmentLight* environment,
-                                     double sceneRadius, EmissionFunction emission, std::optional<double> cutoff = std::nullopt);
+                                     double sceneRadius, EmissionFunction emission);
 
-  // Punctual lights are delta lights: their direct light at a point is a sum over the lights, not
-  // an integral, so the integrator evaluates every light that can reach the point (a shadow ray
-  // each) and none adds noise. `reach` receives the indices of those lights: directional lights,
-  // lights whose sphere of influence (KHR `range`, or the cut-off radius) contains the point (found
-  // through a BVH over the spheres), and lights with neither.
-  void punctualInReach(const glm::dvec3& point, std::vector<std::uint32_t>& reach) const;
-  // Light `light` at `point`, into `sample` (every field, as sample() below); false where it gives none.
+  // The punctual lights to evaluate at a shading point (a shadow ray each), with the probability
+  // of each having been selected: every directional light (probability 1), and the point and spot
+  // lights the light tree selects for the point (LightTree::select: at most maxLights of them,
+  // unbiased, none ever skipped; where no more than maxLights can reach the point, all of them
+  // with probability 1, so a scene lit by few lights renders without noise from them). u: one
+  // uniform number. maxLights 0: every light that can reach the point, without the tree (exact and
+  // slow: the independent estimator the tests compare the tree with).
+  void selectPunctual(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights,
+                      std::vector<LightTree::Selected>& selected) const;
+  // Light `light` at `point`, into `sample` (every field, as sample() below; pdf 1); false where
+  // it gives none.
   bool samplePunctual(std::size_t light, const glm::dvec3& point, LightSample& sample) const;
   std::size_t punctualCount() const { return punctual_.size(); }
-  // The cut-off in use (0: none) and the most irradiance it can drop at any point (N x epsilon,
-  // per colour channel).
-  double cutoffIrradiance() const { return cutoff_; }
-  double droppedIrradianceBound() const { return cutoff_ * static_cast<double>(culledByCutoff_); }
+  // Whether selectPunctual uses its random number (there are point or spot lights).
+  bool hasPunctualTree() const { return !tree_.empty(); }
 
   bool empty() const { return choice_.empty(); }
   // The environment or an emissive triangle, picked by estimated power, then a point on it (next
@@ -176,11 +170,9 @@ class LightSet {
     unsigned index;
   };
   std::vector<Punctual> punctual_;
-  std::vector<std::uint32_t> everywhere_;    // punctual lights with no sphere of influence
-  std::vector<std::uint32_t> sphereLight_;   // sphere k of the index -> punctual light
-  SphereIndex spheres_;
-  double cutoff_ = 0.0;
-  std::size_t culledByCutoff_ = 0;  // lights given a cut-off radius
+  std::vector<std::uint32_t> directional_;  // evaluated everywhere
+  std::vector<std::uint32_t> treeLight_;    // light k of the tree -> punctual light
+  LightTree tree_;
   std::vector<Triangle> triangles_;
   Distribution1D triangleChoice_;
   const EnvironmentLight* environment_ = nullptr;

@@ -235,8 +235,7 @@ Expected<void> PathTracer::setTime(double time, double previousTime) {
     if (lo.x <= hi.x) sceneRadius_ = std::max(1e-3, 0.5 * glm::length(hi - lo));
   }
   return lights_.build(scene_, *rayTracing_, environment_ ? &*environment_ : nullptr, *sceneRadius_,
-                       [this](int node, int primitive, unsigned triangle, glm::dvec2 b) { return emission(node, primitive, triangle, b); },
-                       settings_.lightCutoff);
+                       [this](int node, int primitive, unsigned triangle, glm::dvec2 b) { return emission(node, primitive, triangle, b); });
 }
 
 struct PathTracer::PathSample {
@@ -270,7 +269,7 @@ struct PathTracer::PathState {
 
 // A pixel whose paths wait in the thread's queue (PathScratch::queue): its camera ray and first
 // hit, the same for every path of the pixel (the same hit seen from the same direction), so its
-// shading, ray origin and punctual lights in reach are found once; and its samples still to be
+// shading and ray origin are found once; and its samples still to be
 // traced, [next, upTo).
 struct PathTracer::FirstVertex {
   std::size_t pixel = 0;
@@ -278,7 +277,6 @@ struct PathTracer::FirstVertex {
   const SurfaceHit* hit = nullptr;
   Shading shading;
   glm::dvec3 origin{0.0};
-  std::vector<std::uint32_t> reach;
   int next = 0, upTo = 0;
 };
 
@@ -292,9 +290,9 @@ struct PathTracer::PathScratch {
   BsdfBatch bsdfs;  // the BSDFs of a stage's shading points, evaluated and sampled together
   EquirectBatch equirect;  // escapes' directions mapped to environment image points, together
   std::vector<LightSet::Choice*> choices;  // a stage's light choices, their directions mapped together
-  std::vector<std::uint32_t> reach;       // punctual lights in reach of a shading point
+  std::vector<LightTree::Selected> selected;  // punctual lights selected at a shading point
   // Pixels whose paths are still to be traced: entries [queueHead, queueEnd) of `queue`, which
-  // keeps its entries (and their reach vectors' memory) for the next pixels.
+  // keeps its entries for the next pixels.
   std::vector<FirstVertex> queue;
   std::size_t queueHead = 0, queueEnd = 0;
   std::vector<PathState> paths;   // a batch
@@ -424,14 +422,12 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const F
     bucket += p.throughput * s.material.emission * w;
   }
   if (depth > settings_.bounces) return false;
-  if (first) return scatter(p, depth, hit, s, first->origin, first->reach, scratch, lanes);
-  // Every punctual light in reach: a sum, no noise (LightSet::punctualInReach).
-  if (settings_.nextEventEstimation) lights_.punctualInReach(hit.position, scratch.reach);
-  return scatter(p, depth, hit, s, offsetOrigin(hit.position, s.geometricNormal), scratch.reach, scratch, lanes);
+  if (first) return scatter(p, depth, hit, s, first->origin, scratch, lanes);
+  return scatter(p, depth, hit, s, offsetOrigin(hit.position, s.geometricNormal), scratch, lanes);
 }
 
 bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const Shading& s, const glm::dvec3& origin,
-                         const std::vector<std::uint32_t>& reach, PathScratch& scratch, std::size_t& lanes) const {
+                         PathScratch& scratch, std::size_t& lanes) const {
   p.origin = origin;
   p.shadingNormal = s.shadingNormal;
   p.lightEvaluated = false;
@@ -441,15 +437,23 @@ bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const S
   bsdfs.set(p.lane, s.material, s.shadingNormal, s.geometricNormal, wo);
   if (settings_.nextEventEstimation) {
     ++scratch.shadingPoints;
-    scratch.punctualEvaluated += reach.size();
-    // Every punctual light in reach, here, with the scalar BSDF (there are seldom any).
-    if (!reach.empty()) {
-      const Bsdf bsdf(s.material, Frame(s.shadingNormal), s.geometricNormal);
-      const Bsdf::View view = bsdf.view(wo);
-      LightSample& punctual = scratch.lightSample;
-      for (const std::uint32_t l : reach)
-        if (lights_.samplePunctual(l, hit.position, punctual) && punctual.pdf > 0)
-          addLight(p, depth, punctual, bsdf.evaluate(view, punctual.direction), scratch);
+    // The punctual lights the light tree selects for this point, each divided by the probability
+    // of its selection (LightSet::selectPunctual), here, with the scalar BSDF. The tree's random
+    // number is drawn only where there is a tree, so scenes without point lights keep their stream.
+    if (lights_.punctualCount() > 0) {
+      const double uLight = lights_.hasPunctualTree() ? p.rng.uniform() : 0.0;
+      lights_.selectPunctual(hit.position, s.geometricNormal, uLight, settings_.lightsPerPoint, scratch.selected);
+      scratch.punctualEvaluated += scratch.selected.size();
+      if (!scratch.selected.empty()) {
+        const Bsdf bsdf(s.material, Frame(s.shadingNormal), s.geometricNormal);
+        const Bsdf::View view = bsdf.view(wo);
+        LightSample& punctual = scratch.lightSample;
+        for (const LightTree::Selected& selected : scratch.selected)
+          if (lights_.samplePunctual(selected.light, hit.position, punctual)) {
+            punctual.pdf = selected.probability;
+            addLight(p, depth, punctual, bsdf.evaluate(view, punctual.direction), scratch);
+          }
+      }
     }
     // The environment or an emissive triangle: one Monte Carlo sample (its random numbers drawn
     // in the trace stage whether or not there is anything to choose, so the stream stays aligned),
@@ -574,8 +578,6 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
     if (known) v.shading = *known;
     else shade(hit, -ray.direction, texCoord(hit), v.shading);
     v.origin = offsetOrigin(hit.position, v.shading.geometricNormal);
-    v.reach.clear();
-    if (settings_.nextEventEstimation) lights_.punctualInReach(hit.position, v.reach);
     v.next = sum.samples;
     v.upTo = upTo;
   };
@@ -646,8 +648,7 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
   });
 
   frames::SamplingSummary summary;
-  summary.lightCutoff = lights_.cutoffIrradiance();
-  summary.droppedIrradianceBound = lights_.droppedIrradianceBound();
+  summary.lightsPerPoint = settings_.lightsPerPoint;
   if (settings_.converge) {
     // The targets: tolerance x the discard threshold of each buffer, which is a fraction of the
     // frame's mean luminance (discard's default relative thresholds), estimated from the first

@@ -11,8 +11,9 @@
 // Every buffer of a pixel describes one surface point: the hit of the ray through the pixel
 // centre. Radiance is estimated there (paths start at that hit), not over the pixel's footprint,
 // so the discard compares radiance at the same points as world position and normal. Punctual
-// lights are summed at every path vertex (LightSet::punctualInReach), so a scene lit only by them
-// has noise-free direct light at 1 spp.
+// lights are chosen at every path vertex by the light tree (LightSet::selectPunctual): where no
+// more than lightsPerPoint can reach the point they are all summed, so a scene lit by few of them
+// has noise-free direct light at 1 spp; where more can, they are sampled without bias.
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -42,9 +43,10 @@ struct RenderSettings {
   // false: BSDF sampling alone, no light sampling (an independent estimator for tests; punctual
   // lights are then invisible, as no BSDF sample can hit a point).
   bool nextEventEstimation = true;
-  // Irradiance below which a point or spot light without a range is skipped (LightSet::build):
-  // nullopt automatic, 0 never.
-  std::optional<double> lightCutoff;
+  // Point and spot lights evaluated at a shading point at most, chosen by the light tree
+  // (LightSet::selectPunctual: unbiased, no light skipped; exact where no more than this many can
+  // reach the point). 0: every light that can reach it, without the tree (exact, slow).
+  int lightsPerPoint = 4;
   // Adaptive sampling (`render --converge`): after samplesPerPixel samples, each pixel takes more
   // in rounds until the standard error of its direct and of its indirect luminance is at most
   // tolerance x the discard threshold (thresholdFraction x the frame's mean luminance of that
@@ -69,7 +71,7 @@ using FrameBuffers = frames::FeatureFrame;
 struct RenderStatistics {
   std::uint64_t cameraSamples = 0, rays = 0;
   std::uint64_t shadingPoints = 0;         // path vertices where direct light was gathered
-  std::uint64_t punctualEvaluated = 0;     // punctual lights evaluated at them (in reach)
+  std::uint64_t punctualEvaluated = 0;     // punctual lights evaluated at them (selected)
   std::uint64_t punctualInFrame = 0;       // what evaluating every light would have cost
 };
 
@@ -124,15 +126,14 @@ class PathTracer {
   // emission and its punctual lights to the path's radiance, takes its light sample and puts its
   // BSDF, the light sample's direction and the bounce's random numbers into lane `lanes` of the
   // batch's BSDFs (then counts the lane). false when the path ends here. At a pixel's first hit,
-  // which every path of the pixel shares, `first` holds its shading, ray origin and punctual
-  // lights in reach, found once.
+  // which every path of the pixel shares, `first` holds its shading and ray origin, found once.
   struct FirstVertex;
   bool advance(PathState& path, int depth, const SurfaceHit& hit, const FirstVertex* first, PathScratch& scratch,
                std::size_t& lanes) const;
-  // advance below the hit's emission: the punctual lights in `reach`, the light sample and the
-  // lane; the vertex's rays leave from `origin`.
+  // advance below the hit's emission: the punctual lights the tree selects, the light sample and
+  // the lane; the vertex's rays leave from `origin`.
   bool scatter(PathState& path, int depth, const SurfaceHit& hit, const Shading& shading, const glm::dvec3& origin,
-               const std::vector<std::uint32_t>& reach, PathScratch& scratch, std::size_t& lanes) const;
+               PathScratch& scratch, std::size_t& lanes) const;
   // Second half, once the batch's BSDFs are evaluated and sampled: the light sample's contribution
   // (its shadow ray) and the bounce (the next ray, Russian roulette). false when the path ends.
   bool bounce(PathState& path, int depth, PathScratch& scratch) const;

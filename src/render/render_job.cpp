@@ -103,7 +103,8 @@ nlohmann::json renderRecord(const RenderJob& job) {
                       {"radiance_at", "pixel_centre"}};
   if (s.converge) r["converge"] = {{"tolerance", s.tolerance}, {"max_spp", s.maxSamplesPerPixel},
                                    {"direct_threshold", s.directThresholdFraction}, {"indirect_threshold", s.indirectThresholdFraction}};
-  if (s.lightCutoff) r["light_cutoff"] = *s.lightCutoff;
+  // Point and spot lights through the light tree (frames of the earlier cut-off are not reused).
+  r["lights"] = {{"sampler", "tree"}, {"per_point", s.lightsPerPoint}};
   if (s.jitter) r["jitter"] = "halton23x8";
   // --float32 is recorded, so such a job does not take half-stored frames as complete.
   if (job.float32) r["storage"] = "float32";

@@ -112,7 +112,7 @@ Evaluator::Evaluator(const Scene& scene) : scene_(scene), drivers_(scene.nodes.s
       if (sampler->times.empty()) continue;
       if (channel.light >= 0) {
         auto& l = lightDrivers_[static_cast<std::size_t>(channel.light)];
-        (channel.path == AnimationPath::kLightColor ? l.color : l.intensity) = sampler;
+        (channel.path == AnimationPath::kLightColor ? l.color : channel.path == AnimationPath::kLightRange ? l.range : l.intensity) = sampler;
         continue;
       }
       auto& d = drivers_[static_cast<std::size_t>(channel.node)];
@@ -123,7 +123,8 @@ Evaluator::Evaluator(const Scene& scene) : scene_(scene), drivers_(scene.nodes.s
         case AnimationPath::kWeights: d.weights = sampler; break;
         case AnimationPath::kVisibility: d.visibility = sampler; break;
         case AnimationPath::kLightColor:
-        case AnimationPath::kLightIntensity: break;  // handled above
+        case AnimationPath::kLightIntensity:
+        case AnimationPath::kLightRange: break;  // handled above
       }
     }
   }
@@ -277,6 +278,11 @@ Light Evaluator::light(int index, double t) const {
     double v = 0;
     sampleValues(*d.intensity, t, std::span<double>(&v, 1));
     l.intensity = static_cast<float>(v);
+  }
+  if (d.range) {
+    double v = 0;
+    sampleValues(*d.range, t, std::span<double>(&v, 1));
+    l.range = static_cast<float>(std::max(0.0, v));
   }
   return l;
 }

@@ -70,6 +70,7 @@ class Evaluator {
   struct LightDrivers {
     const Sampler* color = nullptr;
     const Sampler* intensity = nullptr;
+    const Sampler* range = nullptr;
   };
   const Scene& scene_;
   std::vector<Drivers> drivers_;

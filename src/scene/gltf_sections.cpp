@@ -440,7 +440,7 @@ int GltfReader::visibilityPointerNode(const std::string& pointer) {
   return std::stoi(digits);
 }
 
-// Parses "/extensions/KHR_lights_punctual/lights/N/color" (or /intensity): the light and the
+// Parses "/extensions/KHR_lights_punctual/lights/N/color" (or /intensity, /range): the light and the
 // property; light -1 for any other pointer.
 GltfReader::LightPointer GltfReader::lightPointer(const std::string& pointer) {
   static constexpr std::string_view prefix = "/extensions/KHR_lights_punctual/lights/";
@@ -452,6 +452,7 @@ GltfReader::LightPointer GltfReader::lightPointer(const std::string& pointer) {
   if (digits.empty() || digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), ::isdigit)) return {};
   if (property == "color") return {std::stoi(digits), AnimationPath::kLightColor};
   if (property == "intensity") return {std::stoi(digits), AnimationPath::kLightIntensity};
+  if (property == "range") return {std::stoi(digits), AnimationPath::kLightRange};
   return {};
 }
 

@@ -59,6 +59,7 @@ const char* toString(AnimationPath path) {
     case AnimationPath::kVisibility: return "visibility";
     case AnimationPath::kLightColor: return "light color";
     case AnimationPath::kLightIntensity: return "light intensity";
+    case AnimationPath::kLightRange: return "light range";
   }
   return "?";
 }

@@ -160,9 +160,9 @@ struct Node {
 enum class Interpolation { kStep, kLinear, kCubicSpline };
 const char* toString(Interpolation interpolation);
 
-// kLightColor and kLightIntensity: KHR_animation_pointer to a KHR_lights_punctual light's colour or
-// intensity (the channel names a light, not a node).
-enum class AnimationPath { kTranslation, kRotation, kScale, kWeights, kVisibility, kLightColor, kLightIntensity };
+// kLightColor, kLightIntensity and kLightRange: KHR_animation_pointer to a KHR_lights_punctual
+// light's colour, intensity or range (the channel names a light, not a node).
+enum class AnimationPath { kTranslation, kRotation, kScale, kWeights, kVisibility, kLightColor, kLightIntensity, kLightRange };
 const char* toString(AnimationPath path);
 
 // One glTF animation sampler. `values` holds, per key, `components` floats, three times over for

@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
     const dbc_dual_quat pose = {0, sinf(angle / 2), 0, cosf(angle / 2), 0, 0, 0, 0};
     const float eye[3] = {0, 1, 5}, lamp[3] = {2, 3, 2}, white[3] = {1, 1, 1};
     if (check(dbc_frame_begin(s, f, (double)f / 60.0)) || check(dbc_camera(s, camera, eye, 0, 0, 0)) ||
-        check(dbc_model(s, crate, "models/crate", pose)) || check(dbc_light(s, light, lamp, white, DBC_LIGHT_POINT, 0, "none")) ||
+        check(dbc_model(s, crate, "models/crate", pose)) || check(dbc_light(s, light, lamp, white, 0.0f, DBC_FALLOFF_LINEAR, DBC_LIGHT_POINT, 0, "none")) ||
         check(dbc_frame_end(s)))
       return 1;
   }

@@ -52,6 +52,7 @@ struct CaptureState {
   bool done = false;
   bool record = true;
   long long verifyFrame = -1;
+  vector<long long> gameFrames;  // recorded frames whose image the game keeps (DYNBENCH_CAPTURE_GAME_FRAMES)
   bool followAuto = false;
   string directory = "";
   Uint32 windowStart = 0;  // wall clock when the capture window opened (SDL milliseconds)
@@ -216,7 +217,19 @@ void exportMap(const char *map) {
   if (dbc_model_end(state.session) != DBC_OK) failCapture("map model end");
 }
 
-// Map lights (ET_LIGHT entities: attr1 radius, attr2-4 colour 0-255): static, written once.
+// The map's lighting variables (engine/lightmap.cpp), in the lights' units (255 = 1): the lightmap
+// of a surface is max(ambient, sky light x the share of 17 sky rays that escape, sum over lights
+// of colour x (1 - d / radius) x cos + sun x cos), clamped to 255 (generatelumel, calcskylight).
+void recordMapLighting() {
+  float direction[3];
+  toCapture(sunlightdir, direction);
+  const float sun[3] = {sunlightcolor.x * sunlightscale / 255.0f, sunlightcolor.y * sunlightscale / 255.0f, sunlightcolor.z * sunlightscale / 255.0f};
+  const float ambient[3] = {ambientcolor.x / 255.0f, ambientcolor.y / 255.0f, ambientcolor.z / 255.0f};
+  const float sky[3] = {skylightcolor.x / 255.0f, skylightcolor.y / 255.0f, skylightcolor.z / 255.0f};
+  if (dbc_set_lighting(state.session, direction, sun, ambient, sky) != DBC_OK) failCapture("map lighting");
+}
+
+// Map lights (ET_LIGHT entities: attr1 radius, 0 for none, attr2-4 colour 0-255): static, written once.
 void recordStaticLights() {
   const vector<extentity *> &ents = entities::getents();
   loopv(ents) {
@@ -225,7 +238,7 @@ void recordStaticLights() {
     float position[3];
     toCapture(e.o, position);
     const float rgb[3] = {e.attr2 / 255.0f, e.attr3 / 255.0f, e.attr4 / 255.0f};
-    if (dbc_light(state.session, dbc_new_id(state.session), position, rgb, DBC_LIGHT_POINT, 0, "none") != DBC_OK)
+    if (dbc_light(state.session, dbc_new_id(state.session), position, rgb, float(max(0, int(e.attr1))), DBC_FALLOFF_LINEAR, DBC_LIGHT_POINT, 0, "none") != DBC_OK)
       failCapture("static light");
   }
 }
@@ -283,7 +296,7 @@ void recordDynamicLight(const dynbench_dynlight &d) {
   recorded.light = d;
   recorded.id = dynamicLightId(d);
   currentLights.add(recorded);
-  if (dbc_light(state.session, recorded.id, position, rgb, DBC_LIGHT_POINT, 1, type) != DBC_OK) failCapture("dynamic light");
+  if (dbc_light(state.session, recorded.id, position, rgb, max(0.0f, d.radius), DBC_FALLOFF_QUADRATIC, DBC_LIGHT_POINT, 1, type) != DBC_OK) failCapture("dynamic light");
 }
 
 void recordDynamicLights() {
@@ -318,6 +331,40 @@ const char *cameraCut(const vec &position) {
   return reason;
 }
 
+// The game's own image of a recorded frame, for `dynbench fidelity` (docs/fidelity.md): the colour
+// the game drew (8-bit sRGB, as PPM) and its depth buffer turned into view depth in capture units
+// (PFM, 0 where the sky is), read back before the frame is shown. The depth buffer holds
+// z_ndc = 2 d - 1 of OpenGL's perspective (engine/rendergl.cpp: projmatrix.perspective with
+// nearplane and farplane), so view depth = 2 f n / (f + n - z_ndc (f - n)).
+void writeGameFrame(long long frame) {
+  const int w = screenw, h = screenh;
+  vector<uchar> rgb;
+  rgb.setsize(0);
+  loopi(w * h * 3) rgb.add(0);
+  vector<float> depth;
+  loopi(w * h) depth.add(0.0f);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, rgb.getbuf());
+  glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depth.getbuf());
+  const float n = nearplane, f = float(farplane);
+  loopi(w * h) {
+    const float d = depth[i];
+    depth[i] = d >= 1.0f ? 0.0f : 2.0f * f * n / (f + n - (2.0f * d - 1.0f) * (f - n));
+  }
+  defformatstring(folder, "%s/game", state.directory);
+  createdir(folder);
+  // PPM rows run top to bottom, OpenGL's bottom to top; PFM's bottom to top, as OpenGL's.
+  defformatstring(colourPath, "%s/frame_%05lld.ppm", folder, frame);
+  defformatstring(depthPath, "%s/frame_%05lld_depth.pfm", folder, frame);
+  FILE *c = fopen(colourPath, "wb"), *z = fopen(depthPath, "wb");
+  if (!c || !z) failCapture("game frame");
+  fprintf(c, "P6\n%d %d\n255\n", w, h);
+  for (int y = h - 1; y >= 0; --y) fwrite(&rgb[y * w * 3], 1, w * 3, c);
+  fprintf(z, "Pf\n%d %d\n-1.0\n", w, h);
+  fwrite(depth.getbuf(), sizeof(float), w * h, z);
+  if (fclose(c) != 0 || fclose(z) != 0) failCapture("game frame");
+}
+
 // One rendered frame with the map loaded: exports the map first, records inside the window.
 void recordFrame(const char *map) {
   if (state.firstMapMillis < 0) {
@@ -329,6 +376,7 @@ void recordFrame(const char *map) {
     if (dbc_set_camera_settings(state.session, aspectRatio, yfov, nearplane, float(farplane)) != DBC_OK) failCapture("camera settings");
     const float offset[3] = {0, 0, 0};
     if (dbc_set_map(state.session, map, offset) != DBC_OK) failCapture("map");
+    recordMapLighting();
     exportMap(map);
   }
   if (lastmillis - state.firstMapMillis < static_cast<long long>(state.warmupSeconds * 1000.0)) {
@@ -356,6 +404,7 @@ void recordFrame(const char *map) {
     if (dbc_camera_cut(state.session, state.cameraId, cut) != DBC_OK) failCapture("camera cut");
   if (firstFrame) recordStaticLights();
   if (!dynbench_models_write(state.session, firstFrame)) failCapture("model instances");
+  if (state.gameFrames.find(state.recorded) >= 0) writeGameFrame(state.recorded);
   if (state.recorded == state.verifyFrame) {
     defformatstring(path, "%s/skinning_frame_%lld.txt", state.directory, state.recorded);
     if (!dynbench_models_write_verification(path)) failCapture("skinning verification file");
@@ -392,6 +441,16 @@ void dynbench_capture_init() {
   state.record = envNumber("DYNBENCH_CAPTURE_RECORD", 1.0) != 0.0;
   state.verifyFrame = static_cast<long long>(envNumber("DYNBENCH_CAPTURE_VERIFY_FRAME", -1.0));
   state.followAuto = envNumber("DYNBENCH_CAPTURE_FOLLOW_AUTO", 0.0) != 0.0;
+  if (const char *list = std::getenv("DYNBENCH_CAPTURE_GAME_FRAMES"))
+    for (const char *p = list; *p;) {
+      char *end = nullptr;
+      const long long k = std::strtoll(p, &end, 10);
+      if (end == p) break;
+      state.gameFrames.add(k);
+      p = *end == ',' ? end + 1 : end;
+    }
+  // The game's own frames are compared with renders of the world: no HUD text over them.
+  if (state.gameFrames.length()) execute("hidehud 1");
   copystring(state.directory, dir);
   seedMT(state.seed);
   // Occlusion queries answer when the GPU gets to them, not at a fixed frame: what is drawn, and

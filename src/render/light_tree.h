@@ -1,0 +1,66 @@
+#pragma once
+// Many point and spot lights without dropping any: a bounding volume hierarchy over the lights,
+// each node bounding its lights' positions, power and reach, from which a shading point picks the
+// lights that matter to it (Conty Estevez and Kulla, "Importance Sampling of Many Lights with
+// Adaptive Tree Splitting", HPG 2018; pbrt-v4's BVHLightSampler).
+//
+// At a shading point, select() first splits the tree into a cut of at most `maxLights` nodes,
+// most important first (a node whose lights cannot reach the point has importance zero and is
+// left out: its lights contribute exactly nothing there), then walks down from each node of the
+// cut to one light, choosing a child with probability proportional to its importance. Every light
+// that can light the point has a non-zero probability, so the estimate
+//   sum over selected lights of  contribution(light) / probability(light)
+// is unbiased; where the cut reaches single lights (at most maxLights in reach) every probability
+// is 1 and the sum is exact, with no noise.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace dynbench::render {
+
+class LightTree {
+ public:
+  // A light as the tree sees it: where it is, how much it emits and how far it reaches.
+  struct Light {
+    glm::dvec3 position{0.0};
+    double power = 0.0;  // luminance of its intensity (candela), > 0
+    double range = 0.0;  // distance beyond which it gives nothing; <= 0 or infinite: unbounded
+  };
+  struct Selected {
+    std::uint32_t light = 0;   // index into the lights given to build()
+    double probability = 1.0;  // of selecting it (in (0, 1])
+  };
+
+  void build(std::span<const Light> lights);
+  bool empty() const { return nodes_.empty(); }
+  std::size_t size() const { return lightCount_; }
+
+  // The lights for shading point `point` whose surface faces `normal` (unit; lights behind its
+  // plane give nothing there: the BSDFs reflect only above the geometric surface), chosen with one
+  // uniform number u in [0, 1). `selected` is cleared first. maxLights >= 1.
+  void select(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights, std::vector<Selected>& selected) const;
+
+  // The importance select() gives a node or light at a point: an upper-bound-shaped estimate of
+  // the light it sends there, zero only where it provably sends none. Exposed for tests.
+  struct Node {
+    glm::dvec3 lower{0.0}, upper{0.0};  // bounds of the lights' positions
+    double power = 0.0;                 // sum of the lights' powers
+    double range = 0.0;                 // the largest range (infinity when any light is unbounded)
+    std::uint32_t first = 0;            // leaf: the light; interior: the second child (the first follows the node)
+    std::uint32_t count = 0;            // lights below
+  };
+  static double importance(const Node& node, const glm::dvec3& point, const glm::dvec3& normal);
+
+ private:
+  std::vector<Node> nodes_;  // depth first: an interior node's first child follows it
+  std::size_t lightCount_ = 0;
+
+  std::uint32_t buildRange(std::vector<std::uint32_t>& order, std::span<const Light> lights, std::size_t begin, std::size_t end);
+  // From node `n`, one light chosen by importance; probability multiplied into *probability.
+  // Returns false when no light below can light the point.
+  bool descend(std::uint32_t n, const glm::dvec3& point, const glm::dvec3& normal, double u, Selected& out) const;
+};
+
+}  // namespace dynbench::render

@@ -1,0 +1,158 @@
+// The light tree's selection against what it promises: an unbiased estimate of the sum over every
+// light (checked exactly, by enumerating every path down the tree, and by sampling), no light that
+// can give light ever left out, none that cannot ever selected, and an exact sum (probability 1
+// each) where no more lights than the budget can reach the point.
+#include <cmath>
+#include <map>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "render/light_tree.h"
+
+namespace dynbench::render {
+namespace {
+
+std::vector<LightTree::Light> randomLights(int count, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> position(-10.0, 10.0), power(0.1, 50.0), range(1.0, 12.0);
+  std::vector<LightTree::Light> lights;
+  for (int k = 0; k < count; ++k)
+    lights.push_back({{position(rng), position(rng), position(rng)}, power(rng), k % 3 == 0 ? 0.0 : range(rng)});
+  return lights;
+}
+
+// Whether light l can give light at p with normal n (what the renderer would find non-zero).
+bool canLight(const LightTree::Light& l, const glm::dvec3& p, const glm::dvec3& n) {
+  const glm::dvec3 d = l.position - p;
+  if (glm::dot(d, n) <= 0) return false;
+  return !(l.range > 0) || glm::dot(d, d) < l.range * l.range;
+}
+
+// select() is a deterministic function of u, so the share of a fine grid of u that selects a light
+// is its selection probability: it must equal the probability select() reports for it, and be
+// non-zero for every light that can give light there.
+TEST(LightTree, EveryLightThatCanGiveLightIsSelectedWithItsReportedProbability) {
+  const auto lights = randomLights(300, 7);
+  LightTree tree;
+  tree.build(lights);
+  ASSERT_EQ(tree.size(), lights.size());
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> coordinate(-8.0, 8.0);
+  const int grid = 1 << 16;
+  for (int trial = 0; trial < 6; ++trial) {
+    const glm::dvec3 p(coordinate(rng), coordinate(rng), coordinate(rng));
+    const glm::dvec3 n = glm::normalize(glm::dvec3(coordinate(rng), coordinate(rng), coordinate(rng)));
+    for (const int budget : {1, 4}) {
+      std::map<std::uint32_t, double> measure, reported;
+      std::vector<LightTree::Selected> selected;
+      for (int k = 0; k < grid; ++k) {
+        tree.select(p, n, (k + 0.5) / grid, budget, selected);
+        EXPECT_LE(static_cast<int>(selected.size()), budget);
+        for (const auto& s : selected) {
+          ASSERT_TRUE(canLight(lights[s.light], p, n)) << "light " << s.light << " cannot light the point";
+          ASSERT_GT(s.probability, 0.0);
+          measure[s.light] += 1.0 / grid;
+          reported[s.light] = s.probability;
+        }
+      }
+      int reachable = 0;
+      for (std::uint32_t l = 0; l < lights.size(); ++l) {
+        if (!canLight(lights[l], p, n)) continue;
+        ++reachable;
+        // Probabilities far above 1/grid are resolved by the grid; each light must be found.
+        ASSERT_TRUE(measure.count(l)) << "light " << l << " can light the point but is never selected (trial " << trial << ")";
+        EXPECT_NEAR(measure[l], reported[l], 4.0 / grid + 1e-9) << "light " << l;
+      }
+      EXPECT_GT(reachable, 5);
+    }
+  }
+}
+
+TEST(LightTree, TheEstimateOfASumOverLightsIsUnbiased) {
+  // E[sum over selected of w(l) / p(l)] = sum over lights that can light the point of w(l), for
+  // any weights w: here each light's unshadowed irradiance times its range window.
+  const auto lights = randomLights(500, 11);
+  LightTree tree;
+  tree.build(lights);
+  const glm::dvec3 p(0.5, -1.0, 2.0), n(0.0, 1.0, 0.0);
+  auto weight = [&](const LightTree::Light& l) {
+    const glm::dvec3 d = l.position - p;
+    const double d2 = glm::dot(d, d);
+    double w = l.power * glm::dot(d, n) / std::sqrt(d2) / d2;
+    if (l.range > 0) w *= std::max(0.0, 1.0 - (d2 * d2) / std::pow(l.range, 4));
+    return w;
+  };
+  double exact = 0;
+  for (const auto& l : lights)
+    if (canLight(l, p, n)) exact += weight(l);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  for (const int budget : {1, 4, 16}) {
+    const int samples = 200000;
+    double sum = 0, sumSq = 0;
+    std::vector<LightTree::Selected> selected;
+    for (int k = 0; k < samples; ++k) {
+      tree.select(p, n, uniform(rng), budget, selected);
+      double estimate = 0;
+      for (const auto& s : selected) estimate += weight(lights[s.light]) / s.probability;
+      sum += estimate;
+      sumSq += estimate * estimate;
+    }
+    const double mean = sum / samples, standardError = std::sqrt((sumSq / samples - mean * mean) / samples);
+    EXPECT_NEAR(mean, exact, 5 * standardError + 1e-12 * exact) << "budget " << budget;
+    std::printf("budget %2d: relative standard deviation of one estimate %.3f\n", budget, standardError * std::sqrt(samples) / exact);
+  }
+}
+
+TEST(LightTree, FewLightsInReachAreAllSelectedWithProbabilityOne) {
+  // Nine lights whose range covers the origin, 200 whose range ends before it.
+  std::vector<LightTree::Light> lights;
+  for (int k = 0; k < 9; ++k) lights.push_back({{std::cos(k) * 2.0, 1.0 + 0.1 * k, std::sin(k) * 2.0}, 1.0 + k, 5.0});
+  for (int k = 0; k < 200; ++k) lights.push_back({{20.0 + 0.1 * k, 3.0, -4.0}, 100.0, 3.0});
+  LightTree tree;
+  tree.build(lights);
+  std::vector<LightTree::Selected> selected;
+  for (const double u : {0.0, 0.37, 0.999}) {
+    tree.select({0, 0, 0}, {0, 1, 0}, u, 9, selected);
+    ASSERT_EQ(selected.size(), 9u);
+    std::vector<bool> seen(9, false);
+    for (const auto& s : selected) {
+      ASSERT_LT(s.light, 9u);
+      EXPECT_EQ(s.probability, 1.0);
+      seen[s.light] = true;
+    }
+    for (const bool b : seen) EXPECT_TRUE(b);
+    // Below the floor (normal pointing down), none of them can light the point.
+    tree.select({0, 0, 0}, {0, -1, 0}, u, 9, selected);
+    EXPECT_TRUE(selected.empty());
+  }
+}
+
+TEST(LightTree, ANodeOutOfRangeOrBehindThePlaneHasNoImportanceAndOthersHaveSome) {
+  LightTree::Node node;
+  node.lower = {4, 0, -1};
+  node.upper = {6, 2, 1};
+  node.power = 10;
+  node.range = 3.0;
+  node.count = 2;
+  // Nearest point of the box is at distance 4 - 0.5 = 3.5 > 3.
+  EXPECT_EQ(LightTree::importance(node, {0.5, 1, 0}, {1, 0, 0}), 0.0);
+  EXPECT_GT(LightTree::importance(node, {1.5, 1, 0}, {1, 0, 0}), 0.0);
+  // Facing away from the box: every point of it is behind the plane.
+  EXPECT_EQ(LightTree::importance(node, {1.5, 1, 0}, {-1, 0, 0}), 0.0);
+  // A plane that the box crosses: some of it is above.
+  EXPECT_GT(LightTree::importance(node, {5, -1, 0}, {0, 1, 0}), 0.0);
+  EXPECT_GT(LightTree::importance(node, {5, 1.9, 0}, {0, -1, 0}), 0.0);
+  // One light: its irradiance (power cos / d^2) times its window.
+  LightTree::Node leaf;
+  leaf.lower = leaf.upper = {0, 2, 0};
+  leaf.power = 8;
+  leaf.range = 4;
+  leaf.count = 1;
+  const double d = std::sqrt(2.0 * 2.0 + 1.0), cosine = 2.0 / d, window = 1.0 - std::pow(d / 4.0, 4);
+  EXPECT_NEAR(LightTree::importance(leaf, {1, 0, 0}, {0, 1, 0}), 8 * cosine * window / (d * d), 1e-12);
+}
+
+}  // namespace
+}  // namespace dynbench::render
