@@ -1,0 +1,88 @@
+// dynbench fidelity's comparison against known answers: a render that matches the game's frame
+// passes with full agreement; one whose depth is off, or that is black or speckled where the game
+// shows lit walls, fails (docs/fidelity.md).
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "pipeline/fidelity.h"
+
+namespace dynbench::pipeline {
+namespace {
+
+// A corridor-like frame: depth rising towards the centre, a lit band and a dark band, sky on top.
+FidelityImages corridor(int w = 96, int h = 54) {
+  FidelityImages m;
+  m.width = w;
+  m.height = h;
+  m.near = 0.54;
+  m.far = 4096;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  m.gameColour.resize(3 * n);
+  m.gameDepth.resize(n);
+  m.renderRadiance.resize(3 * n);
+  m.renderDepth.resize(n);
+  m.renderHit.resize(n);
+  m.renderDirect.resize(3 * n);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y * w + x);
+      const bool sky = y < h / 6;
+      const double z = sky ? 0.0 : 40.0 + 300.0 * std::exp(-std::abs(x - w / 2.0) / 10.0);
+      const double lit = 0.1 + 0.8 * (0.5 + 0.5 * std::sin(x / 7.0)) * (y > h / 2 ? 1.0 : 0.4);
+      m.gameDepth[i] = static_cast<float>(z);
+      m.renderDepth[i] = static_cast<float>(z);
+      m.renderHit[i] = sky ? 0.0f : 1.0f;
+      for (int c = 0; c < 3; ++c) {
+        m.gameColour[3 * i + c] = static_cast<float>(std::pow(lit, 1 / 2.2));  // sRGB-ish
+        m.renderRadiance[3 * i + c] = static_cast<float>(1000.0 * lit);      // a different exposure
+        m.renderDirect[3 * i + c] = static_cast<float>(800.0 * lit);
+      }
+    }
+  return m;
+}
+
+TEST(Fidelity, ARenderOfTheSameFramePassesWithFullAgreement) {
+  const FidelityFrame f = compareWithGame(corridor());
+  EXPECT_EQ(f.depthAgreement, 1.0);
+  EXPECT_EQ(f.skyAgreement, 1.0);
+  EXPECT_GT(f.correlation, 0.99);  // exposure and tone curve do not matter
+  EXPECT_EQ(f.unlitShare, 0.0);
+  EXPECT_TRUE(f.passed);
+}
+
+TEST(Fidelity, ADepthOffByMoreThanItsToleranceFails) {
+  FidelityImages m = corridor();
+  for (auto& z : m.renderDepth) z *= 1.03f;  // 3 %: beyond 1 % + four 24-bit depth steps at these depths
+  FidelityFrame f = compareWithGame(m);
+  EXPECT_LT(f.depthAgreement, 0.05);
+  EXPECT_FALSE(f.passed);
+  m = corridor();
+  for (auto& z : m.renderDepth) z *= 1.005f;  // 0.5 %: within
+  EXPECT_EQ(compareWithGame(m).depthAgreement, 1.0);
+}
+
+TEST(Fidelity, ABlackOrSpeckledRenderFails) {
+  FidelityImages black = corridor();
+  for (auto& v : black.renderRadiance) v = 0.0f;
+  for (auto& v : black.renderDirect) v = 0.0f;
+  FidelityFrame f = compareWithGame(black);
+  EXPECT_EQ(f.depthAgreement, 1.0);  // the geometry is right
+  EXPECT_EQ(f.unlitShare, 1.0);
+  EXPECT_FALSE(f.passed);
+  // Speckle: each pixel black or bright at random (what two_towers rendered as when its lights were
+  // culled), whatever the game shows.
+  FidelityImages speckle = corridor();
+  std::mt19937 rng(1);
+  for (std::size_t i = 0; i < speckle.renderRadiance.size() / 3; ++i) {
+    const float v = rng() % 8 == 0 ? 5000.0f : 0.0f;
+    for (int c = 0; c < 3; ++c) speckle.renderRadiance[3 * i + c] = v;
+  }
+  f = compareWithGame(speckle);
+  EXPECT_LT(std::abs(f.correlation), kFidelityMinCorrelation);
+  EXPECT_FALSE(f.passed);
+}
+
+}  // namespace
+}  // namespace dynbench::pipeline
