@@ -59,6 +59,13 @@ std::vector<double> toneMapped(const std::vector<double>& luminance, const std::
   return out;
 }
 
+// Whether a rendered depth agrees with the game's view depth z (> 0): within four steps of a 24-bit
+// depth buffer at z, plus 1 % (fidelity.h).
+bool depthAgrees(double rendered, double z, double near, double far) {
+  const double step = std::ldexp(1.0, -24) * (far - near) / (far * near) * z * z;
+  return std::abs(rendered - z) <= 4.0 * step + 0.01 * z;
+}
+
 }  // namespace
 
 FidelityFrame compareWithGame(const FidelityImages& m) {
@@ -68,7 +75,6 @@ FidelityFrame compareWithGame(const FidelityImages& m) {
   const std::size_t n = static_cast<std::size_t>(m.width) * static_cast<std::size_t>(m.height);
   std::size_t either = 0, agree = 0, sameKind = 0, geometry = 0, unlit = 0;
   std::vector<bool> both(n, false);
-  const double quantum = std::ldexp(1.0, -24) * (m.far - m.near) / (m.far * m.near);
   for (std::size_t i = 0; i < n; ++i) {
     const bool game = m.gameDepth[i] > 0, render = m.renderHit[i] > 0;
     sameKind += game == render;
@@ -80,8 +86,7 @@ FidelityFrame compareWithGame(const FidelityImages& m) {
     ++either;
     if (!(game && render)) continue;
     both[i] = true;
-    const double z = m.gameDepth[i];
-    agree += std::abs(m.renderDepth[i] - z) <= 4.0 * quantum * z * z + 0.01 * z;
+    agree += depthAgrees(m.renderDepth[i], m.gameDepth[i], m.near, m.far);
   }
   f.depthAgreement = either ? static_cast<double>(agree) / static_cast<double>(either) : 1.0;
   f.skyAgreement = n ? static_cast<double>(sameKind) / static_cast<double>(n) : 0.0;
@@ -189,7 +194,6 @@ Expected<FidelityOutcome> runFidelity(const FidelityStage& stage) {
     const int w = m.width, h = m.height;
     std::vector<float> side(static_cast<std::size_t>(3 * w) * h * 3, 0.0f);
     const auto preview = frames::previewImage(*rendered);
-    const double quantum = std::ldexp(1.0, -24) * (m.far - m.near) / (m.far * m.near);
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
         const std::size_t i = static_cast<std::size_t>(y * w + x);
@@ -199,8 +203,7 @@ Expected<FidelityOutcome> runFidelity(const FidelityStage& stage) {
           row[3 * (w + x) + c] = preview[3 * i + c];
         }
         const bool game = m.gameDepth[i] > 0, hit = m.renderHit[i] > 0;
-        const double z = m.gameDepth[i];
-        const bool ok = game && hit && std::abs(m.renderDepth[i] - z) <= 4.0 * quantum * z * z + 0.01 * z;
+        const bool ok = game && hit && depthAgrees(m.renderDepth[i], m.gameDepth[i], m.near, m.far);
         if (game || hit) row[3 * (2 * w + x) + (ok ? 1 : 0)] = 1.0f;
       }
     f.sideBySide = stage.output / fmt::format("fidelity_{:05d}.png", k);

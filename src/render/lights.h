@@ -8,7 +8,6 @@
 // intensity; an emissive surface emits emissiveFactor (times emissiveStrength and the emissive
 // texture) as radiance. docs/feature-buffers.md repeats this.
 #include <functional>
-#include <optional>
 #include <span>
 #include <vector>
 
