@@ -171,11 +171,13 @@ TEST_F(Slurm, ASignalledTaskRequeuesAndACancelledOneIsReportedAndRerun) {
   ASSERT_GE(cancelled, 0);
   EXPECT_EQ(shell(fmt::format("scancel {}_{}", job, cancelled)), "");
   // Slurm holds a requeued batch job back for two minutes (its BeginTime); the test lets it start
-  // at once rather than wait.
+  // after three seconds rather than wait. Not at once: slurmd revokes the first run's credential
+  // when the requeue kills it, and refuses a new one issued within the same second ("Killing
+  // non-startable batch job: Job credential revoked"), which ends the task FAILED.
   for (int i = 0; i < 100; ++i) {
     const std::string reason = shell(fmt::format("squeue -h -j {}_{} -o %r", job, signalled));
     if (reason.find("BeginTime") != std::string::npos) {
-      EXPECT_EQ(shell(fmt::format("scontrol update jobid={}_{} StartTime=now", job, signalled)), "");
+      EXPECT_EQ(shell(fmt::format("scontrol update jobid={}_{} StartTime=now+3", job, signalled)), "");
       break;
     }
     std::this_thread::sleep_for(100ms);
