@@ -421,6 +421,59 @@ TEST(Convert, TheMapsSunPlacesTheSkysSunAndCalibratesTheLights) {
   }
 }
 
+TEST(Convert, AStaticLightTheEngineDoesNotAttenuateGetsItsIrradianceAtTheMapsCentre) {
+  // Cube 2 lights a surface with a light of radius 0 at its full colour however far away it is
+  // (colos's "sun"). A map of two triangles spanning x, z in [-10, 10] at y = 0 (offset by the map
+  // offset), a static light of colour 0.5 without a range 50 units from the map's centre: a point
+  // light (its shadows fall as the engine's) of E_u x 0.5 x 50^2 cd, so that the centre gets the
+  // engine's irradiance. The map has no sun and no sky light, only an ambient floor of 0.25: the
+  // sky dome stands for it, E_u = E_dome / 0.25. A dynamic light without a range keeps the candela
+  // rule.
+  const fs::path dir = freshDir("convert_constant_light");
+  dbc_session* s = nullptr;
+  ASSERT_EQ(dbc_open((dir / "capture").c_str(), "test", &s), DBC_OK);
+  const float offset[3] = {5, 0, -5};
+  ASSERT_EQ(dbc_set_map(s, "flat", offset), DBC_OK);
+  const float towardsSun[3] = {0, 1, 0}, none[3] = {0, 0, 0}, ambient[3] = {0.25f, 0.2f, 0.2f};
+  ASSERT_EQ(dbc_set_lighting(s, towardsSun, none, ambient, none), DBC_OK) << dbc_last_error();
+  const float positions[] = {-10, 0, -10, 10, 0, -10, 10, 0, 10, -10, 0, 10};
+  const uint32_t quad[] = {0, 2, 1, 0, 3, 2};
+  ASSERT_EQ(dbc_model_begin(s, "flat"), DBC_OK);
+  const dbc_mesh floor{0, nullptr, nullptr, nullptr, 4, positions, nullptr, nullptr, nullptr, nullptr, 2, quad};
+  ASSERT_EQ(dbc_model_mesh(s, &floor), DBC_OK) << dbc_last_error();
+  ASSERT_EQ(dbc_model_end(s), DBC_OK);
+  const uint64_t camera = dbc_new_id(s), sun = dbc_new_id(s), flash = dbc_new_id(s);
+  const float origin[3] = {0, 2, 0}, sunAt[3] = {5, 30, 35}, grey[3] = {0.5f, 0.5f, 0.5f};
+  ASSERT_EQ(dbc_frame_begin(s, 0, 0.0), DBC_OK);
+  ASSERT_EQ(dbc_camera(s, camera, origin, 0, 0, 0), DBC_OK);
+  ASSERT_EQ(dbc_light(s, sun, sunAt, grey, 0.0f, DBC_FALLOFF_LINEAR, DBC_LIGHT_POINT, 0, "none"), DBC_OK);
+  ASSERT_EQ(dbc_light(s, flash, origin, grey, 0.0f, DBC_FALLOFF_LINEAR, DBC_LIGHT_POINT, 1, "none"), DBC_OK);
+  ASSERT_EQ(dbc_frame_end(s), DBC_OK);
+  ASSERT_EQ(dbc_close(s), DBC_OK);
+  ConvertOptions options;
+  options.capture = dir / "capture";
+  options.output = dir / "out" / "flat.gltf";
+  auto report = convertCapture(options);
+  ASSERT_TRUE(report) << report.error().message;
+  const auto j = readJson(options.output);
+  const auto& calibration = j["extensions"]["DYNBENCH_environment"]["light_calibration"];
+  EXPECT_EQ(calibration["source"], "map ambient");
+  const double dome = calibration["sky_dome_lux"].get<double>();
+  const double lux = calibration["lux_per_unit"].get<double>();
+  EXPECT_NEAR(lux, dome / 0.25, 1e-6 * lux);
+  const auto& lights = j["extensions"]["KHR_lights_punctual"]["lights"];
+  ASSERT_EQ(lights.size(), 2u);
+  EXPECT_EQ(lights[0]["type"], "point");
+  EXPECT_NEAR(lights[0]["intensity"].get<double>(), lux * 0.5 * 2500.0, 1e-6 * lux * 2500.0);
+  EXPECT_FALSE(lights[0].contains("range"));
+  EXPECT_EQ(lights[1]["type"], "point");
+  EXPECT_DOUBLE_EQ(lights[1]["intensity"].get<double>(), 50.0);
+  int status = 0;
+  const std::string validation = validate(options.output, status);
+  EXPECT_EQ(status, 0) << validation;
+  EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
+}
+
 TEST(Convert, TruncatedCaptureKeepsCompleteFrames) {
   const fs::path capture = writeCapture("convert_truncated");
   // Cut Capture.txt inside frame 109 (the last): keep everything before its end record.

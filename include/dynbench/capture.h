@@ -114,8 +114,8 @@ int dbc_joints(dbc_session* session, uint64_t id, const char* model_path, size_t
                const dbc_dual_quat* joints);
 /* A light. rgb: its colour as the engine has it (1: the engine's full light); range: the distance
  * (capture units) at which the engine's light falls to nothing (its radius), with `falloff` on
- * the way; 0 when it has none (the converter then keeps the inverse square without a window, and
- * falloff is ignored). */
+ * the way; 0 when it has none: the engine does not attenuate it at all (falloff is ignored; the
+ * converter gives a static one the engine's irradiance at the map's centre, docs/dataset.md). */
 int dbc_light(dbc_session* session, uint64_t id, const float position[3], const float rgb[3], float range,
               dbc_light_falloff falloff, dbc_light_type type, int dynamic, const char* model_type);
 /* Writes the end-of-frame record and flushes: the frame is complete on disk. */

@@ -37,8 +37,10 @@ void Converter::calibrateLighting() {
     luxPerUnit_ = sky_->sunIlluminanceLux / sun;
     calibration_ = {{"source", "map sun"}, {"engine_sun", sun}, {"sky_sun_lux", sky_->sunIlluminanceLux}};
   } else {
-    // No sun: the sky dome's illuminance on an open horizontal surface is the engine's sky light
-    // (what such a surface gets from it), or, without one, the engine's full light.
+    // No sun: the sky dome's illuminance on an open horizontal surface is the least light the
+    // engine gives a surface open to the sky: its sky light, or its ambient floor (Cube 2's
+    // lightmaps never go below `ambient`, and under the sky rise to `skylight`: lightmap.cpp), or,
+    // without either, the engine's full light.
     double dome = 0.0;
     if (sky_) {
       dome = horizontalIlluminance(sky_->rgb, sky_->width, sky_->height, skyParameters_.sunDisc ? sky_->sunDirection : glm::dvec3(0.0),
@@ -52,29 +54,51 @@ void Converter::calibrateLighting() {
         for (int c = 0; c < 3; ++c) rgb[3 * i + c] = image->pixels[i * static_cast<std::size_t>(image->channels) + c];
       dome = horizontalIlluminance(rgb, image->width, image->height);
     }
-    double skyLight = 1.0;
-    if (lighting && std::max({lighting->sky.r, lighting->sky.g, lighting->sky.b}) > std::max({lighting->ambient.r, lighting->ambient.g, lighting->ambient.b}))
-      skyLight = std::max({lighting->sky.r, lighting->sky.g, lighting->sky.b});
-    luxPerUnit_ = dome / skyLight;
-    calibration_ = {{"source", skyLight == 1.0 ? "sky dome = full light" : "map sky light"}, {"engine_sky_light", skyLight}, {"sky_dome_lux", dome}};
+    const double sky = lighting ? std::max({lighting->sky.r, lighting->sky.g, lighting->sky.b}) : 0.0;
+    const double ambient = lighting ? std::max({lighting->ambient.r, lighting->ambient.g, lighting->ambient.b}) : 0.0;
+    const double floor = std::max(sky, ambient);
+    luxPerUnit_ = floor > 0 ? dome / floor : dome;
+    calibration_ = {{"source", floor <= 0 ? "sky dome = full light" : sky >= ambient ? "map sky light" : "map ambient"},
+                    {"engine_sky_light", floor > 0 ? floor : 1.0},
+                    {"sky_dome_lux", dome}};
   }
   calibration_["lux_per_unit"] = luxPerUnit_;
 }
 
 std::pair<glm::dvec3, double> Converter::lightColorIntensity(const glm::dvec3& capturedColor, double range, LightFalloff falloff,
-                                                            const std::string& modelType, double share) const {
+                                                            const std::string& modelType, double share, double constantAt) const {
   // Engines have negative lights that darken (Cube 2 does); glTF lights only add light, and
   // KHR_lights_punctual colours are in [0, 1]: negative channels become 0.
   const glm::dvec3 captured = glm::max(capturedColor, glm::dvec3(0.0));
   const double peak = std::max({captured.r, captured.g, captured.b});
   const LightRule& rule = options_.lightRules.rule(modelType);
   const glm::dvec3 color = peak > 0 ? captured / peak : glm::dvec3(1.0);
-  const double candela = range > 0 ? luxPerUnit_ * range * range * fluxFactor(falloff) : options_.lightRules.candelaPerUnit;
-  return {color, candela * peak * rule.intensityScale * share};
+  const double perUnit = constantAt > 0 ? luxPerUnit_ * constantAt * constantAt
+                         : range > 0    ? luxPerUnit_ * range * range * fluxFactor(falloff)
+                                        : options_.lightRules.candelaPerUnit;
+  return {color, perUnit * peak * rule.intensityScale * share};
+}
+
+bool Converter::hasConstantIrradiance(const LightRecord& l) {
+  return !l.dynamic && l.type == LightType::kPoint && l.range <= 0 && l.falloff == LightFalloff::kNone;
+}
+
+double Converter::distanceToMapCentre(const glm::dvec3& position) const {
+  const auto& settings = reader_->settings();
+  glm::dvec3 lo(std::numeric_limits<double>::max()), hi(std::numeric_limits<double>::lowest());
+  if (int model = reader_->modelIndex(settings.mapName); !settings.mapName.empty() && model >= 0)
+    for (const auto& mesh : reader_->models()[static_cast<std::size_t>(model)].meshes)
+      for (const auto& p : mesh.positions) {
+        lo = glm::min(lo, glm::dvec3(p) + settings.mapOffset);
+        hi = glm::max(hi, glm::dvec3(p) + settings.mapOffset);
+      }
+  // Without map geometry: one capture unit, the irradiance the engine's light has there.
+  return lo.x <= hi.x ? std::max(glm::length((lo + hi) * 0.5 - position), 1.0) : 1.0;
 }
 
 int Converter::lightDefinition(const LightRecord& l, double share) {
-  const auto [color, intensity] = lightColorIntensity(l.color, l.range, l.falloff, l.modelType, share);
+  const auto [color, intensity] = lightColorIntensity(l.color, l.range, l.falloff, l.modelType, share,
+                                                      hasConstantIrradiance(l) ? distanceToMapCentre(l.position) : 0.0);
   json light = {{"type", l.type == LightType::kSpot ? "spot" : l.type == LightType::kDirectional ? "directional" : "point"},
                 {"color", vec(color)},
                 {"intensity", intensity},

@@ -186,7 +186,7 @@ void Converter::passTwo() {
                                                                          static_cast<float>(t->heldTranslation.y),
                                                                          static_cast<float>(t->heldTranslation.z)});
       if (t->colorOffset) {
-        const auto [color, intensity] = lightColorIntensity(t->heldColor, t->heldRange, t->light.falloff, t->light.modelType, t->lightShare);
+        const auto [color, intensity] = lightColorIntensity(t->heldColor, t->heldRange, t->light.falloff, t->light.modelType, t->lightShare, 0.0);
         t->color.put(std::array<float, 3>{static_cast<float>(color.r), static_cast<float>(color.g), static_cast<float>(color.b)});
         t->intensity.put(static_cast<float>(intensity));
         if (t->rangeOffset) t->range.put(static_cast<float>(t->heldRange));

@@ -170,9 +170,19 @@ class Converter {
 
   // KHR_lights_punctual colour (the captured colour over its largest channel) and intensity of a
   // captured light under the light rules; `share` divides it between a ring's lights. A light with
-  // a range gets the flux the engine's falloff gives within it (docs/dataset.md, "Lights").
+  // a range gets the flux the engine's falloff gives within it; a light of constant irradiance at
+  // `constantAt` (> 0: its distance to the map's centre) the engine's irradiance there
+  // (docs/dataset.md, "Lights").
   std::pair<glm::dvec3, double> lightColorIntensity(const glm::dvec3& captured, double range, LightFalloff falloff,
-                                                    const std::string& modelType, double share) const;
+                                                    const std::string& modelType, double share, double constantAt) const;
+
+  // A static light the engine does not attenuate (falloff `none`; Cube 2's lights of radius 0,
+  // which maps use as a sun) lights every surface with its full colour however far: a constant
+  // irradiance, which no KHR_lights_punctual light gives. It stays a point light, so that its
+  // shadows fall as the engine's do (a directional light from the same place casts them up to
+  // 30 degrees off on colos), with the engine's irradiance at the centre of the map's bounds.
+  static bool hasConstantIrradiance(const LightRecord& l);
+  double distanceToMapCentre(const glm::dvec3& position) const;
 
   // The generated sky (when there is no --env) and the illuminance of the engine's full light,
   // from the map's lighting: computed before any light is written.
