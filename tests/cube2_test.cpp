@@ -192,6 +192,58 @@ TEST(Cube2, SecondMapConvertsAndValidates) {
               j["camera_motion"]["rotation_degrees"]["mean"].get<double>());
 }
 
+// The game as oracle (docs/fidelity.md): two_towers, which has water, so that the engine also
+// draws the world reflected, in third person, with the followed player's own body in it. The
+// game's own frames and the dataset's renders of them agree in depth and lighting, and the
+// dataset holds no player model where the followed player stands (the camera's own body, which
+// the first-person view leaves out, once recorded from the reflection and seen looking down).
+TEST(Cube2, TheGamesOwnFramesAgreeWithTheDatasetsRenderOfThem) {
+  DYNBENCH_NEEDS(test::missingCube2());
+  const auto dir = test::freshDir("cube2_fidelity");
+  auto r = dynbench(fmt::format("capture cube2 -o {} --map two_towers --bots 3 --seconds 2 --seed 1 --width 320 --height 180 --game-frames 40,100",
+                                (dir / "cap").string()),
+                    dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* file : {"game/frame_00040.ppm", "game/frame_00040_depth.pfm", "game/frame_00100.ppm", "game/frame_00100_depth.pfm"})
+    EXPECT_TRUE(fs::exists(dir / "cap" / file)) << file;
+  r = dynbench(fmt::format("convert {} -o {}", (dir / "cap").string(), (dir / "ds" / "two_towers.gltf").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = dynbench(fmt::format("fidelity {} {} -o {}", (dir / "cap").string(), (dir / "ds" / "two_towers.gltf").string(), (dir / "fid").string()), dir);
+  EXPECT_EQ(r.status, 0) << r.out << r.err;
+  const auto report = nlohmann::json::parse(test::slurp(dir / "fid" / "fidelity.json"));
+  ASSERT_EQ(report["frames"].size(), 2u);
+  for (const auto& f : report["frames"]) {
+    EXPECT_GE(f["depth_agreement"].get<double>(), 0.95) << f;
+    EXPECT_GE(f["correlation"].get<double>(), 0.4) << f;
+    EXPECT_LE(f["unlit_share"].get<double>(), 0.15) << f;
+  }
+
+  auto dataset = scene::loadScene(dir / "ds" / "two_towers.gltf");
+  ASSERT_TRUE(dataset) << dataset.error().message;
+  const scene::Evaluator evaluator(*dataset);
+  int cameraNode = -1;
+  std::vector<int> players;
+  for (std::size_t n = 0; n < dataset->nodes.size(); ++n) {
+    if (dataset->nodes[n].camera >= 0) cameraNode = static_cast<int>(n);
+    if (dataset->nodes[n].name.starts_with("model_") && dataset->nodes[n].name.ends_with("snoutx10k")) players.push_back(static_cast<int>(n));
+  }
+  ASSERT_GE(cameraNode, 0);
+  ASSERT_FALSE(players.empty());
+  // Two players' bodies cannot overlap (Cube 2's player radius is 4.1 units), so a body whose
+  // origin (its feet) is within 2 units of straight below the camera is the camera's own.
+  for (int frame = 0; frame < 120; frame += 5) {
+    const double t = frame / 60.0;
+    const glm::dvec3 eye(evaluator.worldMatrix(cameraNode, t)[3]);
+    for (const int p : players) {
+      if (!evaluator.visible(p, t)) continue;
+      const glm::dvec3 feet(evaluator.worldMatrix(p, t)[3]);
+      const double below = eye.y - feet.y, aside = glm::length(glm::dvec2(eye.x - feet.x, eye.z - feet.z));
+      EXPECT_FALSE(aside < 2.0 && below > 0.0 && below < 20.0)
+          << dataset->nodes[static_cast<std::size_t>(p)].name << " stands where the camera is at frame " << frame;
+    }
+  }
+}
+
 TEST(Cube2, PresetsSetGameSettingsAndExplicitOptionsWin) {
   capture::Cube2Options o;
   ASSERT_TRUE(capture::applyCube2Preset("hard", o));

@@ -39,7 +39,7 @@ inline std::string missingGltfValidator() {
 inline std::string missingCube2() {
   if (!capture::findCube2Client({})) return "the Cube 2 client is not built (scripts/setup.sh, then cmake --build)";
   if (!std::filesystem::exists("/usr/share/games/cube2/packages/base/colos.ogz")) return "Debian's cube2-data is not installed";
-  if (!onPath("xvfb-run")) return "xvfb-run is not installed (Debian package xvfb)";
+  if (!onPath("Xvfb")) return "Xvfb is not installed (Debian package xvfb)";
   return {};
 }
 

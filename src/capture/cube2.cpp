@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "capture/check.h"
+#include "capture/xvfb.h"
 #include "core/files.h"
 #include "core/process.h"
 #include "core/runtime_files.h"
@@ -94,7 +95,7 @@ Expected<Cube2Report> captureCube2(const Cube2Options& o, const Cube2Progress& p
   if (!fs::exists(o.data / "packages" / "base" / (o.map + ".ogz"), ec))
     return fail(ErrorCode::kIo, "map '{}' not found in {} (Debian's cube2-data has colos, cyber1, md2, ...)", o.map,
                 (o.data / "packages" / "base").string());
-  if (!o.window && findOnPath("xvfb-run").empty()) return fail(ErrorCode::kExternalTool, "xvfb-run is missing: install Debian's xvfb (scripts/setup.sh does)");
+  if (!o.window && findOnPath("Xvfb").empty()) return fail(ErrorCode::kExternalTool, "Xvfb is missing: install Debian's xvfb (scripts/setup.sh does)");
   if (fs::exists(o.output / "Capture.txt", ec))
     return fail(ErrorCode::kUsage, "{}: already holds a capture; choose an empty folder", o.output.string());
   fs::create_directories(o.output, ec);
@@ -125,14 +126,20 @@ Expected<Cube2Report> captureCube2(const Cube2Options& o, const Cube2Progress& p
     }
     game.environment.emplace_back("DYNBENCH_CAPTURE_GAME_FRAMES", list);
   }
-  game.argv = {"timeout", fmt::format("{}", timeout)};
-  // xvfb-run -a searches upwards from -n for a free display; two runs starting together from the
-  // same number can race for it, so each starts from its own (by process id).
-  if (!o.window)
-    game.argv.insert(game.argv.end(), {"xvfb-run", "-a", "-n", fmt::format("{}", 100 + ::getpid() % 5000), "-s",
-                                       fmt::format("-screen 0 {}x{}x24", o.width, o.height)});
-  game.argv.insert(game.argv.end(), {"./" + client->filename().string(), "-q" + fs::absolute(home).string(), "-k" + fs::absolute(o.data).string(),
-                                     "-r", "-t0", fmt::format("-w{}", o.width), fmt::format("-h{}", o.height), "-x" + *script});
+  // The game's own display (capture/xvfb.h: why not xvfb-run), stopped when the capture ends.
+  std::optional<XvfbDisplay> display;
+  if (!o.window) {
+    auto started = XvfbDisplay::start(o.width, o.height);
+    if (!started) {
+      fs::remove_all(home, ec);
+      return std::unexpected(started.error());
+    }
+    display.emplace(std::move(*started));
+    game.environment.emplace_back("DISPLAY", display->name());
+  }
+  game.argv = {"timeout", fmt::format("{}", timeout), "./" + client->filename().string(), "-q" + fs::absolute(home).string(),
+               "-k" + fs::absolute(o.data).string(), "-r", "-t0", fmt::format("-w{}", o.width), fmt::format("-h{}", o.height),
+               "-x" + *script};
   std::size_t frames = 0;
   std::optional<std::chrono::steady_clock::time_point> captureClosed;  // when the client said the capture is complete
   game.onLine = [&](std::string_view line) {

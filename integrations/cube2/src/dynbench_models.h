@@ -23,7 +23,8 @@
 // game entity (players, their attachments) keeps its id while it is rendered in consecutive frames
 // for the same entity; a part rendered without one (projectiles, gibs, items) takes the id of the
 // nearest instance of the same part in the previous frame, within kDynbenchMaxStepUnits (dynbench_capture.h). The same thing
-// rendered again in one frame (shadow, reflection passes) is recorded once.
+// rendered again in one frame (shadow, glare passes) is recorded once; water reflections, which
+// draw the followed player's own body, are not recorded.
 //
 // Map models are recorded once as static models, except those with a skeletal animation of their
 // own (ANIM_MAPMODEL), which are evaluated every recorded frame and recorded like any skinned model,
@@ -297,6 +298,11 @@ void animmodel::dynbench_capture_part(part *p, const animstate *as, float pitch,
   if (!exportingStatic && !mapModelOwner) {
     if (anim & ANIM_NORENDER) return;  // not drawn (e.g. computed only for its tags)
     if (!d && isMapModel(p->model)) return;  // recorded once as a static model, or by its own pass when animated
+    // A water reflection draws the world as seen from below the water, in third person
+    // (isthirdperson() is true while reflecting): the followed player's own body, which the
+    // first-person view leaves out, is drawn there and nowhere else. Everything else a reflection
+    // draws, the main pass draws too (culling is off while capturing).
+    if (reflecting) return;
   }
   const dynent *owner = d ? d : mapModelOwner;
   const matrix4 &world = matrixstack[matrixpos];
