@@ -449,8 +449,15 @@ void dynbench_capture_init() {
       state.gameFrames.add(k);
       p = *end == ',' ? end + 1 : end;
     }
-  // The game's own frames are compared with renders of the world: no HUD text over them.
-  if (state.gameFrames.length()) execute("hidehud 1");
+  // The game's own frames are compared with renders of the world: no HUD over them, and none of
+  // the text the game floats in the world (players' names, damage numbers: particletext; status
+  // icons and bars above players).
+  if (state.gameFrames.length()) {
+    execute("hidehud 1");
+    execute("particletext 0");
+    execute("statusicons 0");
+    execute("statusbars 0");
+  }
   copystring(state.directory, dir);
   seedMT(state.seed);
   // Occlusion queries answer when the GPU gets to them, not at a fixed frame: what is drawn, and
