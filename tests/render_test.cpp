@@ -157,11 +157,12 @@ PlaneScene pointLightOverPlane() {
 
 TEST(Render, PointLightOverDiffusePlaneGivesTheAnalyticRadianceWithoutNoise) {
   // L = (albedo / pi) I cos(theta) / d^2 = (albedo / pi) I h / d^3 at a point of the plane y = 0.
-  // Punctual light is summed, not sampled, and radiance is taken at the pixel centre's hit: one
-  // sample gives the exact answer, with zero variance.
+  // Punctual light is summed, not sampled, and with the centre "filter" radiance is taken at the
+  // pixel centre's hit: one sample gives the exact answer, with zero variance.
   const PlaneScene p = pointLightOverPlane();
   for (const int spp : {1, 4}) {
     RenderSettings settings;
+    settings.pixelFilter = {PixelFilterType::kCentre, 0.0};
     settings.samplesPerPixel = spp;
     settings.useEnvironment = false;
     auto tracer = tracerFor(p.scene, settings);
@@ -304,6 +305,8 @@ TEST(Render, ARoomLitByAHundredPointLightsRendersAsEvaluatingEveryLight) {
   tree.lightsPerPoint = 4;
   every.lightsPerPoint = 0;
   every.seed = 2;
+  // At the pixel centres, so that evaluating every light is exact (no pixel filter's noise).
+  tree.pixelFilter = every.pixelFilter = {PixelFilterType::kCentre, 0.0};
   auto tt = tracerFor(s, tree), te = tracerFor(s, every);
   ASSERT_TRUE(tt && te);
   ASSERT_TRUE(tt->setTime(0, 0));

@@ -21,6 +21,8 @@ struct RenderCli {
   std::string resolution = fmt::format("{}x{}", render::RenderSettings{}.width, render::RenderSettings{}.height);
   std::optional<std::string> envConstant;
   bool noEnvironment = false;
+  std::string pixelFilter = render::pixelFilterName(render::PixelFilterSpec{}.type);
+  std::optional<double> pixelFilterWidth;
   bool slurm = false;
   pipeline::slurm::Options slurmOptions;
 };
@@ -61,6 +63,9 @@ Expected<void> runRender(const RenderCli& cli) {
   job.settings.width = res->first;
   job.settings.height = res->second;
   job.settings.useEnvironment = !cli.noEnvironment;
+  auto filter = render::parsePixelFilter(cli.pixelFilter);
+  if (!filter) return std::unexpected(filter.error());
+  job.settings.pixelFilter = {*filter, cli.pixelFilterWidth.value_or(render::defaultPixelFilterWidth(*filter))};
   if (cli.envConstant) {
     double r = 0, g = 0, b = 0;
     const int n = std::sscanf(cli.envConstant->c_str(), "%lf,%lf,%lf", &r, &g, &b);
@@ -150,6 +155,13 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
   cmd->add_flag("--jitter", o->job.settings.jitter,
                 "Offset each frame's pixel samples from the centres by the 8-frame Halton (2, 3) sequence, as TAA input "
                 "(recorded as camera.jitter in each sidecar; docs/feature-buffers.md)");
+  cmd->add_option("--pixel-filter", o->pixelFilter,
+                  "Reconstruction filter of the radiance buffers: blackman-harris (Cycles' default), box, or centre (every path from "
+                  "the pixel centre's hit: radiance at a point, aliased; docs/feature-buffers.md)")
+      ->capture_default_str();
+  cmd->add_option("--pixel-filter-width", o->pixelFilterWidth,
+                  "Filter width in pixels, as Cycles' filter_width (default: 1.5 for blackman-harris, 1 for box)")
+      ->check(CLI::Range(1e-3, 8.0));
   cmd->add_flag("--converge", o->job.settings.converge,
                 "Adaptive sampling: after max(--spp, 16) samples, sample each pixel in rounds until the standard error of its direct and of its "
                 "indirect luminance is at most --tolerance x discard's radiance threshold (docs/feature-buffers.md), or --max-spp");

@@ -294,6 +294,9 @@ std::vector<std::string> renderArguments(const render::RenderJob& job) {
   else if (!s.useEnvironment)
     a.push_back("--no-environment");
   if (s.jitter) a.push_back("--jitter");
+  a.insert(a.end(), {"--pixel-filter", render::pixelFilterName(s.pixelFilter.type)});
+  if (s.pixelFilter.type != render::PixelFilterType::kCentre)
+    a.insert(a.end(), {"--pixel-filter-width", fmt::format("{:.17g}", s.pixelFilter.width)});
   if (s.converge)
     a.insert(a.end(), {"--converge", "--tolerance", fmt::format("{:.17g}", s.tolerance), "--max-spp", std::to_string(s.maxSamplesPerPixel)});
   a.insert(a.end(), {"--lights-per-point", std::to_string(s.lightsPerPoint)});

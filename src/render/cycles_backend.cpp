@@ -66,11 +66,16 @@ Expected<fs::path> findBlender(const std::string& blender) {
               blender);
 }
 
-Expected<frames::FeatureFrame> cyclesPassesToContract(const FloatImage& passes, const fs::path& source, const RenderCamera& camera) {
+Expected<frames::FeatureFrame> cyclesPassesToContract(const FloatImage& passes, const fs::path& source, const RenderCamera& camera,
+                                                      const FloatImage* geometryPasses) {
   const Passes p(passes);
+  const Passes g(geometryPasses ? *geometryPasses : passes);
   for (const char* required : {"Position.X", "Normal.X", "DiffDir.R", "DiffInd.R", "DiffCol.R", "Depth.Z"})
-    if (p.find(required) < 0)
+    if (p.find(required) < 0 || g.find(required) < 0)
       return fail(ErrorCode::kParse, "{}: Cycles output lacks the {} pass", source.string(), required);
+  if (geometryPasses && (geometryPasses->width != passes.width || geometryPasses->height != passes.height))
+    return fail(ErrorCode::kParse, "{}: Cycles' geometry render is {}x{}, its radiance render {}x{}", source.string(), geometryPasses->width,
+                geometryPasses->height, passes.width, passes.height);
   frames::FeatureFrame out;
   out.width = passes.width;
   out.height = passes.height;
@@ -82,11 +87,12 @@ Expected<frames::FeatureFrame> cyclesPassesToContract(const FloatImage& passes, 
   const char* rgb = "RGB";
   const glm::dvec3 forward = -glm::dvec3(camera.world()[2]);
   for (std::size_t i = 0; i < n; ++i) {
-    const bool hit = p.at(i, p.find("Depth.Z")) < 1e9f;
+    // The geometry passes from the centre's render (the radiance render's own without a filter).
+    const bool hit = g.at(i, g.find("Depth.Z")) < 1e9f;
     // Blender world (x, y, z) is glTF (x, z, -y).
     auto toGltf = [](glm::dvec3 b) { return glm::dvec3(b.x, b.z, -b.y); };
-    const glm::dvec3 position = toGltf({p.at(i, p.find("Position.X")), p.at(i, p.find("Position.Y")), p.at(i, p.find("Position.Z"))});
-    const glm::dvec3 normal = toGltf({p.at(i, p.find("Normal.X")), p.at(i, p.find("Normal.Y")), p.at(i, p.find("Normal.Z"))});
+    const glm::dvec3 position = toGltf({g.at(i, g.find("Position.X")), g.at(i, g.find("Position.Y")), g.at(i, g.find("Position.Z"))});
+    const glm::dvec3 normal = toGltf({g.at(i, g.find("Normal.X")), g.at(i, g.find("Normal.Y")), g.at(i, g.find("Normal.Z"))});
     for (int c = 0; c < 3; ++c) {
       const std::size_t k = 3 * i + static_cast<std::size_t>(c);
       out.position[k] = hit ? static_cast<float>(position[c]) : 0.0f;
@@ -100,7 +106,7 @@ Expected<frames::FeatureFrame> cyclesPassesToContract(const FloatImage& passes, 
       }
       out.direct[k] = static_cast<float>(direct);
       out.indirect[k] = static_cast<float>(indirect);
-      out.albedo[k] = p.at(i, p.find("DiffCol." + ch));
+      out.albedo[k] = g.at(i, g.find("DiffCol." + ch));
     }
     out.depth[i] = hit ? static_cast<float>(glm::dot(position - camera.position(), forward)) : 0.0f;
     out.hit[i] = hit ? 1.0f : 0.0f;
@@ -139,6 +145,8 @@ Expected<void> CyclesBackend::render(const std::vector<FrameRequest>& requests, 
   j["bounces"] = job.settings.bounces;
   j["seed"] = job.settings.seed;
   j["threads"] = job.threads;
+  const bool filtered = job.settings.pixelFilter.type != PixelFilterType::kCentre;
+  j["pixel_filter"] = {{"type", pixelFilterName(job.settings.pixelFilter.type)}, {"width", job.settings.pixelFilter.width}};
   if (job.settings.constantEnvironment)
     j["environment"] = {{"kind", "constant"},
                         {"radiance", {job.settings.constantEnvironment->r, job.settings.constantEnvironment->g, job.settings.constantEnvironment->b}}};
@@ -154,6 +162,7 @@ Expected<void> CyclesBackend::render(const std::vector<FrameRequest>& requests, 
                             {"time", c.time},
                             {"output", fs::absolute(work / fmt::format("cycles_{:05d}.exr", request.frame)).string()},
                             {"camera", {{"world", frames::matrixJson(c.camera.world())}, {"yfov", c.camera.yfov()}, {"znear", c.camera.znear()}, {"zfar", c.camera.zfar()}}}};
+    if (filtered) frame["geometry_output"] = fs::absolute(work / fmt::format("cycles_{:05d}_geometry.exr", request.frame)).string();
     evaluator.evaluate(c.time, pose);
     frame["lights"] = nlohmann::json::array();
     for (std::size_t n = 0; n < scene.nodes.size(); ++n) {
@@ -185,10 +194,17 @@ Expected<void> CyclesBackend::render(const std::vector<FrameRequest>& requests, 
     // Hand the finished frame over right away, so an interrupted run keeps it.
     const std::size_t k = finished++;
     const fs::path raw = j["frames"][k]["output"].get<std::string>();
+    const fs::path rawGeometry = filtered ? j["frames"][k]["geometry_output"].get<std::string>() : std::string();
     auto frame = [&]() -> Expected<void> {
       auto passes = readImage(raw);
       if (!passes) return std::unexpected(passes.error());
-      auto image = cyclesPassesToContract(*passes, raw, requests[k].cameras.camera);
+      std::optional<FloatImage> geometry;
+      if (filtered) {
+        auto g = readImage(rawGeometry);
+        if (!g) return std::unexpected(g.error());
+        geometry = std::move(*g);
+      }
+      auto image = cyclesPassesToContract(*passes, raw, requests[k].cameras.camera, geometry ? &*geometry : nullptr);
       if (!image) return std::unexpected(image.error());
       image->frame = requests[k].frame;
       image->time = requests[k].cameras.time;
@@ -200,6 +216,7 @@ Expected<void> CyclesBackend::render(const std::vector<FrameRequest>& requests, 
     }
     std::error_code removeError;
     fs::remove(raw, removeError);
+    if (filtered) fs::remove(rawGeometry, removeError);
     if (rows && finished < requests.size()) rows(finished, 0);
     return true;
   };

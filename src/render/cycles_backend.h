@@ -22,7 +22,10 @@ Expected<std::filesystem::path> findBlender(const std::string& blender);
 
 // The backend itself: createCyclesBackend (render/backend.h).
 
-// One Cycles multilayer EXR (Blender's pass names) to the contract's channels.
-Expected<frames::FeatureFrame> cyclesPassesToContract(const FloatImage& passes, const std::filesystem::path& source, const RenderCamera& camera);
+// One Cycles multilayer EXR (Blender's pass names) to the contract's channels: the radiance from
+// `passes`, the geometry (P, N, Z, hit, albedo) from `geometryPasses` when given (a render of the
+// same frame at the pixel centres, when the radiance went through a pixel filter), else from `passes`.
+Expected<frames::FeatureFrame> cyclesPassesToContract(const FloatImage& passes, const std::filesystem::path& source, const RenderCamera& camera,
+                                                      const FloatImage* geometryPasses = nullptr);
 
 }  // namespace dynbench::render

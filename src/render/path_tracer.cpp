@@ -41,13 +41,16 @@ struct PathTracer::Shading {
   double emissiveWeight = 0.0;      // luminance of the emissive factor (the light choice's weight)
 };
 
-PathTracer::PathTracer(const scene::Scene& scene, const RenderSettings& settings) : scene_(scene), settings_(settings) {}
+PathTracer::PathTracer(const scene::Scene& scene, const RenderSettings& settings)
+    : scene_(scene), settings_(settings), filter_(settings.pixelFilter) {}
 PathTracer::~PathTracer() = default;
 
 Expected<std::unique_ptr<PathTracer>> PathTracer::create(const scene::Scene& scene, const RenderSettings& settings,
                                                          std::vector<std::string>& warnings) {
   if (settings.width <= 0 || settings.height <= 0 || settings.samplesPerPixel <= 0 || settings.bounces < 0 || settings.pathBatch <= 0)
     return fail(ErrorCode::kUsage, "render settings: resolution, samples and path batch must be positive, bounces non-negative");
+  if (settings.pixelFilter.type != PixelFilterType::kCentre && !(settings.pixelFilter.width > 0 && settings.pixelFilter.width <= 8))
+    return fail(ErrorCode::kUsage, "--pixel-filter-width {}: expected a width in pixels in (0, 8]", settings.pixelFilter.width);
   std::unique_ptr<PathTracer> tracer(new PathTracer(scene, settings));
   auto textures = TextureSet::load(scene, warnings);
   if (!textures) return std::unexpected(textures.error());
@@ -269,8 +272,8 @@ struct PathTracer::PathState {
 
 // A pixel whose paths wait in the thread's queue (PathScratch::queue): its camera ray and first
 // hit, the same for every path of the pixel (the same hit seen from the same direction), so its
-// shading and ray origin are found once; and its samples still to be
-// traced, [next, upTo).
+// shading and ray origin are found once; and its samples still to be traced, [next, upTo). With a
+// pixel filter each path traces its own camera ray: `hit` is null and `ray` unused.
 struct PathTracer::FirstVertex {
   std::size_t pixel = 0;
   Ray ray;
@@ -302,8 +305,9 @@ struct PathTracer::PathScratch {
 };
 
 void PathTracer::tracePaths(std::span<PathState> paths, PathScratch& scratch) const {
+  // A path's camera ray is set by whoever queued it (its pixel's, or its own through the filter).
+  const bool ownCameraRays = !filter_.atCentre();
   for (PathState& p : paths) {
-    p.ray = p.first->ray;
     p.throughput = glm::dvec3(1.0);
     p.out = PathSample{};
     p.previousBsdfPdf = 0.0;
@@ -318,7 +322,8 @@ void PathTracer::tracePaths(std::span<PathState> paths, PathScratch& scratch) co
     // Stage 1: trace; start loading the hit's texture coordinates and the environment pixel of an
     // escape; start the light choice (which loads the table entry stage 2 reads).
     bool any = false;
-    if (depth > 0) {
+    const bool streamed = depth > 0 || ownCameraRays;  // this depth's hits come from the stream
+    if (streamed) {
       scratch.streamRays.clear();
       for (PathState& p : paths)
         if (p.active) scratch.streamRays.push_back(p.ray);
@@ -331,7 +336,7 @@ void PathTracer::tracePaths(std::span<PathState> paths, PathScratch& scratch) co
       scratch.rays += scratch.streamRays.size();
     }
     // The hits are read where the stream left them (a hit record is 150 bytes: not copied).
-    auto hitOf = [&](const PathState& p) -> const SurfaceHit& { return depth == 0 ? *p.first->hit : scratch.streamHits[p.streamIndex]; };
+    auto hitOf = [&](const PathState& p) -> const SurfaceHit& { return streamed ? scratch.streamHits[p.streamIndex] : *p.first->hit; };
     auto escaped = [&](const PathState& p) { return p.active && !hitOf(p).hit && environment_; };
     std::size_t escapes = 0;
     for (PathState& p : paths) {
@@ -342,7 +347,7 @@ void PathTracer::tracePaths(std::span<PathState> paths, PathScratch& scratch) co
         if (environment_) scratch.equirect.setDirection(escapes++, p.ray.direction);
         continue;
       }
-      if (depth > 0) prefetchTexCoords(hit);
+      if (streamed) prefetchTexCoords(hit);
       if (lightSample && shadesHere) {
         const double uChoice = p.rng.uniform();
         const glm::dvec2 uLight = p.rng.uniform2();
@@ -368,7 +373,7 @@ void PathTracer::tracePaths(std::span<PathState> paths, PathScratch& scratch) co
       if (!p.active) continue;
       const SurfaceHit& hit = hitOf(p);
       if (!hit.hit) continue;
-      if (depth > 0) {
+      if (streamed) {
         p.uv = texCoord(hit);
         prefetchTextures(hit, p.uv);
       }
@@ -383,7 +388,7 @@ void PathTracer::tracePaths(std::span<PathState> paths, PathScratch& scratch) co
     // once (BsdfBatch); then each path's light sample (its shadow ray) and its bounce.
     std::size_t lanes = 0;
     for (PathState& p : paths)
-      if (p.active) p.active = advance(p, depth, hitOf(p), depth == 0 ? p.first : nullptr, scratch, lanes);
+      if (p.active) p.active = advance(p, depth, hitOf(p), streamed ? nullptr : p.first, scratch, lanes);
     if (lanes > 0) scratch.bsdfs.run(lanes);
     for (PathState& p : paths)
       if (p.active) p.active = bounce(p, depth, scratch);
@@ -557,13 +562,22 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
     const int px = static_cast<int>(pixel % static_cast<std::size_t>(width)), py = static_cast<int>(pixel / static_cast<std::size_t>(width));
     return camera.ray(px + 0.5 + jitter.x, py + 0.5 + jitter.y);
   };
-  // A pixel's samples up to `upTo`: one environment lookup where its camera ray `ray` escapes, else
-  // its paths queued in the thread's scratch (`known`: the first hit's shading when the caller has
-  // it already, the first round's buffers). flush traces them.
+  // With a pixel filter: a radiance sample's own camera ray, through the (jittered) pixel centre
+  // offset by the filter, from the first two numbers of the sample's random stream.
+  const bool filtered = !filter_.atCentre();
+  auto filteredRay = [&](std::size_t pixel, Random& rng) {
+    const int px = static_cast<int>(pixel % static_cast<std::size_t>(width)), py = static_cast<int>(pixel / static_cast<std::size_t>(width));
+    const glm::dvec2 offset = filter_.offset(rng.uniform2());
+    return camera.ray(px + 0.5 + jitter.x + offset.x, py + 0.5 + jitter.y + offset.y);
+  };
+  // A pixel's samples up to `upTo`: at the pixel centre, one environment lookup where its camera
+  // ray `ray` escapes, else its paths queued in the thread's scratch (`known`: the first hit's
+  // shading when the caller has it already, the first round's buffers); with a filter, its paths
+  // queued to trace their own camera rays. flush traces them.
   auto enqueue = [&](std::size_t pixel, const Ray& ray, int upTo, PathScratch& scratch, const Shading* known = nullptr) {
     const SurfaceHit& hit = firstHits[pixel];
     PixelSums& sum = sums[pixel];
-    if (!hit.hit) {
+    if (!filtered && !hit.hit) {
       // The camera sees the environment: a single lookup, no noise.
       const glm::dvec3 le = environment_ ? environment_->radiance(ray.direction) : glm::dvec3(0.0);
       while (sum.samples < upTo) sum.add(le, glm::dvec3(0.0));
@@ -574,10 +588,12 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
     FirstVertex& v = scratch.queue[scratch.queueEnd++];
     v.pixel = pixel;
     v.ray = ray;
-    v.hit = &hit;
-    if (known) v.shading = *known;
-    else shade(hit, -ray.direction, texCoord(hit), v.shading);
-    v.origin = offsetOrigin(hit.position, v.shading.geometricNormal);
+    v.hit = filtered ? nullptr : &hit;
+    if (!filtered) {
+      if (known) v.shading = *known;
+      else shade(hit, -ray.direction, texCoord(hit), v.shading);
+      v.origin = offsetOrigin(hit.position, v.shading.geometricNormal);
+    }
     v.next = sum.samples;
     v.upTo = upTo;
   };
@@ -603,6 +619,7 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
         for (; v.next < v.upTo && n < batch; ++v.next, ++n) {
           paths[n].first = &v;
           paths[n].rng = Random(settings_.seed, frameIndex, v.pixel, static_cast<std::uint64_t>(v.next));
+          paths[n].ray = v.hit ? v.ray : filteredRay(v.pixel, paths[n].rng);
         }
       }
       tracePaths(paths, scratch);

@@ -8,9 +8,11 @@
 // one or more further bounces. `bounces` counts those further bounces, as Cycles' "max bounces"
 // does: 0 renders direct light only.
 //
-// Every buffer of a pixel describes one surface point: the hit of the ray through the pixel
-// centre. Radiance is estimated there (paths start at that hit), not over the pixel's footprint,
-// so the discard compares radiance at the same points as world position and normal. Punctual
+// The geometry buffers of a pixel (P, N, Z, id, motion, albedo, hit) describe one surface point:
+// the hit of the ray through the pixel centre. Radiance is the pixel's: the mean of paths whose
+// camera rays are spread over the pixel by the reconstruction filter (RenderSettings::pixelFilter),
+// as Cycles' radiance passes are; with the centre "filter" every path starts at the centre's hit
+// (radiance at a point, which aliases where a texture or an edge is finer than a pixel). Punctual
 // lights are chosen at every path vertex by the light tree (LightSet::selectPunctual): where no
 // more than lightsPerPoint can reach the point they are all summed, so a scene lit by few of them
 // has noise-free direct light at 1 spp; where more can, they are sampled without bias.
@@ -27,6 +29,7 @@
 #include "render/bsdf.h"
 #include "render/camera.h"
 #include "render/lights.h"
+#include "render/pixel_filter.h"
 #include "render/raytracing_scene.h"
 #include "render/textures.h"
 
@@ -59,6 +62,11 @@ struct RenderSettings {
   // describe) is offset from the pixel centre by frames::jitterOffset(frame), as a real-time
   // renderer jitters its projection for TAA.
   bool jitter = false;
+  // render --pixel-filter: the reconstruction filter `direct` and `indirect` (and their variances)
+  // estimate the pixel's radiance through (render/pixel_filter.h): each radiance sample traces its
+  // own camera ray, offset from the (jittered) pixel centre by the filter. The geometry buffers stay
+  // the centre's. kCentre: every path starts at the centre's hit (radiance at a point, aliased).
+  PixelFilterSpec pixelFilter;
   double directThresholdFraction = 0.1, indirectThresholdFraction = 0.1;
   // Paths traced together (PathTracer::tracePaths); 1 traces one path at a time. The image does
   // not depend on it (tested): only the speed does.
@@ -142,6 +150,7 @@ class PathTracer {
 
   const scene::Scene& scene_;
   RenderSettings settings_;
+  PixelFilter filter_;
   TextureSet textures_;
   std::optional<EnvironmentLight> environment_;
   std::unique_ptr<RayTracingScene> rayTracing_;

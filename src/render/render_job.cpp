@@ -98,9 +98,11 @@ nlohmann::json renderRecord(const RenderJob& job) {
                       {"width", s.width},
                       {"height", s.height},
                       {"environment", s.constantEnvironment ? "constant" : (s.useEnvironment ? "dataset" : "none")},
-                      // Radiance at the pixel centre's hit, punctual lights summed (docs/feature-buffers.md):
-                      // frames of the earlier footprint-sampled integrator are not reused.
-                      {"radiance_at", "pixel_centre"}};
+                      // Radiance through the pixel filter, or at the pixel centre's hit
+                      // (docs/feature-buffers.md): frames of another kind are not reused.
+                      {"radiance_at", s.pixelFilter.type == PixelFilterType::kCentre ? "pixel_centre" : "pixel_filter"}};
+  if (s.pixelFilter.type != PixelFilterType::kCentre)
+    r["pixel_filter"] = {{"type", pixelFilterName(s.pixelFilter.type)}, {"width", s.pixelFilter.width}};
   if (s.converge) r["converge"] = {{"tolerance", s.tolerance}, {"max_spp", s.maxSamplesPerPixel},
                                    {"direct_threshold", s.directThresholdFraction}, {"indirect_threshold", s.indirectThresholdFraction}};
   // Point and spot lights through the light tree (frames of the earlier cut-off are not reused).

@@ -262,10 +262,18 @@ cycles.caustics_refractive = True
 cycles.blur_glossy = 0.0
 cycles.sample_clamp_direct = 0.0
 cycles.sample_clamp_indirect = 0.0
-# dynbench takes every buffer at the pixel centre's hit; Cycles' narrowest box filter (0.01 px) is
-# the closest it gets to that.
-cycles.pixel_filter_type = "BOX"
-cycles.filter_width = 0.01
+# The geometry buffers are the pixel centre's hit; Cycles' narrowest box filter (0.01 px) is the
+# closest it gets to that. The radiance goes through the job's pixel filter (docs/feature-buffers.md):
+# with one, each frame is rendered twice, first at the centre with one sample for the geometry
+# passes (Cycles averages the normal pass over the filter), then through the filter.
+CENTRE_FILTER = ("BOX", 0.01)
+pixel_filter = job.get("pixel_filter", {"type": "centre"})
+RADIANCE_FILTER = {
+    "centre": CENTRE_FILTER,
+    "box": ("BOX", pixel_filter.get("width", 1.0)),
+    "blackman-harris": ("BLACKMAN_HARRIS", pixel_filter.get("width", 1.5)),
+}[pixel_filter["type"]]
+cycles.pixel_filter_type, cycles.filter_width = CENTRE_FILTER
 
 layer = scene.view_layers[0]
 layer.use_pass_z = True
@@ -297,6 +305,13 @@ for frame in job["frames"]:
         else:
             obj.data.energy = light["intensity"] * 4.0 * math.pi
         obj.hide_render = not light["visible"]
+    if "geometry_output" in frame:
+        cycles.samples = 1
+        cycles.pixel_filter_type, cycles.filter_width = CENTRE_FILTER
+        render.filepath = frame["geometry_output"]
+        bpy.ops.render.render(write_still=True)
+    cycles.samples = job["samples_per_pixel"]
+    cycles.pixel_filter_type, cycles.filter_width = RADIANCE_FILTER
     render.filepath = frame["output"]
     bpy.ops.render.render(write_still=True)
     print("DYNBENCH_FRAME_DONE %d" % frame["frame"], flush=True)
