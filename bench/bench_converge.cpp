@@ -43,7 +43,9 @@ Outcome renderAndDiscard(const render::RenderJob& base, const fs::path& out) {
   }
   pipeline::DiscardStage discard;
   discard.frames = out;
+  discard.thresholds.geometryTest = discard::Thresholds::GeometryTest::kBilinear;  // the figures' form (docs/metrics.md)
   discard.thresholds.relativePosition = true;
+  discard.thresholds.position = discard::kBilinearPositionThreshold;
   auto d = pipeline::runDiscard(discard);
   if (!d) {
     std::fprintf(stderr, "%s\n", d.error().message.c_str());

@@ -156,7 +156,6 @@ int main(int argc, char** argv) {
 
   std::printf("\n%-28s %10s %10s\n", "method (per frame)", "ms", "core-ms");
   MethodContext context;
-  context.thresholds.relativePosition = true, context.thresholds.position = 0.01;
   context.sceneSize = discard::sceneSize(refFrame);
   for (const char* name : {"none", "accumulate", "taa", "svgf"}) {
     auto method = createMethod(name, context);

@@ -71,7 +71,6 @@ TEST(Methods, AccumulateErrorFallsAsOneOverSqrtNOnAStaticScene) {
   // The measured MSE averages P = 3 x 64 x 48 independent squared Gaussians, so its relative
   // standard deviation is sqrt(2 / P) = 1.47 %; 4 of those (5.9 %) bound each frame's ratio.
   MethodContext context;
-  context.thresholds.relativePosition = true, context.thresholds.position = 0.01;
   context.sceneSize = discard::sceneSize(planeFrame(0, 0.0, 1));
   auto method = createMethod("accumulate", context);
   ASSERT_TRUE(method.has_value());

@@ -16,12 +16,18 @@ namespace fs = std::filesystem;
 struct DiscardCli {
   std::string frames, json, csv, masks, plots;
   discard::Thresholds thresholds;
+  std::optional<double> position;  // default by the geometry test
   bool includeCuts = false;
 };
 
 Expected<void> runDiscard(const DiscardCli& cli) {
+  discard::Thresholds thresholds = cli.thresholds;
+  // --relative-position sizes the bilinear test's threshold: it asks for the thesis's test.
+  if (thresholds.relativePosition) thresholds.geometryTest = discard::Thresholds::GeometryTest::kBilinear;
+  const bool bilinear = thresholds.geometryTest == discard::Thresholds::GeometryTest::kBilinear;
+  thresholds.position = cli.position.value_or(bilinear ? discard::kBilinearPositionThreshold : discard::Thresholds{}.position);
   std::optional<Progress> progress;
-  auto outcome = pipeline::runDiscard({cli.frames, cli.thresholds, cli.includeCuts, cli.json, cli.csv, cli.masks, cli.plots},
+  auto outcome = pipeline::runDiscard({cli.frames, thresholds, cli.includeCuts, cli.json, cli.csv, cli.masks, cli.plots},
                                       [&](std::size_t done, std::size_t total) {
                                         if (!progress) progress.emplace("discard", total, "frames");
                                         progress->update(done);
@@ -40,11 +46,22 @@ void addDiscardCommand(CLI::App& app, CommandRun& run) {
   auto* cmd = app.add_subcommand("discard", "Reprojection discard percentages of a frames folder (thesis Table 6.7)");
   cmd->footer("FRAMES_DIR holds frame_NNNNN.exr + frame_NNNNN.json per frame (docs/feature-buffers.md), e.g. from\n"
               "`dynbench render`. Definitions and defaults: docs/metrics.md.\n"
-              "Example: dynbench discard frames/run1 --relative-position --json discard.json --masks masks/");
+              "Example: dynbench discard frames/run1 --json discard.json --masks masks/");
   cmd->add_option("FRAMES_DIR", o->frames, "Folder of feature-buffer frames")->required();
-  cmd->add_option("--threshold-position", o->thresholds.position, "World-position distance, scene units (a fraction of the scene's size with --relative-position)")
+  using Geometry = discard::Thresholds::GeometryTest;
+  cmd->add_option("--geometry-test", o->thresholds.geometryTest,
+                  "taps (default): each bilinear tap of the history on its own, its distance from the pixel's tangent plane against "
+                  "--threshold-position x the view depth (as SVGF and NRD test history); bilinear: the thesis's test on the bilinear "
+                  "sample, position in scene units (docs/metrics.md)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, Geometry>{{"taps", Geometry::kTaps}, {"bilinear", Geometry::kBilinear}}));
+  cmd->add_option("--threshold-position", o->position,
+                  fmt::format("World position: taps: plane distance as a fraction of the view depth (default {}); bilinear: distance in "
+                              "scene units (default {}), a fraction of the scene's size with --relative-position",
+                              discard::Thresholds{}.position, discard::kBilinearPositionThreshold))
       ->check(nonNegative());
-  cmd->add_flag("--relative-position", o->thresholds.relativePosition, "Position threshold as a fraction of the scene's size");
+  cmd->add_flag("--relative-position", o->thresholds.relativePosition,
+                "The thesis's bilinear test (implies --geometry-test bilinear) with the position threshold as a fraction of the first "
+                "frame's scene size");
   cmd->add_option("--threshold-normal", o->thresholds.normal, "Shading-normal vector distance (0.1: a turn of about 5.7 degrees)")->check(nonNegative());
   cmd->add_option("--threshold-direct", o->thresholds.direct,
                   "Direct radiance distance, a fraction of the frame's mean luminance")

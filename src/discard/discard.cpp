@@ -93,7 +93,7 @@ double sceneSize(const FeatureFrame& frame) {
 
 Thresholds absoluteThresholds(const Thresholds& t, const FeatureFrame& current, double size) {
   Thresholds a = t;
-  if (t.relativePosition) a.position = t.position * size;
+  if (t.relativePosition && t.geometryTest == Thresholds::GeometryTest::kBilinear) a.position = t.position * size;
   if (!t.absoluteRadiance) {
     a.direct = t.direct * meanLuminance(current.direct);
     a.indirect = t.indirect * meanLuminance(current.indirect);
@@ -110,6 +110,50 @@ const char* radianceTestName(Thresholds::RadianceTest test) {
     case Thresholds::RadianceTest::kPlain: return "plain";
   }
   return "?";
+}
+
+const char* geometryTestName(Thresholds::GeometryTest test) {
+  return test == Thresholds::GeometryTest::kTaps ? "taps" : "bilinear";
+}
+
+HistoryTest testHistory(const glm::dvec3& p, const glm::dvec3& n, double viewDepth, const FeatureFrame& previous, const BilinearTaps& taps,
+                        const Thresholds& t) {
+  HistoryTest result;
+  result.history = taps;
+  if (t.geometryTest == Thresholds::GeometryTest::kBilinear) {
+    // Position and normal history of a surface cannot come from the background.
+    bool historyMissesGeometry = false;
+    for (int k = 0; k < 4; ++k)
+      if (taps.weight[k] > 0 && previous.hit[taps.index[k]] <= 0) historyMissesGeometry = true;
+    result.position = !historyMissesGeometry && glm::length(p - sample3(previous.position, taps)) <= t.position;
+    result.normal = !historyMissesGeometry && glm::length(n - sample3(previous.normal, taps)) <= t.normal;
+    result.consistent = result.position && result.normal;
+    return result;
+  }
+  // Per tap: the tap's point within position x Z of the current point's tangent plane (NRD's
+  // relative plane distance), and its normal within the normal threshold.
+  const double planeTolerance = t.position * std::abs(viewDepth);
+  BilinearTaps kept{};
+  double keptWeight = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    kept.index[k] = taps.index[k];
+    kept.weight[k] = 0.0;
+    if (!(taps.weight[k] > 0) || previous.hit[taps.index[k]] <= 0) continue;
+    const bool samePlane = std::abs(glm::dot(n, at3(previous.position, taps.index[k]) - p)) <= planeTolerance;
+    const bool sameNormal = glm::length(n - at3(previous.normal, taps.index[k])) <= t.normal;
+    result.position |= samePlane;
+    result.normal |= sameNormal;
+    if (samePlane && sameNormal) {
+      kept.weight[k] = taps.weight[k];
+      keptWeight += taps.weight[k];
+    }
+  }
+  if (keptWeight > 0) {
+    result.consistent = true;
+    for (double& w : kept.weight) w /= keptWeight;
+    result.history = kept;
+  }
+  return result;
 }
 
 namespace {
@@ -172,23 +216,22 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
         } else {
           // A jittered frame's buffers hold its samples at centre + jitter (render --jitter).
           const BilinearTaps taps = bilinearTaps(q->x - previous.camera.jitter.x, q->y - previous.camera.jitter.y, previous.width, previous.height);
-          bool historyMissesGeometry = false;
-          for (int k = 0; k < 4; ++k)
-            if (taps.weight[k] > 0 && previous.hit[taps.index[k]] <= 0) historyMissesGeometry = true;
-          // Position and normal history of a surface cannot come from the background.
-          if (historyMissesGeometry || glm::length(p - sample3(previous.position, taps)) > t.position) bits |= kPosition;
-          if (historyMissesGeometry || glm::length(at3(current.normal, i) - sample3(previous.normal, taps)) > t.normal) bits |= kNormal;
+          const double viewDepth = -(current.camera.view * glm::dvec4(p, 1.0)).z;
+          const HistoryTest history = testHistory(p, at3(current.normal, i), viewDepth, previous, taps, t);
+          if (!history.position) bits |= kPosition;
+          if (!history.normal) bits |= kNormal;
           // The probability (0 or 1 for the deterministic tests) that the radiance changed.
           auto radianceChange = [&](const std::vector<float>& now, const std::vector<float>& before, double threshold,
                                     const std::vector<float>& varNow, const std::vector<float>& varBefore) {
-            const glm::dvec3 a = at3(now, i), b = sample3(before, taps);
+            const glm::dvec3 a = at3(now, i), b = sample3(before, history.history);
             const double d = glm::length(a - b);
             // Variance of the difference: the pixel's plus the bilinear sample's, sum of w_k^2 var_k
             // (independent pixels).
             double var = 0.0;
             if (variance && test != Test::kPlain) {
               var = varNow[i];
-              for (int k = 0; k < 4; ++k) var += taps.weight[k] * taps.weight[k] * varBefore[taps.index[k]];
+              const BilinearTaps& h = history.history;
+              for (int k = 0; k < 4; ++k) var += h.weight[k] * h.weight[k] * varBefore[h.index[k]];
             }
             switch (test) {
               case Test::kPlain: return d > threshold ? 1.0 : 0.0;
@@ -261,7 +304,7 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
       run.width = frame->width;
       run.height = frame->height;
       run.sceneSize = sceneSize(*frame);
-      if (thresholds.relativePosition && run.sceneSize <= 0)
+      if (thresholds.relativePosition && thresholds.geometryTest == Thresholds::GeometryTest::kBilinear && run.sceneSize <= 0)
         return fail(ErrorCode::kInvalidData, "{}: --relative-position needs geometry in the first frame to size the scene",
                     (*entries)[k].image.string());
     } else if (frame->width != run.width || frame->height != run.height) {
@@ -364,7 +407,8 @@ std::string discardJson(const DiscardRun& run, const std::string& framesDir) {
   j["width"] = run.width;
   j["height"] = run.height;
   j["scene_size"] = run.sceneSize;
-  j["thresholds"] = {{"position", t.position},       {"relative_position", t.relativePosition}, {"normal", t.normal},
+  j["thresholds"] = {{"geometry_test", geometryTestName(t.geometryTest)},
+                     {"position", t.position},       {"relative_position", t.relativePosition}, {"normal", t.normal},
                      {"direct", t.direct},           {"indirect", t.indirect},                 {"absolute_radiance", t.absoluteRadiance},
                      {"radiance_test", radianceTestName(t.radianceTest)}, {"noise_sigmas", t.noiseSigmas}};
   j["mean"] = percentagesJson(run.mean);

@@ -20,9 +20,22 @@ using frames::FeatureFrame;
 using frames::FrameCamera;
 
 struct Thresholds {
-  // World-position distance, in scene units; with relativePosition, a fraction of the scene's size
-  // (the diagonal of the first frame's world-position bounding box).
-  double position = 0.05;
+  // How a reprojected surface pixel's history is tested (docs/metrics.md, "Geometry tests"):
+  //  kTaps (default): each of the four bilinear taps of the previous frame on its own, as SVGF and
+  //    NVIDIA's NRD test history: a tap is the same surface when its world position lies within
+  //    `position` x the pixel's view depth of the current point's tangent plane (NRD's relative
+  //    plane distance, its disocclusionThreshold 0.01), and has the same normal when
+  //    ||n_i - n_tap|| <= `normal`. Position (normal) is discarded when no tap passes; radiance is
+  //    compared with the taps that pass both, their weights renormalised. Free of scene units and
+  //    of the first frame, and of resolution on smooth surfaces (the taps of a plane lie on it).
+  //  kBilinear: the thesis's test: the bilinear sample of the four taps against the current pixel,
+  //    position in scene units (or relativePosition), every tap on geometry.
+  enum class GeometryTest { kTaps, kBilinear };
+  GeometryTest geometryTest = GeometryTest::kTaps;
+  // kTaps: plane distance / view depth. kBilinear: world-position distance, in scene units; with
+  // relativePosition, a fraction of the scene's size (the diagonal of the first frame's
+  // world-position bounding box).
+  double position = 0.01;
   bool relativePosition = false;
   // Shading-normal vector distance ||n_i - n_{i-1}|| (0.1 is a turn of about 5.7 degrees).
   double normal = 0.1;
@@ -43,6 +56,9 @@ struct Thresholds {
 };
 
 const char* radianceTestName(Thresholds::RadianceTest test);  // "expected", "noise-aware", "plain"
+const char* geometryTestName(Thresholds::GeometryTest test);  // "taps", "bilinear"
+// The thesis's default world-position threshold of the bilinear test: 0.05 scene units.
+inline constexpr double kBilinearPositionThreshold = 0.05;
 
 // A 95 % interval of a percentage.
 struct Interval {
@@ -82,6 +98,18 @@ struct BilinearTaps {
 BilinearTaps bilinearTaps(double x, double y, int width, int height);
 glm::dvec3 sample3(const std::vector<float>& buffer, const BilinearTaps& taps);
 double sample1(const std::vector<float>& buffer, const BilinearTaps& taps);
+
+// The geometry test of one reprojected surface pixel (Thresholds::GeometryTest) against the
+// previous frame's taps around where it lands: whether its position and its normal have history,
+// and the taps its radiance history is read from (those consistent in both, renormalised; all four
+// when none is). `viewDepth` is the current pixel's Z; thresholds absolute.
+struct HistoryTest {
+  bool position = false, normal = false;  // history found for the feature
+  bool consistent = false;                // some history is the same surface in both
+  BilinearTaps history{};
+};
+HistoryTest testHistory(const glm::dvec3& p, const glm::dvec3& n, double viewDepth, const FeatureFrame& previous, const BilinearTaps& taps,
+                        const Thresholds& absolute);
 
 // Where world point p lands in a frame's image, in continuous pixel coordinates; nullopt behind
 // the camera (clip w <= 0). Eq. (2.2) then perspective division and Eq. (2.3).

@@ -19,14 +19,9 @@ struct EvaluateOptions {
   std::filesystem::path frames;     // the input: noisy radiance, G-buffers, motion
   std::filesystem::path reference;  // converged frames of the same frame numbers and size
   std::vector<std::string> methods{"none", "accumulate", "taa", "svgf"};
-  // The history tests of `accumulate` and of the warped-error mask: the demo's discard settings
-  // (position 1 % of the scene's size, normal 0.1).
-  discard::Thresholds thresholds = [] {
-    discard::Thresholds t;
-    t.relativePosition = true;
-    t.position = 0.01;
-    return t;
-  }();
+  // The history tests of `accumulate` and of the warped-error mask: discard's default geometry
+  // test (per tap: plane distance 1 % of the view depth, normal 0.1).
+  discard::Thresholds thresholds;
   double pixelsPerDegree = flip::defaultPixelsPerDegree();
   std::filesystem::path json, csv;  // optional outputs
   // Optional: OUT/METHOD/frame_NNNNN.exr per frame (the external-method contract, so an output can

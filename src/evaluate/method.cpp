@@ -27,15 +27,18 @@ std::optional<discard::BilinearTaps> historyTaps(const frames::FeatureFrame& cur
   // The previous frame's buffers are at its samples: centre + its jitter.
   const discard::BilinearTaps taps =
       discard::bilinearTaps(q->x - previous.camera.jitter.x, q->y - previous.camera.jitter.y, previous.width, previous.height);
-  for (int k = 0; k < 4; ++k)
-    if (taps.weight[k] > 0 && (previous.hit[taps.index[k]] > 0) != hit) return std::nullopt;
-  if (hit) {
-    const glm::dvec3 n(current.normal[3 * i], current.normal[3 * i + 1], current.normal[3 * i + 2]);
-    if (glm::length(p - discard::sample3(previous.position, taps)) > absolute.position ||
-        glm::length(n - discard::sample3(previous.normal, taps)) > absolute.normal)
-      return std::nullopt;
+  if (!hit) {
+    // The background's history is the background.
+    for (int k = 0; k < 4; ++k)
+      if (taps.weight[k] > 0 && previous.hit[taps.index[k]] > 0) return std::nullopt;
+    return taps;
   }
-  return taps;
+  // A surface's: the taps the discard's geometry test keeps (discard::testHistory).
+  const glm::dvec3 n(current.normal[3 * i], current.normal[3 * i + 1], current.normal[3 * i + 2]);
+  const double viewDepth = -(current.camera.view * glm::dvec4(p, 1.0)).z;
+  const discard::HistoryTest test = discard::testHistory(p, n, viewDepth, previous, taps, absolute);
+  if (!test.consistent) return std::nullopt;
+  return test.history;
 }
 
 const char* builtInMethodNames() { return "none, accumulate, taa, svgf, external:DIR"; }

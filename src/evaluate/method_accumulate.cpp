@@ -15,6 +15,7 @@ class AccumulateMethod final : public TemporalMethod {
   std::string name() const override { return "accumulate"; }
   nlohmann::json parameters() const override {
     return {{"alpha_min", kAlphaMin},
+            {"geometry_test", discard::geometryTestName(context_.thresholds.geometryTest)},
             {"position_threshold", context_.thresholds.position},
             {"relative_position", context_.thresholds.relativePosition},
             {"normal_threshold", context_.thresholds.normal}};
