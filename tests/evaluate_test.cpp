@@ -104,6 +104,94 @@ TEST(Methods, TaaAndSvgfReduceNoiseOnAStaticScene) {
   EXPECT_FALSE(createMethod("external:/no/such/dir", MethodContext{}).has_value());
 }
 
+// Stripes with sharp edges across the image, 1.65 pixels wide: finer than a pixel can resolve, so
+// a sample at a pixel's centre aliases and the pixel's integral is a blend.
+double stripes(double x, double y) {
+  const double u = (x + 0.6 * y) / 3.3;
+  return u - std::floor(u) < 0.5 ? 1.5 : 0.5;
+}
+
+TEST(Methods, CatmullRomHistoryInterpolatesAndKeepsConstants) {
+  RgbImage image{5, 4, std::vector<float>(3 * 5 * 4)};
+  for (std::size_t i = 0; i < image.rgb.size(); ++i) image.rgb[i] = static_cast<float>((i * 7919) % 13) / 13.0f;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 5; ++x) {
+      const glm::dvec3 at = sampleCatmullRom(image, x + 0.5, y + 0.5);
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(at[k], image.rgb[3 * (static_cast<std::size_t>(y) * 5 + x) + k], 1e-12) << x << "," << y;
+    }
+  RgbImage flat{5, 4, std::vector<float>(3 * 5 * 4, 0.25f)};
+  EXPECT_NEAR(sampleCatmullRom(flat, 2.3, 1.7).x, 0.25, 1e-12);
+  // A linear ramp is reproduced between the centres (Catmull-Rom is exact on linear data).
+  RgbImage ramp{8, 1, std::vector<float>(3 * 8)};
+  for (int x = 0; x < 8; ++x)
+    for (int k = 0; k < 3; ++k) ramp.rgb[3 * static_cast<std::size_t>(x) + k] = static_cast<float>(x);
+  EXPECT_NEAR(sampleCatmullRom(ramp, 3.8, 0.5).x, 3.3, 1e-6);
+}
+
+TEST(Methods, TaaTurnsJitteredSamplesIntoThePixelsIntegral) {
+  // A static camera over a static scene of sharp stripes, with jittered input (render --jitter:
+  // frame n samples each pixel at its centre + the Halton (2, 3) offset of n) and no noise: `none`
+  // shows the aliased point samples, while TAA's exponential history averages the jitter
+  // positions towards the pixel's integral (the reference: a 16 x 16 box average over the pixel).
+  // The bound: with blend a = 0.1, frame n's output weighs frame n - k by a (1 - a)^k and the
+  // first frame by (1 - a)^(n-1). Were the samples' errors against the integral independent with
+  // variance v, the output's mean squared error would be v S(n),
+  //   S(n) = (1 - a)^(2(n-1)) + a^2 (1 - (1 - a)^(2(n-1))) / (1 - (1 - a)^2),
+  // falling from 1 to a / (2 - a) = 0.053 (S(3) = 0.67, S(8) = 0.27). Halton offsets are
+  // stratified, which only helps an average; the variance clip adds a bias where a pixel's 3 x 3
+  // samples all lie on one side of an edge its area crosses (the box then excludes the blend),
+  // bounded here by 0.1 v. v is none's error averaged over the 8 jitter phases (a single
+  // frame's error depends on its phase).
+  auto frameAt = [](long n, bool reference) {
+    frames::FeatureFrame f = planeFrame(n, 0.0, 1);
+    f.camera.jitter = reference ? glm::dvec2(0.0) : frames::jitterOffset(n);
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) {
+        double value = 0.0;
+        if (reference) {
+          for (int sy = 0; sy < 16; ++sy)
+            for (int sx = 0; sx < 16; ++sx) value += stripes(x + (sx + 0.5) / 16, y + (sy + 0.5) / 16) / 256.0;
+        } else {
+          value = stripes(x + 0.5 + f.camera.jitter.x, y + 0.5 + f.camera.jitter.y);
+        }
+        const std::size_t i = static_cast<std::size_t>(y) * kW + x;
+        for (int k = 0; k < 3; ++k) f.direct[3 * i + k] = static_cast<float>(value);
+      }
+    return f;
+  };
+  const RgbImage reference = frameRadiance(frameAt(0, true));
+  auto mse = [&](const RgbImage& image) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < image.rgb.size(); ++i) sum += std::pow(image.rgb[i] - reference.rgb[i], 2);
+    return sum / static_cast<double>(image.rgb.size());
+  };
+  auto none = createMethod("none", MethodContext{}), taa = createMethod("taa", MethodContext{});
+  ASSERT_TRUE(none && taa);
+  constexpr int kFrames = 10;
+  double errorNone[kFrames + 1] = {}, errorTaa[kFrames + 1] = {}, v = 0.0;
+  for (int n = 1; n <= kFrames; ++n) {
+    const frames::FeatureFrame input = frameAt(n, false);
+    auto a = (*none)->process(input), b = (*taa)->process(input);
+    ASSERT_TRUE(a && b);
+    errorNone[n] = mse(a->image), errorTaa[n] = mse(b->image);
+    if (n <= 8) v += errorNone[n] / 8.0;
+  }
+  const double a = 0.1;
+  auto S = [a](int n) {
+    const double decay = std::pow(1.0 - a, 2.0 * (n - 1));
+    return decay + a * a * (1.0 - decay) / (1.0 - (1.0 - a) * (1.0 - a));
+  };
+  for (int n = 1; n <= kFrames; ++n) {
+    const double bound = v * (S(n) + 0.1);
+    std::printf("frame %d: MSE none %.5f, taa %.5f (bound %.5f)\n", n, errorNone[n], errorTaa[n], bound);
+    if (n >= 2) EXPECT_LT(errorTaa[n], errorNone[n]) << "frame " << n;
+    EXPECT_LT(errorTaa[n], bound) << "frame " << n;
+  }
+  // And it keeps falling through the 8 jitter phases: around frame 8 (frames 7-9) at most
+  // (S(8) + 0.1) / S(3) of its error around frame 2 (frames 2-3), what the bound allows.
+  EXPECT_LT((errorTaa[7] + errorTaa[8] + errorTaa[9]) / 3.0, (S(8) + 0.1) / S(3) * (errorTaa[2] + errorTaa[3]) / 2.0);
+}
+
 fs::path writeSequence(const std::string& name, double sigma, long cutAt, int count) {
   const fs::path dir = fs::temp_directory_path() / ("dynbench_evaluate_" + name);
   fs::remove_all(dir);

@@ -47,6 +47,10 @@ const char* builtInMethodNames();
 
 // Shared by the methods: the frame's full radiance (direct + indirect) as an RgbImage.
 RgbImage frameRadiance(const frames::FeatureFrame& frame);
+// An image resampled at continuous pixel coordinates (x, y) (pixel centres at +0.5) by the
+// Catmull-Rom cubic in x and in y (Keys 1981, a = -0.5), edges clamped: TAA's history fetch.
+// Interpolates (a pixel centre returns that pixel) and keeps constants; its lobes may overshoot.
+glm::dvec3 sampleCatmullRom(const RgbImage& image, double x, double y);
 
 // Where pixel (px, py) of `current` finds its history in `previous`: the bilinear taps in the
 // previous frame's sample grid, or nullopt when it has none (off screen, Eq. 3.3; or a surface

@@ -1,11 +1,14 @@
 // `taa`: temporal anti-aliasing as in Karis 2014 ("High Quality Temporal Supersampling") and Salvi
 // 2016 ("An Excursion in Temporal Supersampling"): the history is fetched where the frame's
-// motion vector points (bilinear), the 3x3 neighbourhood of the current input gives the mean mu
+// motion vector points with a Catmull-Rom bicubic filter (as Falcor's and Unreal's TAA do: a
+// bilinear fetch blurs the history a little at every frame, and over the ~10 frames the blend
+// keeps, a sub-pixel motion smears it to a visibly softer image), the 3x3 neighbourhood of the current input gives the mean mu
 // and standard deviation sigma of each YCoCg channel, and the history is *variance-clipped*
 // (Salvi): moved along the line towards mu until it lies in the box mu +- gamma sigma (not clamped
 // per channel, and not clipped to the neighbourhood's min/max box). Then
 // out = lerp(history, current, 0.1). Meant for input rendered with `render --jitter`.
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "evaluate/method.h"
@@ -16,11 +19,39 @@ namespace {
 glm::dvec3 toYCoCg(glm::dvec3 c) { return {0.25 * c.r + 0.5 * c.g + 0.25 * c.b, 0.5 * c.r - 0.5 * c.b, -0.25 * c.r + 0.5 * c.g - 0.25 * c.b}; }
 glm::dvec3 fromYCoCg(glm::dvec3 v) { return {v.x + v.y - v.z, v.x + v.z, v.x - v.y - v.z}; }
 
+// The Catmull-Rom spline's weights of the four samples around t in [0, 1) (Keys' cubic, a = -0.5).
+std::array<double, 4> catmullRomWeights(double t) {
+  const double t2 = t * t, t3 = t2 * t;
+  return {0.5 * (-t3 + 2.0 * t2 - t), 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0), 0.5 * (-3.0 * t3 + 4.0 * t2 + t), 0.5 * (t3 - t2)};
+}
+
+}  // namespace
+
+glm::dvec3 sampleCatmullRom(const RgbImage& image, double x, double y) {
+  // Texel space: pixel (i, j)'s centre at (i + 0.5, j + 0.5); the 4 x 4 texels around, clamped at
+  // the edges. The weights of each axis sum to 1, so a constant image is returned exactly.
+  const double u = x - 0.5, v = y - 0.5;
+  const double fx = std::floor(u), fy = std::floor(v);
+  const auto wx = catmullRomWeights(u - fx), wy = catmullRomWeights(v - fy);
+  const int x0 = static_cast<int>(fx) - 1, y0 = static_cast<int>(fy) - 1;
+  glm::dvec3 sum(0.0);
+  for (int j = 0; j < 4; ++j) {
+    const std::size_t row = static_cast<std::size_t>(std::clamp(y0 + j, 0, image.height - 1)) * static_cast<std::size_t>(image.width);
+    for (int i = 0; i < 4; ++i) {
+      const std::size_t k = 3 * (row + static_cast<std::size_t>(std::clamp(x0 + i, 0, image.width - 1)));
+      sum += (wx[static_cast<std::size_t>(i)] * wy[static_cast<std::size_t>(j)]) * glm::dvec3(image.rgb[k], image.rgb[k + 1], image.rgb[k + 2]);
+    }
+  }
+  return sum;
+}
+
+namespace {
+
 class TaaMethod final : public TemporalMethod {
  public:
   std::string name() const override { return "taa"; }
   nlohmann::json parameters() const override {
-    return {{"blend", kBlend}, {"gamma", kGamma}, {"history", "variance clip in YCoCg, 3x3"}, {"reprojection", "motion vectors, bilinear"}};
+    return {{"blend", kBlend}, {"gamma", kGamma}, {"history", "variance clip in YCoCg, 3x3"}, {"reprojection", "motion vectors, Catmull-Rom"}};
   }
   void reset() override { history_.reset(); }
 
@@ -34,8 +65,12 @@ class TaaMethod final : public TemporalMethod {
         for (int px = 0; px < w; ++px) {
           const std::size_t i = static_cast<std::size_t>(py) * w + px;
           const glm::dvec2 motion(frame.motion[2 * i], frame.motion[2 * i + 1]);
-          // The motion vector starts at the pixel's sample (centre + jitter).
-          const glm::dvec2 q = glm::dvec2(px + 0.5, py + 0.5) + frame.camera.jitter + motion;
+          // TAA's output (and so its history) is at the pixel centres, while the input and its
+          // motion vector are at the jittered sample: the history of this output pixel is at its
+          // centre moved by the motion (the sample's, a fraction of a pixel away: as Karis's
+          // velocity buffer is read). Reading it at centre + jitter + motion, as before, resampled
+          // the still image by each frame's jitter, a shift of up to half a pixel every frame.
+          const glm::dvec2 q = glm::dvec2(px + 0.5, py + 0.5) + motion;
           if (!(std::abs(motion.x) < 1e8) || q.x < 0 || q.y < 0 || q.x > w || q.y > h) continue;
           glm::dvec3 sum(0.0), sumSq(0.0);
           for (int dy = -1; dy <= 1; ++dy)
@@ -45,7 +80,9 @@ class TaaMethod final : public TemporalMethod {
               sum += c, sumSq += c * c;
             }
           const glm::dvec3 mean = sum / 9.0, sigma = glm::sqrt(glm::max(sumSq / 9.0 - mean * mean, 0.0));
-          const glm::dvec3 history = toYCoCg(discard::sample3(history_->rgb, discard::bilinearTaps(q.x, q.y, w, h)));
+          // Catmull-Rom's negative lobes can overshoot at an edge; the clip below pulls such a
+          // value back into the neighbourhood's box.
+          const glm::dvec3 history = toYCoCg(sampleCatmullRom(*history_, q.x, q.y));
           // Salvi's clip towards the box centre.
           const glm::dvec3 offset = history - mean, extent = kGamma * sigma + 1e-7;
           const glm::dvec3 units = glm::abs(offset) / extent;

@@ -63,13 +63,18 @@ DatasetRenders datasetRenders(const fs::path& dataset, const fs::path& run, cons
     render.job.frames.first = (animationFrames - window) / 2;
     render.job.frames.last = render.job.frames.first + window - 1;
   }
-  // The temporal methods' input: the same window rendered as a real-time renderer would (a few
-  // samples per pixel, another seed so its noise is independent of the reference's).
+  // The temporal methods' input: the same window rendered as a real-time renderer would: a few
+  // paths per pixel from its G-buffer's hit (the pixel centre, no filter), the projection jittered
+  // from frame to frame (the Halton sequence TAA needs to turn aliasing into anti-aliasing), and
+  // another seed so its noise is independent of the reference's. The reference is the converged
+  // radiance through the pixel filter: what a method should reconstruct.
   RenderStage input = render;
   input.job.output = run / "input";
   input.job.settings.converge = false;
   input.job.settings.samplesPerPixel = o.inputSamplesPerPixel;
   input.job.settings.seed = o.seed + 1;
+  input.job.settings.jitter = true;
+  input.job.settings.pixelFilter = {render::PixelFilterType::kCentre, 0.0};
   return {render, input};
 }
 
@@ -98,8 +103,7 @@ Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, cons
 
   DiscardStage discard;
   discard.frames = render.job.output;
-  discard.thresholds.relativePosition = true;
-  discard.thresholds.position = 0.01;  // 1% of the scene's size
+  // discard's defaults: the per-tap geometry test (docs/metrics.md), radiance relative to the frame.
   discard.json = run / "discard.json";
   discard.csv = run / "discard.csv";
   discard.masks = run / "masks";
