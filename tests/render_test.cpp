@@ -16,6 +16,7 @@
 #include "render/equirect_batch.h"
 #include "render/lights.h"
 #include "render/path_tracer.h"
+#include "render/textures.h"
 #include "scene/evaluate.h"
 #include "scene/load.h"
 
@@ -1039,6 +1040,36 @@ TEST(Sampling, EnvironmentPdfMatchesItsSamples) {
     ASSERT_NEAR(pdf, env->pdf(d), 1e-6 * pdf);
   }
   EXPECT_NEAR(integral / n, 1.0, 0.02);
+}
+
+TEST(Textures, MipLevelsAverageTheLevelBelowAndTheLodCountsTexelsPerCone) {
+  // A one-texel checker of 0.2 and 0.8, 8 x 4 texels: level 1 (4 x 2) is 0.5 everywhere, the top
+  // (1 x 1) too; level 0 keeps its texels.
+  Texture t;
+  t.width = 8, t.height = 4;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 8; ++x) t.texels.push_back(glm::vec4((x + y) % 2 ? 0.8f : 0.2f, 0.5f, 0.5f, 1.0f));
+  t.buildMips();
+  ASSERT_EQ(t.mips.size(), 3u);  // 4 x 2, 2 x 1, 1 x 1
+  EXPECT_EQ(t.mips[0].width, 4);
+  EXPECT_EQ(t.mips[0].height, 2);
+  for (const auto& texel : t.mips[0].texels) EXPECT_NEAR(texel.r, 0.5f, 1e-6f);
+  EXPECT_NEAR(t.mips.back().texels[0].r, 0.5f, 1e-6f);
+  // At a texel centre, level 0 returns the texel; at level 1 and above the average; halfway
+  // between levels 0 and 1, half of each.
+  const glm::dvec2 centre((2 + 0.5) / 8.0, (1 + 0.5) / 4.0);  // texel (2, 1): 0.8
+  const double perTexel = -0.5 * std::log2(8.0 * 4.0);      // the lod at which the level is 0
+  EXPECT_NEAR(t.sample(centre, -1e9).r, 0.8, 1e-6);
+  EXPECT_NEAR(t.sample(centre, perTexel + 1.0).r, 0.5, 1e-6);
+  EXPECT_NEAR(t.sample(centre, perTexel + 0.5).r, 0.65, 1e-6);
+  EXPECT_NEAR(t.sample(centre, perTexel + 10.0).r, 0.5, 1e-6);
+  // Ray cones: a 256 x 256 texture over a 2 x 2 quad is 128 texels a unit; a cone 1/16 unit wide
+  // meeting it head on covers 8 texels: level 3. At 60 degrees off the normal it covers twice as
+  // many along the surface: level 4.
+  const double texture = 0.5 * std::log2(256.0 * 256.0);
+  EXPECT_NEAR(textureLod(1.0 / 16.0, 1.0, 0.5, 2.0) + texture, 3.0, 1e-12);
+  EXPECT_NEAR(textureLod(1.0 / 16.0, 0.5, 0.5, 2.0) + texture, 4.0, 1e-12);
+  EXPECT_TRUE(std::isinf(textureLod(0.0, 1.0, 0.5, 2.0)));  // no cone: level 0
 }
 
 }  // namespace

@@ -141,21 +141,37 @@ glm::dvec3 PathTracer::emission(int node, int primitive, unsigned triangle, glm:
   return emission(*m, texCoord(node, primitive, triangle, b));
 }
 
-glm::dvec3 PathTracer::emission(const scene::Material& m, glm::dvec2 uv) const {
+glm::dvec3 PathTracer::emission(const scene::Material& m, glm::dvec2 uv, double lod) const {
   glm::dvec3 e(m.emissiveFactor);
-  if (e != glm::dvec3(0.0) && m.emissiveTexture.image >= 0) e *= glm::dvec3(textures_.sample(m.emissiveTexture, true, uv));
+  if (e != glm::dvec3(0.0) && m.emissiveTexture.image >= 0) e *= glm::dvec3(textures_.sample(m.emissiveTexture, true, uv, lod));
   return e;
 }
 
-PathTracer::Shading PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv) const {
+PathTracer::Shading PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, double coneWidth) const {
   Shading s;
-  shade(hit, wo, uv, s);
+  shade(hit, wo, uv, coneWidth, s);
   return s;
 }
 
-void PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, Shading& s) const {
+double PathTracer::textureLodAt(const SurfaceHit& hit, const glm::dvec3& direction, double coneWidth) const {
+  const scene::Primitive& prim = *hit.source;
+  if (prim.uvs.empty() || !(coneWidth > 0)) return -kInfinity;
+  const auto p = rayTracing_->trianglePositions(hit);
+  const std::uint32_t* idx = hit.vertices.data();
+  const glm::dvec2 d1 = glm::dvec2(prim.uvs[idx[1]]) - glm::dvec2(prim.uvs[idx[0]]);
+  const glm::dvec2 d2 = glm::dvec2(prim.uvs[idx[2]]) - glm::dvec2(prim.uvs[idx[0]]);
+  const double uvArea = std::abs(d1.x * d2.y - d2.x * d1.y);
+  const double worldArea = glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
+  return textureLod(coneWidth, glm::dot(hit.geometricNormal, direction), uvArea, worldArea);
+}
+
+void PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, double coneWidth, Shading& s) const {
   const scene::Material* m = materialOf(*hit.source);
   SurfaceMaterial& mat = s.material;
+  // The level of detail only where a texture is read.
+  const bool textured = m && (m->baseColorTexture.image >= 0 || m->metallicRoughnessTexture.image >= 0 || m->normalTexture.image >= 0 ||
+                              m->emissiveTexture.image >= 0);
+  const double lod = textured ? textureLodAt(hit, -wo, coneWidth) : -kInfinity;
   if (!m) {
     // glTF's default material when a primitive has none: white, metallic 1, roughness 1 (§3.9.6).
     mat = SurfaceMaterial{};
@@ -163,13 +179,13 @@ void PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 u
     s.emissiveWeight = 0.0;
   } else {
     glm::dvec4 base(m->baseColorFactor);
-    if (m->baseColorTexture.image >= 0) base *= textures_.sample(m->baseColorTexture, true, uv);
+    if (m->baseColorTexture.image >= 0) base *= textures_.sample(m->baseColorTexture, true, uv, lod);
     mat.baseColor = glm::dvec3(base);
     if (m->workflow == scene::MaterialWorkflow::kMetallicRoughness) {
       mat.metallic = m->metallicFactor;
       mat.roughness = m->roughnessFactor;
       if (m->metallicRoughnessTexture.image >= 0) {
-        const glm::dvec4 mr = textures_.sample(m->metallicRoughnessTexture, false, uv);
+        const glm::dvec4 mr = textures_.sample(m->metallicRoughnessTexture, false, uv, lod);
         mat.roughness *= mr.g;  // glTF: green = roughness, blue = metallic
         mat.metallic *= mr.b;
       }
@@ -181,7 +197,7 @@ void PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 u
     mat.specular = m->specularFactor;
     mat.specularColor = glm::dvec3(m->specularColorFactor);
     s.emissiveWeight = LightSet::emissiveWeight(glm::dvec3(m->emissiveFactor));
-    mat.emission = emission(*m, uv);
+    mat.emission = emission(*m, uv, lod);
   }
   // Both sides of a surface are shaded alike: the normals are turned towards the viewer. When a
   // mesh's winding contradicts its vertex normals, the vertex normals say which side is which.
@@ -205,7 +221,7 @@ void PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 u
         if (glm::length(t) > 1e-20) {
           t = glm::normalize(t);
           const glm::dvec3 b = glm::cross(n, t);
-          const glm::dvec3 texel = 2.0 * glm::dvec3(textures_.sample(m->normalTexture, false, uv)) - 1.0;
+          const glm::dvec3 texel = 2.0 * glm::dvec3(textures_.sample(m->normalTexture, false, uv, lod)) - 1.0;
           const glm::dvec3 mapped = texel.x * t + texel.y * b + texel.z * n;
           if (glm::length(mapped) > 1e-12) n = glm::normalize(mapped);
         }
@@ -252,6 +268,7 @@ struct PathTracer::PathState {
   Ray ray;
   std::size_t streamIndex = 0;  // where the hit of `ray` is in the batch's stream (depth > 0)
   glm::dvec3 throughput{1.0};
+  double pathLength = 0.0;  // from the camera to the current hit along the path: the ray cone's length
   PathSample out;
   double previousBsdfPdf = 0.0;  // solid-angle pdf of the BSDF sample that made `ray`
   bool previousDelta = true;     // camera rays: nothing else could have found the emitter
@@ -299,6 +316,11 @@ struct PathTracer::PathScratch {
   std::vector<FirstVertex> queue;
   std::size_t queueHead = 0, queueEnd = 0;
   std::vector<PathState> paths;   // a batch
+  // The spread angle of a pixel's ray cone (Akenine-Möller et al. 2019: atan(2 tan(yfov / 2) / H)),
+  // set by render for its frame: the cone of a path is pixelSpread x its length, for the textures'
+  // level of detail at each hit (the primary cone carried along the path; a surface's curvature
+  // and roughness do not widen it).
+  double pixelSpread = 0.0;
   std::vector<Ray> streamRays;        // the batch's rays still going, and their hits
   std::vector<SurfaceHit> streamHits;
   std::uint64_t rays = 0, shadingPoints = 0, punctualEvaluated = 0;
@@ -309,6 +331,7 @@ void PathTracer::tracePaths(std::span<PathState> paths, PathScratch& scratch) co
   const bool ownCameraRays = !filter_.atCentre();
   for (PathState& p : paths) {
     p.throughput = glm::dvec3(1.0);
+    p.pathLength = 0.0;
     p.out = PathSample{};
     p.previousBsdfPdf = 0.0;
     p.previousDelta = true;
@@ -415,8 +438,9 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const F
     return false;
   }
   const glm::dvec3 wo = -ray.direction;
+  p.pathLength += hit.distance;
   // The hit's shading, written in place (scratch.shading: returned, GCC zeroed and copied it).
-  if (!first) shade(hit, wo, p.uv, scratch.shading);
+  if (!first) shade(hit, wo, p.uv, scratch.pixelSpread * p.pathLength, scratch.shading);
   const Shading& s = first ? first->shading : scratch.shading;
   if (s.material.emission != glm::dvec3(0.0)) {
     double w = 1.0;
@@ -554,7 +578,13 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
   const glm::dvec3 forward = -glm::dvec3(camera.world()[2]);
   std::vector<PixelSums> sums(pixels);
   std::vector<SurfaceHit> firstHits(pixels);
-  tbb::enumerable_thread_specific<PathScratch> scratches;
+  // A pixel's ray cone spreads by this angle (radians) per unit of length (textureLod).
+  const double pixelSpread = std::atan(2.0 * std::tan(0.5 * camera.yfov()) / height);
+  tbb::enumerable_thread_specific<PathScratch> scratches([pixelSpread] {
+    PathScratch scratch;
+    scratch.pixelSpread = pixelSpread;
+    return scratch;
+  });
   const glm::dvec2 jitter = settings_.jitter ? frames::jitterOffset(static_cast<long>(frameIndex)) : glm::dvec2(0.0);
 
   // The ray through a pixel's (jittered) centre.
@@ -591,7 +621,7 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
     v.hit = filtered ? nullptr : &hit;
     if (!filtered) {
       if (known) v.shading = *known;
-      else shade(hit, -ray.direction, texCoord(hit), v.shading);
+      else shade(hit, -ray.direction, texCoord(hit), pixelSpread * hit.distance, v.shading);
       v.origin = offsetOrigin(hit.position, v.shading.geometricNormal);
     }
     v.next = sum.samples;
@@ -643,7 +673,7 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
         firstHits[pixel] = hit;
         std::optional<Shading> shading;
         if (hit.hit) {
-          const Shading& s = shading.emplace(shade(hit, -ray.direction, texCoord(hit)));
+          const Shading& s = shading.emplace(shade(hit, -ray.direction, texCoord(hit), pixelSpread * hit.distance));
           put3(out.position, pixel, hit.position);
           put3(out.normal, pixel, s.shadingNormal);
           put3(out.albedo, pixel, s.material.baseColor);

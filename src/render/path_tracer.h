@@ -18,6 +18,7 @@
 // has noise-free direct light at 1 spp; where more can, they are sampled without bias.
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -102,11 +103,16 @@ class PathTracer {
  private:
   struct Shading;
   PathTracer(const scene::Scene& scene, const RenderSettings& settings);
-  // The material at a hit seen from direction wo, at the hit's texture coordinates uv.
-  Shading shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv) const;
-  void shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, Shading& shading) const;  // every field written
+  // The material at a hit seen from direction wo, at the hit's texture coordinates uv, its
+  // textures filtered for a ray cone of width coneWidth there (textureLod; 0: level 0, unfiltered).
+  Shading shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, double coneWidth) const;
+  void shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, double coneWidth, Shading& shading) const;  // every field written
+  // The texture-independent level of detail of a ray cone of width coneWidth arriving along
+  // `direction` at the hit's triangle (textureLod).
+  double textureLodAt(const SurfaceHit& hit, const glm::dvec3& direction, double coneWidth) const;
   glm::dvec3 emission(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
-  glm::dvec3 emission(const scene::Material& material, glm::dvec2 uv) const;  // the same, at texture coordinates uv
+  // The same, at texture coordinates uv and texture level of detail lod (-infinity: level 0).
+  glm::dvec3 emission(const scene::Material& material, glm::dvec2 uv, double lod = -std::numeric_limits<double>::infinity()) const;
   glm::dvec2 texCoord(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
   glm::dvec2 texCoord(const SurfaceHit& hit) const;  // the same, from the vertex indices the hit carries
   // Memory prefetches of the batched tracer: a hit's vertex texture coordinates, then the texels

@@ -1,6 +1,8 @@
 #include "render/textures.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
@@ -110,6 +112,80 @@ glm::dvec4 Texture::sample(glm::dvec2 uv) const {
   return glm::dvec4((1 - ty) * ((1 - tx) * a + tx * b) + ty * ((1 - tx) * c + tx * d));
 }
 
+namespace {
+
+// Bilinear lookup in a float level, repeating at the edges (the same texel centres and wrap as
+// level 0's Footprint).
+glm::vec4 bilinear(const MipLevel& level, glm::dvec2 uv) {
+  const double x = uv.x * level.width - 0.5, y = uv.y * level.height - 0.5;
+  const double fx = std::floor(x), fy = std::floor(y);
+  auto wrap = [](double f, int n) {
+    long i = static_cast<long>(f) % n;
+    return static_cast<std::size_t>(i < 0 ? i + n : i);
+  };
+  const std::size_t x0 = wrap(fx, level.width), y0 = wrap(fy, level.height);
+  const std::size_t x1 = (x0 + 1) % static_cast<std::size_t>(level.width), y1 = (y0 + 1) % static_cast<std::size_t>(level.height);
+  const auto w = static_cast<std::size_t>(level.width);
+  const auto tx = static_cast<float>(x - fx), ty = static_cast<float>(y - fy);
+  const auto& t = level.texels;
+  return (1 - ty) * ((1 - tx) * t[y0 * w + x0] + tx * t[y0 * w + x1]) + ty * ((1 - tx) * t[y1 * w + x0] + tx * t[y1 * w + x1]);
+}
+
+}  // namespace
+
+void Texture::buildMips() {
+  mips.clear();
+  // Level 0 in decoded values, as the levels above hold them.
+  MipLevel below{width, height, {}};
+  below.texels.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+  for (std::size_t i = 0; i < below.texels.size(); ++i) {
+    if (codes.empty()) {
+      below.texels[i] = texels[i];
+    } else {
+      const auto& k = codes[i];
+      below.texels[i] = glm::vec4(decodeColour[k[0]], decodeColour[k[1]], decodeColour[k[2]], decodeAlpha[k[3]]);
+    }
+  }
+  while (below.width > 1 || below.height > 1) {
+    MipLevel level{std::max(1, below.width / 2), std::max(1, below.height / 2), {}};
+    level.texels.resize(static_cast<std::size_t>(level.width) * static_cast<std::size_t>(level.height));
+    // The 2 x 2 box below each texel (an odd side's last row or column joins the box before it
+    // only through the clamp: a box filter, as glGenerateMipmap's usual implementation).
+    for (int y = 0; y < level.height; ++y)
+      for (int x = 0; x < level.width; ++x) {
+        glm::vec4 sum(0.0f);
+        for (int dy = 0; dy < 2; ++dy)
+          for (int dx = 0; dx < 2; ++dx) {
+            const int sx = std::min(2 * x + dx, below.width - 1), sy = std::min(2 * y + dy, below.height - 1);
+            sum += below.texels[static_cast<std::size_t>(sy) * static_cast<std::size_t>(below.width) + static_cast<std::size_t>(sx)];
+          }
+        level.texels[static_cast<std::size_t>(y) * static_cast<std::size_t>(level.width) + static_cast<std::size_t>(x)] = 0.25f * sum;
+      }
+    mips.push_back(level);
+    below = std::move(level);
+  }
+}
+
+glm::dvec4 Texture::sample(glm::dvec2 uv, double lod) const {
+  const double level = lod + 0.5 * std::log2(static_cast<double>(width) * static_cast<double>(height));
+  if (!(level > 0.0) || mips.empty()) return sample(uv);  // magnified, or no filtering (NaN, -inf)
+  const double top = static_cast<double>(mips.size());
+  if (level >= top) return glm::dvec4(bilinear(mips.back(), uv));
+  const auto lower = static_cast<std::size_t>(level);
+  const double t = level - static_cast<double>(lower);
+  const glm::dvec4 a = lower == 0 ? sample(uv) : glm::dvec4(bilinear(mips[lower - 1], uv));
+  const glm::dvec4 b(bilinear(mips[lower], uv));
+  return a + t * (b - a);
+}
+
+double textureLod(double coneWidth, double cosine, double uvArea, double worldArea) {
+  if (!(coneWidth > 0) || !(uvArea > 0) || !(worldArea > 0)) return -std::numeric_limits<double>::infinity();
+  // A grazing cone's footprint grows as 1 / |cos|; capped, as the paper's implementations do, so
+  // that a ray along a surface does not ask for a level beyond the texture.
+  const double c = std::max(std::abs(cosine), 1e-3);
+  return 0.5 * std::log2(uvArea / worldArea) + std::log2(coneWidth) - std::log2(c);
+}
+
 void Texture::prefetch(glm::dvec2 uv) const {
   const Footprint f = footprint(uv);
   // The two texels of a row share a cache line but at a line's end or the image's edge: one
@@ -155,8 +231,14 @@ Expected<TextureSet> TextureSet::load(const scene::Scene& scene, std::vector<std
       return;
     }
     if (decoded->width <= 0 || decoded->height <= 0 || decoded->channels <= 0) return;
-    if (wantLinear[i]) set.linear_[i] = toTexture(*decoded, true);
-    if (wantRaw[i]) set.raw_[i] = toTexture(*decoded, false);
+    if (wantLinear[i]) {
+      set.linear_[i] = toTexture(*decoded, true);
+      set.linear_[i].buildMips();
+    }
+    if (wantRaw[i]) {
+      set.raw_[i] = toTexture(*decoded, false);
+      set.raw_[i].buildMips();
+    }
   });
   for (auto& p : problems)
     if (!p.empty()) warnings.push_back(std::move(p));
@@ -176,6 +258,11 @@ void TextureSet::prefetch(const scene::TextureRef& ref, bool srgb, glm::dvec2 uv
 glm::dvec4 TextureSet::sample(const scene::TextureRef& ref, bool srgb, glm::dvec2 uv, glm::dvec4 fallback) const {
   const Texture* t = find(ref.image, srgb);
   return t ? t->sample(uv) : fallback;
+}
+
+glm::dvec4 TextureSet::sample(const scene::TextureRef& ref, bool srgb, glm::dvec2 uv, double lod, glm::dvec4 fallback) const {
+  const Texture* t = find(ref.image, srgb);
+  return t ? t->sample(uv, lod) : fallback;
 }
 
 }  // namespace dynbench::render
