@@ -210,6 +210,25 @@ TEST(Discard, ExpectedTestCountsEachPixelWithTheProbabilityOfARealChange) {
   const double half = 1.959963984540054 * std::sqrt(n * p * (1 - p)) / n * 100.0;
   EXPECT_NEAR(r.percentages.directInterval->low, 100.0 * p - half, 1e-3);
   EXPECT_NEAR(r.percentages.directInterval->high, 100.0 * p + half, 1e-3);
+  // The noise on the thresholds' scale is sigma = tau / 2 here, at the edge of "uncertain": a
+  // little less and no pixel is, a little more and every pixel is.
+  for (const double scale : {0.9, 1.1}) {
+    FeatureFrame a = now, b = before;
+    for (auto* f : {&a, &b}) std::fill(f->directVariance.begin(), f->directVariance.end(), static_cast<float>(scale * sigma * sigma / 6));
+    EXPECT_EQ(discardFrame(a, b, absolute(1.0, 1.0, tau, tau)).percentages.directNoisy, scale < 1 ? 0.0 : 100.0) << scale;
+  }
+  {
+    FeatureFrame noisier = now, noisierBefore = before;
+    for (auto* f : {&noisier, &noisierBefore})
+      std::fill(f->directVariance.begin(), f->directVariance.end(), static_cast<float>(1.1 * sigma * sigma / 6));
+    // Only the left half of the current frame: its noise is the sum of both frames', so the right
+    // half (variance 0 in the current frame) stays below half the threshold.
+    for (int y = 0; y < h; ++y)
+      for (int x = w / 2; x < w; ++x) noisier.directVariance[static_cast<std::size_t>(y * w + x)] = 0.0f;
+    const auto noisy = discardFrame(noisier, noisierBefore, absolute(1.0, 1.0, tau, tau));
+    EXPECT_NEAR(noisy.percentages.directNoisy, 50.0, 1e-9);
+    EXPECT_EQ(noisy.percentages.indirectNoisy, 0.0);
+  }
   // Indirect did not change and has no noise: exactly 0, an interval of width 0.
   EXPECT_EQ(r.percentages.indirect, 0.0);
   EXPECT_EQ(r.percentages.indirectInterval->halfWidth(), 0.0);
@@ -409,7 +428,7 @@ TEST(DiscardCli, CameraCutsAreMarkedAndLeftOutOfTheMeanUnlessIncluded) {
                                         (dir / "c.csv").string()), dir);
   ASSERT_EQ(cut.status, 0) << cut.err;
   EXPECT_NE(cut.out.find("3 frame pairs of which 1 camera cuts are left out"), std::string::npos) << cut.out;
-  EXPECT_NE(cut.out.find("1 of 3 frame pairs are camera cuts; the mean leaves them out"), std::string::npos) << cut.out;  // spdlog warns on stdout
+  EXPECT_NE(cut.err.find("1 of 3 frame pairs are camera cuts; the mean leaves them out"), std::string::npos) << cut.err;  // warnings on stderr
   const auto p = nlohmann::json::parse(test::slurp(dir / "p.json"));
   const auto c = nlohmann::json::parse(test::slurp(dir / "c.json"));
   EXPECT_EQ(c["cut_pairs"], 1);

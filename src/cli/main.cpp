@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <iostream>
 
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include "cli/commands.h"
@@ -49,6 +50,9 @@ int runCommandLine(int argc, char** argv) {
   // Every option's help shows its default, taken from the options struct it is bound to: the
   // struct is the one place a default is written.
   app.option_defaults()->always_capture_default();
+  // Warnings and errors go to standard error, so that a command's output (a Markdown table, JSON
+  // on standard output) stays what it says it is when piped.
+  spdlog::set_default_logger(spdlog::stderr_color_st("dynbench"));
   spdlog::set_pattern("dynbench: %l: %v");
 
   cli::CommandRun run;

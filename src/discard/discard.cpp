@@ -130,29 +130,37 @@ HistoryTest testHistory(const glm::dvec3& p, const glm::dvec3& n, double viewDep
     result.consistent = result.position && result.normal;
     return result;
   }
-  // Per tap: the tap's point within position x Z of the current point's tangent plane (NRD's
-  // relative plane distance), and its normal within the normal threshold.
+  // Per tap: is the tap's point within position x Z of the current point's tangent plane (NRD's
+  // relative plane distance)? Those taps are the surface's history; their bilinear weights,
+  // renormalised, read its normal and radiance there. Where no tap is, all the taps on geometry
+  // are read (they are another surface: the comparison then fails as it should).
   const double planeTolerance = t.position * std::abs(viewDepth);
-  BilinearTaps kept{};
-  double keptWeight = 0.0;
+  BilinearTaps same{}, onGeometry{};
+  double sameWeight = 0.0, geometryWeight = 0.0;
   for (int k = 0; k < 4; ++k) {
-    kept.index[k] = taps.index[k];
-    kept.weight[k] = 0.0;
+    same.index[k] = onGeometry.index[k] = taps.index[k];
+    same.weight[k] = onGeometry.weight[k] = 0.0;
     if (!(taps.weight[k] > 0) || previous.hit[taps.index[k]] <= 0) continue;
-    const bool samePlane = std::abs(glm::dot(n, at3(previous.position, taps.index[k]) - p)) <= planeTolerance;
-    const bool sameNormal = glm::length(n - at3(previous.normal, taps.index[k])) <= t.normal;
-    result.position |= samePlane;
-    result.normal |= sameNormal;
-    if (samePlane && sameNormal) {
-      kept.weight[k] = taps.weight[k];
-      keptWeight += taps.weight[k];
+    onGeometry.weight[k] = taps.weight[k];
+    geometryWeight += taps.weight[k];
+    if (std::abs(glm::dot(n, at3(previous.position, taps.index[k]) - p)) <= planeTolerance) {
+      same.weight[k] = taps.weight[k];
+      sameWeight += taps.weight[k];
     }
   }
-  if (keptWeight > 0) {
-    result.consistent = true;
-    for (double& w : kept.weight) w /= keptWeight;
-    result.history = kept;
-  }
+  result.position = sameWeight > 0;
+  const double total = result.position ? sameWeight : geometryWeight;
+  if (total <= 0) return result;  // every tap is background: no history of a surface
+  BilinearTaps& read = result.history;
+  read = result.position ? same : onGeometry;
+  for (double& w : read.weight) w /= total;
+  // The normal there: the taps' normals interpolated and renormalised (on a curved surface a
+  // single tap's normal is up to a pixel's turn away, which would make the column shrink with
+  // the pixel).
+  const glm::dvec3 interpolated = sample3(previous.normal, read);
+  const double length = glm::length(interpolated);
+  result.normal = length > 0 && glm::length(n - interpolated / length) <= t.normal;
+  result.consistent = result.position && result.normal;
   return result;
 }
 
@@ -175,6 +183,7 @@ double exceedanceProbability(double d, double sigma, double tau) {
 struct FrameSums {
   std::array<double, 5> count{};
   double directVariance = 0.0, indirectVariance = 0.0;
+  double directNoisy = 0.0, indirectNoisy = 0.0;  // pixels whose noise exceeds half the threshold
 };
 
 }  // namespace
@@ -222,7 +231,7 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
           if (!history.normal) bits |= kNormal;
           // The probability (0 or 1 for the deterministic tests) that the radiance changed.
           auto radianceChange = [&](const std::vector<float>& now, const std::vector<float>& before, double threshold,
-                                    const std::vector<float>& varNow, const std::vector<float>& varBefore) {
+                                    const std::vector<float>& varNow, const std::vector<float>& varBefore, double& noisy) {
             const glm::dvec3 a = at3(now, i), b = sample3(before, history.history);
             const double d = glm::length(a - b);
             // Variance of the difference: the pixel's plus the bilinear sample's, sum of w_k^2 var_k
@@ -245,10 +254,15 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
             // of a grey change of that luminance, sqrt(3) |dY| (noise scaled alike), so both tests
             // agree on grey changes without noise.
             constexpr double kGrey = 1.7320508075688772;  // sqrt(3)
+            // Undetermined: noise above half the threshold leaves the outcome to chance (a pixel
+            // whose true change is 0 counts 2 Phi(-2) = 5 % or more in expectation).
+            if (kGrey * std::sqrt(var) > 0.5 * threshold) noisy += 1.0;
             return exceedanceProbability(kGrey * std::abs(luminance(a) - luminance(b)), kGrey * std::sqrt(var), threshold);
           };
-          const double pd = radianceChange(current.direct, previous.direct, t.direct, current.directVariance, previous.directVariance);
-          const double pi = radianceChange(current.indirect, previous.indirect, t.indirect, current.indirectVariance, previous.indirectVariance);
+          const double pd =
+              radianceChange(current.direct, previous.direct, t.direct, current.directVariance, previous.directVariance, row.directNoisy);
+          const double pi = radianceChange(current.indirect, previous.indirect, t.indirect, current.indirectVariance, previous.indirectVariance,
+                                           row.indirectNoisy);
           row.count[3] += pd;
           row.count[4] += pi;
           row.directVariance += pd * (1.0 - pd);
@@ -267,6 +281,8 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
     for (std::size_t b = 0; b < 5; ++b) total.count[b] += row.count[b];
     total.directVariance += row.directVariance;
     total.indirectVariance += row.indirectVariance;
+    total.directNoisy += row.directNoisy;
+    total.indirectNoisy += row.indirectNoisy;
   }
   const double scale = 100.0 / static_cast<double>(n);  // Eq. (3.4), as a percentage
   auto& p = result.percentages;
@@ -280,6 +296,8 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
     };
     p.directInterval = interval(p.direct, total.directVariance);
     p.indirectInterval = interval(p.indirect, total.indirectVariance);
+    p.directNoisy = total.directNoisy * scale;
+    p.indirectNoisy = total.indirectNoisy * scale;
   }
   return result;
 }
@@ -366,6 +384,18 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
     };
     run.mean.directInterval = meanInterval(run.mean.direct, &FramePercentages::directInterval);
     run.mean.indirectInterval = meanInterval(run.mean.indirect, &FramePercentages::indirectInterval);
+    for (const FramePercentages* f : averaged) {
+      run.mean.directNoisy += f->directNoisy / n;
+      run.mean.indirectNoisy += f->indirectNoisy / n;
+    }
+    // The interval covers the count's chance, not the bias noise gives the expected test: say
+    // when a column is mostly noise.
+    for (const auto& [name, noisy] : {std::pair{"direct", run.mean.directNoisy}, {"indirect", run.mean.indirectNoisy}})
+      if (noisy > kNoisyWarning)
+        run.warnings.push_back(fmt::format("the {} radiance column is uncertain: the noise of {:.1f} % of the pixels exceeds half the "
+                                           "threshold, and noise alone counts as change there (render with --converge, a lower "
+                                           "--tolerance or a higher --max-spp)",
+                                           name, noisy));
   }
   return run;
 }
@@ -392,9 +422,11 @@ namespace {
 nlohmann::json percentagesJson(const FramePercentages& p) {
   nlohmann::json j = {{"frustum", p.frustum}, {"world_position", p.position}, {"shading_normal", p.normal}, {"direct_radiance", p.direct},
                       {"indirect_radiance", p.indirect}};
-  if (p.directInterval && p.indirectInterval)
+  if (p.directInterval && p.indirectInterval) {
     j["interval"] = {{"direct_radiance", {p.directInterval->low, p.directInterval->high}},
                      {"indirect_radiance", {p.indirectInterval->low, p.indirectInterval->high}}};
+    j["noisy"] = {{"direct_radiance", p.directNoisy}, {"indirect_radiance", p.indirectNoisy}};
+  }
   return j;
 }
 
@@ -446,6 +478,14 @@ Expected<FramePercentages> readPercentages(const JsonFields& f, const std::strin
       if (!high) return std::unexpected(high.error());
       *target = Interval{*low, *high};
     }
+  }
+  // Uncertain shares: optional (files of earlier versions have none).
+  for (auto [key, target] : {std::pair{"direct_radiance", &p.directNoisy}, {"indirect_radiance", &p.indirectNoisy}}) {
+    const std::string pointer = base + "/noisy/" + key;
+    if (!f.has(pointer)) continue;
+    auto v = f.number(pointer);
+    if (!v) return std::unexpected(v.error());
+    *target = *v;
   }
   return p;
 }

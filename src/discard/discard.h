@@ -24,10 +24,11 @@ struct Thresholds {
   //  kTaps (default): each of the four bilinear taps of the previous frame on its own, as SVGF and
   //    NVIDIA's NRD test history: a tap is the same surface when its world position lies within
   //    `position` x the pixel's view depth of the current point's tangent plane (NRD's relative
-  //    plane distance, its disocclusionThreshold 0.01), and has the same normal when
-  //    ||n_i - n_tap|| <= `normal`. Position (normal) is discarded when no tap passes; radiance is
-  //    compared with the taps that pass both, their weights renormalised. Free of scene units and
-  //    of the first frame, and of resolution on smooth surfaces (the taps of a plane lie on it).
+  //    plane distance, its disocclusionThreshold 0.01). Position is discarded when no tap is; the
+  //    normal when the same-surface taps' interpolated, renormalised normal is more than `normal`
+  //    away (all taps on geometry where none is the same surface); radiance is compared with the
+  //    same-surface taps, their weights renormalised. Free of scene units and of the first frame,
+  //    and of resolution on smooth surfaces (the taps of a plane lie on it).
   //  kBilinear: the thesis's test: the bilinear sample of the four taps against the current pixel,
   //    position in scene units (or relativePosition), every tap on geometry.
   enum class GeometryTest { kTaps, kBilinear };
@@ -81,8 +82,15 @@ struct FramePercentages {
   double frustum = 0, position = 0, normal = 0, direct = 0, indirect = 0;  // percent of w x h
   // The radiance columns' 95 % intervals (the kExpected test; absent otherwise).
   std::optional<Interval> directInterval, indirectInterval;
+  // The expected test: percent of w x h whose noise (on the threshold's scale) exceeds half the
+  // threshold, where noise alone counts as change with probability 5 % or more. A column whose
+  // share is large measures the render's noise more than the dataset (a warning says so).
+  double directNoisy = 0, indirectNoisy = 0;
   bool cut = false;  // frame i's sidecar marks a camera cut: a jump, not motion
 };
+
+// The share of uncertain pixels (FramePercentages::directNoisy) above which discard warns.
+inline constexpr double kNoisyWarning = 5.0;
 
 struct DiscardResult {
   FramePercentages percentages;
@@ -105,7 +113,7 @@ double sample1(const std::vector<float>& buffer, const BilinearTaps& taps);
 // when none is). `viewDepth` is the current pixel's Z; thresholds absolute.
 struct HistoryTest {
   bool position = false, normal = false;  // history found for the feature
-  bool consistent = false;                // some history is the same surface in both
+  bool consistent = false;                // the history is the same surface, of the same normal
   BilinearTaps history{};
 };
 HistoryTest testHistory(const glm::dvec3& p, const glm::dvec3& n, double viewDepth, const FeatureFrame& previous, const BilinearTaps& taps,
