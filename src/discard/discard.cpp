@@ -131,36 +131,37 @@ HistoryTest testHistory(const glm::dvec3& p, const glm::dvec3& n, double viewDep
     return result;
   }
   // Per tap: is the tap's point within position x Z of the current point's tangent plane (NRD's
-  // relative plane distance)? Those taps are the surface's history; their bilinear weights,
-  // renormalised, read its normal and radiance there. Where no tap is, all the taps on geometry
-  // are read (they are another surface: the comparison then fails as it should).
+  // relative plane distance), and is its normal within the normal threshold? Position (normal)
+  // has history when some tap passes its test: each test on its own, as the thesis's columns are.
+  // A single tap, not an interpolation of the taps: across a crease the taps of both faces lie
+  // near the tangent plane, and their mean normal is neither face's. Radiance is read from the
+  // taps of the same surface, renormalised (all the taps on geometry where none is: another
+  // surface, whose comparison then fails as it should).
   const double planeTolerance = t.position * std::abs(viewDepth);
   BilinearTaps same{}, onGeometry{};
   double sameWeight = 0.0, geometryWeight = 0.0;
+  bool sameNormal = false;
   for (int k = 0; k < 4; ++k) {
     same.index[k] = onGeometry.index[k] = taps.index[k];
     same.weight[k] = onGeometry.weight[k] = 0.0;
     if (!(taps.weight[k] > 0) || previous.hit[taps.index[k]] <= 0) continue;
     onGeometry.weight[k] = taps.weight[k];
     geometryWeight += taps.weight[k];
+    const bool normalMatches = glm::length(n - at3(previous.normal, taps.index[k])) <= t.normal;
+    result.normal |= normalMatches;
     if (std::abs(glm::dot(n, at3(previous.position, taps.index[k]) - p)) <= planeTolerance) {
       same.weight[k] = taps.weight[k];
       sameWeight += taps.weight[k];
+      sameNormal |= normalMatches;
     }
   }
   result.position = sameWeight > 0;
+  result.consistent = result.position && sameNormal;
   const double total = result.position ? sameWeight : geometryWeight;
   if (total <= 0) return result;  // every tap is background: no history of a surface
   BilinearTaps& read = result.history;
   read = result.position ? same : onGeometry;
   for (double& w : read.weight) w /= total;
-  // The normal there: the taps' normals interpolated and renormalised (on a curved surface a
-  // single tap's normal is up to a pixel's turn away, which would make the column shrink with
-  // the pixel).
-  const glm::dvec3 interpolated = sample3(previous.normal, read);
-  const double length = glm::length(interpolated);
-  result.normal = length > 0 && glm::length(n - interpolated / length) <= t.normal;
-  result.consistent = result.position && result.normal;
   return result;
 }
 
@@ -229,18 +230,51 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
           const HistoryTest history = testHistory(p, at3(current.normal, i), viewDepth, previous, taps, t);
           if (!history.position) bits |= kPosition;
           if (!history.normal) bits |= kNormal;
+          // The radiance history: in the taps test, where the 4 x 4 taps around the point are all
+          // the same surface, the Catmull-Rom cubic of them (as TAA reads its history): the bilinear
+          // sample is a blur, which at a shadow or texture edge a pixel or two wide differs from the
+          // edge itself by more than the threshold, a band that halves with the pixel's size.
+          std::array<std::size_t, 16> cubicIndex{};
+          std::array<double, 16> cubicWeight{};
+          bool cubic = false;
+          if (t.geometryTest == Thresholds::GeometryTest::kTaps && history.position) {
+            const double u = q->x - previous.camera.jitter.x - 0.5, v = q->y - previous.camera.jitter.y - 0.5;
+            const double fx = std::floor(u), fy = std::floor(v);
+            const auto wx = catmullRomWeights(u - fx), wy = catmullRomWeights(v - fy);
+            const int x0 = static_cast<int>(fx) - 1, y0 = static_cast<int>(fy) - 1;
+            const glm::dvec3 normal = at3(current.normal, i);
+            const double planeTolerance = t.position * std::abs(viewDepth);
+            cubic = x0 >= 0 && y0 >= 0 && x0 + 3 < previous.width && y0 + 3 < previous.height;
+            for (int j = 0; j < 4 && cubic; ++j)
+              for (int k = 0; k < 4 && cubic; ++k) {
+                const std::size_t tap = static_cast<std::size_t>(y0 + j) * static_cast<std::size_t>(previous.width) + static_cast<std::size_t>(x0 + k);
+                cubic = previous.hit[tap] > 0 && std::abs(glm::dot(normal, at3(previous.position, tap) - p)) <= planeTolerance;
+                cubicIndex[static_cast<std::size_t>(4 * j + k)] = tap;
+                cubicWeight[static_cast<std::size_t>(4 * j + k)] = wx[static_cast<std::size_t>(k)] * wy[static_cast<std::size_t>(j)];
+              }
+          }
           // The probability (0 or 1 for the deterministic tests) that the radiance changed.
           auto radianceChange = [&](const std::vector<float>& now, const std::vector<float>& before, double threshold,
                                     const std::vector<float>& varNow, const std::vector<float>& varBefore, double& noisy) {
-            const glm::dvec3 a = at3(now, i), b = sample3(before, history.history);
+            const glm::dvec3 a = at3(now, i);
+            glm::dvec3 b(0.0);
+            if (cubic) {
+              for (std::size_t k = 0; k < 16; ++k) b += cubicWeight[k] * at3(before, cubicIndex[k]);
+            } else {
+              b = sample3(before, history.history);
+            }
             const double d = glm::length(a - b);
-            // Variance of the difference: the pixel's plus the bilinear sample's, sum of w_k^2 var_k
+            // Variance of the difference: the pixel's plus the history sample's, sum of w_k^2 var_k
             // (independent pixels).
             double var = 0.0;
             if (variance && test != Test::kPlain) {
               var = varNow[i];
-              const BilinearTaps& h = history.history;
-              for (int k = 0; k < 4; ++k) var += h.weight[k] * h.weight[k] * varBefore[h.index[k]];
+              if (cubic) {
+                for (std::size_t k = 0; k < 16; ++k) var += cubicWeight[k] * cubicWeight[k] * varBefore[cubicIndex[k]];
+              } else {
+                const BilinearTaps& h = history.history;
+                for (int k = 0; k < 4; ++k) var += h.weight[k] * h.weight[k] * varBefore[h.index[k]];
+              }
             }
             switch (test) {
               case Test::kPlain: return d > threshold ? 1.0 : 0.0;

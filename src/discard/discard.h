@@ -24,11 +24,12 @@ struct Thresholds {
   //  kTaps (default): each of the four bilinear taps of the previous frame on its own, as SVGF and
   //    NVIDIA's NRD test history: a tap is the same surface when its world position lies within
   //    `position` x the pixel's view depth of the current point's tangent plane (NRD's relative
-  //    plane distance, its disocclusionThreshold 0.01). Position is discarded when no tap is; the
-  //    normal when the same-surface taps' interpolated, renormalised normal is more than `normal`
-  //    away (all taps on geometry where none is the same surface); radiance is compared with the
-  //    same-surface taps, their weights renormalised. Free of scene units and of the first frame,
-  //    and of resolution on smooth surfaces (the taps of a plane lie on it).
+  //    plane distance, its disocclusionThreshold 0.01), and has the same normal when
+  //    ||n_i - n_tap|| <= `normal`. Position (normal) is discarded when no tap passes its test;
+  //    radiance is compared with the Catmull-Rom cubic of the 4 x 4 taps where all are the same
+  //    surface, else with the same-surface bilinear taps, their weights renormalised. Free of scene
+  //    units and of the first frame, and of resolution on smooth surfaces (the taps of a plane lie
+  //    on it).
   //  kBilinear: the thesis's test: the bilinear sample of the four taps against the current pixel,
   //    position in scene units (or relativePosition), every tap on geometry.
   enum class GeometryTest { kTaps, kBilinear };
@@ -113,7 +114,7 @@ double sample1(const std::vector<float>& buffer, const BilinearTaps& taps);
 // when none is). `viewDepth` is the current pixel's Z; thresholds absolute.
 struct HistoryTest {
   bool position = false, normal = false;  // history found for the feature
-  bool consistent = false;                // the history is the same surface, of the same normal
+  bool consistent = false;                // a tap is the same surface with the same normal
   BilinearTaps history{};
 };
 HistoryTest testHistory(const glm::dvec3& p, const glm::dvec3& n, double viewDepth, const FeatureFrame& previous, const BilinearTaps& taps,

@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 
+#include "core/math.h"
 #include "evaluate/method.h"
 
 namespace dynbench::evaluate {
@@ -18,12 +19,6 @@ namespace {
 
 glm::dvec3 toYCoCg(glm::dvec3 c) { return {0.25 * c.r + 0.5 * c.g + 0.25 * c.b, 0.5 * c.r - 0.5 * c.b, -0.25 * c.r + 0.5 * c.g - 0.25 * c.b}; }
 glm::dvec3 fromYCoCg(glm::dvec3 v) { return {v.x + v.y - v.z, v.x + v.z, v.x - v.y - v.z}; }
-
-// The Catmull-Rom spline's weights of the four samples around t in [0, 1) (Keys' cubic, a = -0.5).
-std::array<double, 4> catmullRomWeights(double t) {
-  const double t2 = t * t, t3 = t2 * t;
-  return {0.5 * (-t3 + 2.0 * t2 - t), 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0), 0.5 * (-3.0 * t3 + 4.0 * t2 + t), 0.5 * (t3 - t2)};
-}
 
 }  // namespace
 
