@@ -60,8 +60,6 @@ glm::dmat4 matrixOf(const DualQuaternion& q);
 // by 2°, not 358°.
 double wrapDegrees(double degreesValue);
 
-// Luminance of linear Rec.709 RGB (ITU-R BT.709 Y): the one scalar the renderer's variance
-// channels, light choice and the discard's noise test use.
 // The Catmull-Rom spline's weights of the four samples around t in [0, 1) (Keys' cubic, a = -0.5):
 // interpolating, exact on quadratics, summing to 1.
 inline std::array<double, 4> catmullRomWeights(double t) {
@@ -69,6 +67,8 @@ inline std::array<double, 4> catmullRomWeights(double t) {
   return {0.5 * (-t3 + 2.0 * t2 - t), 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0), 0.5 * (-3.0 * t3 + 4.0 * t2 + t), 0.5 * (t3 - t2)};
 }
 
+// Luminance of linear Rec.709 RGB (ITU-R BT.709 Y): the one scalar the renderer's variance
+// channels, light choice and the discard's noise test use.
 inline double luminance(const glm::dvec3& rgb) { return 0.2126 * rgb.r + 0.7152 * rgb.g + 0.0722 * rgb.b; }
 
 // sin and cos of an angle, computed in single precision and widened. For Monte Carlo sampling

@@ -39,10 +39,46 @@ BilinearTaps bilinearTaps(double x, double y, int width, int height) {
                       {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty}};
 }
 
-glm::dvec3 sample3(const std::vector<float>& buffer, const BilinearTaps& taps) {
+namespace {
+
+// Sum of weight x value over a set of taps (bilinear or cubic).
+template <typename Taps>
+glm::dvec3 weightedSum3(const std::vector<float>& buffer, const Taps& taps) {
   glm::dvec3 s(0.0);
-  for (int k = 0; k < 4; ++k) s += taps.weight[k] * at3(buffer, taps.index[k]);
+  for (std::size_t k = 0; k < std::size(taps.weight); ++k) s += taps.weight[k] * at3(buffer, taps.index[k]);
   return s;
+}
+
+// The variance of such a sum of independent pixels: sum of weight^2 x variance.
+template <typename Taps>
+double weightedVariance(const std::vector<float>& variance, const Taps& taps) {
+  double s = 0.0;
+  for (std::size_t k = 0; k < std::size(taps.weight); ++k) s += taps.weight[k] * taps.weight[k] * variance[taps.index[k]];
+  return s;
+}
+
+}  // namespace
+
+glm::dvec3 sample3(const std::vector<float>& buffer, const BilinearTaps& taps) { return weightedSum3(buffer, taps); }
+glm::dvec3 sample3(const std::vector<float>& buffer, const CubicTaps& taps) { return weightedSum3(buffer, taps); }
+
+CubicTaps catmullRomTaps(double x, double y, int width, int height) {
+  // Texel space: pixel (i, j)'s centre at (i + 0.5, j + 0.5); the taps are the 4 x 4 centres
+  // around, the first one pixel left of and above the bilinear cell's.
+  const double u = x - 0.5, v = y - 0.5;
+  const double fx = std::floor(u), fy = std::floor(v);
+  const auto wx = catmullRomWeights(u - fx), wy = catmullRomWeights(v - fy);
+  const int x0 = static_cast<int>(fx) - 1, y0 = static_cast<int>(fy) - 1;
+  CubicTaps taps{};
+  taps.inside = x0 >= 0 && y0 >= 0 && x0 + 3 < width && y0 + 3 < height;
+  for (int j = 0; j < 4; ++j)
+    for (int k = 0; k < 4; ++k) {
+      const auto tap = static_cast<std::size_t>(4 * j + k);
+      taps.index[tap] = static_cast<std::size_t>(std::clamp(y0 + j, 0, height - 1)) * static_cast<std::size_t>(width) +
+                        static_cast<std::size_t>(std::clamp(x0 + k, 0, width - 1));
+      taps.weight[tap] = wx[static_cast<std::size_t>(k)] * wy[static_cast<std::size_t>(j)];
+    }
+  return taps;
 }
 
 double sample1(const std::vector<float>& buffer, const BilinearTaps& taps) {
@@ -116,6 +152,10 @@ const char* geometryTestName(Thresholds::GeometryTest test) {
   return test == Thresholds::GeometryTest::kTaps ? "taps" : "bilinear";
 }
 
+bool onTangentPlane(const glm::dvec3& p, const glm::dvec3& n, const glm::dvec3& q, double viewDepth, const Thresholds& t) {
+  return std::abs(glm::dot(n, q - p)) <= t.position * std::abs(viewDepth);
+}
+
 HistoryTest testHistory(const glm::dvec3& p, const glm::dvec3& n, double viewDepth, const FeatureFrame& previous, const BilinearTaps& taps,
                         const Thresholds& t) {
   HistoryTest result;
@@ -137,7 +177,6 @@ HistoryTest testHistory(const glm::dvec3& p, const glm::dvec3& n, double viewDep
   // near the tangent plane, and their mean normal is neither face's. Radiance is read from the
   // taps of the same surface, renormalised (all the taps on geometry where none is: another
   // surface, whose comparison then fails as it should).
-  const double planeTolerance = t.position * std::abs(viewDepth);
   BilinearTaps same{}, onGeometry{};
   double sameWeight = 0.0, geometryWeight = 0.0;
   bool sameNormal = false;
@@ -149,7 +188,7 @@ HistoryTest testHistory(const glm::dvec3& p, const glm::dvec3& n, double viewDep
     geometryWeight += taps.weight[k];
     const bool normalMatches = glm::length(n - at3(previous.normal, taps.index[k])) <= t.normal;
     result.normal |= normalMatches;
-    if (std::abs(glm::dot(n, at3(previous.position, taps.index[k]) - p)) <= planeTolerance) {
+    if (onTangentPlane(p, n, at3(previous.position, taps.index[k]), viewDepth, t)) {
       same.weight[k] = taps.weight[k];
       sameWeight += taps.weight[k];
       sameNormal |= normalMatches;
@@ -227,55 +266,31 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
           // A jittered frame's buffers hold its samples at centre + jitter (render --jitter).
           const BilinearTaps taps = bilinearTaps(q->x - previous.camera.jitter.x, q->y - previous.camera.jitter.y, previous.width, previous.height);
           const double viewDepth = -(current.camera.view * glm::dvec4(p, 1.0)).z;
-          const HistoryTest history = testHistory(p, at3(current.normal, i), viewDepth, previous, taps, t);
+          const glm::dvec3 normal = at3(current.normal, i);
+          const HistoryTest history = testHistory(p, normal, viewDepth, previous, taps, t);
           if (!history.position) bits |= kPosition;
           if (!history.normal) bits |= kNormal;
           // The radiance history: in the taps test, where the 4 x 4 taps around the point are all
           // the same surface, the Catmull-Rom cubic of them (as TAA reads its history): the bilinear
           // sample is a blur, which at a shadow or texture edge a pixel or two wide differs from the
           // edge itself by more than the threshold, a band that halves with the pixel's size.
-          std::array<std::size_t, 16> cubicIndex{};
-          std::array<double, 16> cubicWeight{};
-          bool cubic = false;
-          if (t.geometryTest == Thresholds::GeometryTest::kTaps && history.position) {
-            const double u = q->x - previous.camera.jitter.x - 0.5, v = q->y - previous.camera.jitter.y - 0.5;
-            const double fx = std::floor(u), fy = std::floor(v);
-            const auto wx = catmullRomWeights(u - fx), wy = catmullRomWeights(v - fy);
-            const int x0 = static_cast<int>(fx) - 1, y0 = static_cast<int>(fy) - 1;
-            const glm::dvec3 normal = at3(current.normal, i);
-            const double planeTolerance = t.position * std::abs(viewDepth);
-            cubic = x0 >= 0 && y0 >= 0 && x0 + 3 < previous.width && y0 + 3 < previous.height;
-            for (int j = 0; j < 4 && cubic; ++j)
-              for (int k = 0; k < 4 && cubic; ++k) {
-                const std::size_t tap = static_cast<std::size_t>(y0 + j) * static_cast<std::size_t>(previous.width) + static_cast<std::size_t>(x0 + k);
-                cubic = previous.hit[tap] > 0 && std::abs(glm::dot(normal, at3(previous.position, tap) - p)) <= planeTolerance;
-                cubicIndex[static_cast<std::size_t>(4 * j + k)] = tap;
-                cubicWeight[static_cast<std::size_t>(4 * j + k)] = wx[static_cast<std::size_t>(k)] * wy[static_cast<std::size_t>(j)];
-              }
-          }
+          const bool tapsTest = t.geometryTest == Thresholds::GeometryTest::kTaps;
+          const CubicTaps cubicTaps = tapsTest && history.position
+                                          ? catmullRomTaps(q->x - previous.camera.jitter.x, q->y - previous.camera.jitter.y, previous.width, previous.height)
+                                          : CubicTaps{};
+          bool cubic = tapsTest && history.position && cubicTaps.inside;
+          for (std::size_t k = 0; k < 16 && cubic; ++k)
+            cubic = previous.hit[cubicTaps.index[k]] > 0 && onTangentPlane(p, normal, at3(previous.position, cubicTaps.index[k]), viewDepth, t);
           // The probability (0 or 1 for the deterministic tests) that the radiance changed.
           auto radianceChange = [&](const std::vector<float>& now, const std::vector<float>& before, double threshold,
                                     const std::vector<float>& varNow, const std::vector<float>& varBefore, double& noisy) {
-            const glm::dvec3 a = at3(now, i);
-            glm::dvec3 b(0.0);
-            if (cubic) {
-              for (std::size_t k = 0; k < 16; ++k) b += cubicWeight[k] * at3(before, cubicIndex[k]);
-            } else {
-              b = sample3(before, history.history);
-            }
+            const glm::dvec3 a = at3(now, i), b = cubic ? sample3(before, cubicTaps) : sample3(before, history.history);
             const double d = glm::length(a - b);
             // Variance of the difference: the pixel's plus the history sample's, sum of w_k^2 var_k
             // (independent pixels).
             double var = 0.0;
-            if (variance && test != Test::kPlain) {
-              var = varNow[i];
-              if (cubic) {
-                for (std::size_t k = 0; k < 16; ++k) var += cubicWeight[k] * cubicWeight[k] * varBefore[cubicIndex[k]];
-              } else {
-                const BilinearTaps& h = history.history;
-                for (int k = 0; k < 4; ++k) var += h.weight[k] * h.weight[k] * varBefore[h.index[k]];
-              }
-            }
+            if (variance && test != Test::kPlain)
+              var = varNow[i] + (cubic ? weightedVariance(varBefore, cubicTaps) : weightedVariance(varBefore, history.history));
             switch (test) {
               case Test::kPlain: return d > threshold ? 1.0 : 0.0;
               case Test::kNoiseAware:

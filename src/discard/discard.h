@@ -107,16 +107,29 @@ struct BilinearTaps {
 BilinearTaps bilinearTaps(double x, double y, int width, int height);
 glm::dvec3 sample3(const std::vector<float>& buffer, const BilinearTaps& taps);
 double sample1(const std::vector<float>& buffer, const BilinearTaps& taps);
+// The Catmull-Rom cubic's 4 x 4 taps around continuous pixel coordinates (x, y) (Keys' a = -0.5,
+// weights summing to 1, some negative), clamped at the image's edges; `inside` when none was.
+struct CubicTaps {
+  std::size_t index[16];
+  double weight[16];
+  bool inside;
+};
+CubicTaps catmullRomTaps(double x, double y, int width, int height);
+glm::dvec3 sample3(const std::vector<float>& buffer, const CubicTaps& taps);
 
 // The geometry test of one reprojected surface pixel (Thresholds::GeometryTest) against the
 // previous frame's taps around where it lands: whether its position and its normal have history,
-// and the taps its radiance history is read from (those consistent in both, renormalised; all four
-// when none is). `viewDepth` is the current pixel's Z; thresholds absolute.
+// and the taps its radiance history is read from (kTaps: those of the same surface, renormalised,
+// or all on geometry when none is; kBilinear: all four). `viewDepth` is the current pixel's Z;
+// thresholds absolute.
 struct HistoryTest {
   bool position = false, normal = false;  // history found for the feature
   bool consistent = false;                // a tap is the same surface with the same normal
   BilinearTaps history{};
 };
+// The taps test's "same surface": q within position x |viewDepth| of the plane through p normal
+// to n (NRD's relative plane distance).
+bool onTangentPlane(const glm::dvec3& p, const glm::dvec3& n, const glm::dvec3& q, double viewDepth, const Thresholds& absolute);
 HistoryTest testHistory(const glm::dvec3& p, const glm::dvec3& n, double viewDepth, const FeatureFrame& previous, const BilinearTaps& taps,
                         const Thresholds& absolute);
 

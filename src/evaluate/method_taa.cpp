@@ -2,16 +2,14 @@
 // 2016 ("An Excursion in Temporal Supersampling"): the history is fetched where the frame's
 // motion vector points with a Catmull-Rom bicubic filter (as Falcor's and Unreal's TAA do: a
 // bilinear fetch blurs the history a little at every frame, and over the ~10 frames the blend
-// keeps, a sub-pixel motion smears it to a visibly softer image), the 3x3 neighbourhood of the current input gives the mean mu
-// and standard deviation sigma of each YCoCg channel, and the history is *variance-clipped*
+// keeps, a sub-pixel motion smears it to a visibly softer image), the 3x3 neighbourhood of the
+// current input gives the mean mu and standard deviation sigma of each YCoCg channel, and the history is *variance-clipped*
 // (Salvi): moved along the line towards mu until it lies in the box mu +- gamma sigma (not clamped
 // per channel, and not clipped to the neighbourhood's min/max box). Then
 // out = lerp(history, current, 0.1). Meant for input rendered with `render --jitter`.
 #include <algorithm>
-#include <array>
 #include <cmath>
 
-#include "core/math.h"
 #include "evaluate/method.h"
 
 namespace dynbench::evaluate {
@@ -23,21 +21,7 @@ glm::dvec3 fromYCoCg(glm::dvec3 v) { return {v.x + v.y - v.z, v.x + v.z, v.x - v
 }  // namespace
 
 glm::dvec3 sampleCatmullRom(const RgbImage& image, double x, double y) {
-  // Texel space: pixel (i, j)'s centre at (i + 0.5, j + 0.5); the 4 x 4 texels around, clamped at
-  // the edges. The weights of each axis sum to 1, so a constant image is returned exactly.
-  const double u = x - 0.5, v = y - 0.5;
-  const double fx = std::floor(u), fy = std::floor(v);
-  const auto wx = catmullRomWeights(u - fx), wy = catmullRomWeights(v - fy);
-  const int x0 = static_cast<int>(fx) - 1, y0 = static_cast<int>(fy) - 1;
-  glm::dvec3 sum(0.0);
-  for (int j = 0; j < 4; ++j) {
-    const std::size_t row = static_cast<std::size_t>(std::clamp(y0 + j, 0, image.height - 1)) * static_cast<std::size_t>(image.width);
-    for (int i = 0; i < 4; ++i) {
-      const std::size_t k = 3 * (row + static_cast<std::size_t>(std::clamp(x0 + i, 0, image.width - 1)));
-      sum += (wx[static_cast<std::size_t>(i)] * wy[static_cast<std::size_t>(j)]) * glm::dvec3(image.rgb[k], image.rgb[k + 1], image.rgb[k + 2]);
-    }
-  }
-  return sum;
+  return discard::sample3(image.rgb, discard::catmullRomTaps(x, y, image.width, image.height));
 }
 
 namespace {

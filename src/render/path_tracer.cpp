@@ -153,10 +153,10 @@ PathTracer::Shading PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& w
   return s;
 }
 
-double PathTracer::textureLodAt(const SurfaceHit& hit, const glm::dvec3& direction, double coneWidth) const {
+double PathTracer::textureLodAt(const SurfaceHit& hit, const std::array<glm::dvec3, 3>& p, const glm::dvec3& direction,
+                                double coneWidth) const {
   const scene::Primitive& prim = *hit.source;
   if (prim.uvs.empty() || !(coneWidth > 0)) return -kInfinity;
-  const auto p = rayTracing_->trianglePositions(hit);
   const std::uint32_t* idx = hit.vertices.data();
   const glm::dvec2 d1 = glm::dvec2(prim.uvs[idx[1]]) - glm::dvec2(prim.uvs[idx[0]]);
   const glm::dvec2 d2 = glm::dvec2(prim.uvs[idx[2]]) - glm::dvec2(prim.uvs[idx[0]]);
@@ -168,10 +168,12 @@ double PathTracer::textureLodAt(const SurfaceHit& hit, const glm::dvec3& directi
 void PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, double coneWidth, Shading& s) const {
   const scene::Material* m = materialOf(*hit.source);
   SurfaceMaterial& mat = s.material;
-  // The level of detail only where a texture is read.
+  // The triangle's corners and the level of detail only where a texture is read.
   const bool textured = m && (m->baseColorTexture.image >= 0 || m->metallicRoughnessTexture.image >= 0 || m->normalTexture.image >= 0 ||
                               m->emissiveTexture.image >= 0);
-  const double lod = textured ? textureLodAt(hit, -wo, coneWidth) : -kInfinity;
+  std::array<glm::dvec3, 3> corners{};
+  if (textured) corners = rayTracing_->trianglePositions(hit);
+  const double lod = textured ? textureLodAt(hit, corners, -wo, coneWidth) : -kInfinity;
   if (!m) {
     // glTF's default material when a primitive has none: white, metallic 1, roughness 1 (§3.9.6).
     mat = SurfaceMaterial{};
@@ -208,7 +210,7 @@ void PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 u
   if (m && m->normalTexture.image >= 0 && textures_.find(m->normalTexture.image, false)) {
     // Tangent frame from the triangle's uv parameterisation (what glTF implies when a mesh has no
     // TANGENT attribute), then n = T x + B y + N z with (x, y, z) = 2 texel - 1.
-    const auto p = rayTracing_->trianglePositions(hit);
+    const auto& p = corners;
     const scene::Primitive& prim = *hit.source;
     if (!prim.uvs.empty()) {
       const std::uint32_t* idx = hit.vertices.data();

@@ -16,6 +16,7 @@
 // lights are chosen at every path vertex by the light tree (LightSet::selectPunctual): where no
 // more than lightsPerPoint can reach the point they are all summed, so a scene lit by few of them
 // has noise-free direct light at 1 spp; where more can, they are sampled without bias.
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <limits>
@@ -108,8 +109,9 @@ class PathTracer {
   Shading shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, double coneWidth) const;
   void shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, double coneWidth, Shading& shading) const;  // every field written
   // The texture-independent level of detail of a ray cone of width coneWidth arriving along
-  // `direction` at the hit's triangle (textureLod).
-  double textureLodAt(const SurfaceHit& hit, const glm::dvec3& direction, double coneWidth) const;
+  // `direction` at the hit's triangle, whose world corners are `corners` (textureLod).
+  double textureLodAt(const SurfaceHit& hit, const std::array<glm::dvec3, 3>& corners, const glm::dvec3& direction,
+                      double coneWidth) const;
   glm::dvec3 emission(int node, int primitive, unsigned triangle, glm::dvec2 barycentric) const;
   // The same, at texture coordinates uv and texture level of detail lod (-infinity: level 0).
   glm::dvec3 emission(const scene::Material& material, glm::dvec2 uv, double lod = -std::numeric_limits<double>::infinity()) const;

@@ -100,13 +100,14 @@ Texture::Footprint Texture::footprint(glm::dvec2 uv) const {
   return {{y0 * w + x0, y0 * w + x1, y1 * w + x0, y1 * w + x1}, x - fx, y - fy};
 }
 
+glm::vec4 Texture::texel(std::size_t i) const {
+  if (codes.empty()) return texels[i];
+  const auto& k = codes[i];
+  return glm::vec4(decodeColour[k[0]], decodeColour[k[1]], decodeColour[k[2]], decodeAlpha[k[3]]);
+}
+
 glm::dvec4 Texture::sample(glm::dvec2 uv) const {
   const Footprint f = footprint(uv);
-  auto texel = [&](std::size_t i) {
-    if (codes.empty()) return texels[i];
-    const auto& k = codes[i];
-    return glm::vec4(decodeColour[k[0]], decodeColour[k[1]], decodeColour[k[2]], decodeAlpha[k[3]]);
-  };
   const glm::vec4 a = texel(f.index[0]), b = texel(f.index[1]), c = texel(f.index[2]), d = texel(f.index[3]);
   const float tx = f.tx, ty = f.ty;
   return glm::dvec4((1 - ty) * ((1 - tx) * a + tx * b) + ty * ((1 - tx) * c + tx * d));
@@ -138,14 +139,7 @@ void Texture::buildMips() {
   // Level 0 in decoded values, as the levels above hold them.
   MipLevel below{width, height, {}};
   below.texels.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
-  for (std::size_t i = 0; i < below.texels.size(); ++i) {
-    if (codes.empty()) {
-      below.texels[i] = texels[i];
-    } else {
-      const auto& k = codes[i];
-      below.texels[i] = glm::vec4(decodeColour[k[0]], decodeColour[k[1]], decodeColour[k[2]], decodeAlpha[k[3]]);
-    }
-  }
+  for (std::size_t i = 0; i < below.texels.size(); ++i) below.texels[i] = texel(i);
   while (below.width > 1 || below.height > 1) {
     MipLevel level{std::max(1, below.width / 2), std::max(1, below.height / 2), {}};
     level.texels.resize(static_cast<std::size_t>(level.width) * static_cast<std::size_t>(level.height));

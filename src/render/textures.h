@@ -45,6 +45,7 @@ struct Texture {
   void prefetch(glm::dvec2 uv) const;
 
  private:
+  glm::vec4 texel(std::size_t i) const;  // texel i of level 0, decoded
   struct Footprint {
     std::size_t index[4];  // texels (x0, y0), (x1, y0), (x0, y1), (x1, y1)
     float tx, ty;          // bilinear weights of x1 and y1
