@@ -173,13 +173,18 @@ HistoryTest testHistory(const glm::dvec3& p, const glm::dvec3& n, double viewDep
   // Per tap: is the tap's point within position x Z of the current point's tangent plane (NRD's
   // relative plane distance), and is its normal within the normal threshold? Position (normal)
   // has history when some tap passes its test: each test on its own, as the thesis's columns are.
-  // A single tap, not an interpolation of the taps: across a crease the taps of both faces lie
-  // near the tangent plane, and their mean normal is neither face's. Radiance is read from the
-  // taps of the same surface, renormalised (all the taps on geometry where none is: another
-  // surface, whose comparison then fails as it should).
+  // The normal has history when a single tap's matches, or the interpolation of the same-surface
+  // taps' normals does: across a crease the taps of both faces lie near the tangent plane and
+  // their mean normal is neither face's, but a tap of the pixel's own face matches; on a curved
+  // surface a pixel wide or less, neighbouring taps differ by more than the threshold and none
+  // matches a point between them, but their interpolation does (to second order in the turn
+  // across a pixel), as the surface's normal there was in the previous frame. Radiance is read
+  // from the taps of the same surface, renormalised (all the taps on geometry where none is:
+  // another surface, whose comparison then fails as it should).
   BilinearTaps same{}, onGeometry{};
   double sameWeight = 0.0, geometryWeight = 0.0;
   bool sameNormal = false;
+  glm::dvec3 sameNormalSum(0.0);
   for (int k = 0; k < 4; ++k) {
     same.index[k] = onGeometry.index[k] = taps.index[k];
     same.weight[k] = onGeometry.weight[k] = 0.0;
@@ -192,7 +197,12 @@ HistoryTest testHistory(const glm::dvec3& p, const glm::dvec3& n, double viewDep
       same.weight[k] = taps.weight[k];
       sameWeight += taps.weight[k];
       sameNormal |= normalMatches;
+      sameNormalSum += taps.weight[k] * at3(previous.normal, taps.index[k]);
     }
+  }
+  if (sameWeight > 0 && !sameNormal && glm::length(sameNormalSum) > 0) {
+    sameNormal = glm::length(n - glm::normalize(sameNormalSum)) <= t.normal;
+    result.normal |= sameNormal;
   }
   result.position = sameWeight > 0;
   result.consistent = result.position && sameNormal;
@@ -281,11 +291,31 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
           bool cubic = tapsTest && history.position && cubicTaps.inside;
           for (std::size_t k = 0; k < 16 && cubic; ++k)
             cubic = previous.hit[cubicTaps.index[k]] > 0 && onTangentPlane(p, normal, at3(previous.position, cubicTaps.index[k]), viewDepth, t);
+          // At an edge (the surface has history but its 4 x 4 taps are not all of it) the
+          // pixel-filtered radiance mixes surfaces in both frames, in proportions that move with
+          // the edge: there the history is the range of the 2 x 2 taps around the point (TAA's
+          // neighbourhood clamp, read backwards) and the change is how far the pixel lies outside
+          // it. Otherwise a band a pixel or two wide along every silhouette counts as a change of
+          // lighting, a share that halves with the pixel's size (docs/metrics.md).
+          const bool edge = tapsTest && history.position && !cubic;
           // The probability (0 or 1 for the deterministic tests) that the radiance changed.
           auto radianceChange = [&](const std::vector<float>& now, const std::vector<float>& before, double threshold,
                                     const std::vector<float>& varNow, const std::vector<float>& varBefore, double& noisy) {
             const glm::dvec3 a = at3(now, i), b = cubic ? sample3(before, cubicTaps) : sample3(before, history.history);
             const double d = glm::length(a - b);
+            constexpr double kGrey = 1.7320508075688772;  // sqrt(3): a grey change's RGB distance per unit luminance
+            // At an edge, the threshold grows by the history's distance from the range's nearest
+            // point to the pixel (on the thresholds' scale), so that what is compared is the
+            // pixel's distance outside the range.
+            if (edge) {
+              double low = 1e300, high = -1e300;
+              for (const std::size_t tap : taps.index) {
+                const double y = luminance(at3(before, tap));
+                low = std::min(low, y);
+                high = std::max(high, y);
+              }
+              threshold += kGrey * std::abs(luminance(b) - std::clamp(luminance(a), low, high));
+            }
             // Variance of the difference: the pixel's plus the history sample's, sum of w_k^2 var_k
             // (independent pixels).
             double var = 0.0;
@@ -302,7 +332,6 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
             // pixels is biased up by their noise. On the thresholds' scale it is the RGB distance
             // of a grey change of that luminance, sqrt(3) |dY| (noise scaled alike), so both tests
             // agree on grey changes without noise.
-            constexpr double kGrey = 1.7320508075688772;  // sqrt(3)
             // Undetermined: noise above half the threshold leaves the outcome to chance (a pixel
             // whose true change is 0 counts 2 Phi(-2) = 5 % or more in expectation).
             if (kGrey * std::sqrt(var) > 0.5 * threshold) noisy += 1.0;
