@@ -26,9 +26,10 @@ struct Thresholds {
   //    `position` x the pixel's view depth of the current point's tangent plane (NRD's relative
   //    plane distance, its disocclusionThreshold 0.01), and has the same normal when
   //    ||n_i - n_tap|| <= `normal`. Position is discarded when no tap passes its test, normal when
-    //    neither a tap nor the normalised interpolation of the same-surface taps' normals does;
+  //    neither a tap nor the normalised interpolation of the same-surface taps' normals does;
   //    radiance is compared with the Catmull-Rom cubic of the 4 x 4 taps where all are the same
-  //    surface, else with the same-surface bilinear taps, their weights renormalised. Free of scene
+  //    surface, else with the same-surface bilinear taps, their weights renormalised, and there
+  //    (an edge) a change is the pixel's distance outside the range of the 2 x 2 taps. Free of scene
   //    units and of the first frame, and of resolution on smooth surfaces (the taps of a plane lie
   //    on it).
   //  kBilinear: the thesis's test: the bilinear sample of the four taps against the current pixel,
