@@ -3,10 +3,13 @@
 #include "evaluate/flip.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <type_traits>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 namespace dynbench::evaluate::flip {
@@ -16,65 +19,114 @@ using std::numbers::pi;
 
 // Linear sRGB -> XYZ from the sRGB primaries and the D65 white (x, y) = (0.3127, 0.3290) of
 // IEC 61966-2-1, to seven digits; the inverse is computed from it so that a round trip is exact to
-// rounding.
-const glm::dmat3& rgbToXyzMatrix() {
-  // glm is column-major: each row below is a column (R, G, B).
-  static const glm::dmat3 m(0.4123908, 0.2126390, 0.0193308,   //
-                            0.3575843, 0.7151687, 0.1191948,   //
-                            0.1804808, 0.0721923, 0.9505322);
-  return m;
-}
-const glm::dmat3& xyzToRgbMatrix() {
-  static const glm::dmat3 m = glm::inverse(rgbToXyzMatrix());
-  return m;
-}
+// rounding. glm is column-major: each row below is a column (R, G, B).
+const glm::dmat3 kRgbToXyz(0.4123908, 0.2126390, 0.0193308,   //
+                           0.3575843, 0.7151687, 0.1191948,   //
+                           0.1804808, 0.0721923, 0.9505322);
+const glm::dmat3 kXyzToRgb = glm::inverse(kRgbToXyz);
 // The reference white: XYZ of linear RGB (1, 1, 1).
-const glm::dvec3& whitePoint() {
-  static const glm::dvec3 white = rgbToXyzMatrix() * glm::dvec3(1.0);
-  return white;
+const glm::dvec3 kWhite = kRgbToXyz * glm::dvec3(1.0);
+// The same in single precision, the per-pixel path's (as the authors' tool computes).
+const glm::mat3 kRgbToXyzF(kRgbToXyz), kXyzToRgbF(kXyzToRgb);
+const glm::vec3 kWhiteF(kWhite);
+
+const glm::dvec3& whitePoint() { return kWhite; }
+
+// The colour pipeline for double (the tested per-step functions below) and float (the per-pixel
+// path): one definition of each step.
+template <typename T>
+using Vec3 = glm::vec<3, T, glm::defaultp>;
+template <typename T>
+const auto& rgbToXyzOf() {
+  if constexpr (std::is_same_v<T, float>) return kRgbToXyzF; else return kRgbToXyz;
+}
+template <typename T>
+const auto& xyzToRgbOf() {
+  if constexpr (std::is_same_v<T, float>) return kXyzToRgbF; else return kXyzToRgb;
+}
+template <typename T>
+const Vec3<T>& whiteOf() {
+  if constexpr (std::is_same_v<T, float>) return kWhiteF; else return kWhite;
 }
 
-// CIELAB's f(t) and its inverse (CIE 15:2004, delta = 6/29).
-double labF(double t) {
-  constexpr double delta = 6.0 / 29.0;
-  return t > delta * delta * delta ? std::cbrt(t) : t / (3.0 * delta * delta) + 4.0 / 29.0;
+// CIELAB's f(t) (CIE 15:2004, delta = 6/29).
+template <typename T>
+T labF(T t) {
+  constexpr T delta = T(6) / T(29);
+  return t > delta * delta * delta ? std::cbrt(t) : t / (T(3) * delta * delta) + T(4) / T(29);
 }
+template <typename T>
+Vec3<T> linearRgbToXyzT(Vec3<T> rgb) { return rgbToXyzOf<T>() * rgb; }
+template <typename T>
+Vec3<T> xyzToLinearRgbT(Vec3<T> xyz) { return xyzToRgbOf<T>() * xyz; }
+template <typename T>
+Vec3<T> xyzToYcxczT(Vec3<T> xyz) {
+  const Vec3<T> n = xyz / whiteOf<T>();
+  return {T(116) * n.y - T(16), T(500) * (n.x - n.y), T(200) * (n.y - n.z)};
+}
+template <typename T>
+Vec3<T> ycxczToXyzT(Vec3<T> v) {
+  const T y = (v.x + T(16)) / T(116);
+  return Vec3<T>(y + v.y / T(500), y, y - v.z / T(200)) * whiteOf<T>();
+}
+template <typename T>
+Vec3<T> xyzToLabT(Vec3<T> xyz) {
+  const Vec3<T> n = xyz / whiteOf<T>();
+  const T fx = labF(n.x), fy = labF(n.y), fz = labF(n.z);
+  return {T(116) * fy - T(16), T(500) * (fx - fy), T(200) * (fy - fz)};
+}
+template <typename T>
+Vec3<T> huntAdjustT(Vec3<T> lab) { return {lab.x, T(0.01) * lab.x * lab.y, T(0.01) * lab.x * lab.z}; }
 
 // One plane of w x h floats.
 using Plane = std::vector<float>;
 
-// Correlates each row (horizontal) or each column (vertical) with a kernel of odd length,
-// clamping at the edges, as the authors' tool does.
-void filterHorizontal(const Plane& in, Plane& out, int w, int h, const std::vector<float>& kernel) {
-  const int r = static_cast<int>(kernel.size() / 2);
-  out.assign(in.size(), 0.0f);
-  tbb::parallel_for(0, h, [&](int y) {
-    const float* row = in.data() + static_cast<std::size_t>(y) * w;
-    float* dst = out.data() + static_cast<std::size_t>(y) * w;
-    for (int x = 0; x < w; ++x) {
-      float sum = 0.0f;
-      for (int k = -r; k <= r; ++k) sum += kernel[k + r] * row[std::clamp(x + k, 0, w - 1)];
-      dst[x] = sum;
+// The separable filters, in two passes. Each output row is accumulated one kernel tap at a time
+// over a contiguous row, so that the compiler vectorises the loop over x: the previous form, a
+// clamped gather of every tap for every output pixel, did not vectorise and was most of ꟻLIP's
+// time. Edges are clamped, as the authors' tool does. All kernels of a pass have one length.
+//
+// Rows: every row of `in` correlated with each kernel, one output plane per kernel.
+std::vector<Plane> rowPass(const Plane& in, int w, int h, std::initializer_list<const std::vector<float>*> kernels) {
+  const int r = static_cast<int>((*kernels.begin())->size() / 2);
+  std::vector<Plane> out(kernels.size(), Plane(in.size()));
+  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+    std::vector<float> padded(static_cast<std::size_t>(w + 2 * r));
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      const float* src = in.data() + static_cast<std::size_t>(y) * w;
+      for (int x = 0; x < w + 2 * r; ++x) padded[static_cast<std::size_t>(x)] = src[std::clamp(x - r, 0, w - 1)];
+      std::size_t k = 0;
+      for (const std::vector<float>* kernel : kernels) {
+        float* dst = out[k++].data() + static_cast<std::size_t>(y) * w;
+        std::fill(dst, dst + w, 0.0f);
+        for (int t = 0; t <= 2 * r; ++t) {
+          const float weight = (*kernel)[static_cast<std::size_t>(t)];
+          const float* p = padded.data() + t;
+          for (int x = 0; x < w; ++x) dst[x] += weight * p[x];
+        }
+      }
     }
   });
-}
-void filterVertical(const Plane& in, Plane& out, int w, int h, const std::vector<float>& kernel) {
-  const int r = static_cast<int>(kernel.size() / 2);
-  out.assign(in.size(), 0.0f);
-  tbb::parallel_for(0, h, [&](int y) {
-    float* dst = out.data() + static_cast<std::size_t>(y) * w;
-    for (int k = -r; k <= r; ++k) {
-      const float weight = kernel[k + r];
-      const float* row = in.data() + static_cast<std::size_t>(std::clamp(y + k, 0, h - 1)) * w;
-      for (int x = 0; x < w; ++x) dst[x] += weight * row[x];
-    }
-  });
-}
-Plane separable(const Plane& in, int w, int h, const std::vector<float>& kx, const std::vector<float>& ky) {
-  Plane tmp, out;
-  filterHorizontal(in, tmp, w, h, kx);
-  filterVertical(tmp, out, w, h, ky);
   return out;
+}
+// Columns, for one output row y: out[x] = sum_t kernel[t] in[clamp(y + t - r)][x].
+void columnAt(const Plane& in, int w, int h, int y, const std::vector<float>& kernel, float* out) {
+  const int r = static_cast<int>(kernel.size() / 2);
+  std::fill(out, out + w, 0.0f);
+  for (int t = 0; t <= 2 * r; ++t) {
+    const float weight = kernel[static_cast<std::size_t>(t)];
+    const float* src = in.data() + static_cast<std::size_t>(std::clamp(y + t - r, 0, h - 1)) * w;
+    for (int x = 0; x < w; ++x) out[x] += weight * src[x];
+  }
+}
+// The column pass of several filters at once: for each block of rows, `rows` scratch rows of w
+// floats and a callback per output row.
+template <typename PerRow>
+void columnPass(int w, int h, std::size_t rows, PerRow&& perRow) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& block) {
+    std::vector<float> scratch(rows * static_cast<std::size_t>(w));
+    for (int y = block.begin(); y < block.end(); ++y) perRow(y, scratch.data());
+  });
 }
 
 // The contrast sensitivity functions of [HPG20] §4.1 (after Mannos & Sakrison / Johnson &
@@ -116,19 +168,23 @@ Opponent toOpponent(const RgbImage& image) {
   Opponent o;
   const std::size_t n = image.pixelCount();
   o.y.resize(n), o.cx.resize(n), o.cz.resize(n), o.luminance.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const glm::dvec3 rgb = glm::clamp(glm::dvec3(image.rgb[3 * i], image.rgb[3 * i + 1], image.rgb[3 * i + 2]), 0.0, 1.0);
-    const glm::dvec3 xyz = linearRgbToXyz(rgb);
-    const glm::dvec3 v = xyzToYcxcz(xyz);
-    o.y[i] = static_cast<float>(v.x), o.cx[i] = static_cast<float>(v.y), o.cz[i] = static_cast<float>(v.z);
-    // (Y + 16) / 116 of YCxCz: the luminance relative to white, the feature detector's input.
-    o.luminance[i] = static_cast<float>(xyz.y / whitePoint().y);
-  }
+  const float whiteY = static_cast<float>(whitePoint().y);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i < range.end(); ++i) {
+      const glm::vec3 rgb = glm::clamp(glm::vec3(image.rgb[3 * i], image.rgb[3 * i + 1], image.rgb[3 * i + 2]), 0.0f, 1.0f);
+      const glm::vec3 xyz = linearRgbToXyzT(rgb);
+      const glm::vec3 v = xyzToYcxczT(xyz);
+      o.y[i] = v.x, o.cx[i] = v.y, o.cz[i] = v.z;
+      // (Y + 16) / 116 of YCxCz: the luminance relative to white, the feature detector's input.
+      o.luminance[i] = xyz.y / whiteY;
+    }
+  });
   return o;
 }
 
-// The spatially filtered image in Hunt-adjusted L*a*b*, per pixel ([HPG20] §4.1, Fig. 3).
-std::vector<glm::vec3> filteredHuntLab(const Opponent& o, int w, int h, double ppd) {
+// The spatially filtered image in Hunt-adjusted L*a*b*, per pixel ([HPG20] §4.1, Fig. 3), as
+// three planes.
+std::array<Plane, 3> filteredHuntLab(const Opponent& o, int w, int h, double ppd) {
   const int radius = spatialRadius(ppd);
   double sumY = 0, sumCx = 0, sum1 = 0, sum2 = 0;
   const auto kY = csfKernel(kAchromatic, radius, ppd, &sumY);
@@ -136,24 +192,49 @@ std::vector<glm::vec3> filteredHuntLab(const Opponent& o, int w, int h, double p
   const auto k1 = csfKernel(kBlueYellow1, radius, ppd, &sum1);
   const auto k2 = csfKernel(kBlueYellow2, radius, ppd, &sum2);
   // Single-Gaussian channels: the 2D kernel normalised to sum 1 is the product of two 1D
-  // kernels normalised to sum 1.
-  const Plane y = separable(o.y, w, h, scaled(kY, 1.0 / sumY), scaled(kY, 1.0 / sumY));
-  const Plane cx = separable(o.cx, w, h, scaled(kCx, 1.0 / sumCx), scaled(kCx, 1.0 / sumCx));
-  // Blue-yellow: sum_i A_i G_i(x) G_i(y) with A_i = a_i sqrt(pi / b_i), normalised by its 2D sum
-  // S = sum_i A_i (sum_x G_i)^2.
+  // kernels normalised to sum 1. Blue-yellow: sum_i A_i G_i(x) G_i(y) with A_i = a_i sqrt(pi /
+  // b_i), normalised by its 2D sum S = sum_i A_i (sum_x G_i)^2.
+  const auto kYn = scaled(kY, 1.0 / sumY), kCxn = scaled(kCx, 1.0 / sumCx);
   const double a1 = kBlueYellow1.a * std::sqrt(pi / kBlueYellow1.b), a2 = kBlueYellow2.a * std::sqrt(pi / kBlueYellow2.b);
   const double s = a1 * sum1 * sum1 + a2 * sum2 * sum2;
-  const Plane cz1 = separable(o.cz, w, h, scaled(k1, a1 / s), k1);
-  const Plane cz2 = separable(o.cz, w, h, scaled(k2, a2 / s), k2);
+  const auto k1s = scaled(k1, a1 / s), k2s = scaled(k2, a2 / s);
+  const Plane ry = std::move(rowPass(o.y, w, h, {&kYn})[0]), rcx = std::move(rowPass(o.cx, w, h, {&kCxn})[0]);
+  const std::vector<Plane> rcz = rowPass(o.cz, w, h, {&k1s, &k2s});
 
-  std::vector<glm::vec3> lab(o.y.size());
-  tbb::parallel_for(std::size_t(0), lab.size(), [&](std::size_t i) {
-    const glm::dvec3 ycxcz(y[i], cx[i], static_cast<double>(cz1[i]) + cz2[i]);
-    // Back to linear RGB, clamped to the display's gamut, then to L*a*b* and Hunt's adjustment.
-    const glm::dvec3 rgb = glm::clamp(xyzToLinearRgb(ycxczToXyz(ycxcz)), 0.0, 1.0);
-    lab[i] = glm::vec3(huntAdjust(xyzToLab(linearRgbToXyz(rgb))));
+  std::array<Plane, 3> lab;
+  for (Plane& p : lab) p.resize(o.y.size());
+  columnPass(w, h, 4, [&](int y, float* scratch) {
+    float *fy = scratch, *fcx = scratch + w, *fcz1 = scratch + 2 * w, *fcz2 = scratch + 3 * w;
+    columnAt(ry, w, h, y, kYn, fy);
+    columnAt(rcx, w, h, y, kCxn, fcx);
+    columnAt(rcz[0], w, h, y, k1, fcz1);
+    columnAt(rcz[1], w, h, y, k2, fcz2);
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      // Back to linear RGB, clamped to the display's gamut, then to L*a*b* and Hunt's adjustment.
+      const glm::vec3 rgb = glm::clamp(xyzToLinearRgbT(ycxczToXyzT(glm::vec3(fy[x], fcx[x], fcz1[x] + fcz2[x]))), 0.0f, 1.0f);
+      const glm::vec3 hunt = huntAdjustT(xyzToLabT(linearRgbToXyzT(rgb)));
+      lab[0][i] = hunt.x, lab[1][i] = hunt.y, lab[2][i] = hunt.z;
+    }
   });
   return lab;
+}
+
+// Narkowicz's fit (a x^2 + b x) / (c x^2 + d x + e) with a = 2.51, b = 0.03, c = 2.43, d = 0.59,
+// e = 0.14, applied to 0.6 x: [EG21] §3 cancels the fit's built-in 0.6 pre-exposure so that an
+// exposure of 0 shows the radiance as is.
+template <typename T>
+T acesToneMapT(T x) {
+  const T s = T(0.6) * x;
+  return (T(2.51) * s * s + T(0.03) * s) / (T(2.43) * s * s + T(0.59) * s + T(0.14));
+}
+
+// [HPG20] Eq. 4 for either precision, given c_max (maxColorDistance).
+template <typename T>
+T remapColorErrorT(T hyabDistance, T cmax) {
+  const T d = std::pow(hyabDistance, T(kQc)), breakPoint = T(kPc) * cmax;
+  if (d < breakPoint) return d * T(kPt) / breakPoint;
+  return std::min(T(1), T(kPt) + (d - breakPoint) / (cmax - breakPoint) * (T(1) - T(kPt)));
 }
 
 // 1D Gaussian, first and second derivative kernels of the feature detector ([HPG20] §4.2).
@@ -195,23 +276,12 @@ glm::dvec3 linearToSrgb(glm::dvec3 l) {
   auto f = [](double c) { return c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055; };
   return {f(l.x), f(l.y), f(l.z)};
 }
-glm::dvec3 linearRgbToXyz(glm::dvec3 rgb) { return rgbToXyzMatrix() * rgb; }
-glm::dvec3 xyzToLinearRgb(glm::dvec3 xyz) { return xyzToRgbMatrix() * xyz; }
-
-glm::dvec3 xyzToYcxcz(glm::dvec3 xyz) {
-  const glm::dvec3 n = xyz / whitePoint();
-  return {116.0 * n.y - 16.0, 500.0 * (n.x - n.y), 200.0 * (n.y - n.z)};
-}
-glm::dvec3 ycxczToXyz(glm::dvec3 v) {
-  const double y = (v.x + 16.0) / 116.0;
-  return glm::dvec3(y + v.y / 500.0, y, y - v.z / 200.0) * whitePoint();
-}
-glm::dvec3 xyzToLab(glm::dvec3 xyz) {
-  const glm::dvec3 n = xyz / whitePoint();
-  const double fx = labF(n.x), fy = labF(n.y), fz = labF(n.z);
-  return {116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)};
-}
-glm::dvec3 huntAdjust(glm::dvec3 lab) { return {lab.x, 0.01 * lab.x * lab.y, 0.01 * lab.x * lab.z}; }
+glm::dvec3 linearRgbToXyz(glm::dvec3 rgb) { return linearRgbToXyzT(rgb); }
+glm::dvec3 xyzToLinearRgb(glm::dvec3 xyz) { return xyzToLinearRgbT(xyz); }
+glm::dvec3 xyzToYcxcz(glm::dvec3 xyz) { return xyzToYcxczT(xyz); }
+glm::dvec3 ycxczToXyz(glm::dvec3 v) { return ycxczToXyzT(v); }
+glm::dvec3 xyzToLab(glm::dvec3 xyz) { return xyzToLabT(xyz); }
+glm::dvec3 huntAdjust(glm::dvec3 lab) { return huntAdjustT(lab); }
 double hyab(glm::dvec3 a, glm::dvec3 b) {
   return std::abs(a.x - b.x) + std::hypot(a.y - b.y, a.z - b.z);
 }
@@ -223,49 +293,72 @@ double maxColorDistance() {
   }();
   return cmax;
 }
-double remapColorError(double hyabDistance) {
-  const double cmax = maxColorDistance(), d = std::pow(hyabDistance, kQc), breakPoint = kPc * cmax;
-  if (d < breakPoint) return d * kPt / breakPoint;
-  return std::min(1.0, kPt + (d - breakPoint) / (cmax - breakPoint) * (1.0 - kPt));
-}
+double remapColorError(double hyabDistance) { return remapColorErrorT(hyabDistance, maxColorDistance()); }
 
 FeatureResponse featureResponse(const std::vector<float>& luminance, int w, int h, double ppd) {
   const FeatureKernels k = featureKernels(ppd);
-  // x derivatives smoothed in y, y derivatives smoothed in x.
-  const Plane dx = separable(luminance, w, h, k.first, k.gaussian), dy = separable(luminance, w, h, k.gaussian, k.first);
-  const Plane ddx = separable(luminance, w, h, k.second, k.gaussian), ddy = separable(luminance, w, h, k.gaussian, k.second);
+  // The rows' Gaussian, first and second derivative in one pass; then the columns: x derivatives
+  // smoothed in y, y derivatives smoothed in x, and their magnitudes, in another.
+  const std::vector<Plane> rows = rowPass(luminance, w, h, {&k.gaussian, &k.first, &k.second});
   FeatureResponse r;
   r.edge.resize(luminance.size()), r.point.resize(luminance.size());
-  for (std::size_t i = 0; i < luminance.size(); ++i) {
-    r.edge[i] = std::hypot(dx[i], dy[i]);
-    r.point[i] = std::hypot(ddx[i], ddy[i]);
-  }
+  columnPass(w, h, 4, [&](int y, float* scratch) {
+    float *dx = scratch, *dy = scratch + w, *ddx = scratch + 2 * w, *ddy = scratch + 3 * w;
+    columnAt(rows[1], w, h, y, k.gaussian, dx);
+    columnAt(rows[0], w, h, y, k.first, dy);
+    columnAt(rows[2], w, h, y, k.gaussian, ddx);
+    columnAt(rows[0], w, h, y, k.second, ddy);
+    float* edge = r.edge.data() + static_cast<std::size_t>(y) * w;
+    float* point = r.point.data() + static_cast<std::size_t>(y) * w;
+    for (int x = 0; x < w; ++x) {
+      edge[x] = std::sqrt(dx[x] * dx[x] + dy[x] * dy[x]);
+      point[x] = std::sqrt(ddx[x] * ddx[x] + ddy[x] * ddy[x]);
+    }
+  });
   return r;
 }
 
-std::vector<float> ldrFlip(const RgbImage& reference, const RgbImage& test, double ppd) {
-  const int w = reference.width, h = reference.height;
-  const Opponent ref = toOpponent(reference), tst = toOpponent(test);
-  const std::vector<glm::vec3> refLab = filteredHuntLab(ref, w, h, ppd), tstLab = filteredHuntLab(tst, w, h, ppd);
-  const FeatureResponse refF = featureResponse(ref.luminance, w, h, ppd), tstF = featureResponse(tst.luminance, w, h, ppd);
-  std::vector<float> error(refLab.size());
-  tbb::parallel_for(std::size_t(0), error.size(), [&](std::size_t i) {
-    const double colour = remapColorError(hyab(glm::dvec3(refLab[i]), glm::dvec3(tstLab[i])));
-    // [HPG20] Eq. 6: the feature difference, max of edge and point, over sqrt(2), to the q_f.
-    const double edge = std::abs(refF.edge[i] - tstF.edge[i]), point = std::abs(refF.point[i] - tstF.point[i]);
-    const double feature = std::pow(std::max(edge, point) / std::numbers::sqrt2, kQf);
-    error[i] = static_cast<float>(std::pow(colour, 1.0 - feature));  // [HPG20] Eq. 5
+namespace {
+
+// What ꟻLIP needs of one image: its filtered Hunt-adjusted L*a*b* and its feature responses.
+struct Prepared {
+  std::array<Plane, 3> lab;
+  FeatureResponse features;
+};
+Prepared prepare(const RgbImage& image, double ppd) {
+  Opponent o = toOpponent(image);
+  FeatureResponse features = featureResponse(o.luminance, image.width, image.height, ppd);
+  return {filteredHuntLab(o, image.width, image.height, ppd), std::move(features)};
+}
+
+// [HPG20] Eqs. 5-6 per pixel, passed to combine(i, error).
+template <typename Combine>
+void pixelErrors(const Prepared& ref, const Prepared& test, Combine&& combine) {
+  static_assert(kQf == 0.5, "the feature exponent is a square root below");
+  const float cmax = static_cast<float>(maxColorDistance());
+  const std::size_t n = ref.lab[0].size();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i < range.end(); ++i) {
+      const float dl = ref.lab[0][i] - test.lab[0][i], da = ref.lab[1][i] - test.lab[1][i], db = ref.lab[2][i] - test.lab[2][i];
+      const float colour = remapColorErrorT(std::abs(dl) + std::sqrt(da * da + db * db), cmax);  // HyAB, [HPG20] Eq. 3
+      // Eq. 6: the feature difference, max of edge and point, over sqrt(2), to the q_f.
+      const float edge = std::abs(ref.features.edge[i] - test.features.edge[i]);
+      const float point = std::abs(ref.features.point[i] - test.features.point[i]);
+      const float feature = std::sqrt(std::max(edge, point) / std::numbers::sqrt2_v<float>);
+      combine(i, std::pow(colour, 1.0f - feature));  // Eq. 5
+    }
   });
+}
+
+}  // namespace
+
+std::vector<float> ldrFlip(const RgbImage& reference, const RgbImage& test, double ppd) {
+  std::vector<float> error(reference.pixelCount());
+  pixelErrors(prepare(reference, ppd), prepare(test, ppd), [&](std::size_t i, float e) { error[i] = e; });
   return error;
 }
 
-double acesToneMap(double x) {
-  // Narkowicz's fit (a x^2 + b x) / (c x^2 + d x + e) with a = 2.51, b = 0.03, c = 2.43, d = 0.59,
-  // e = 0.14, applied to 0.6 x: [EG21] §3 cancels the fit's built-in 0.6 pre-exposure so that an
-  // exposure of 0 shows the radiance as is.
-  const double s = 0.6 * x;
-  return (2.51 * s * s + 0.03 * s) / (2.43 * s * s + 0.59 * s + 0.14);
-}
+double acesToneMap(double x) { return acesToneMapT(x); }
 
 ExposureRange hdrExposureRange(const RgbImage& reference) {
   ExposureRange range;
@@ -306,14 +399,17 @@ HdrFlipResult hdrFlip(const RgbImage& reference, const RgbImage& test, double pp
   const ExposureRange& r = result.exposures;
   for (int e = 0; e < r.count; ++e) {
     const double exposure = r.start + e * (r.stop - r.start) / (r.count - 1);
-    const double scale = std::exp2(exposure);
+    const float scale = static_cast<float>(std::exp2(exposure));
     auto expose = [&](const RgbImage& in) {
       RgbImage out = in;
-      for (float& v : out.rgb) v = static_cast<float>(std::clamp(acesToneMap(scale * v), 0.0, 1.0));
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, out.rgb.size()), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t i = range.begin(); i < range.end(); ++i) out.rgb[i] = std::clamp(acesToneMapT(scale * out.rgb[i]), 0.0f, 1.0f);
+      });
       return out;
     };
-    const std::vector<float> ldr = ldrFlip(expose(reference), expose(test), ppd);
-    for (std::size_t i = 0; i < ldr.size(); ++i) result.error[i] = std::max(result.error[i], ldr[i]);  // [EG21] Eq. 3
+    // [EG21] Eq. 3: the per-pixel maximum over the exposures.
+    pixelErrors(prepare(expose(reference), ppd), prepare(expose(test), ppd),
+                [&](std::size_t i, float error) { result.error[i] = std::max(result.error[i], error); });
   }
   return result;
 }
