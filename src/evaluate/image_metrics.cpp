@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "evaluate/magma.h"  // generated from Debian's matplotlib (tools/colormap/magma_header.py)
 
 namespace dynbench::evaluate {
@@ -45,33 +48,63 @@ std::optional<double> ssim(const RgbImage& reference, const RgbImage& test) {
   constexpr double kSigma = 1.5, c1 = 0.01 * 0.01, c2 = 0.03 * 0.03;  // (K1 L)^2, (K2 L)^2 with L = 1
   const int w = reference.width, h = reference.height;
   if (w < kSize || h < kSize) return std::nullopt;
-  double kernel[kSize], kernelSum = 0.0;
-  for (int i = 0; i < kSize; ++i) kernelSum += kernel[i] = std::exp(-(i - kRadius) * (i - kRadius) / (2.0 * kSigma * kSigma));
-  for (double& k : kernel) k /= kernelSum;
-  // Windowed means of x, y, x^2, y^2, xy, separably over the valid region.
+  double kernelSum = 0.0, kernelD[kSize];
+  for (int i = 0; i < kSize; ++i) kernelSum += kernelD[i] = std::exp(-(i - kRadius) * (i - kRadius) / (2.0 * kSigma * kSigma));
+  double kernel[kSize];
+  for (int i = 0; i < kSize; ++i) kernel[i] = kernelD[i] / kernelSum;
+  // Windowed means of x, y, x^2, y^2, xy, separably over the valid region, each filter tap
+  // accumulated over a contiguous row so that the loops vectorise; rows in parallel, added in row
+  // order (the result does not depend on the schedule). In double: the variances E[x^2] - mu^2
+  // cancel, and in single precision their error reached 1e-4 of c2 on flat regions.
   const int vw = w - kSize + 1, vh = h - kSize + 1;
+  const auto plane = static_cast<std::size_t>(vw) * static_cast<std::size_t>(h);
   double total = 0.0;
+  std::vector<double> moments(5 * plane);  // horizontal pass: five planes of vw x h
+  std::vector<double> rowSums(static_cast<std::size_t>(vh));
   for (int channel = 0; channel < 3; ++channel) {
-    std::vector<double> rows(5 * static_cast<std::size_t>(vw) * h);  // horizontal pass, 5 moments
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < vw; ++x) {
-        double m[5] = {0, 0, 0, 0, 0};
-        for (int k = 0; k < kSize; ++k) {
-          const std::size_t p = 3 * (static_cast<std::size_t>(y) * w + x + k) + channel;
-          const double a = reference.rgb[p], b = test.rgb[p];
-          m[0] += kernel[k] * a, m[1] += kernel[k] * b, m[2] += kernel[k] * a * a, m[3] += kernel[k] * b * b, m[4] += kernel[k] * a * b;
+    tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+      std::vector<double> a(static_cast<std::size_t>(w)), b(static_cast<std::size_t>(w));
+      for (int y = rows.begin(); y < rows.end(); ++y) {
+        for (int x = 0; x < w; ++x) {
+          const std::size_t p = 3 * (static_cast<std::size_t>(y) * w + x) + channel;
+          a[static_cast<std::size_t>(x)] = reference.rgb[p], b[static_cast<std::size_t>(x)] = test.rgb[p];
         }
-        std::copy(m, m + 5, rows.begin() + 5 * (static_cast<std::ptrdiff_t>(y) * vw + x));
+        double* m[5];
+        for (int j = 0; j < 5; ++j) {
+          m[j] = moments.data() + j * plane + static_cast<std::size_t>(y) * vw;
+          std::fill(m[j], m[j] + vw, 0.0);
+        }
+        for (int k = 0; k < kSize; ++k) {
+          const double wk = kernel[k];
+          const double *pa = a.data() + k, *pb = b.data() + k;
+          for (int x = 0; x < vw; ++x) {
+            m[0][x] += wk * pa[x], m[1][x] += wk * pb[x], m[2][x] += wk * pa[x] * pa[x], m[3][x] += wk * pb[x] * pb[x];
+            m[4][x] += wk * pa[x] * pb[x];
+          }
+        }
       }
-    double channelSum = 0.0;
-    for (int y = 0; y < vh; ++y)
-      for (int x = 0; x < vw; ++x) {
-        double m[5] = {0, 0, 0, 0, 0};
+    });
+    tbb::parallel_for(tbb::blocked_range<int>(0, vh), [&](const tbb::blocked_range<int>& rows) {
+      std::vector<double> sums(5 * static_cast<std::size_t>(vw));
+      for (int y = rows.begin(); y < rows.end(); ++y) {
+        std::fill(sums.begin(), sums.end(), 0.0);
         for (int k = 0; k < kSize; ++k)
-          for (int j = 0; j < 5; ++j) m[j] += kernel[k] * rows[5 * (static_cast<std::size_t>(y + k) * vw + x) + j];
-        const double muA = m[0], muB = m[1], varA = m[2] - muA * muA, varB = m[3] - muB * muB, cov = m[4] - muA * muB;
-        channelSum += ((2 * muA * muB + c1) * (2 * cov + c2)) / ((muA * muA + muB * muB + c1) * (varA + varB + c2));
+          for (int j = 0; j < 5; ++j) {
+            const double* src = moments.data() + j * plane + static_cast<std::size_t>(y + k) * vw;
+            double* dst = sums.data() + static_cast<std::size_t>(j) * vw;
+            for (int x = 0; x < vw; ++x) dst[x] += kernel[k] * src[x];
+          }
+        double rowSum = 0.0;
+        for (int x = 0; x < vw; ++x) {
+          const double muA = sums[x], muB = sums[vw + x], varA = sums[2 * vw + x] - muA * muA, varB = sums[3 * vw + x] - muB * muB;
+          const double cov = sums[4 * vw + x] - muA * muB;
+          rowSum += ((2 * muA * muB + c1) * (2 * cov + c2)) / ((muA * muA + muB * muB + c1) * (varA + varB + c2));
+        }
+        rowSums[static_cast<std::size_t>(y)] = rowSum;
       }
+    });
+    double channelSum = 0.0;
+    for (double r : rowSums) channelSum += r;
     total += channelSum / (static_cast<double>(vw) * vh);
   }
   return total / 3.0;
