@@ -11,6 +11,7 @@
 #include <tbb/parallel_for.h>
 
 #include "evaluate/method.h"
+#include "evaluate/svgf_atrous.h"
 
 namespace dynbench::evaluate {
 namespace {
@@ -139,54 +140,36 @@ class SvgfMethod final : public TemporalMethod {
       }
     });
 
-    // 4. A-trous wavelet filter, 5 iterations with steps 1, 2, 4, 8, 16 ([S17] §4.3-4.4); the
-    // first iteration's output is the colour history of the next frame.
+    // 4. A-trous wavelet filter, 5 iterations with steps 1, 2, 4, 8, 16 ([S17] §4.3-4.4), in
+    // single precision over SIMD lanes (svgf_atrous.h); the first iteration's output is the colour
+    // history of the next frame.
+    planes_.resize(w, h);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = index(x, y), j = planes_.at(x, y);
+        planes_.depth[j] = f.depth[i], planes_.hit[j] = f.hit[i] > 0 ? 1.0f : 0.0f;
+        planes_.nx[j] = f.normal[3 * i], planes_.ny[j] = f.normal[3 * i + 1], planes_.nz[j] = f.normal[3 * i + 2];
+        planes_.gradX[j] = static_cast<float>(gradZ[i].x), planes_.gradY[j] = static_cast<float>(gradZ[i].y);
+        planes_.r[j] = static_cast<float>(illumination[i].r), planes_.g[j] = static_cast<float>(illumination[i].g);
+        planes_.b[j] = static_cast<float>(illumination[i].b), planes_.variance[j] = static_cast<float>(variance[i]);
+      }
+    auto illuminationAt = [&](const svgf::AtrousPlanes& planes, std::size_t i, int x, int y) {
+      const std::size_t j = planes.at(x, y);
+      return f.hit[i] > 0 ? glm::dvec3(planes.r[j], planes.g[j], planes.b[j]) : illumination[i];
+    };
     std::vector<glm::dvec3> feedback;
     for (int iteration = 0; iteration < kIterations; ++iteration) {
-      const int step = 1 << iteration;
-      std::vector<glm::dvec3> nextIllumination = illumination;
-      std::vector<double> nextVariance = variance;
-      // Rows are independent within an iteration.
-      tbb::parallel_for(0, h, [&](int y) {
-        for (int x = 0; x < w; ++x) {
-          const std::size_t i = index(x, y);
-          if (f.hit[i] <= 0) continue;
-          // Variance prefiltered with a 3x3 Gaussian for the luminance weight ([S17] Eq. 5).
-          double blurred = 0.0, blurWeight = 0.0;
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-              const int xx = std::clamp(x + dx, 0, w - 1), yy = std::clamp(y + dy, 0, h - 1);
-              const double g = (dx ? 0.5 : 1.0) * (dy ? 0.5 : 1.0);
-              blurred += g * variance[index(xx, yy)], blurWeight += g;
-            }
-          const double lumDenominator = kSigmaL * std::sqrt(std::max(0.0, blurred / blurWeight)) + 1e-10;
-          const double lp = luminance(illumination[i]);
-          const glm::dvec3 np = at(f.normal, i);
-          glm::dvec3 sum(0.0);
-          double sumW = 0.0, sumVar = 0.0;
-          for (int ky = -2; ky <= 2; ++ky)
-            for (int kx = -2; kx <= 2; ++kx) {
-              const int xx = x + kx * step, yy = y + ky * step;
-              if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-              const std::size_t j = index(xx, yy);
-              if (f.hit[j] <= 0) continue;
-              const double hk = kAtrous[std::abs(kx)] * kAtrous[std::abs(ky)];
-              // [S17] Eqs. 3-4: depth, normal and luminance edge-stopping weights.
-              const double wz = std::exp(-std::abs(f.depth[i] - f.depth[j]) /
-                                         (kSigmaZ * std::abs(glm::dot(gradZ[i], glm::dvec2(kx * step, ky * step))) + 1e-8));
-              const double wn = normalWeight(np, at(f.normal, j));
-              const double wl = std::exp(-std::abs(lp - luminance(illumination[j])) / lumDenominator);
-              const double wgt = (kx == 0 && ky == 0) ? hk : hk * wz * wn * wl;
-              sum += wgt * illumination[j], sumW += wgt, sumVar += wgt * wgt * variance[j];
-            }
-          nextIllumination[i] = sum / sumW;
-          nextVariance[i] = sumVar / (sumW * sumW);  // [S17] Eq. 2
-        }
-      });
-      illumination.swap(nextIllumination);
-      variance.swap(nextVariance);
-      if (iteration == 0) feedback = illumination;
+      svgf::atrousIteration(planes_, 1 << iteration, {static_cast<float>(kSigmaZ), static_cast<float>(kSigmaL)}, filtered_);
+      std::swap(planes_.r, filtered_.r), std::swap(planes_.g, filtered_.g), std::swap(planes_.b, filtered_.b);
+      std::swap(planes_.variance, filtered_.variance);
+      if (iteration == 0) {
+        feedback.resize(n);
+        for (int y = 0; y < h; ++y)
+          for (int x = 0; x < w; ++x) feedback[index(x, y)] = illuminationAt(planes_, index(x, y), x, y);
+      }
     }
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) illumination[index(x, y)] = illuminationAt(planes_, index(x, y), x, y);
 
     // 5. Remodulate with the albedo; keep this frame's history.
     RgbImage out = frameRadiance(f);
@@ -207,6 +190,8 @@ class SvgfMethod final : public TemporalMethod {
   }
 
  private:
+  // The à-trous planes, kept between frames to save their allocation.
+  svgf::AtrousPlanes planes_, filtered_;
   struct History {
     int width = 0, height = 0;
     glm::dvec2 jitter{0.0};

@@ -1,0 +1,140 @@
+// The à-trous iteration's kernel, compiled once per SIMD target by Highway's foreach_target (this
+// file includes itself through HWY_TARGET_INCLUDE) and picked at run time by HWY_DYNAMIC_DISPATCH.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "evaluate/svgf_atrous.cpp"
+#include <hwy/foreach_target.h>  // before highway.h
+
+#include <hwy/highway.h>
+#include <hwy/contrib/math/math-inl.h>
+
+#include "evaluate/svgf_atrous.h"
+
+#ifndef DYNBENCH_SVGF_ATROUS_ARGS
+#define DYNBENCH_SVGF_ATROUS_ARGS
+namespace dynbench::evaluate::svgf {
+// What the kernel reads and writes: the padded planes (AtrousPlanes' layout), the prefiltered
+// variance and the luminance of the illumination.
+struct AtrousArgs {
+  const float *depth, *nx, *ny, *nz, *hit, *gradX, *gradY, *r, *g, *b, *variance, *luminance, *blurredVariance;
+  float *outR, *outG, *outB, *outVariance;
+  int width, stride, step;
+  float sigmaZ, sigmaL;
+};
+}  // namespace dynbench::evaluate::svgf
+#endif
+
+HWY_BEFORE_NAMESPACE();
+namespace dynbench::evaluate::svgf::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+using D = hn::ScalableTag<float>;
+using V = hn::Vec<D>;
+
+// Rows [y0, y1): for each pixel the 5x5 taps `step` apart, weighted by the B3 spline times the
+// edge-stopping weights of [S17] Eqs. 3-5: exp(-|dz| / (sigma_z |grad z . offset| + 1e-8)
+// - |dl| / (sigma_l sqrt(g(Var)) + 1e-10)) x max(0, n . n')^128 (one exponential for the depth
+// and luminance weights, as Falcor's SVGFAtrous computes them), the centre tap by the spline
+// alone; the variance by the squared weights ([S17] Eq. 2).
+void AtrousRows(const AtrousArgs* a, int y0, int y1) {
+  const D d;
+  const std::size_t lanes = hn::Lanes(d);
+  static constexpr float kSpline[3] = {3.0f / 8.0f, 1.0f / 4.0f, 1.0f / 16.0f};  // [S17] §4.3: B3 spline
+  const V zero = hn::Zero(d), depthEpsilon = hn::Set(d, 1e-8f), lumEpsilon = hn::Set(d, 1e-10f);
+  const V sigmaZ = hn::Set(d, a->sigmaZ), sigmaL = hn::Set(d, a->sigmaL);
+  // exp(-x) for x above 80 is below 2e-35: counted as 0 (the float exponential's range ends at 88).
+  const V expLimit = hn::Set(d, 80.0f);
+  const int pad = AtrousPlanes::kPad;
+  for (int y = y0; y < y1; ++y) {
+    // Lanes beyond the row's last pixel read and write the padding (at least kPad wide, more than
+    // a vector): their centre is not a hit, so they copy their input.
+    for (int x = 0; x < a->width; x += static_cast<int>(lanes)) {
+      const std::size_t c = static_cast<std::size_t>(y + pad) * static_cast<std::size_t>(a->stride) + static_cast<std::size_t>(x + pad);
+      const V hitC = hn::LoadU(d, a->hit + c);
+      const V zc = hn::LoadU(d, a->depth + c), lc = hn::LoadU(d, a->luminance + c);
+      const V nxc = hn::LoadU(d, a->nx + c), nyc = hn::LoadU(d, a->ny + c), nzc = hn::LoadU(d, a->nz + c);
+      const V gx = hn::LoadU(d, a->gradX + c), gy = hn::LoadU(d, a->gradY + c);
+      const V lumDenominator = hn::MulAdd(sigmaL, hn::Sqrt(hn::Max(zero, hn::LoadU(d, a->blurredVariance + c))), lumEpsilon);
+      V sumR = zero, sumG = zero, sumB = zero, sumW = zero, sumV = zero;
+      for (int ky = -2; ky <= 2; ++ky)
+        for (int kx = -2; kx <= 2; ++kx) {
+          const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(ky * a->step) * a->stride + kx * a->step;
+          const std::size_t j = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(c) + offset);
+          const V spline = hn::Set(d, kSpline[kx < 0 ? -kx : kx] * kSpline[ky < 0 ? -ky : ky]);
+          V w = spline;
+          if (kx != 0 || ky != 0) {
+            const V depthDenominator =
+                hn::MulAdd(sigmaZ, hn::Abs(hn::MulAdd(gx, hn::Set(d, static_cast<float>(kx * a->step)), hn::Mul(gy, hn::Set(d, static_cast<float>(ky * a->step))))),
+                           depthEpsilon);
+            const V dz = hn::Div(hn::Abs(hn::Sub(zc, hn::LoadU(d, a->depth + j))), depthDenominator);
+            const V dl = hn::Div(hn::Abs(hn::Sub(lc, hn::LoadU(d, a->luminance + j))), lumDenominator);
+            V wn = hn::MulAdd(nxc, hn::LoadU(d, a->nx + j), hn::MulAdd(nyc, hn::LoadU(d, a->ny + j), hn::Mul(nzc, hn::LoadU(d, a->nz + j))));
+            wn = hn::Max(wn, zero);
+            for (int k = 0; k < 7; ++k) wn = hn::Mul(wn, wn);  // ^128
+            const V e = hn::Exp(d, hn::Neg(hn::Min(hn::Add(dz, dl), expLimit)));
+            w = hn::IfThenElseZero(hn::Gt(hn::LoadU(d, a->hit + j), zero), hn::Mul(hn::Mul(spline, e), wn));
+          }
+          sumR = hn::MulAdd(w, hn::LoadU(d, a->r + j), sumR);
+          sumG = hn::MulAdd(w, hn::LoadU(d, a->g + j), sumG);
+          sumB = hn::MulAdd(w, hn::LoadU(d, a->b + j), sumB);
+          sumW = hn::Add(sumW, w);
+          sumV = hn::MulAdd(hn::Mul(w, w), hn::LoadU(d, a->variance + j), sumV);
+        }
+      const auto surface = hn::Gt(hitC, zero);
+      // Where the centre is not a hit the sums may be 0: divide by 1 there, the result is not used.
+      const V safeW = hn::IfThenElse(surface, sumW, hn::Set(d, 1.0f));
+      const V inverse = hn::Div(hn::Set(d, 1.0f), safeW);
+      hn::StoreU(hn::IfThenElse(surface, hn::Mul(sumR, inverse), hn::LoadU(d, a->r + c)), d, a->outR + c);
+      hn::StoreU(hn::IfThenElse(surface, hn::Mul(sumG, inverse), hn::LoadU(d, a->g + c)), d, a->outG + c);
+      hn::StoreU(hn::IfThenElse(surface, hn::Mul(sumB, inverse), hn::LoadU(d, a->b + c)), d, a->outB + c);
+      hn::StoreU(hn::IfThenElse(surface, hn::Mul(sumV, hn::Mul(inverse, inverse)), hn::LoadU(d, a->variance + c)), d, a->outVariance + c);
+    }
+  }
+}
+
+}  // namespace dynbench::evaluate::svgf::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+#include <algorithm>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace dynbench::evaluate::svgf {
+
+HWY_EXPORT(AtrousRows);
+
+void AtrousPlanes::resize(int w, int h) {
+  width = w, height = h, stride = w + 2 * kPad;
+  // (+ kPad: the last row's lanes past its end, a vector at most, read taps up to 2 x 16 further.)
+  const std::size_t n = static_cast<std::size_t>(stride) * static_cast<std::size_t>(h + 2 * kPad) + kPad;
+  for (auto* plane : {&depth, &nx, &ny, &nz, &hit, &gradX, &gradY, &r, &g, &b, &variance}) plane->assign(n, 0.0f);
+}
+
+void atrousIteration(const AtrousPlanes& p, int step, const AtrousWeights& weights, AtrousPlanes& out) {
+  if (out.width != p.width || out.height != p.height) out.resize(p.width, p.height);
+  const int w = p.width, h = p.height;
+  // The illumination's luminance (Rec. 709) and the variance's 3x3 Gaussian (1, 2, 1)^2 / 16 at
+  // clamped coordinates, once per iteration rather than once per tap.
+  std::vector<float> luminance(p.r.size(), 0.0f), blurred(p.r.size(), 0.0f);
+  tbb::parallel_for(0, h, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = p.at(x, y);
+      luminance[i] = 0.2126f * p.r[i] + 0.7152f * p.g[i] + 0.0722f * p.b[i];
+      float sum = 0.0f;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          sum += (dx ? 0.5f : 1.0f) * (dy ? 0.5f : 1.0f) * p.variance[p.at(std::clamp(x + dx, 0, w - 1), std::clamp(y + dy, 0, h - 1))];
+      blurred[i] = sum / 4.0f;
+    }
+  });
+  const AtrousArgs args{p.depth.data(), p.nx.data(),       p.ny.data(),       p.nz.data(),       p.hit.data(),       p.gradX.data(),
+                        p.gradY.data(), p.r.data(),        p.g.data(),        p.b.data(),        p.variance.data(),  luminance.data(),
+                        blurred.data(), out.r.data(),      out.g.data(),      out.b.data(),      out.variance.data(), w,
+                        p.stride,       step,              weights.sigmaZ,    weights.sigmaL};
+  tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& rows) {
+    HWY_DYNAMIC_DISPATCH(AtrousRows)(&args, rows.begin(), rows.end());
+  });
+}
+
+}  // namespace dynbench::evaluate::svgf
+#endif

@@ -1,0 +1,39 @@
+#pragma once
+// SVGF's à-trous wavelet filter ([S17] §4.3-4.4, Eqs. 1-5), one iteration at a time, in single
+// precision over SIMD lanes (Google's Highway picks SSE4, AVX2 or AVX-512 at run time, as in
+// render/bsdf_batch.cpp). Its 25 taps a pixel with an exponential each, in double precision and one
+// pixel at a time, were nearly all of `svgf`'s time (5 s a 1080p frame; issue 34).
+//
+// The planes are structure of arrays, padded by kPad pixels on every side whose `hit` is 0, so a
+// tap outside the image weighs nothing, as the scalar filter skipped it, and a row of lanes reads
+// its taps with plain unaligned loads.
+#include <cstddef>
+#include <vector>
+
+namespace dynbench::evaluate::svgf {
+
+struct AtrousPlanes {
+  static constexpr int kPad = 32;  // two taps of the largest step, 16
+  int width = 0, height = 0, stride = 0;
+  // Per frame: depth, shading normal, hit (1 or 0), depth gradient (per pixel, a pixel's step).
+  std::vector<float> depth, nx, ny, nz, hit, gradX, gradY;
+  // Per iteration: the illumination being filtered and its variance.
+  std::vector<float> r, g, b, variance;
+
+  void resize(int w, int h);
+  std::size_t at(int x, int y) const {
+    return static_cast<std::size_t>(y + kPad) * static_cast<std::size_t>(stride) + static_cast<std::size_t>(x + kPad);
+  }
+};
+
+struct AtrousWeights {
+  float sigmaZ = 1.0f, sigmaL = 4.0f;  // [S17] §4.4 (sigma_n = 128 is fixed: seven squarings)
+};
+
+// One iteration with taps `step` pixels apart: r, g, b and variance of `planes` filtered into
+// those of `out` (resized to match; its geometry planes are not touched). Pixels that hit nothing
+// are copied. The variance's 3x3 Gaussian prefilter of the luminance weight ([S17] Eq. 5) reads
+// clamped coordinates, as the scalar filter did.
+void atrousIteration(const AtrousPlanes& planes, int step, const AtrousWeights& weights, AtrousPlanes& out);
+
+}  // namespace dynbench::evaluate::svgf
