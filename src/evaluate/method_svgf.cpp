@@ -21,7 +21,6 @@ constexpr int kHistoryCap = 32;                           // [Falcor] the histor
 constexpr int kIterations = 5;                             // [S17] §4.3: five a-trous iterations
 constexpr double kSigmaZ = 1.0, kSigmaN = 128.0, kSigmaL = 4.0;  // [S17] §4.4
 constexpr double kDepthReject = 10.0, kNormalReject = 16.0;       // [Falcor] reprojection consistency
-constexpr int kVarianceRadius = 3;                                // [S17] §4.2: 7x7 bilateral
 constexpr double kMomentsSigmaL = 10.0;                           // [Falcor] luminance weight there
 constexpr double kAlbedoFloor = 1e-3;                             // demodulation of black albedo
 constexpr double kDiffuseShare = 0.96;                            // glTF dielectric: 1 - F0
@@ -52,8 +51,9 @@ class SvgfMethod final : public TemporalMethod {
     auto at = [&](const std::vector<float>& b, std::size_t i) { return glm::dvec3(b[3 * i], b[3 * i + 1], b[3 * i + 2]); };
     auto index = [w](int x, int y) { return static_cast<std::size_t>(y) * w + x; };
     // Depth gradient (central differences where the neighbours are surfaces) for the depth weight.
+    // Rows in parallel here and below: each pixel's result depends on the inputs alone.
     std::vector<glm::dvec2> gradZ(n, glm::dvec2(0.0));
-    for (int y = 0; y < h; ++y)
+    tbb::parallel_for(0, h, [&](int y) {
       for (int x = 0; x < w; ++x) {
         auto dz = [&](int x0, int y0, int x1, int y1) {
           const std::size_t a = index(std::clamp(x0, 0, w - 1), std::clamp(y0, 0, h - 1)), b = index(std::clamp(x1, 0, w - 1), std::clamp(y1, 0, h - 1));
@@ -61,6 +61,7 @@ class SvgfMethod final : public TemporalMethod {
         };
         gradZ[index(x, y)] = {dz(x - 1, y, x + 1, y), dz(x, y - 1, x, y + 1)};
       }
+    });
 
     // 1. Demodulate: illumination = radiance / albedo ([S17] §3). The radiance buffer holds the
     // specular reflection too, which is not proportional to the base colour: a glTF dielectric
@@ -68,17 +69,17 @@ class SvgfMethod final : public TemporalMethod {
     // B), so the demodulating albedo is 0.96 base + 0.04. Dividing by the base colour alone
     // magnifies the specular part of dark texels and spreads it over bright ones.
     std::vector<glm::dvec3> albedo(n), illumination(n);
-    for (std::size_t i = 0; i < n; ++i) {
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
       albedo[i] = f.hit[i] > 0 ? glm::max(kDiffuseShare * at(f.albedo, i) + (1.0 - kDiffuseShare), kAlbedoFloor) : glm::dvec3(1.0);
       illumination[i] = (at(f.direct, i) + at(f.indirect, i)) / albedo[i];
-    }
+    });
 
     // 2. Temporal accumulation of illumination and its luminance moments ([S17] §4.1).
     std::vector<glm::dvec2> moments(n);
     std::vector<int> length(n, 1);
-    std::vector<double> variance(n, 0.0);
-    long kept = 0;
-    for (int y = 0; y < h; ++y)
+    std::vector<long> keptInRow(static_cast<std::size_t>(h), 0);
+    tbb::parallel_for(0, h, [&](int y) {
+      long& kept = keptInRow[static_cast<std::size_t>(y)];
       for (int x = 0; x < w; ++x) {
         const std::size_t i = index(x, y);
         const double l = luminance(illumination[i]);
@@ -110,49 +111,29 @@ class SvgfMethod final : public TemporalMethod {
         moments[i] = m + am * (moments[i] - m);
         ++kept;
       }
+    });
+    long kept = 0;
+    for (long k : keptInRow) kept += k;
 
     // 3. Variance: from the temporal moments, or where the history is short (< 4 frames) from the
-    // 7x7 bilateral neighbourhood's moments, boosted by 4 / length ([S17] §4.2, [Falcor]).
-    tbb::parallel_for(0, h, [&](int y) {
-      for (int x = 0; x < w; ++x) {
-        const std::size_t i = index(x, y);
-        if (f.hit[i] <= 0) continue;
-        if (length[i] >= 4) {
-          variance[i] = std::max(0.0, moments[i].y - moments[i].x * moments[i].x);
-          continue;
-        }
-        glm::dvec2 m(0.0);
-        double weight = 0.0;
-        for (int dy = -kVarianceRadius; dy <= kVarianceRadius; ++dy)
-          for (int dx = -kVarianceRadius; dx <= kVarianceRadius; ++dx) {
-            const int xx = x + dx, yy = y + dy;
-            if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-            const std::size_t j = index(xx, yy);
-            if (f.hit[j] <= 0) continue;
-            const double wz = std::exp(-std::abs(f.depth[i] - f.depth[j]) / (kSigmaZ * std::abs(glm::dot(gradZ[i], glm::dvec2(dx, dy))) + 1e-8));
-            const double wn = normalWeight(at(f.normal, i), at(f.normal, j));
-            const double wl = std::exp(-std::abs(luminance(illumination[i]) - luminance(illumination[j])) / kMomentsSigmaL);
-            const double wgt = (dx == 0 && dy == 0) ? 1.0 : wz * wn * wl;
-            m += wgt * moments[j], weight += wgt;
-          }
-        m /= weight;
-        variance[i] = std::max(0.0, m.y - m.x * m.x) * 4.0 / length[i];
-      }
-    });
-
-    // 4. A-trous wavelet filter, 5 iterations with steps 1, 2, 4, 8, 16 ([S17] §4.3-4.4), in
-    // single precision over SIMD lanes (svgf_atrous.h); the first iteration's output is the colour
-    // history of the next frame.
+    // 7x7 bilateral neighbourhood's moments, boosted by 4 / length ([S17] §4.2, [Falcor]); then
+    // 4. the à-trous wavelet filter, 5 iterations with steps 1, 2, 4, 8, 16 ([S17] §4.3-4.4). Both
+    // in single precision over SIMD lanes (svgf_atrous.h); the first iteration's output is the
+    // colour history of the next frame.
     planes_.resize(w, h);
-    for (int y = 0; y < h; ++y)
+    tbb::parallel_for(0, h, [&](int y) {
       for (int x = 0; x < w; ++x) {
         const std::size_t i = index(x, y), j = planes_.at(x, y);
         planes_.depth[j] = f.depth[i], planes_.hit[j] = f.hit[i] > 0 ? 1.0f : 0.0f;
         planes_.nx[j] = f.normal[3 * i], planes_.ny[j] = f.normal[3 * i + 1], planes_.nz[j] = f.normal[3 * i + 2];
         planes_.gradX[j] = static_cast<float>(gradZ[i].x), planes_.gradY[j] = static_cast<float>(gradZ[i].y);
         planes_.r[j] = static_cast<float>(illumination[i].r), planes_.g[j] = static_cast<float>(illumination[i].g);
-        planes_.b[j] = static_cast<float>(illumination[i].b), planes_.variance[j] = static_cast<float>(variance[i]);
+        planes_.b[j] = static_cast<float>(illumination[i].b);
+        planes_.moment1[j] = static_cast<float>(moments[i].x), planes_.temporalVariance[j] = static_cast<float>(moments[i].y - moments[i].x * moments[i].x);
+        planes_.historyLength[j] = static_cast<float>(length[i]);
       }
+    });
+    svgf::estimateVariance(planes_, static_cast<float>(kSigmaZ), static_cast<float>(kMomentsSigmaL));
     auto illuminationAt = [&](const svgf::AtrousPlanes& planes, std::size_t i, int x, int y) {
       const std::size_t j = planes.at(x, y);
       return f.hit[i] > 0 ? glm::dvec3(planes.r[j], planes.g[j], planes.b[j]) : illumination[i];
@@ -164,12 +145,14 @@ class SvgfMethod final : public TemporalMethod {
       std::swap(planes_.variance, filtered_.variance);
       if (iteration == 0) {
         feedback.resize(n);
-        for (int y = 0; y < h; ++y)
+        tbb::parallel_for(0, h, [&](int y) {
           for (int x = 0; x < w; ++x) feedback[index(x, y)] = illuminationAt(planes_, index(x, y), x, y);
+        });
       }
     }
-    for (int y = 0; y < h; ++y)
+    tbb::parallel_for(0, h, [&](int y) {
       for (int x = 0; x < w; ++x) illumination[index(x, y)] = illuminationAt(planes_, index(x, y), x, y);
+    });
 
     // 5. Remodulate with the albedo; keep this frame's history.
     RgbImage out = frameRadiance(f);

@@ -20,6 +20,12 @@ struct AtrousArgs {
   int width, stride, step;
   float sigmaZ, sigmaL;
 };
+struct MomentsArgs {
+  const float *depth, *nx, *ny, *nz, *hit, *gradX, *gradY, *luminance, *moment1, *temporalVariance, *historyLength;
+  float* variance;
+  int width, stride;
+  float sigmaZ, sigmaL;
+};
 }  // namespace dynbench::evaluate::svgf
 #endif
 
@@ -90,6 +96,60 @@ void AtrousRows(const AtrousArgs* a, int y0, int y1) {
   }
 }
 
+// Rows [y0, y1) of the variance estimate (estimateVariance). A vector of lanes whose histories are
+// all 4 frames or longer skips the 49 taps.
+void MomentsRows(const MomentsArgs* a, int y0, int y1) {
+  const D d;
+  const std::size_t lanes = hn::Lanes(d);
+  constexpr int kRadius = 3;  // [S17] §4.2: 7x7
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), four = hn::Set(d, 4.0f), depthEpsilon = hn::Set(d, 1e-8f);
+  const V sigmaZ = hn::Set(d, a->sigmaZ), inverseSigmaL = hn::Set(d, 1.0f / a->sigmaL), expLimit = hn::Set(d, 80.0f);
+  const int pad = AtrousPlanes::kPad;
+  for (int y = y0; y < y1; ++y)
+    for (int x = 0; x < a->width; x += static_cast<int>(lanes)) {
+      const std::size_t c = static_cast<std::size_t>(y + pad) * static_cast<std::size_t>(a->stride) + static_cast<std::size_t>(x + pad);
+      const auto surface = hn::Gt(hn::LoadU(d, a->hit + c), zero);
+      const V length = hn::LoadU(d, a->historyLength + c);
+      const V m1c = hn::LoadU(d, a->moment1 + c), vc = hn::LoadU(d, a->temporalVariance + c);
+      V variance = hn::Max(zero, vc);
+      const auto spatial = hn::And(surface, hn::Lt(length, four));
+      if (!hn::AllFalse(d, spatial)) {
+        const V zc = hn::LoadU(d, a->depth + c), lc = hn::LoadU(d, a->luminance + c);
+        const V nxc = hn::LoadU(d, a->nx + c), nyc = hn::LoadU(d, a->ny + c), nzc = hn::LoadU(d, a->nz + c);
+        const V gx = hn::LoadU(d, a->gradX + c), gy = hn::LoadU(d, a->gradY + c);
+        // The weighted m2 - m1^2 of the neighbourhood as E[v] + Var(m1), v = m2 - m1^2 per pixel
+        // (computed in double), Var(m1) of m1 - m1(centre): the same number without single
+        // precision's cancellation of two large second moments.
+        V sumV = vc, sumD = zero, sumD2 = zero, sumW = one;  // the centre weighs 1
+        for (int dy = -kRadius; dy <= kRadius; ++dy)
+          for (int dx = -kRadius; dx <= kRadius; ++dx) {
+            if (dx == 0 && dy == 0) continue;
+            const std::size_t j = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(c) + static_cast<std::ptrdiff_t>(dy) * a->stride + dx);
+            const V depthDenominator =
+                hn::MulAdd(sigmaZ, hn::Abs(hn::MulAdd(gx, hn::Set(d, static_cast<float>(dx)), hn::Mul(gy, hn::Set(d, static_cast<float>(dy))))), depthEpsilon);
+            const V dz = hn::Div(hn::Abs(hn::Sub(zc, hn::LoadU(d, a->depth + j))), depthDenominator);
+            const V dl = hn::Mul(hn::Abs(hn::Sub(lc, hn::LoadU(d, a->luminance + j))), inverseSigmaL);
+            V wn = hn::MulAdd(nxc, hn::LoadU(d, a->nx + j), hn::MulAdd(nyc, hn::LoadU(d, a->ny + j), hn::Mul(nzc, hn::LoadU(d, a->nz + j))));
+            wn = hn::Max(wn, zero);
+            for (int k = 0; k < 7; ++k) wn = hn::Mul(wn, wn);  // ^128
+            const V w = hn::IfThenElseZero(hn::Gt(hn::LoadU(d, a->hit + j), zero),
+                                           hn::Mul(hn::Exp(d, hn::Neg(hn::Min(hn::Add(dz, dl), expLimit))), wn));
+            const V deviation = hn::Sub(hn::LoadU(d, a->moment1 + j), m1c);
+            sumV = hn::MulAdd(w, hn::LoadU(d, a->temporalVariance + j), sumV);
+            sumD = hn::MulAdd(w, deviation, sumD);
+            sumD2 = hn::MulAdd(w, hn::Mul(deviation, deviation), sumD2);
+            sumW = hn::Add(sumW, w);
+          }
+        const V inverse = hn::Div(one, sumW);
+        const V meanD = hn::Mul(sumD, inverse);
+        const V spread = hn::Add(hn::Mul(sumV, inverse), hn::NegMulAdd(meanD, meanD, hn::Mul(sumD2, inverse)));
+        const V boosted = hn::Div(hn::Mul(hn::Max(zero, spread), four), hn::Max(length, one));
+        variance = hn::IfThenElse(spatial, boosted, variance);
+      }
+      hn::StoreU(hn::IfThenElseZero(surface, variance), d, a->variance + c);
+    }
+}
+
 }  // namespace dynbench::evaluate::svgf::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -102,12 +162,14 @@ HWY_AFTER_NAMESPACE();
 namespace dynbench::evaluate::svgf {
 
 HWY_EXPORT(AtrousRows);
+HWY_EXPORT(MomentsRows);
 
 void AtrousPlanes::resize(int w, int h) {
   width = w, height = h, stride = w + 2 * kPad;
   // (+ kPad: the last row's lanes past its end, a vector at most, read taps up to 2 x 16 further.)
   const std::size_t n = static_cast<std::size_t>(stride) * static_cast<std::size_t>(h + 2 * kPad) + kPad;
-  for (auto* plane : {&depth, &nx, &ny, &nz, &hit, &gradX, &gradY, &r, &g, &b, &variance}) plane->assign(n, 0.0f);
+  for (auto* plane : {&depth, &nx, &ny, &nz, &hit, &gradX, &gradY, &r, &g, &b, &variance, &moment1, &temporalVariance, &historyLength})
+    plane->assign(n, 0.0f);
 }
 
 void atrousIteration(const AtrousPlanes& p, int step, const AtrousWeights& weights, AtrousPlanes& out) {
@@ -133,6 +195,24 @@ void atrousIteration(const AtrousPlanes& p, int step, const AtrousWeights& weigh
                         p.stride,       step,              weights.sigmaZ,    weights.sigmaL};
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& rows) {
     HWY_DYNAMIC_DISPATCH(AtrousRows)(&args, rows.begin(), rows.end());
+  });
+}
+
+void estimateVariance(AtrousPlanes& p, float sigmaZ, float momentsSigmaL) {
+  const int w = p.width, h = p.height;
+  std::vector<float> luminance(p.r.size(), 0.0f);
+  tbb::parallel_for(0, h, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = p.at(x, y);
+      luminance[i] = 0.2126f * p.r[i] + 0.7152f * p.g[i] + 0.0722f * p.b[i];
+    }
+  });
+  const MomentsArgs args{p.depth.data(),    p.nx.data(),      p.ny.data(),         p.nz.data(),       p.hit.data(),
+                         p.gradX.data(),    p.gradY.data(),   luminance.data(),    p.moment1.data(),  p.temporalVariance.data(),
+                         p.historyLength.data(), p.variance.data(), w,             p.stride,          sigmaZ,
+                         momentsSigmaL};
+  tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& rows) {
+    HWY_DYNAMIC_DISPATCH(MomentsRows)(&args, rows.begin(), rows.end());
   });
 }
 

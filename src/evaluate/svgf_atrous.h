@@ -1,8 +1,8 @@
 #pragma once
-// SVGF's à-trous wavelet filter ([S17] §4.3-4.4, Eqs. 1-5), one iteration at a time, in single
-// precision over SIMD lanes (Google's Highway picks SSE4, AVX2 or AVX-512 at run time, as in
-// render/bsdf_batch.cpp). Its 25 taps a pixel with an exponential each, in double precision and one
-// pixel at a time, were nearly all of `svgf`'s time (5 s a 1080p frame; issue 34).
+// SVGF's spatial filters, the à-trous wavelet filter ([S17] §4.3-4.4, Eqs. 1-5) one iteration at a
+// time and the variance estimate's 7x7 bilateral filter (§4.2), in single precision over SIMD lanes (Google's Highway picks SSE4, AVX2 or AVX-512 at run time, as in
+// render/bsdf_batch.cpp). Their 25 and 49 taps a pixel with two exponentials each, in double
+// precision and one pixel at a time, were nearly all of `svgf`'s time (5 s a 1080p frame; issue 34).
 //
 // The planes are structure of arrays, padded by kPad pixels on every side whose `hit` is 0, so a
 // tap outside the image weighs nothing, as the scalar filter skipped it, and a row of lanes reads
@@ -19,6 +19,9 @@ struct AtrousPlanes {
   std::vector<float> depth, nx, ny, nz, hit, gradX, gradY;
   // Per iteration: the illumination being filtered and its variance.
   std::vector<float> r, g, b, variance;
+  // For the variance estimate: the temporally accumulated luminance moment m1, the variance
+  // m2 - m1^2 of the accumulated moments (computed in double) and the history length.
+  std::vector<float> moment1, temporalVariance, historyLength;
 
   void resize(int w, int h);
   std::size_t at(int x, int y) const {
@@ -35,5 +38,12 @@ struct AtrousWeights {
 // are copied. The variance's 3x3 Gaussian prefilter of the luminance weight ([S17] Eq. 5) reads
 // clamped coordinates, as the scalar filter did.
 void atrousIteration(const AtrousPlanes& planes, int step, const AtrousWeights& weights, AtrousPlanes& out);
+
+// The variance estimate of [S17] §4.2 into `planes.variance`: where the history is 4 frames or
+// longer, the temporal moments' m2 - m1^2; where shorter, the moments of the 7x7 neighbourhood
+// weighted by the depth, normal and luminance edge-stopping weights (sigma_l = 10 on the
+// illumination's luminance, [Falcor] SVGFFilterMoments; the centre weighs 1), boosted by
+// 4 / length. Pixels that hit nothing get 0.
+void estimateVariance(AtrousPlanes& planes, float sigmaZ, float momentsSigmaL);
 
 }  // namespace dynbench::evaluate::svgf
