@@ -87,35 +87,39 @@ double sample1(const std::vector<float>& buffer, const BilinearTaps& taps) {
   return s;
 }
 
-std::optional<glm::dvec2> reproject(const FrameCamera& camera, const glm::dvec3& p) {
-  const glm::dvec4 clip = camera.projection * camera.view * glm::dvec4(p, 1.0);  // Eq. (2.2)
-  if (clip.w <= 0) return std::nullopt;
-  const glm::dvec2 ndc(clip.x / clip.w, clip.y / clip.w);  // perspective division
-  return glm::dvec2((ndc.x + 1.0) * 0.5 * camera.width, (1.0 - ndc.y) * 0.5 * camera.height);  // Eq. (2.3), row 0 at the top
-}
-
-std::optional<glm::dvec2> reprojectDirection(const FrameCamera& camera, const glm::dvec3& direction) {
-  const glm::dvec4 clip = camera.projection * camera.view * glm::dvec4(direction, 0.0);
-  if (clip.w <= 0) return std::nullopt;
-  const glm::dvec2 ndc(clip.x / clip.w, clip.y / clip.w);
-  return glm::dvec2((ndc.x + 1.0) * 0.5 * camera.width, (1.0 - ndc.y) * 0.5 * camera.height);
-}
-
 namespace {
 
-// The direction from the near to the far plane through continuous pixel coordinates, given the
-// inverse of projection x view.
-glm::dvec3 directionThrough(const glm::dmat4& inverseViewProjection, double x, double y, int width, int height) {
+// Clip coordinates to continuous pixel coordinates: perspective division and Eq. (2.3), row 0 at
+// the top; nullopt behind the camera (clip w <= 0).
+std::optional<glm::dvec2> toPixels(const glm::dvec4& clip, int width, int height) {
+  if (clip.w <= 0) return std::nullopt;
+  const glm::dvec2 ndc(clip.x / clip.w, clip.y / clip.w);
+  return glm::dvec2((ndc.x + 1.0) * 0.5 * width, (1.0 - ndc.y) * 0.5 * height);
+}
+
+}  // namespace
+
+Projector::Projector(const FrameCamera& camera)
+    : viewProjection(camera.projection * camera.view), inverseViewProjection(glm::inverse(viewProjection)), width(camera.width), height(camera.height) {}
+
+std::optional<glm::dvec2> Projector::point(const glm::dvec3& p) const { return toPixels(viewProjection * glm::dvec4(p, 1.0), width, height); }  // Eq. (2.2)
+
+std::optional<glm::dvec2> Projector::direction(const glm::dvec3& d) const { return toPixels(viewProjection * glm::dvec4(d, 0.0), width, height); }
+
+glm::dvec3 Projector::pixelDirection(double x, double y) const {
+  // The direction from the near to the far plane through the pixel coordinates.
   const glm::dvec2 ndc(2.0 * x / width - 1.0, 1.0 - 2.0 * y / height);
   const glm::dvec4 near = inverseViewProjection * glm::dvec4(ndc, -1.0, 1.0), far = inverseViewProjection * glm::dvec4(ndc, 1.0, 1.0);
   return glm::normalize(glm::dvec3(far) / far.w - glm::dvec3(near) / near.w);
 }
 
-}  // namespace
+std::optional<glm::dvec2> reproject(const FrameCamera& camera, const glm::dvec3& p) { return Projector(camera).point(p); }
 
-glm::dvec3 pixelDirection(const FrameCamera& camera, double x, double y) {
-  return directionThrough(glm::inverse(camera.projection * camera.view), x, y, camera.width, camera.height);
+std::optional<glm::dvec2> reprojectDirection(const FrameCamera& camera, const glm::dvec3& direction) {
+  return Projector(camera).direction(direction);
 }
+
+glm::dvec3 pixelDirection(const FrameCamera& camera, double x, double y) { return Projector(camera).pixelDirection(x, y); }
 
 double sceneSize(const FeatureFrame& frame) {
   glm::dvec3 lo(1e300), hi(-1e300);
@@ -254,7 +258,7 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
     const double x = q.x - 0.5, y = q.y - 0.5;
     return x < -kEdge || x > previous.width - 1 + kEdge || y < -kEdge || y > previous.height - 1 + kEdge;
   };
-  const glm::dmat4 inverseCurrent = glm::inverse(current.camera.projection * current.camera.view);
+  const Projector currentProjector(current.camera), previousProjector(previous.camera);
   // Rows in parallel (TBB); each row's sums are added in row order at the end, so the result does
   // not depend on the schedule.
   std::vector<FrameSums> rowSums(static_cast<std::size_t>(h));
@@ -265,11 +269,11 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
       unsigned char bits = 0;
       if (current.hit[i] <= 0) {
         // Background: the environment at infinity; its history is only lost at the frustum edge.
-        const auto q = reprojectDirection(previous.camera, directionThrough(inverseCurrent, px + 0.5, py + 0.5, w, h));
+        const auto q = previousProjector.direction(currentProjector.pixelDirection(px + 0.5, py + 0.5));
         if (!q || outside(*q)) bits |= kFrustum;
       } else {
         const glm::dvec3 p = at3(current.position, i);
-        const auto q = reproject(previous.camera, p);
+        const auto q = previousProjector.point(p);
         if (!q || outside(*q)) {
           bits |= kFrustum;
         } else {

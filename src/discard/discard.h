@@ -135,6 +135,18 @@ bool onTangentPlane(const glm::dvec3& p, const glm::dvec3& n, const glm::dvec3& 
 HistoryTest testHistory(const glm::dvec3& p, const glm::dvec3& n, double viewDepth, const FeatureFrame& previous, const BilinearTaps& taps,
                         const Thresholds& absolute);
 
+// A frame camera's projection x view and its inverse, multiplied once for the many points of a
+// frame reprojected into it (reproject, reprojectDirection and pixelDirection below, which
+// multiplied them for every pixel).
+struct Projector {
+  explicit Projector(const FrameCamera& camera);
+  std::optional<glm::dvec2> point(const glm::dvec3& p) const;
+  std::optional<glm::dvec2> direction(const glm::dvec3& direction) const;
+  glm::dvec3 pixelDirection(double x, double y) const;
+  glm::dmat4 viewProjection, inverseViewProjection;
+  int width = 0, height = 0;
+};
+
 // Where world point p lands in a frame's image, in continuous pixel coordinates; nullopt behind
 // the camera (clip w <= 0). Eq. (2.2) then perspective division and Eq. (2.3).
 std::optional<glm::dvec2> reproject(const FrameCamera& camera, const glm::dvec3& p);

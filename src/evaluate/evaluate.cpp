@@ -7,6 +7,7 @@
 #include <map>
 
 #include <fmt/format.h>
+#include <tbb/parallel_for.h>
 
 #include "core/files.h"
 #include "core/image_io.h"
@@ -59,12 +60,11 @@ ReferencePair referencePair(const RgbImage& ref, const RgbImage& refPrev, const 
   pair.scale = displayScale(ref);
   pair.display = toDisplay(ref, pair.scale), pair.previousDisplay = toDisplay(refPrev, pair.scale);
   pair.warp.resize(refFrame.pixelCount());
-  for (int y = 0; y < refFrame.height; ++y)
-    for (int x = 0; x < refFrame.width; ++x) {
-      auto& taps = pair.warp[static_cast<std::size_t>(y) * refFrame.width + x];
-      taps = historyTaps(refFrame, refPrevFrame, absolute, x, y, /*useMotion=*/true);
-      if (taps) ++pair.warped;
-    }
+  const HistoryLookup lookup(refFrame, refPrevFrame, absolute, /*useMotion=*/true);
+  tbb::parallel_for(0, refFrame.height, [&](int y) {
+    for (int x = 0; x < refFrame.width; ++x) pair.warp[static_cast<std::size_t>(y) * refFrame.width + x] = lookup(x, y);
+  });
+  for (const auto& taps : pair.warp) pair.warped += taps ? 1 : 0;
   return pair;
 }
 

@@ -57,9 +57,25 @@ glm::dvec3 sampleCatmullRom(const RgbImage& image, double x, double y);
 // whose history fails the discard stage's world-position and normal tests, or comes from the
 // background, and the other way round). Surfaces are followed by their motion vector (useMotion)
 // or by the camera matrices (thesis Eqs. 2.2-2.3); the background always by the matrices.
-// `absolute` are discard::absoluteThresholds.
-std::optional<discard::BilinearTaps> historyTaps(const frames::FeatureFrame& current, const frames::FeatureFrame& previous,
-                                                 const discard::Thresholds& absolute, int px, int py, bool useMotion);
+// `absolute` are discard::absoluteThresholds. One per pair of frames (the cameras' matrices are
+// multiplied once); the frames and thresholds must outlive it.
+class HistoryLookup {
+ public:
+  HistoryLookup(const frames::FeatureFrame& current, const frames::FeatureFrame& previous, const discard::Thresholds& absolute, bool useMotion);
+  std::optional<discard::BilinearTaps> operator()(int px, int py) const;
+
+ private:
+  const frames::FeatureFrame& current_;
+  const frames::FeatureFrame& previous_;
+  const discard::Thresholds& absolute_;
+  bool useMotion_;
+  discard::Projector currentProjector_, previousProjector_;
+};
+
+// The parts of a frame that HistoryLookup reads of the previous one (number, camera, size,
+// position, normal, hit): what a method keeps as its history's geometry, instead of a copy of
+// every buffer (at 1080p about 150 MB a frame).
+frames::FeatureFrame historyFrame(const frames::FeatureFrame& frame);
 
 // Factories, one per method file.
 std::unique_ptr<TemporalMethod> makeNoneMethod();

@@ -4,6 +4,8 @@
 // by the discard stage's own world-position and shading-normal tests.
 #include <algorithm>
 
+#include <tbb/parallel_for.h>
+
 #include "evaluate/method.h"
 
 namespace dynbench::evaluate {
@@ -30,20 +32,25 @@ class AccumulateMethod final : public TemporalMethod {
       const frames::FeatureFrame& prev = previous_->frame;
       const discard::Thresholds t = discard::absoluteThresholds(context_.thresholds, frame, context_.sceneSize);
       const int w = frame.width, h = frame.height;
-      for (int py = 0; py < h; ++py)
+      const HistoryLookup lookup(frame, prev, t, /*useMotion=*/false);
+      // Rows in parallel: each pixel reads the previous output only.
+      std::vector<long> keptInRow(static_cast<std::size_t>(h), 0);
+      tbb::parallel_for(0, h, [&](int py) {
         for (int px = 0; px < w; ++px) {
           const std::size_t i = static_cast<std::size_t>(py) * w + px;
-          const auto found = historyTaps(frame, prev, t, px, py, /*useMotion=*/false);
+          const auto found = lookup(px, py);
           if (!found) continue;
           const discard::BilinearTaps& taps = *found;
           const glm::dvec3 history = discard::sample3(previous_->output.rgb, taps);
           const double n = discard::sample1(previous_->count, taps) + 1.0, alpha = std::max(1.0 / n, kAlphaMin);
           for (int k = 0; k < 3; ++k) out.rgb[3 * i + k] = static_cast<float>(history[k] + alpha * (out.rgb[3 * i + k] - history[k]));
           count[i] = static_cast<float>(n);
-          ++kept;
+          ++keptInRow[static_cast<std::size_t>(py)];
         }
+      });
+      for (long k : keptInRow) kept += k;
     }
-    previous_ = History{frame, out, std::move(count)};
+    previous_ = History{historyFrame(frame), out, std::move(count)};
     return MethodOutput{std::move(out), static_cast<double>(kept) / static_cast<double>(frame.pixelCount())};
   }
 
