@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <type_traits>
 
 #include <tbb/blocked_range.h>
@@ -28,40 +29,21 @@ const glm::dmat3 kRgbToXyz(0.4123908, 0.2126390, 0.0193308,   //
 const glm::dmat3 kXyzToRgb = glm::inverse(kRgbToXyz);
 // The reference white: XYZ of linear RGB (1, 1, 1).
 const glm::dvec3 kWhite = kRgbToXyz * glm::dvec3(1.0);
-// The same in single precision, the per-pixel path's (as the authors' tool computes).
-const glm::mat3 kRgbToXyzF(kRgbToXyz), kXyzToRgbF(kXyzToRgb);
-const glm::vec3 kWhiteF(kWhite);
 
 const glm::dvec3& whitePoint() { return kWhite; }
 
-// The colour pipeline for double (the tested per-step functions below) and float (the per-pixel
-// path): one definition of each step.
 template <typename T>
 using Vec3 = glm::vec<3, T, glm::defaultp>;
-template <typename T>
-const auto& rgbToXyzOf() {
-  if constexpr (std::is_same_v<T, float>) return kRgbToXyzF; else return kRgbToXyz;
-}
-template <typename T>
-const auto& xyzToRgbOf() {
-  if constexpr (std::is_same_v<T, float>) return kXyzToRgbF; else return kXyzToRgb;
-}
-template <typename T>
-const Vec3<T>& whiteOf() {
-  if constexpr (std::is_same_v<T, float>) return kWhiteF; else return kWhite;
-}
 
 // The cube root of a positive float: the exponent divided by 3 in the bits (a guess within 4 %),
 // then two steps of Halley's iteration y <- y (y^3 + 2x) / (2y^3 + x), cubically convergent:
 // within 2.4e-7 relative (3 ulp of cbrtf) over [0.008, 2], checked on every float there. glibc's
 // cbrtf, not vectorised, with frexpf and scalbnf was a sixth of ꟻLIP's time.
 float cubeRoot(float x) {
-  float y = std::bit_cast<float>(std::bit_cast<std::uint32_t>(x) / 3u + 709921077u);
-  for (int k = 0; k < 2; ++k) {
-    const float y3 = y * y * y;
-    y = y * (y3 + 2.0f * x) / (2.0f * y3 + x);
-  }
-  return y;
+  const float y0 = std::bit_cast<float>(std::bit_cast<std::uint32_t>(x) / 3u + 709921077u);
+  const float c0 = y0 * y0 * y0, y1 = y0 * (c0 + 2.0f * x) / (2.0f * c0 + x);
+  const float c1 = y1 * y1 * y1;
+  return y1 * (c1 + 2.0f * x) / (2.0f * c1 + x);
 }
 double cubeRoot(double x) { return std::cbrt(x); }
 
@@ -71,28 +53,34 @@ T labF(T t) {
   constexpr T delta = T(6) / T(29);
   return t > delta * delta * delta ? cubeRoot(t) : t / (T(3) * delta * delta) + T(4) / T(29);
 }
+// The colour pipeline for double (the tested per-step functions below) and float (the per-pixel
+// path): one definition of each step, the constants with it.
 template <typename T>
-Vec3<T> linearRgbToXyzT(Vec3<T> rgb) { return rgbToXyzOf<T>() * rgb; }
-template <typename T>
-Vec3<T> xyzToLinearRgbT(Vec3<T> xyz) { return xyzToRgbOf<T>() * xyz; }
-template <typename T>
-Vec3<T> xyzToYcxczT(Vec3<T> xyz) {
-  const Vec3<T> n = xyz / whiteOf<T>();
-  return {T(116) * n.y - T(16), T(500) * (n.x - n.y), T(200) * (n.y - n.z)};
-}
-template <typename T>
-Vec3<T> ycxczToXyzT(Vec3<T> v) {
-  const T y = (v.x + T(16)) / T(116);
-  return Vec3<T>(y + v.y / T(500), y, y - v.z / T(200)) * whiteOf<T>();
-}
-template <typename T>
-Vec3<T> xyzToLabT(Vec3<T> xyz) {
-  const Vec3<T> n = xyz / whiteOf<T>();
-  const T fx = labF(n.x), fy = labF(n.y), fz = labF(n.z);
-  return {T(116) * fy - T(16), T(500) * (fx - fy), T(200) * (fy - fz)};
-}
-template <typename T>
-Vec3<T> huntAdjustT(Vec3<T> lab) { return {lab.x, T(0.01) * lab.x * lab.y, T(0.01) * lab.x * lab.z}; }
+struct ColourSpace {
+  glm::mat<3, 3, T, glm::defaultp> rgbToXyz, xyzToRgb;
+  Vec3<T> white;
+
+  Vec3<T> linearRgbToXyz(Vec3<T> rgb) const { return rgbToXyz * rgb; }
+  Vec3<T> xyzToLinearRgb(Vec3<T> xyz) const { return xyzToRgb * xyz; }
+  Vec3<T> xyzToYcxcz(Vec3<T> xyz) const {
+    const Vec3<T> n = xyz / white;
+    return {T(116) * n.y - T(16), T(500) * (n.x - n.y), T(200) * (n.y - n.z)};
+  }
+  Vec3<T> ycxczToXyz(Vec3<T> v) const {
+    const T y = (v.x + T(16)) / T(116);
+    return Vec3<T>(y + v.y / T(500), y, y - v.z / T(200)) * white;
+  }
+  Vec3<T> xyzToLab(Vec3<T> xyz) const {
+    const Vec3<T> n = xyz / white;
+    const T fx = labF(n.x), fy = labF(n.y), fz = labF(n.z);
+    return {T(116) * fy - T(16), T(500) * (fx - fy), T(200) * (fy - fz)};
+  }
+  static Vec3<T> huntAdjust(Vec3<T> lab) { return {lab.x, T(0.01) * lab.x * lab.y, T(0.01) * lab.x * lab.z}; }
+};
+// In double for the tested steps; in single precision for the per-pixel path (as the authors' tool
+// computes).
+const ColourSpace<double> kColour{kRgbToXyz, kXyzToRgb, kWhite};
+const ColourSpace<float> kColourF{glm::mat3(kRgbToXyz), glm::mat3(kXyzToRgb), glm::vec3(kWhite)};
 
 // One plane of w x h floats.
 using Plane = std::vector<float>;
@@ -102,38 +90,43 @@ using Plane = std::vector<float>;
 // clamped gather of every tap for every output pixel, did not vectorise and was most of ꟻLIP's
 // time. Edges are clamped, as the authors' tool does. All kernels of a pass have one length.
 //
-// Rows: every row of `in` correlated with each kernel, one output plane per kernel.
-std::vector<Plane> rowPass(const Plane& in, int w, int h, std::initializer_list<const std::vector<float>*> kernels) {
+// dst[x] += weight x src[x], x in [0, n): the filters' inner loop. The build targets baseline
+// x86-64 (SSE2, no FMA); GCC's function multiversioning also compiles it for x86-64-v3 (AVX2, FMA)
+// and v4 (AVX-512) and picks one when the program loads.
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+[[gnu::target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")]]
+#endif
+void addScaled(float* dst, const float* src, float weight, int n) {
+  for (int x = 0; x < n; ++x) dst[x] += weight * src[x];
+}
+
+// Rows: every row of `in` correlated with each kernel, into out[first + k] for kernel k (planes
+// reused from call to call: fresh ones cost a page fault every 4 KiB).
+void rowPass(const Plane& in, int w, int h, std::initializer_list<const std::vector<float>*> kernels, std::vector<Plane>& out,
+             std::size_t first = 0) {
   const int r = static_cast<int>((*kernels.begin())->size() / 2);
-  std::vector<Plane> out(kernels.size(), Plane(in.size()));
+  if (out.size() < first + kernels.size()) out.resize(first + kernels.size());
+  for (std::size_t k = 0; k < kernels.size(); ++k) out[first + k].resize(in.size());
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
     std::vector<float> padded(static_cast<std::size_t>(w + 2 * r));
     for (int y = rows.begin(); y < rows.end(); ++y) {
       const float* src = in.data() + static_cast<std::size_t>(y) * w;
       for (int x = 0; x < w + 2 * r; ++x) padded[static_cast<std::size_t>(x)] = src[std::clamp(x - r, 0, w - 1)];
-      std::size_t k = 0;
+      std::size_t k = first;
       for (const std::vector<float>* kernel : kernels) {
         float* dst = out[k++].data() + static_cast<std::size_t>(y) * w;
         std::fill(dst, dst + w, 0.0f);
-        for (int t = 0; t <= 2 * r; ++t) {
-          const float weight = (*kernel)[static_cast<std::size_t>(t)];
-          const float* p = padded.data() + t;
-          for (int x = 0; x < w; ++x) dst[x] += weight * p[x];
-        }
+        for (int t = 0; t <= 2 * r; ++t) addScaled(dst, padded.data() + t, (*kernel)[static_cast<std::size_t>(t)], w);
       }
     }
   });
-  return out;
 }
 // Columns, for one output row y: out[x] = sum_t kernel[t] in[clamp(y + t - r)][x].
 void columnAt(const Plane& in, int w, int h, int y, const std::vector<float>& kernel, float* out) {
   const int r = static_cast<int>(kernel.size() / 2);
   std::fill(out, out + w, 0.0f);
-  for (int t = 0; t <= 2 * r; ++t) {
-    const float weight = kernel[static_cast<std::size_t>(t)];
-    const float* src = in.data() + static_cast<std::size_t>(std::clamp(y + t - r, 0, h - 1)) * w;
-    for (int x = 0; x < w; ++x) out[x] += weight * src[x];
-  }
+  for (int t = 0; t <= 2 * r; ++t)
+    addScaled(out, in.data() + static_cast<std::size_t>(std::clamp(y + t - r, 0, h - 1)) * w, kernel[static_cast<std::size_t>(t)], w);
 }
 // The column pass of several filters at once: for each block of rows, `rows` scratch rows of w
 // floats and a callback per output row.
@@ -176,31 +169,46 @@ std::vector<float> scaled(std::vector<float> k, double factor) {
   return k;
 }
 
-// YCxCz planes of an image (linear RGB clamped to [0, 1]) and its luminance.
+// YCxCz planes of an image (linear RGB clamped to [0, 1]) and its luminance; with an exposure
+// scale, of the image tone-mapped by HDR-ꟻLIP's ACES curve at that exposure first.
 struct Opponent {
   Plane y, cx, cz, luminance;
 };
-Opponent toOpponent(const RgbImage& image) {
-  Opponent o;
+template <typename T>
+T acesToneMapT(T x);
+void toOpponent(const RgbImage& image, std::optional<float> exposureScale, Opponent& o) {
   const std::size_t n = image.pixelCount();
   o.y.resize(n), o.cx.resize(n), o.cz.resize(n), o.luminance.resize(n);
   const float whiteY = static_cast<float>(whitePoint().y);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& range) {
+    const ColourSpace<float> colour = kColourF;
     for (std::size_t i = range.begin(); i < range.end(); ++i) {
-      const glm::vec3 rgb = glm::clamp(glm::vec3(image.rgb[3 * i], image.rgb[3 * i + 1], image.rgb[3 * i + 2]), 0.0f, 1.0f);
-      const glm::vec3 xyz = linearRgbToXyzT(rgb);
-      const glm::vec3 v = xyzToYcxczT(xyz);
+      glm::vec3 rgb(image.rgb[3 * i], image.rgb[3 * i + 1], image.rgb[3 * i + 2]);
+      if (exposureScale) rgb = glm::vec3(acesToneMapT(*exposureScale * rgb.x), acesToneMapT(*exposureScale * rgb.y), acesToneMapT(*exposureScale * rgb.z));
+      rgb = glm::clamp(rgb, 0.0f, 1.0f);
+      const glm::vec3 xyz = colour.linearRgbToXyz(rgb);
+      const glm::vec3 v = colour.xyzToYcxcz(xyz);
       o.y[i] = v.x, o.cx[i] = v.y, o.cz[i] = v.z;
       // (Y + 16) / 116 of YCxCz: the luminance relative to white, the feature detector's input.
       o.luminance[i] = xyz.y / whiteY;
     }
   });
-  return o;
+}
+
+// A row of filtered YCxCz (Cz as its two Gaussians' parts) back to linear RGB, clamped to the
+// display's gamut, then to Hunt-adjusted L*a*b*.
+void huntLabRow(const float* y, const float* cx, const float* cz1, const float* cz2, float* l, float* a, float* b, int n) {
+  const ColourSpace<float> colour = kColourF;
+  for (int x = 0; x < n; ++x) {
+    const glm::vec3 rgb = glm::clamp(colour.xyzToLinearRgb(colour.ycxczToXyz(glm::vec3(y[x], cx[x], cz1[x] + cz2[x]))), 0.0f, 1.0f);
+    const glm::vec3 hunt = colour.huntAdjust(colour.xyzToLab(colour.linearRgbToXyz(rgb)));
+    l[x] = hunt.x, a[x] = hunt.y, b[x] = hunt.z;
+  }
 }
 
 // The spatially filtered image in Hunt-adjusted L*a*b*, per pixel ([HPG20] §4.1, Fig. 3), as
 // three planes.
-std::array<Plane, 3> filteredHuntLab(const Opponent& o, int w, int h, double ppd) {
+void filteredHuntLab(const Opponent& o, int w, int h, double ppd, std::vector<Plane>& rows, std::array<Plane, 3>& lab) {
   const int radius = spatialRadius(ppd);
   double sumY = 0, sumCx = 0, sum1 = 0, sum2 = 0;
   const auto kY = csfKernel(kAchromatic, radius, ppd, &sumY);
@@ -214,26 +222,20 @@ std::array<Plane, 3> filteredHuntLab(const Opponent& o, int w, int h, double ppd
   const double a1 = kBlueYellow1.a * std::sqrt(pi / kBlueYellow1.b), a2 = kBlueYellow2.a * std::sqrt(pi / kBlueYellow2.b);
   const double s = a1 * sum1 * sum1 + a2 * sum2 * sum2;
   const auto k1s = scaled(k1, a1 / s), k2s = scaled(k2, a2 / s);
-  const Plane ry = std::move(rowPass(o.y, w, h, {&kYn})[0]), rcx = std::move(rowPass(o.cx, w, h, {&kCxn})[0]);
-  const std::vector<Plane> rcz = rowPass(o.cz, w, h, {&k1s, &k2s});
-
-  std::array<Plane, 3> lab;
+  rowPass(o.y, w, h, {&kYn}, rows, 0);
+  rowPass(o.cx, w, h, {&kCxn}, rows, 1);
+  rowPass(o.cz, w, h, {&k1s, &k2s}, rows, 2);
+  const Plane &ry = rows[0], &rcx = rows[1], &rcz1 = rows[2], &rcz2 = rows[3];
   for (Plane& p : lab) p.resize(o.y.size());
   columnPass(w, h, 4, [&](int y, float* scratch) {
     float *fy = scratch, *fcx = scratch + w, *fcz1 = scratch + 2 * w, *fcz2 = scratch + 3 * w;
     columnAt(ry, w, h, y, kYn, fy);
     columnAt(rcx, w, h, y, kCxn, fcx);
-    columnAt(rcz[0], w, h, y, k1, fcz1);
-    columnAt(rcz[1], w, h, y, k2, fcz2);
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * w + x;
-      // Back to linear RGB, clamped to the display's gamut, then to L*a*b* and Hunt's adjustment.
-      const glm::vec3 rgb = glm::clamp(xyzToLinearRgbT(ycxczToXyzT(glm::vec3(fy[x], fcx[x], fcz1[x] + fcz2[x]))), 0.0f, 1.0f);
-      const glm::vec3 hunt = huntAdjustT(xyzToLabT(linearRgbToXyzT(rgb)));
-      lab[0][i] = hunt.x, lab[1][i] = hunt.y, lab[2][i] = hunt.z;
-    }
+    columnAt(rcz1, w, h, y, k1, fcz1);
+    columnAt(rcz2, w, h, y, k2, fcz2);
+    const std::size_t row = static_cast<std::size_t>(y) * w;
+    huntLabRow(fy, fcx, fcz1, fcz2, lab[0].data() + row, lab[1].data() + row, lab[2].data() + row, w);
   });
-  return lab;
 }
 
 // Narkowicz's fit (a x^2 + b x) / (c x^2 + d x + e) with a = 2.51, b = 0.03, c = 2.43, d = 0.59,
@@ -292,12 +294,12 @@ glm::dvec3 linearToSrgb(glm::dvec3 l) {
   auto f = [](double c) { return c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055; };
   return {f(l.x), f(l.y), f(l.z)};
 }
-glm::dvec3 linearRgbToXyz(glm::dvec3 rgb) { return linearRgbToXyzT(rgb); }
-glm::dvec3 xyzToLinearRgb(glm::dvec3 xyz) { return xyzToLinearRgbT(xyz); }
-glm::dvec3 xyzToYcxcz(glm::dvec3 xyz) { return xyzToYcxczT(xyz); }
-glm::dvec3 ycxczToXyz(glm::dvec3 v) { return ycxczToXyzT(v); }
-glm::dvec3 xyzToLab(glm::dvec3 xyz) { return xyzToLabT(xyz); }
-glm::dvec3 huntAdjust(glm::dvec3 lab) { return huntAdjustT(lab); }
+glm::dvec3 linearRgbToXyz(glm::dvec3 rgb) { return kColour.linearRgbToXyz(rgb); }
+glm::dvec3 xyzToLinearRgb(glm::dvec3 xyz) { return kColour.xyzToLinearRgb(xyz); }
+glm::dvec3 xyzToYcxcz(glm::dvec3 xyz) { return kColour.xyzToYcxcz(xyz); }
+glm::dvec3 ycxczToXyz(glm::dvec3 v) { return kColour.ycxczToXyz(v); }
+glm::dvec3 xyzToLab(glm::dvec3 xyz) { return kColour.xyzToLab(xyz); }
+glm::dvec3 huntAdjust(glm::dvec3 lab) { return ColourSpace<double>::huntAdjust(lab); }
 double hyab(glm::dvec3 a, glm::dvec3 b) {
   return std::abs(a.x - b.x) + std::hypot(a.y - b.y, a.z - b.z);
 }
@@ -311,12 +313,13 @@ double maxColorDistance() {
 }
 double remapColorError(double hyabDistance) { return remapColorErrorT(hyabDistance, maxColorDistance()); }
 
-FeatureResponse featureResponse(const std::vector<float>& luminance, int w, int h, double ppd) {
+namespace {
+
+void featureResponseInto(const std::vector<float>& luminance, int w, int h, double ppd, std::vector<Plane>& rows, FeatureResponse& r) {
   const FeatureKernels k = featureKernels(ppd);
   // The rows' Gaussian, first and second derivative in one pass; then the columns: x derivatives
   // smoothed in y, y derivatives smoothed in x, and their magnitudes, in another.
-  const std::vector<Plane> rows = rowPass(luminance, w, h, {&k.gaussian, &k.first, &k.second});
-  FeatureResponse r;
+  rowPass(luminance, w, h, {&k.gaussian, &k.first, &k.second}, rows);
   r.edge.resize(luminance.size()), r.point.resize(luminance.size());
   columnPass(w, h, 4, [&](int y, float* scratch) {
     float *dx = scratch, *dy = scratch + w, *ddx = scratch + 2 * w, *ddy = scratch + 3 * w;
@@ -331,6 +334,14 @@ FeatureResponse featureResponse(const std::vector<float>& luminance, int w, int 
       point[x] = std::sqrt(ddx[x] * ddx[x] + ddy[x] * ddy[x]);
     }
   });
+}
+
+}  // namespace
+
+FeatureResponse featureResponse(const std::vector<float>& luminance, int w, int h, double ppd) {
+  std::vector<Plane> rows;
+  FeatureResponse r;
+  featureResponseInto(luminance, w, h, ppd, rows, r);
   return r;
 }
 
@@ -341,10 +352,15 @@ struct Prepared {
   std::array<Plane, 3> lab;
   FeatureResponse features;
 };
-Prepared prepare(const RgbImage& image, double ppd) {
-  Opponent o = toOpponent(image);
-  FeatureResponse features = featureResponse(o.luminance, image.width, image.height, ppd);
-  return {filteredHuntLab(o, image.width, image.height, ppd), std::move(features)};
+// The planes of the intermediate steps, kept from one image (and exposure) to the next.
+struct Workspace {
+  Opponent opponent;
+  std::vector<Plane> rows;
+};
+void prepare(const RgbImage& image, std::optional<float> exposureScale, double ppd, Workspace& work, Prepared& out) {
+  toOpponent(image, exposureScale, work.opponent);
+  featureResponseInto(work.opponent.luminance, image.width, image.height, ppd, work.rows, out.features);
+  filteredHuntLab(work.opponent, image.width, image.height, ppd, work.rows, out.lab);
 }
 
 // [HPG20] Eqs. 5-6 per pixel, passed to combine(i, error).
@@ -370,7 +386,11 @@ void pixelErrors(const Prepared& ref, const Prepared& test, Combine&& combine) {
 
 std::vector<float> ldrFlip(const RgbImage& reference, const RgbImage& test, double ppd) {
   std::vector<float> error(reference.pixelCount());
-  pixelErrors(prepare(reference, ppd), prepare(test, ppd), [&](std::size_t i, float e) { error[i] = e; });
+  Workspace work;
+  Prepared ref, tst;
+  prepare(reference, std::nullopt, ppd, work, ref);
+  prepare(test, std::nullopt, ppd, work, tst);
+  pixelErrors(ref, tst, [&](std::size_t i, float e) { error[i] = e; });
   return error;
 }
 
@@ -413,19 +433,15 @@ HdrFlipResult hdrFlip(const RgbImage& reference, const RgbImage& test, double pp
   result.exposures = hdrExposureRange(reference);
   result.error.assign(reference.pixelCount(), 0.0f);
   const ExposureRange& r = result.exposures;
+  Workspace work;
+  Prepared ref, tst;
   for (int e = 0; e < r.count; ++e) {
     const double exposure = r.start + e * (r.stop - r.start) / (r.count - 1);
     const float scale = static_cast<float>(std::exp2(exposure));
-    auto expose = [&](const RgbImage& in) {
-      RgbImage out = in;
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, out.rgb.size()), [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t i = range.begin(); i < range.end(); ++i) out.rgb[i] = std::clamp(acesToneMapT(scale * out.rgb[i]), 0.0f, 1.0f);
-      });
-      return out;
-    };
+    prepare(reference, scale, ppd, work, ref);
+    prepare(test, scale, ppd, work, tst);
     // [EG21] Eq. 3: the per-pixel maximum over the exposures.
-    pixelErrors(prepare(expose(reference), ppd), prepare(expose(test), ppd),
-                [&](std::size_t i, float error) { result.error[i] = std::max(result.error[i], error); });
+    pixelErrors(ref, tst, [&](std::size_t i, float error) { result.error[i] = std::max(result.error[i], error); });
   }
   return result;
 }
