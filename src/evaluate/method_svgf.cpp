@@ -158,16 +158,16 @@ class SvgfMethod final : public TemporalMethod {
     RgbImage out = frameRadiance(f);
     History next;
     next.width = w, next.height = h, next.jitter = f.camera.jitter;
-    next.illumination = feedback.empty() ? illumination : feedback;
-    next.moments = moments, next.length = length;
+    next.moments = std::move(moments), next.length = std::move(length);
     next.depth = f.depth, next.id = f.id, next.hit = f.hit;
     next.normal.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
       next.normal[i] = at(f.normal, i);
-      if (f.hit[i] <= 0) continue;
+      if (f.hit[i] <= 0) return;
       const glm::dvec3 c = illumination[i] * albedo[i];
       for (int k = 0; k < 3; ++k) out.rgb[3 * i + k] = static_cast<float>(c[k]);
-    }
+    });
+    next.illumination = feedback.empty() ? std::move(illumination) : std::move(feedback);
     history_ = std::move(next);
     return MethodOutput{std::move(out), static_cast<double>(kept) / static_cast<double>(n)};
   }

@@ -58,7 +58,7 @@ void AtrousRows(const AtrousArgs* a, int y0, int y1) {
       const V zc = hn::LoadU(d, a->depth + c), lc = hn::LoadU(d, a->luminance + c);
       const V nxc = hn::LoadU(d, a->nx + c), nyc = hn::LoadU(d, a->ny + c), nzc = hn::LoadU(d, a->nz + c);
       const V gx = hn::LoadU(d, a->gradX + c), gy = hn::LoadU(d, a->gradY + c);
-      const V lumDenominator = hn::MulAdd(sigmaL, hn::Sqrt(hn::Max(zero, hn::LoadU(d, a->blurredVariance + c))), lumEpsilon);
+      const V inverseLum = hn::Div(hn::Set(d, 1.0f), hn::MulAdd(sigmaL, hn::Sqrt(hn::Max(zero, hn::LoadU(d, a->blurredVariance + c))), lumEpsilon));
       V sumR = zero, sumG = zero, sumB = zero, sumW = zero, sumV = zero;
       for (int ky = -2; ky <= 2; ++ky)
         for (int kx = -2; kx <= 2; ++kx) {
@@ -70,8 +70,8 @@ void AtrousRows(const AtrousArgs* a, int y0, int y1) {
             const V depthDenominator =
                 hn::MulAdd(sigmaZ, hn::Abs(hn::MulAdd(gx, hn::Set(d, static_cast<float>(kx * a->step)), hn::Mul(gy, hn::Set(d, static_cast<float>(ky * a->step))))),
                            depthEpsilon);
-            const V dz = hn::Div(hn::Abs(hn::Sub(zc, hn::LoadU(d, a->depth + j))), depthDenominator);
-            const V dl = hn::Div(hn::Abs(hn::Sub(lc, hn::LoadU(d, a->luminance + j))), lumDenominator);
+            const V dz = hn::Mul(hn::Abs(hn::Sub(zc, hn::LoadU(d, a->depth + j))), hn::Div(hn::Set(d, 1.0f), depthDenominator));
+            const V dl = hn::Mul(hn::Abs(hn::Sub(lc, hn::LoadU(d, a->luminance + j))), inverseLum);
             V wn = hn::MulAdd(nxc, hn::LoadU(d, a->nx + j), hn::MulAdd(nyc, hn::LoadU(d, a->ny + j), hn::Mul(nzc, hn::LoadU(d, a->nz + j))));
             wn = hn::Max(wn, zero);
             for (int k = 0; k < 7; ++k) wn = hn::Mul(wn, wn);  // ^128
@@ -127,7 +127,7 @@ void MomentsRows(const MomentsArgs* a, int y0, int y1) {
             const std::size_t j = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(c) + static_cast<std::ptrdiff_t>(dy) * a->stride + dx);
             const V depthDenominator =
                 hn::MulAdd(sigmaZ, hn::Abs(hn::MulAdd(gx, hn::Set(d, static_cast<float>(dx)), hn::Mul(gy, hn::Set(d, static_cast<float>(dy))))), depthEpsilon);
-            const V dz = hn::Div(hn::Abs(hn::Sub(zc, hn::LoadU(d, a->depth + j))), depthDenominator);
+            const V dz = hn::Mul(hn::Abs(hn::Sub(zc, hn::LoadU(d, a->depth + j))), hn::Div(hn::Set(d, 1.0f), depthDenominator));
             const V dl = hn::Mul(hn::Abs(hn::Sub(lc, hn::LoadU(d, a->luminance + j))), inverseSigmaL);
             V wn = hn::MulAdd(nxc, hn::LoadU(d, a->nx + j), hn::MulAdd(nyc, hn::LoadU(d, a->ny + j), hn::Mul(nzc, hn::LoadU(d, a->nz + j))));
             wn = hn::Max(wn, zero);
@@ -176,18 +176,24 @@ void atrousIteration(const AtrousPlanes& p, int step, const AtrousWeights& weigh
   if (out.width != p.width || out.height != p.height) out.resize(p.width, p.height);
   const int w = p.width, h = p.height;
   // The illumination's luminance (Rec. 709) and the variance's 3x3 Gaussian (1, 2, 1)^2 / 16 at
-  // clamped coordinates, once per iteration rather than once per tap.
-  std::vector<float> luminance(p.r.size(), 0.0f), blurred(p.r.size(), 0.0f);
+  // clamped coordinates, once per iteration rather than once per tap; the Gaussian separably, rows
+  // then columns, each a loop the compiler vectorises (with a clamped index per tap it took most of
+  // the iteration's time).
+  std::vector<float> luminance(p.r.size(), 0.0f), rows(p.r.size(), 0.0f), blurred(p.r.size(), 0.0f);
   tbb::parallel_for(0, h, [&](int y) {
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = p.at(x, y);
-      luminance[i] = 0.2126f * p.r[i] + 0.7152f * p.g[i] + 0.0722f * p.b[i];
-      float sum = 0.0f;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-          sum += (dx ? 0.5f : 1.0f) * (dy ? 0.5f : 1.0f) * p.variance[p.at(std::clamp(x + dx, 0, w - 1), std::clamp(y + dy, 0, h - 1))];
-      blurred[i] = sum / 4.0f;
-    }
+    const std::size_t row = p.at(0, y);
+    const float *r = p.r.data() + row, *g = p.g.data() + row, *b = p.b.data() + row, *v = p.variance.data() + row;
+    float *l = luminance.data() + row, *out = rows.data() + row;
+    for (int x = 0; x < w; ++x) l[x] = 0.2126f * r[x] + 0.7152f * g[x] + 0.0722f * b[x];
+    for (int x = 1; x < w - 1; ++x) out[x] = 0.25f * v[x - 1] + 0.5f * v[x] + 0.25f * v[x + 1];
+    out[0] = 0.75f * v[0] + 0.25f * v[std::min(1, w - 1)];
+    if (w > 1) out[w - 1] = 0.25f * v[w - 2] + 0.75f * v[w - 1];
+  });
+  tbb::parallel_for(0, h, [&](int y) {
+    const float *above = rows.data() + p.at(0, std::max(y - 1, 0)), *centre = rows.data() + p.at(0, y);
+    const float* below = rows.data() + p.at(0, std::min(y + 1, h - 1));
+    float* out = blurred.data() + p.at(0, y);
+    for (int x = 0; x < w; ++x) out[x] = 0.25f * above[x] + 0.5f * centre[x] + 0.25f * below[x];
   });
   const AtrousArgs args{p.depth.data(), p.nx.data(),       p.ny.data(),       p.nz.data(),       p.hit.data(),       p.gradX.data(),
                         p.gradY.data(), p.r.data(),        p.g.data(),        p.b.data(),        p.variance.data(),  luminance.data(),
