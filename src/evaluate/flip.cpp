@@ -15,6 +15,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "evaluate/vector_loops.h"
+
 namespace dynbench::evaluate::flip {
 namespace {
 
@@ -86,20 +88,9 @@ const ColourSpace<float> kColourF{glm::mat3(kRgbToXyz), glm::mat3(kXyzToRgb), gl
 using Plane = std::vector<float>;
 
 // The separable filters, in two passes. Each output row is accumulated one kernel tap at a time
-// over a contiguous row, so that the compiler vectorises the loop over x: the previous form, a
-// clamped gather of every tap for every output pixel, did not vectorise and was most of ꟻLIP's
-// time. Edges are clamped, as the authors' tool does. All kernels of a pass have one length.
-//
-// dst[x] += weight x src[x], x in [0, n): the filters' inner loop. The build targets baseline
-// x86-64 (SSE2, no FMA); GCC's function multiversioning also compiles it for x86-64-v3 (AVX2, FMA)
-// and v4 (AVX-512) and picks one when the program loads.
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
-[[gnu::target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")]]
-#endif
-void addScaled(float* dst, const float* src, float weight, int n) {
-  for (int x = 0; x < n; ++x) dst[x] += weight * src[x];
-}
-
+// over a contiguous row (addScaled, vector_loops.h): the previous form, a clamped gather of every
+// tap for every output pixel, did not vectorise and was most of ꟻLIP's time. Edges are clamped,
+// as the authors' tool does. All kernels of a pass have one length.
 // Rows: every row of `in` correlated with each kernel, into out[first + k] for kernel k (planes
 // reused from call to call: fresh ones cost a page fault every 4 KiB).
 void rowPass(const Plane& in, int w, int h, std::initializer_list<const std::vector<float>*> kernels, std::vector<Plane>& out,

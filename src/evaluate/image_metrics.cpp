@@ -7,6 +7,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "evaluate/vector_loops.h"
+
 #include "evaluate/magma.h"  // generated from Debian's matplotlib (tools/colormap/magma_header.py)
 
 namespace dynbench::evaluate {
@@ -63,24 +65,20 @@ std::optional<double> ssim(const RgbImage& reference, const RgbImage& test) {
   std::vector<double> rowSums(static_cast<std::size_t>(vh));
   for (int channel = 0; channel < 3; ++channel) {
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
-      std::vector<double> a(static_cast<std::size_t>(w)), b(static_cast<std::size_t>(w));
+      // The row's x, y, x^2, y^2 and xy, then each tap of the kernel over them (addScaled).
+      std::vector<double> products(5 * static_cast<std::size_t>(w));
       for (int y = rows.begin(); y < rows.end(); ++y) {
+        double* p[5];
+        for (int j = 0; j < 5; ++j) p[j] = products.data() + static_cast<std::size_t>(j) * w;
         for (int x = 0; x < w; ++x) {
-          const std::size_t p = 3 * (static_cast<std::size_t>(y) * w + x) + channel;
-          a[static_cast<std::size_t>(x)] = reference.rgb[p], b[static_cast<std::size_t>(x)] = test.rgb[p];
+          const std::size_t i = 3 * (static_cast<std::size_t>(y) * w + x) + channel;
+          const double a = reference.rgb[i], b = test.rgb[i];
+          p[0][x] = a, p[1][x] = b, p[2][x] = a * a, p[3][x] = b * b, p[4][x] = a * b;
         }
-        double* m[5];
         for (int j = 0; j < 5; ++j) {
-          m[j] = moments.data() + j * plane + static_cast<std::size_t>(y) * vw;
-          std::fill(m[j], m[j] + vw, 0.0);
-        }
-        for (int k = 0; k < kSize; ++k) {
-          const double wk = kernel[k];
-          const double *pa = a.data() + k, *pb = b.data() + k;
-          for (int x = 0; x < vw; ++x) {
-            m[0][x] += wk * pa[x], m[1][x] += wk * pb[x], m[2][x] += wk * pa[x] * pa[x], m[3][x] += wk * pb[x] * pb[x];
-            m[4][x] += wk * pa[x] * pb[x];
-          }
+          double* m = moments.data() + j * plane + static_cast<std::size_t>(y) * vw;
+          std::fill(m, m + vw, 0.0);
+          for (int k = 0; k < kSize; ++k) addScaled(m, p[j] + k, kernel[k], vw);
         }
       }
     });
@@ -89,11 +87,8 @@ std::optional<double> ssim(const RgbImage& reference, const RgbImage& test) {
       for (int y = rows.begin(); y < rows.end(); ++y) {
         std::fill(sums.begin(), sums.end(), 0.0);
         for (int k = 0; k < kSize; ++k)
-          for (int j = 0; j < 5; ++j) {
-            const double* src = moments.data() + j * plane + static_cast<std::size_t>(y + k) * vw;
-            double* dst = sums.data() + static_cast<std::size_t>(j) * vw;
-            for (int x = 0; x < vw; ++x) dst[x] += kernel[k] * src[x];
-          }
+          for (int j = 0; j < 5; ++j)
+            addScaled(sums.data() + static_cast<std::size_t>(j) * vw, moments.data() + j * plane + static_cast<std::size_t>(y + k) * vw, kernel[k], vw);
         double rowSum = 0.0;
         for (int x = 0; x < vw; ++x) {
           const double muA = sums[x], muB = sums[vw + x], varA = sums[2 * vw + x] - muA * muA, varB = sums[3 * vw + x] - muB * muB;
