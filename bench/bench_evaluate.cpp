@@ -6,7 +6,9 @@
 // The images are synthetic: a textured, lit pattern with HDR highlights and per-pixel noise, as a
 // low-sample render is; the frames are a static camera over a plane (motion 0), so every method
 // keeps its history and runs its full path.
+#include <cctype>
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -22,6 +24,7 @@
 #include "evaluate/compare.h"
 #include "evaluate/image_metrics.h"
 #include "evaluate/method.h"
+#include "frames/frame_io.h"
 
 using namespace dynbench;
 using namespace dynbench::evaluate;
@@ -78,16 +81,33 @@ frames::FeatureFrame syntheticFrame(int w, int h, long index, double noise) {
 
 int main(int argc, char** argv) {
   int w = 1920, h = 1080;
-  std::string flipTool;
+  std::string flipTool, windowDir;
+  int windowFrames = 48;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--res" && i + 1 < argc) {
       if (std::sscanf(argv[++i], "%dx%d", &w, &h) != 2) return std::fprintf(stderr, "bench_evaluate: --res WxH\n"), 2;
     } else if (a == "--flip-tool" && i + 1 < argc) {
       flipTool = argv[++i];
+    } else if (a == "--write-window" && i + 1 < argc) {
+      windowDir = argv[++i];
+      if (i + 1 < argc && std::isdigit(static_cast<unsigned char>(argv[i + 1][0]))) windowFrames = std::atoi(argv[++i]);
     } else {
-      return std::fprintf(stderr, "usage: bench_evaluate [--res WxH] [--flip-tool PATH]\n"), 2;
+      return std::fprintf(stderr, "usage: bench_evaluate [--res WxH] [--flip-tool PATH] [--write-window DIR [FRAMES]]\n"), 2;
     }
+  }
+  if (!windowDir.empty()) {
+    // A window for timing `dynbench evaluate` by hand (old and new builds on the same files):
+    // DIR/reference (noise-free) and DIR/input (noisy) synthetic frames 0..FRAMES-1.
+    for (int k = 0; k < windowFrames; ++k)
+      for (const auto& [folder, noise] : {std::pair{"reference", 0.0}, std::pair{"input", 0.5}}) {
+        frames::FeatureFrame f = syntheticFrame(w, h, 100 + k, noise);
+        f.frame = k, f.time = k / 24.0;
+        if (auto ok = frames::writeFrame(fs::path(windowDir) / folder, f, {{"engine", "bench_evaluate synthetic"}, {"noise", noise}}); !ok)
+          return std::fprintf(stderr, "bench_evaluate: %s\n", ok.error().message.c_str()), 1;
+      }
+    std::printf("wrote %d frames of %dx%d to %s/reference and %s/input\n", windowFrames, w, h, windowDir.c_str(), windowDir.c_str());
+    return 0;
   }
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   std::printf("bench_evaluate: %dx%d, %u cores; median of 3 runs, ms per frame (core-ms = ms x cores)\n\n", w, h, cores);

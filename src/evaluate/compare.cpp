@@ -82,37 +82,53 @@ Expected<LoadedImage> loadImage(const fs::path& path) {
   return out;
 }
 
-ScoredImage scoreImage(const RgbImage& reference, const RgbImage& test, bool hdr, double ppd) {
+namespace {
+
+// An LDR image (linear, decoded from sRGB) back to the values its file encodes.
+RgbImage encodeSrgb(RgbImage image) {
+  for (std::size_t p = 0; p < image.pixelCount(); ++p) {
+    const glm::dvec3 c = flip::linearToSrgb(glm::dvec3(image.rgb[3 * p], image.rgb[3 * p + 1], image.rgb[3 * p + 2]));
+    for (int k = 0; k < 3; ++k) image.rgb[3 * p + k] = static_cast<float>(c[k]);
+  }
+  return image;
+}
+
+}  // namespace
+
+PreparedReference::PreparedReference(const RgbImage& reference, bool hdr_, double ppd) : linear(reference), hdr(hdr_), pixelsPerDegree(ppd) {
+  // PSNR and SSIM on display values: HDR through the reference's display exposure and ACES, LDR as
+  // the file encodes it (sRGB).
+  if (hdr) {
+    displayScale = evaluate::displayScale(reference);
+    display = toDisplay(reference, displayScale);
+    flip.emplace(reference, ppd);
+  } else {
+    display = encodeSrgb(reference);
+  }
+}
+
+ScoredImage scoreImage(const PreparedReference& reference, const RgbImage& test) {
   ScoredImage out;
   ImageScores& s = out.scores;
-  s.hdr = hdr;
-  if (hdr) {
-    flip::HdrFlipResult r = flip::hdrFlip(reference, test, ppd);
+  s.hdr = reference.hdr;
+  if (reference.hdr) {
+    flip::HdrFlipResult r = reference.flip->compare(test);
     out.flipError = std::move(r.error);
     s.exposures = r.exposures;
   } else {
-    out.flipError = flip::ldrFlip(reference, test, ppd);
+    out.flipError = flip::ldrFlip(reference.linear, test, reference.pixelsPerDegree);
   }
   s.flip = flip::pool(out.flipError);
-  // PSNR and SSIM on display values: HDR through the reference's display exposure and ACES, LDR as
-  // the file encodes it (sRGB).
-  RgbImage refDisplay, testDisplay;
-  if (hdr) {
-    const double scale = displayScale(reference);
-    refDisplay = toDisplay(reference, scale), testDisplay = toDisplay(test, scale);
-  } else {
-    refDisplay = reference, testDisplay = test;
-    for (RgbImage* image : {&refDisplay, &testDisplay})
-      for (std::size_t p = 0; p < image->pixelCount(); ++p) {
-        const glm::dvec3 c = flip::linearToSrgb(glm::dvec3(image->rgb[3 * p], image->rgb[3 * p + 1], image->rgb[3 * p + 2]));
-        for (int k = 0; k < 3; ++k) image->rgb[3 * p + k] = static_cast<float>(c[k]);
-      }
-  }
-  s.psnr = psnr(refDisplay, testDisplay);
-  s.ssim = ssim(refDisplay, testDisplay);
-  s.relMse = relMse(reference, test);
-  s.smape = smape(reference, test);
+  const RgbImage testDisplay = reference.hdr ? toDisplay(test, reference.displayScale) : encodeSrgb(test);
+  s.psnr = psnr(reference.display, testDisplay);
+  s.ssim = ssim(reference.display, testDisplay);
+  s.relMse = relMse(reference.linear, test);
+  s.smape = smape(reference.linear, test);
   return out;
+}
+
+ScoredImage scoreImage(const RgbImage& reference, const RgbImage& test, bool hdr, double ppd) {
+  return scoreImage(PreparedReference(reference, hdr, ppd), test);
 }
 
 std::string scoresJson(const ImageScores& s, int indent) {

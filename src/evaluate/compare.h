@@ -36,6 +36,16 @@ struct ScoredImage {
 };
 // Scores `test` against `reference` (same size, same range; the caller checks).
 ScoredImage scoreImage(const RgbImage& reference, const RgbImage& test, bool hdr, double pixelsPerDegree);
+// A reference prepared once for scoring many test images against it: its HDR-ꟻLIP half and its
+// display image. scoreImage(prepared, test) equals scoreImage(reference, test, hdr, ppd).
+struct PreparedReference {
+  PreparedReference(const RgbImage& reference, bool hdr, double pixelsPerDegree);
+  RgbImage linear, display;
+  bool hdr;
+  double pixelsPerDegree, displayScale = 1.0;
+  std::optional<flip::HdrFlipReference> flip;
+};
+ScoredImage scoreImage(const PreparedReference& reference, const RgbImage& test);
 
 struct CompareOptions {
   std::filesystem::path reference;

@@ -53,12 +53,12 @@ struct ReferencePair {
   std::vector<std::optional<discard::BilinearTaps>> warp;
   long warped = 0;  // pixels with a warp
 };
-ReferencePair referencePair(const RgbImage& ref, const RgbImage& refPrev, const frames::FeatureFrame& refFrame,
+ReferencePair referencePair(const PreparedReference& ref, const RgbImage& refPrev, const frames::FeatureFrame& refFrame,
                             const frames::FeatureFrame& refPrevFrame, const discard::Thresholds& absolute) {
   ReferencePair pair;
-  pair.current = &ref, pair.previous = &refPrev;
-  pair.scale = displayScale(ref);
-  pair.display = toDisplay(ref, pair.scale), pair.previousDisplay = toDisplay(refPrev, pair.scale);
+  pair.current = &ref.linear, pair.previous = &refPrev;
+  pair.scale = ref.displayScale;
+  pair.display = ref.display, pair.previousDisplay = toDisplay(refPrev, pair.scale);
   pair.warp.resize(refFrame.pixelCount());
   const HistoryLookup lookup(refFrame, refPrevFrame, absolute, /*useMotion=*/true);
   tbb::parallel_for(0, refFrame.height, [&](int y) {
@@ -178,13 +178,16 @@ Expected<EvaluateRun> runEvaluate(const EvaluateOptions& options, const Evaluate
     const bool cut = f == 0 || input->cut || reference->cut || entry.frame != previousFrame + 1;
     const RgbImage referenceImage = frameRadiance(*reference);
     const discard::Thresholds absolute = discard::absoluteThresholds(options.thresholds, *reference, context.sceneSize);
+    // The reference's share of the scores (its HDR-ꟻLIP exposures, its display image), once for
+    // every method.
+    const PreparedReference preparedReference(referenceImage, /*hdr=*/true, options.pixelsPerDegree);
     std::optional<ReferencePair> pair;
-    if (!cut && previousReference) pair = referencePair(referenceImage, *previousReferenceImage, *reference, *previousReference, absolute);
+    if (!cut && previousReference) pair = referencePair(preparedReference, *previousReferenceImage, *reference, *previousReference, absolute);
     for (std::size_t m = 0; m < methods.size(); ++m) {
       if (cut) methods[m]->reset(), previousOutput[m].reset();
       auto output = methods[m]->process(*input);
       if (!output) return std::unexpected(output.error());
-      const ScoredImage scored = scoreImage(referenceImage, output->image, /*hdr=*/true, options.pixelsPerDegree);
+      const ScoredImage scored = scoreImage(preparedReference, output->image);
       FrameScores s;
       s.frame = entry.frame, s.cut = cut;
       s.flip = scored.scores.flip.mean, s.psnr = scored.scores.psnr, s.ssim = scored.scores.ssim, s.relMse = scored.scores.relMse;

@@ -419,23 +419,44 @@ ExposureRange hdrExposureRange(const RgbImage& reference) {
   return range;
 }
 
-HdrFlipResult hdrFlip(const RgbImage& reference, const RgbImage& test, double ppd) {
-  HdrFlipResult result;
-  result.exposures = hdrExposureRange(reference);
-  result.error.assign(reference.pixelCount(), 0.0f);
-  const ExposureRange& r = result.exposures;
+struct HdrFlipReference::State {
+  ExposureRange exposures;
+  std::vector<double> scales;      // 2^exposure, one per exposure
+  std::vector<Prepared> prepared;  // the reference at each exposure
+  double ppd = 0.0;
+  int width = 0, height = 0;
+};
+
+HdrFlipReference::HdrFlipReference(const RgbImage& reference, double ppd) {
+  auto state = std::make_shared<State>();
+  state->exposures = hdrExposureRange(reference);
+  state->ppd = ppd, state->width = reference.width, state->height = reference.height;
+  const ExposureRange& r = state->exposures;
   Workspace work;
-  Prepared ref, tst;
+  state->prepared.resize(static_cast<std::size_t>(r.count));
   for (int e = 0; e < r.count; ++e) {
     const double exposure = r.start + e * (r.stop - r.start) / (r.count - 1);
-    const float scale = static_cast<float>(std::exp2(exposure));
-    prepare(reference, scale, ppd, work, ref);
-    prepare(test, scale, ppd, work, tst);
+    state->scales.push_back(std::exp2(exposure));
+    prepare(reference, static_cast<float>(state->scales.back()), ppd, work, state->prepared[static_cast<std::size_t>(e)]);
+  }
+  state_ = std::move(state);
+}
+
+HdrFlipResult HdrFlipReference::compare(const RgbImage& test) const {
+  HdrFlipResult result;
+  result.exposures = state_->exposures;
+  result.error.assign(test.pixelCount(), 0.0f);
+  Workspace work;
+  Prepared tst;
+  for (std::size_t e = 0; e < state_->prepared.size(); ++e) {
+    prepare(test, static_cast<float>(state_->scales[e]), state_->ppd, work, tst);
     // [EG21] Eq. 3: the per-pixel maximum over the exposures.
-    pixelErrors(ref, tst, [&](std::size_t i, float error) { result.error[i] = std::max(result.error[i], error); });
+    pixelErrors(state_->prepared[e], tst, [&](std::size_t i, float error) { result.error[i] = std::max(result.error[i], error); });
   }
   return result;
 }
+
+HdrFlipResult hdrFlip(const RgbImage& reference, const RgbImage& test, double ppd) { return HdrFlipReference(reference, ppd).compare(test); }
 
 Pooled pool(const std::vector<float>& error) {
   Pooled p;

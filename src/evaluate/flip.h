@@ -8,6 +8,7 @@
 // No packaged implementation exists in Debian or npm, so it is written here from those papers;
 // docs/metrics.md says how it was checked against the authors' own tool. Each step is a function
 // of its own so that the tests can check it with answers worked by hand.
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -87,6 +88,18 @@ struct HdrFlipResult {
   ExposureRange exposures;
 };
 HdrFlipResult hdrFlip(const RgbImage& reference, const RgbImage& test, double pixelsPerDegree);
+// The reference's half of HDR-ꟻLIP, its exposure range and its filtered colours and features at
+// every exposure, computed once for many test images (evaluate scores each method's output of a
+// frame against one reference). compare(test) equals hdrFlip(reference, test, ppd).
+class HdrFlipReference {
+ public:
+  HdrFlipReference(const RgbImage& reference, double pixelsPerDegree);
+  HdrFlipResult compare(const RgbImage& test) const;
+
+ private:
+  struct State;
+  std::shared_ptr<const State> state_;
+};
 
 // ---- pooling ([RTG2] §19.4) ------------------------------------------------------------------
 // The mean (the authors' recommended single number), and the median and quartiles of the error
