@@ -35,19 +35,45 @@ namespace hn = hwy::HWY_NAMESPACE;
 using D = hn::ScalableTag<float>;
 using V = hn::Vec<D>;
 
+// The planes both kernels weigh taps by (AtrousArgs' and MomentsArgs' first members).
+struct Geometry {
+  const float *depth, *nx, *ny, *nz, *hit, *gradX, *gradY, *luminance;
+};
+// A vector of centre pixels' geometry.
+struct Centre {
+  V z, luminance, nx, ny, nz, gx, gy;
+};
+HWY_INLINE Centre LoadCentre(D d, const Geometry& g, std::size_t c) {
+  return {hn::LoadU(d, g.depth + c), hn::LoadU(d, g.luminance + c), hn::LoadU(d, g.nx + c), hn::LoadU(d, g.ny + c),
+          hn::LoadU(d, g.nz + c),    hn::LoadU(d, g.gradX + c),     hn::LoadU(d, g.gradY + c)};
+}
+// The edge-stopping weight of the tap at index j, (ox, oy) pixels from the centre ([S17] Eqs. 3-5):
+// exp(-|dz| / (sigma_z |grad z . o| + 1e-8) - |dl| x inverseLuminanceScale) x max(0, n . n')^128,
+// one exponential for the depth and luminance terms as Falcor computes them; 0 where the tap hit
+// nothing. exp(-x) above x = 80 (below 2e-35) is taken as 0: single precision's exponential ends
+// at 88.
+HWY_INLINE V EdgeStoppingWeight(D d, const Geometry& g, const Centre& c, std::size_t j, float ox, float oy, V sigmaZ, V inverseLuminanceScale) {
+  const V zero = hn::Zero(d);
+  const V depthDenominator = hn::MulAdd(sigmaZ, hn::Abs(hn::MulAdd(c.gx, hn::Set(d, ox), hn::Mul(c.gy, hn::Set(d, oy)))), hn::Set(d, 1e-8f));
+  const V dz = hn::Div(hn::Abs(hn::Sub(c.z, hn::LoadU(d, g.depth + j))), depthDenominator);
+  const V dl = hn::Mul(hn::Abs(hn::Sub(c.luminance, hn::LoadU(d, g.luminance + j))), inverseLuminanceScale);
+  V wn = hn::MulAdd(c.nx, hn::LoadU(d, g.nx + j), hn::MulAdd(c.ny, hn::LoadU(d, g.ny + j), hn::Mul(c.nz, hn::LoadU(d, g.nz + j))));
+  wn = hn::Max(wn, zero);
+  for (int k = 0; k < 7; ++k) wn = hn::Mul(wn, wn);  // ^128
+  const V e = hn::Exp(d, hn::Neg(hn::Min(hn::Add(dz, dl), hn::Set(d, 80.0f))));
+  return hn::IfThenElseZero(hn::Gt(hn::LoadU(d, g.hit + j), zero), hn::Mul(e, wn));
+}
+
 // Rows [y0, y1): for each pixel the 5x5 taps `step` apart, weighted by the B3 spline times the
-// edge-stopping weights of [S17] Eqs. 3-5: exp(-|dz| / (sigma_z |grad z . offset| + 1e-8)
-// - |dl| / (sigma_l sqrt(g(Var)) + 1e-10)) x max(0, n . n')^128 (one exponential for the depth
-// and luminance weights, as Falcor's SVGFAtrous computes them), the centre tap by the spline
-// alone; the variance by the squared weights ([S17] Eq. 2).
+// edge-stopping weight, the luminance's scale sigma_l sqrt(g(Var)) + 1e-10; the centre tap by the
+// spline alone; the variance by the squared weights ([S17] Eq. 2).
 void AtrousRows(const AtrousArgs* a, int y0, int y1) {
   const D d;
   const std::size_t lanes = hn::Lanes(d);
   static constexpr float kSpline[3] = {3.0f / 8.0f, 1.0f / 4.0f, 1.0f / 16.0f};  // [S17] §4.3: B3 spline
-  const V zero = hn::Zero(d), depthEpsilon = hn::Set(d, 1e-8f), lumEpsilon = hn::Set(d, 1e-10f);
+  const V zero = hn::Zero(d), lumEpsilon = hn::Set(d, 1e-10f);
   const V sigmaZ = hn::Set(d, a->sigmaZ), sigmaL = hn::Set(d, a->sigmaL);
-  // exp(-x) for x above 80 is below 2e-35: counted as 0 (the float exponential's range ends at 88).
-  const V expLimit = hn::Set(d, 80.0f);
+  const Geometry g{a->depth, a->nx, a->ny, a->nz, a->hit, a->gradX, a->gradY, a->luminance};
   const int pad = AtrousPlanes::kPad;
   for (int y = y0; y < y1; ++y) {
     // Lanes beyond the row's last pixel read and write the padding (at least kPad wide, more than
@@ -55,9 +81,7 @@ void AtrousRows(const AtrousArgs* a, int y0, int y1) {
     for (int x = 0; x < a->width; x += static_cast<int>(lanes)) {
       const std::size_t c = static_cast<std::size_t>(y + pad) * static_cast<std::size_t>(a->stride) + static_cast<std::size_t>(x + pad);
       const V hitC = hn::LoadU(d, a->hit + c);
-      const V zc = hn::LoadU(d, a->depth + c), lc = hn::LoadU(d, a->luminance + c);
-      const V nxc = hn::LoadU(d, a->nx + c), nyc = hn::LoadU(d, a->ny + c), nzc = hn::LoadU(d, a->nz + c);
-      const V gx = hn::LoadU(d, a->gradX + c), gy = hn::LoadU(d, a->gradY + c);
+      const Centre centre = LoadCentre(d, g, c);
       const V inverseLum = hn::Div(hn::Set(d, 1.0f), hn::MulAdd(sigmaL, hn::Sqrt(hn::Max(zero, hn::LoadU(d, a->blurredVariance + c))), lumEpsilon));
       V sumR = zero, sumG = zero, sumB = zero, sumW = zero, sumV = zero;
       for (int ky = -2; ky <= 2; ++ky)
@@ -65,19 +89,9 @@ void AtrousRows(const AtrousArgs* a, int y0, int y1) {
           const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(ky * a->step) * a->stride + kx * a->step;
           const std::size_t j = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(c) + offset);
           const V spline = hn::Set(d, kSpline[kx < 0 ? -kx : kx] * kSpline[ky < 0 ? -ky : ky]);
-          V w = spline;
-          if (kx != 0 || ky != 0) {
-            const V depthDenominator =
-                hn::MulAdd(sigmaZ, hn::Abs(hn::MulAdd(gx, hn::Set(d, static_cast<float>(kx * a->step)), hn::Mul(gy, hn::Set(d, static_cast<float>(ky * a->step))))),
-                           depthEpsilon);
-            const V dz = hn::Mul(hn::Abs(hn::Sub(zc, hn::LoadU(d, a->depth + j))), hn::Div(hn::Set(d, 1.0f), depthDenominator));
-            const V dl = hn::Mul(hn::Abs(hn::Sub(lc, hn::LoadU(d, a->luminance + j))), inverseLum);
-            V wn = hn::MulAdd(nxc, hn::LoadU(d, a->nx + j), hn::MulAdd(nyc, hn::LoadU(d, a->ny + j), hn::Mul(nzc, hn::LoadU(d, a->nz + j))));
-            wn = hn::Max(wn, zero);
-            for (int k = 0; k < 7; ++k) wn = hn::Mul(wn, wn);  // ^128
-            const V e = hn::Exp(d, hn::Neg(hn::Min(hn::Add(dz, dl), expLimit)));
-            w = hn::IfThenElseZero(hn::Gt(hn::LoadU(d, a->hit + j), zero), hn::Mul(hn::Mul(spline, e), wn));
-          }
+          const V w = kx == 0 && ky == 0 ? spline
+                                         : hn::Mul(spline, EdgeStoppingWeight(d, g, centre, j, static_cast<float>(kx * a->step),
+                                                                              static_cast<float>(ky * a->step), sigmaZ, inverseLum));
           sumR = hn::MulAdd(w, hn::LoadU(d, a->r + j), sumR);
           sumG = hn::MulAdd(w, hn::LoadU(d, a->g + j), sumG);
           sumB = hn::MulAdd(w, hn::LoadU(d, a->b + j), sumB);
@@ -102,8 +116,9 @@ void MomentsRows(const MomentsArgs* a, int y0, int y1) {
   const D d;
   const std::size_t lanes = hn::Lanes(d);
   constexpr int kRadius = 3;  // [S17] §4.2: 7x7
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), four = hn::Set(d, 4.0f), depthEpsilon = hn::Set(d, 1e-8f);
-  const V sigmaZ = hn::Set(d, a->sigmaZ), inverseSigmaL = hn::Set(d, 1.0f / a->sigmaL), expLimit = hn::Set(d, 80.0f);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), four = hn::Set(d, 4.0f);
+  const V sigmaZ = hn::Set(d, a->sigmaZ), inverseSigmaL = hn::Set(d, 1.0f / a->sigmaL);
+  const Geometry g{a->depth, a->nx, a->ny, a->nz, a->hit, a->gradX, a->gradY, a->luminance};
   const int pad = AtrousPlanes::kPad;
   for (int y = y0; y < y1; ++y)
     for (int x = 0; x < a->width; x += static_cast<int>(lanes)) {
@@ -114,9 +129,7 @@ void MomentsRows(const MomentsArgs* a, int y0, int y1) {
       V variance = hn::Max(zero, vc);
       const auto spatial = hn::And(surface, hn::Lt(length, four));
       if (!hn::AllFalse(d, spatial)) {
-        const V zc = hn::LoadU(d, a->depth + c), lc = hn::LoadU(d, a->luminance + c);
-        const V nxc = hn::LoadU(d, a->nx + c), nyc = hn::LoadU(d, a->ny + c), nzc = hn::LoadU(d, a->nz + c);
-        const V gx = hn::LoadU(d, a->gradX + c), gy = hn::LoadU(d, a->gradY + c);
+        const Centre centre = LoadCentre(d, g, c);
         // The weighted m2 - m1^2 of the neighbourhood as E[v] + Var(m1), v = m2 - m1^2 per pixel
         // (computed in double), Var(m1) of m1 - m1(centre): the same number without single
         // precision's cancellation of two large second moments.
@@ -125,15 +138,7 @@ void MomentsRows(const MomentsArgs* a, int y0, int y1) {
           for (int dx = -kRadius; dx <= kRadius; ++dx) {
             if (dx == 0 && dy == 0) continue;
             const std::size_t j = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(c) + static_cast<std::ptrdiff_t>(dy) * a->stride + dx);
-            const V depthDenominator =
-                hn::MulAdd(sigmaZ, hn::Abs(hn::MulAdd(gx, hn::Set(d, static_cast<float>(dx)), hn::Mul(gy, hn::Set(d, static_cast<float>(dy))))), depthEpsilon);
-            const V dz = hn::Mul(hn::Abs(hn::Sub(zc, hn::LoadU(d, a->depth + j))), hn::Div(hn::Set(d, 1.0f), depthDenominator));
-            const V dl = hn::Mul(hn::Abs(hn::Sub(lc, hn::LoadU(d, a->luminance + j))), inverseSigmaL);
-            V wn = hn::MulAdd(nxc, hn::LoadU(d, a->nx + j), hn::MulAdd(nyc, hn::LoadU(d, a->ny + j), hn::Mul(nzc, hn::LoadU(d, a->nz + j))));
-            wn = hn::Max(wn, zero);
-            for (int k = 0; k < 7; ++k) wn = hn::Mul(wn, wn);  // ^128
-            const V w = hn::IfThenElseZero(hn::Gt(hn::LoadU(d, a->hit + j), zero),
-                                           hn::Mul(hn::Exp(d, hn::Neg(hn::Min(hn::Add(dz, dl), expLimit))), wn));
+            const V w = EdgeStoppingWeight(d, g, centre, j, static_cast<float>(dx), static_cast<float>(dy), sigmaZ, inverseSigmaL);
             const V deviation = hn::Sub(hn::LoadU(d, a->moment1 + j), m1c);
             sumV = hn::MulAdd(w, hn::LoadU(d, a->temporalVariance + j), sumV);
             sumD = hn::MulAdd(w, deviation, sumD);
