@@ -14,6 +14,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include "evaluate/vector_loops.h"
 
@@ -462,7 +463,7 @@ Pooled pool(const std::vector<float>& error) {
   Pooled p;
   if (error.empty()) return p;
   std::vector<float> sorted = error;
-  std::sort(sorted.begin(), sorted.end());
+  tbb::parallel_sort(sorted.begin(), sorted.end());  // the same order as std::sort: floats, no ties that differ
   double total = 0.0;
   for (float e : sorted) total += e;
   p.mean = total / static_cast<double>(sorted.size());

@@ -26,12 +26,15 @@ double displayScale(const RgbImage& reference) {
 
 RgbImage toDisplay(const RgbImage& linear, double scale) {
   RgbImage out = linear;
-  for (std::size_t i = 0; i < out.pixelCount(); ++i) {
-    glm::dvec3 c(linear.rgb[3 * i], linear.rgb[3 * i + 1], linear.rgb[3 * i + 2]);
-    c = glm::dvec3(flip::acesToneMap(scale * c.x), flip::acesToneMap(scale * c.y), flip::acesToneMap(scale * c.z));
-    c = flip::linearToSrgb(glm::clamp(c, 0.0, 1.0));
-    for (int k = 0; k < 3; ++k) out.rgb[3 * i + k] = static_cast<float>(c[k]);
-  }
+  // Pixels in parallel (the sRGB curve's pow per channel made this a tenth of evaluate's time).
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, out.pixelCount()), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i < range.end(); ++i) {
+      glm::dvec3 c(linear.rgb[3 * i], linear.rgb[3 * i + 1], linear.rgb[3 * i + 2]);
+      c = glm::dvec3(flip::acesToneMap(scale * c.x), flip::acesToneMap(scale * c.y), flip::acesToneMap(scale * c.z));
+      c = flip::linearToSrgb(glm::clamp(c, 0.0, 1.0));
+      for (int k = 0; k < 3; ++k) out.rgb[3 * i + k] = static_cast<float>(c[k]);
+    }
+  });
   return out;
 }
 
