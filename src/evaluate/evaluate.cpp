@@ -50,7 +50,8 @@ struct ReferencePair {
   const RgbImage* current = nullptr;
   const RgbImage* previous = nullptr;
   double scale = 1.0;
-  RgbImage display, previousDisplay;
+  const RgbImage* display = nullptr;  // the current reference's (PreparedReference's)
+  RgbImage previousDisplay;
   std::vector<std::optional<discard::BilinearTaps>> warp;
   long warped = 0;  // pixels with a warp
 };
@@ -59,7 +60,7 @@ ReferencePair referencePair(const PreparedReference& ref, const RgbImage& refPre
   ReferencePair pair;
   pair.current = &ref.linear, pair.previous = &refPrev;
   pair.scale = ref.displayScale;
-  pair.display = ref.display, pair.previousDisplay = toDisplay(refPrev, pair.scale);
+  pair.display = &ref.display, pair.previousDisplay = toDisplay(refPrev, pair.scale);
   pair.warp.resize(refFrame.pixelCount());
   const HistoryLookup lookup(refFrame, refPrevFrame, absolute, /*useMotion=*/true);
   tbb::parallel_for(0, refFrame.height, [&](int y) {
@@ -76,7 +77,7 @@ struct TemporalScores {
 // docs/metrics.md, "Temporal error".
 TemporalScores temporalScores(const RgbImage& out, const RgbImage& outPrev, const ReferencePair& ref) {
   const RgbImage dOut = toDisplay(out, ref.scale), dOutPrev = toDisplay(outPrev, ref.scale);
-  const RgbImage &dRef = ref.display, &dRefPrev = ref.previousDisplay, &r = *ref.current, &rPrev = *ref.previous;
+  const RgbImage &dRef = *ref.display, &dRefPrev = ref.previousDisplay, &r = *ref.current, &rPrev = *ref.previous;
   TemporalScores s{};
   double sq = 0.0, rel = 0.0;
   for (std::size_t k = 0; k < r.rgb.size(); ++k) {

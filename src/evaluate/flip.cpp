@@ -161,13 +161,35 @@ std::vector<float> scaled(std::vector<float> k, double factor) {
   return k;
 }
 
+// Narkowicz's fit (a x^2 + b x) / (c x^2 + d x + e) with a = 2.51, b = 0.03, c = 2.43, d = 0.59,
+// e = 0.14, applied to 0.6 x: [EG21] §3 cancels the fit's built-in 0.6 pre-exposure so that an
+// exposure of 0 shows the radiance as is.
+template <typename T>
+T acesToneMapT(T x) {
+  const T s = T(0.6) * x;
+  return (T(2.51) * s * s + T(0.03) * s) / (T(2.43) * s * s + T(0.59) * s + T(0.14));
+}
+
+// HyAB distance |dL| + ||d(a, b)|| of two Hunt-adjusted L*a*b* colours ([HPG20] Eq. 3), from
+// their differences.
+template <typename T>
+T hyabT(T dl, T da, T db) {
+  return std::abs(dl) + std::sqrt(da * da + db * db);
+}
+
+// [HPG20] Eq. 4 for either precision, given c_max (maxColorDistance).
+template <typename T>
+T remapColorErrorT(T hyabDistance, T cmax) {
+  const T d = std::pow(hyabDistance, T(kQc)), breakPoint = T(kPc) * cmax;
+  if (d < breakPoint) return d * T(kPt) / breakPoint;
+  return std::min(T(1), T(kPt) + (d - breakPoint) / (cmax - breakPoint) * (T(1) - T(kPt)));
+}
+
 // YCxCz planes of an image (linear RGB clamped to [0, 1]) and its luminance; with an exposure
 // scale, of the image tone-mapped by HDR-ꟻLIP's ACES curve at that exposure first.
 struct Opponent {
   Plane y, cx, cz, luminance;
 };
-template <typename T>
-T acesToneMapT(T x);
 void toOpponent(const RgbImage& image, std::optional<float> exposureScale, Opponent& o) {
   const std::size_t n = image.pixelCount();
   o.y.resize(n), o.cx.resize(n), o.cz.resize(n), o.luminance.resize(n);
@@ -230,23 +252,6 @@ void filteredHuntLab(const Opponent& o, int w, int h, double ppd, std::vector<Pl
   });
 }
 
-// Narkowicz's fit (a x^2 + b x) / (c x^2 + d x + e) with a = 2.51, b = 0.03, c = 2.43, d = 0.59,
-// e = 0.14, applied to 0.6 x: [EG21] §3 cancels the fit's built-in 0.6 pre-exposure so that an
-// exposure of 0 shows the radiance as is.
-template <typename T>
-T acesToneMapT(T x) {
-  const T s = T(0.6) * x;
-  return (T(2.51) * s * s + T(0.03) * s) / (T(2.43) * s * s + T(0.59) * s + T(0.14));
-}
-
-// [HPG20] Eq. 4 for either precision, given c_max (maxColorDistance).
-template <typename T>
-T remapColorErrorT(T hyabDistance, T cmax) {
-  const T d = std::pow(hyabDistance, T(kQc)), breakPoint = T(kPc) * cmax;
-  if (d < breakPoint) return d * T(kPt) / breakPoint;
-  return std::min(T(1), T(kPt) + (d - breakPoint) / (cmax - breakPoint) * (T(1) - T(kPt)));
-}
-
 // 1D Gaussian, first and second derivative kernels of the feature detector ([HPG20] §4.2).
 struct FeatureKernels {
   std::vector<float> gaussian, first, second;
@@ -292,9 +297,7 @@ glm::dvec3 xyzToYcxcz(glm::dvec3 xyz) { return kColour.xyzToYcxcz(xyz); }
 glm::dvec3 ycxczToXyz(glm::dvec3 v) { return kColour.ycxczToXyz(v); }
 glm::dvec3 xyzToLab(glm::dvec3 xyz) { return kColour.xyzToLab(xyz); }
 glm::dvec3 huntAdjust(glm::dvec3 lab) { return ColourSpace<double>::huntAdjust(lab); }
-double hyab(glm::dvec3 a, glm::dvec3 b) {
-  return std::abs(a.x - b.x) + std::hypot(a.y - b.y, a.z - b.z);
-}
+double hyab(glm::dvec3 a, glm::dvec3 b) { return hyabT(a.x - b.x, a.y - b.y, a.z - b.z); }
 double maxColorDistance() {
   static const double cmax = [] {
     const glm::dvec3 green = huntAdjust(xyzToLab(linearRgbToXyz({0.0, 1.0, 0.0})));
@@ -364,7 +367,7 @@ void pixelErrors(const Prepared& ref, const Prepared& test, Combine&& combine) {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& range) {
     for (std::size_t i = range.begin(); i < range.end(); ++i) {
       const float dl = ref.lab[0][i] - test.lab[0][i], da = ref.lab[1][i] - test.lab[1][i], db = ref.lab[2][i] - test.lab[2][i];
-      const float colour = remapColorErrorT(std::abs(dl) + std::sqrt(da * da + db * db), cmax);  // HyAB, [HPG20] Eq. 3
+      const float colour = remapColorErrorT(hyabT(dl, da, db), cmax);
       // Eq. 6: the feature difference, max of edge and point, over sqrt(2), to the q_f.
       const float edge = std::abs(ref.features.edge[i] - test.features.edge[i]);
       const float point = std::abs(ref.features.point[i] - test.features.point[i]);
@@ -422,23 +425,22 @@ ExposureRange hdrExposureRange(const RgbImage& reference) {
 
 struct HdrFlipReference::State {
   ExposureRange exposures;
-  std::vector<double> scales;      // 2^exposure, one per exposure
+  std::vector<float> scales;       // 2^exposure, one per exposure
   std::vector<Prepared> prepared;  // the reference at each exposure
   double ppd = 0.0;
-  int width = 0, height = 0;
 };
 
 HdrFlipReference::HdrFlipReference(const RgbImage& reference, double ppd) {
   auto state = std::make_shared<State>();
   state->exposures = hdrExposureRange(reference);
-  state->ppd = ppd, state->width = reference.width, state->height = reference.height;
+  state->ppd = ppd;
   const ExposureRange& r = state->exposures;
   Workspace work;
   state->prepared.resize(static_cast<std::size_t>(r.count));
   for (int e = 0; e < r.count; ++e) {
     const double exposure = r.start + e * (r.stop - r.start) / (r.count - 1);
-    state->scales.push_back(std::exp2(exposure));
-    prepare(reference, static_cast<float>(state->scales.back()), ppd, work, state->prepared[static_cast<std::size_t>(e)]);
+    state->scales.push_back(static_cast<float>(std::exp2(exposure)));
+    prepare(reference, state->scales.back(), ppd, work, state->prepared[static_cast<std::size_t>(e)]);
   }
   state_ = std::move(state);
 }
@@ -450,7 +452,7 @@ HdrFlipResult HdrFlipReference::compare(const RgbImage& test) const {
   Workspace work;
   Prepared tst;
   for (std::size_t e = 0; e < state_->prepared.size(); ++e) {
-    prepare(test, static_cast<float>(state_->scales[e]), state_->ppd, work, tst);
+    prepare(test, state_->scales[e], state_->ppd, work, tst);
     // [EG21] Eq. 3: the per-pixel maximum over the exposures.
     pixelErrors(state_->prepared[e], tst, [&](std::size_t i, float error) { result.error[i] = std::max(result.error[i], error); });
   }

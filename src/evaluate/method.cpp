@@ -1,5 +1,9 @@
 #include "evaluate/method.h"
 
+#include <algorithm>
+
+#include <tbb/parallel_for.h>
+
 namespace dynbench::evaluate {
 
 RgbImage frameRadiance(const frames::FeatureFrame& frame) {
@@ -43,6 +47,14 @@ std::optional<discard::BilinearTaps> HistoryLookup::operator()(int px, int py) c
   const discard::HistoryTest test = discard::testHistory(p, n, viewDepth, previous, taps, absolute_);
   if (!test.consistent) return std::nullopt;
   return test.history;
+}
+
+long sumOverRows(int height, const std::function<long(int)>& row) {
+  std::vector<long> perRow(static_cast<std::size_t>(std::max(height, 0)), 0);
+  tbb::parallel_for(0, height, [&](int y) { perRow[static_cast<std::size_t>(y)] = row(y); });
+  long sum = 0;
+  for (long n : perRow) sum += n;
+  return sum;
 }
 
 frames::FeatureFrame historyFrame(const frames::FeatureFrame& frame) {

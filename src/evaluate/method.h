@@ -3,6 +3,7 @@
 // G-buffers and motion, the feature-buffer contract) into output images, reusing its own history.
 // Each method is one file behind this interface (docs/metrics.md, "Temporal methods"); `evaluate`
 // runs it over a frames folder in order and scores every output against a converged reference.
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -71,6 +72,11 @@ class HistoryLookup {
   bool useMotion_;
   discard::Projector currentProjector_, previousProjector_;
 };
+
+// Runs row(y) for every row y in [0, height), rows in parallel (each row's work must depend on
+// the inputs alone), and returns the sum of what they return: a method's count of pixels that kept
+// their history, independent of the schedule.
+long sumOverRows(int height, const std::function<long(int)>& row);
 
 // The parts of a frame that HistoryLookup reads of the previous one (number, camera, size,
 // position, normal, hit): what a method keeps as its history's geometry, instead of a copy of

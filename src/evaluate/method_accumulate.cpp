@@ -4,8 +4,6 @@
 // by the discard stage's own world-position and shading-normal tests.
 #include <algorithm>
 
-#include <tbb/parallel_for.h>
-
 #include "evaluate/method.h"
 
 namespace dynbench::evaluate {
@@ -34,8 +32,8 @@ class AccumulateMethod final : public TemporalMethod {
       const int w = frame.width, h = frame.height;
       const HistoryLookup lookup(frame, prev, t, /*useMotion=*/false);
       // Rows in parallel: each pixel reads the previous output only.
-      std::vector<long> keptInRow(static_cast<std::size_t>(h), 0);
-      tbb::parallel_for(0, h, [&](int py) {
+      kept = sumOverRows(h, [&](int py) {
+        long keptInRow = 0;
         for (int px = 0; px < w; ++px) {
           const std::size_t i = static_cast<std::size_t>(py) * w + px;
           const auto found = lookup(px, py);
@@ -45,10 +43,10 @@ class AccumulateMethod final : public TemporalMethod {
           const double n = discard::sample1(previous_->count, taps) + 1.0, alpha = std::max(1.0 / n, kAlphaMin);
           for (int k = 0; k < 3; ++k) out.rgb[3 * i + k] = static_cast<float>(history[k] + alpha * (out.rgb[3 * i + k] - history[k]));
           count[i] = static_cast<float>(n);
-          ++keptInRow[static_cast<std::size_t>(py)];
+          ++keptInRow;
         }
+        return keptInRow;
       });
-      for (long k : keptInRow) kept += k;
     }
     previous_ = History{historyFrame(frame), out, std::move(count)};
     return MethodOutput{std::move(out), static_cast<double>(kept) / static_cast<double>(frame.pixelCount())};

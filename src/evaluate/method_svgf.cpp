@@ -77,9 +77,8 @@ class SvgfMethod final : public TemporalMethod {
     // 2. Temporal accumulation of illumination and its luminance moments ([S17] §4.1).
     std::vector<glm::dvec2> moments(n);
     std::vector<int> length(n, 1);
-    std::vector<long> keptInRow(static_cast<std::size_t>(h), 0);
-    tbb::parallel_for(0, h, [&](int y) {
-      long& kept = keptInRow[static_cast<std::size_t>(y)];
+    const long kept = sumOverRows(h, [&](int y) {
+      long keptInRow = 0;
       for (int x = 0; x < w; ++x) {
         const std::size_t i = index(x, y);
         const double l = luminance(illumination[i]);
@@ -109,11 +108,10 @@ class SvgfMethod final : public TemporalMethod {
         const double a = std::max(kAlphaColour, 1.0 / length[i]), am = std::max(kAlphaMoments, 1.0 / length[i]);
         illumination[i] = colour + a * (illumination[i] - colour);
         moments[i] = m + am * (moments[i] - m);
-        ++kept;
+        ++keptInRow;
       }
+      return keptInRow;
     });
-    long kept = 0;
-    for (long k : keptInRow) kept += k;
 
     // 3. Variance: from the temporal moments, or where the history is short (< 4 frames) from the
     // 7x7 bilateral neighbourhood's moments, boosted by 4 / length ([S17] §4.2, [Falcor]); then

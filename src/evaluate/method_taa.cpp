@@ -10,8 +10,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <tbb/parallel_for.h>
-
 #include "evaluate/method.h"
 
 namespace dynbench::evaluate {
@@ -43,8 +41,8 @@ class TaaMethod final : public TemporalMethod {
     const int w = frame.width, h = frame.height;
     if (history_ && history_->width == w && history_->height == h) {
       // Rows in parallel: each pixel reads the input and the history only.
-      std::vector<long> keptInRow(static_cast<std::size_t>(h), 0);
-      tbb::parallel_for(0, h, [&](int py) {
+      kept = sumOverRows(h, [&](int py) {
+        long keptInRow = 0;
         for (int px = 0; px < w; ++px) {
           const std::size_t i = static_cast<std::size_t>(py) * w + px;
           const glm::dvec2 motion(frame.motion[2 * i], frame.motion[2 * i + 1]);
@@ -74,10 +72,10 @@ class TaaMethod final : public TemporalMethod {
           const glm::dvec3 current = toYCoCg({input.rgb[3 * i], input.rgb[3 * i + 1], input.rgb[3 * i + 2]});
           const glm::dvec3 blended = fromYCoCg(clipped + kBlend * (current - clipped));
           for (int k = 0; k < 3; ++k) out.rgb[3 * i + k] = static_cast<float>(blended[k]);
-          ++keptInRow[static_cast<std::size_t>(py)];
+          ++keptInRow;
         }
+        return keptInRow;
       });
-      for (long k : keptInRow) kept += k;
     }
     history_ = out;
     return MethodOutput{std::move(out), static_cast<double>(kept) / static_cast<double>(frame.pixelCount())};
