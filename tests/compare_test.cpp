@@ -55,6 +55,13 @@ TEST(Flip, ColourPipelineRoundTripsAndMatchesHandValues) {
   EXPECT_NEAR(red.x, 53.24, 0.01);
   EXPECT_NEAR(red.y, 80.09, 0.01);
   EXPECT_NEAR(red.z, 67.20, 0.01);
+  // The white's XYZ is the reciprocal of the authors' INV_DEFAULT_ILLUMINANT (FLIP.h: 1.052156925,
+  // 1, 0.918357670): 0.9504285, 1, 1.0889004. The sRGB standard's seven-digit matrix gives
+  // 0.9504559, 1.0000025, 1.0890578 instead, which moved every mean by about 1e-5 relative.
+  const glm::dvec3 whiteXyz = flip::linearRgbToXyz(glm::dvec3(1.0));
+  EXPECT_NEAR(whiteXyz.x, 1.0 / 1.052156925, 1e-7);  // (their constant is a float)
+  EXPECT_NEAR(whiteXyz.y, 1.0, 1e-9);
+  EXPECT_NEAR(whiteXyz.z, 1.0 / 0.918357670, 1e-7);
 }
 
 TEST(Flip, HuntAdjustedHyabOfConstantColoursMatchesHandValues) {
