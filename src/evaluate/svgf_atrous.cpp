@@ -5,7 +5,6 @@
 #include <hwy/foreach_target.h>  // before highway.h
 
 #include <hwy/highway.h>
-#include <hwy/contrib/math/math-inl.h>
 
 #include "evaluate/svgf_atrous.h"
 
@@ -37,7 +36,7 @@ using V = hn::Vec<D>;
 
 // The planes both kernels weigh taps by (AtrousArgs' and MomentsArgs' first members).
 struct Geometry {
-  const float *depth, *nx, *ny, *nz, *hit, *gradX, *gradY, *luminance;
+  const float *depth, *nx, *ny, *nz, *gradX, *gradY, *luminance;
 };
 // A vector of centre pixels' geometry.
 struct Centre {
@@ -47,21 +46,46 @@ HWY_INLINE Centre LoadCentre(D d, const Geometry& g, std::size_t c) {
   return {hn::LoadU(d, g.depth + c), hn::LoadU(d, g.luminance + c), hn::LoadU(d, g.nx + c), hn::LoadU(d, g.ny + c),
           hn::LoadU(d, g.nz + c),    hn::LoadU(d, g.gradX + c),     hn::LoadU(d, g.gradY + c)};
 }
-// The edge-stopping weight of the tap at index j, (ox, oy) pixels from the centre ([S17] Eqs. 3-5):
-// exp(-|dz| / (sigma_z |grad z . o| + 1e-8) - |dl| x inverseLuminanceScale) x max(0, n . n')^128,
-// one exponential for the depth and luminance terms as Falcor computes them; 0 where the tap hit
-// nothing. exp(-x) above x = 80 (below 2e-35) is taken as 0: single precision's exponential ends
-// at 88.
-HWY_INLINE V EdgeStoppingWeight(D d, const Geometry& g, const Centre& c, std::size_t j, float ox, float oy, V sigmaZ, V inverseLuminanceScale) {
+// exp(-x) for x in [0, 80] (the edge-stopping exponent's range, below): 2^-k e^-y with k = round(x
+// log2 e) and y = x - k ln 2 in [-0.35, 0.35], e^-y by its Taylor polynomial to degree 6 (error
+// 0.35^7 / 7! = 1.2e-7 relative), 2^-k in the exponent bits: within 4.3e-7 relative of exp on
+// every float in [0, 80] (checked by hand against std::exp in double). Highway's Exp serves every
+// float and was a quarter of the filter's time; this range needs no overflow or underflow handling.
+HWY_INLINE V NegExpShortRange(D d, V x) {
+  const hn::RebindToSigned<D> di;
+  const V k = hn::Round(hn::Mul(x, hn::Set(d, 1.44269504f)));
+  const V y = hn::NegMulAdd(k, hn::Set(d, 0.693147181f), x);
+  V p = hn::Set(d, 1.0f / 720.0f);
+  p = hn::MulAdd(p, y, hn::Set(d, -1.0f / 120.0f));
+  p = hn::MulAdd(p, y, hn::Set(d, 1.0f / 24.0f));
+  p = hn::MulAdd(p, y, hn::Set(d, -1.0f / 6.0f));
+  p = hn::MulAdd(p, y, hn::Set(d, 0.5f));
+  p = hn::MulAdd(p, y, hn::Set(d, -1.0f));
+  p = hn::MulAdd(p, y, hn::Set(d, 1.0f));
+  const auto exponent = hn::ShiftLeft<23>(hn::Sub(hn::Set(di, 127), hn::ConvertTo(di, k)));  // 2^-k, k <= 116
+  return hn::Mul(p, hn::BitCast(d, exponent));
+}
+
+// The edge-stopping weight of the tap at index j ([S17] Eqs. 3-5):
+// exp(-|dz| x inverseDepthScale - |dl| x inverseLuminanceScale) x max(0, n . n')^128, one
+// exponential for the depth and luminance terms as Falcor computes them. A tap that hit nothing
+// has the normal 0 (AtrousPlanes), so its weight is 0 without a test. exp(-x) above x = 80 (below
+// 2e-35) is taken as 0: single precision's exponential ends at 88.
+HWY_INLINE V EdgeStoppingWeight(D d, const Geometry& g, const Centre& c, std::size_t j, V inverseDepthScale, V inverseLuminanceScale) {
   const V zero = hn::Zero(d);
-  const V depthDenominator = hn::MulAdd(sigmaZ, hn::Abs(hn::MulAdd(c.gx, hn::Set(d, ox), hn::Mul(c.gy, hn::Set(d, oy)))), hn::Set(d, 1e-8f));
-  const V dz = hn::Div(hn::Abs(hn::Sub(c.z, hn::LoadU(d, g.depth + j))), depthDenominator);
   const V dl = hn::Mul(hn::Abs(hn::Sub(c.luminance, hn::LoadU(d, g.luminance + j))), inverseLuminanceScale);
+  const V exponent = hn::MulAdd(hn::Abs(hn::Sub(c.z, hn::LoadU(d, g.depth + j))), inverseDepthScale, dl);
   V wn = hn::MulAdd(c.nx, hn::LoadU(d, g.nx + j), hn::MulAdd(c.ny, hn::LoadU(d, g.ny + j), hn::Mul(c.nz, hn::LoadU(d, g.nz + j))));
   wn = hn::Max(wn, zero);
   for (int k = 0; k < 7; ++k) wn = hn::Mul(wn, wn);  // ^128
-  const V e = hn::Exp(d, hn::Neg(hn::Min(hn::Add(dz, dl), hn::Set(d, 80.0f))));
-  return hn::IfThenElseZero(hn::Gt(hn::LoadU(d, g.hit + j), zero), hn::Mul(e, wn));
+  const V e = NegExpShortRange(d, hn::Min(exponent, hn::Set(d, 80.0f)));
+  return hn::Mul(e, wn);
+}
+// 1 / (sigma_z |grad z . o| + 1e-8) for the offset o = (ox, oy) ([S17] Eq. 3's depth scale); the
+// same for o and -o, so the 5x5 and 7x7 loops compute it once per pair of taps.
+HWY_INLINE V InverseDepthScale(D d, const Centre& c, float ox, float oy, V sigmaZ) {
+  const V scale = hn::MulAdd(sigmaZ, hn::Abs(hn::MulAdd(c.gx, hn::Set(d, ox), hn::Mul(c.gy, hn::Set(d, oy)))), hn::Set(d, 1e-8f));
+  return hn::Div(hn::Set(d, 1.0f), scale);
 }
 
 // Rows [y0, y1): for each pixel the 5x5 taps `step` apart, weighted by the B3 spline times the
@@ -73,7 +97,7 @@ void AtrousRows(const AtrousArgs* a, int y0, int y1) {
   static constexpr float kSpline[3] = {3.0f / 8.0f, 1.0f / 4.0f, 1.0f / 16.0f};  // [S17] §4.3: B3 spline
   const V zero = hn::Zero(d), lumEpsilon = hn::Set(d, 1e-10f);
   const V sigmaZ = hn::Set(d, a->sigmaZ), sigmaL = hn::Set(d, a->sigmaL);
-  const Geometry g{a->depth, a->nx, a->ny, a->nz, a->hit, a->gradX, a->gradY, a->luminance};
+  const Geometry g{a->depth, a->nx, a->ny, a->nz, a->gradX, a->gradY, a->luminance};
   const int pad = AtrousPlanes::kPad;
   for (int y = y0; y < y1; ++y) {
     // Lanes beyond the row's last pixel read and write the padding (at least kPad wide, more than
@@ -83,20 +107,25 @@ void AtrousRows(const AtrousArgs* a, int y0, int y1) {
       const V hitC = hn::LoadU(d, a->hit + c);
       const Centre centre = LoadCentre(d, g, c);
       const V inverseLum = hn::Div(hn::Set(d, 1.0f), hn::MulAdd(sigmaL, hn::Sqrt(hn::Max(zero, hn::LoadU(d, a->blurredVariance + c))), lumEpsilon));
-      V sumR = zero, sumG = zero, sumB = zero, sumW = zero, sumV = zero;
-      for (int ky = -2; ky <= 2; ++ky)
-        for (int kx = -2; kx <= 2; ++kx) {
+      // The centre tap weighs the spline alone; the others come in pairs o, -o sharing a depth scale.
+      const V centreSpline = hn::Set(d, kSpline[0] * kSpline[0]);
+      V sumR = hn::Mul(centreSpline, hn::LoadU(d, a->r + c)), sumG = hn::Mul(centreSpline, hn::LoadU(d, a->g + c));
+      V sumB = hn::Mul(centreSpline, hn::LoadU(d, a->b + c)), sumW = centreSpline;
+      V sumV = hn::Mul(hn::Mul(centreSpline, centreSpline), hn::LoadU(d, a->variance + c));
+      for (int ky = 0; ky <= 2; ++ky)
+        for (int kx = ky == 0 ? 1 : -2; kx <= 2; ++kx) {
+          const V spline = hn::Set(d, kSpline[kx < 0 ? -kx : kx] * kSpline[ky]);
+          const V inverseDepth = InverseDepthScale(d, centre, static_cast<float>(kx * a->step), static_cast<float>(ky * a->step), sigmaZ);
           const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(ky * a->step) * a->stride + kx * a->step;
-          const std::size_t j = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(c) + offset);
-          const V spline = hn::Set(d, kSpline[kx < 0 ? -kx : kx] * kSpline[ky < 0 ? -ky : ky]);
-          const V w = kx == 0 && ky == 0 ? spline
-                                         : hn::Mul(spline, EdgeStoppingWeight(d, g, centre, j, static_cast<float>(kx * a->step),
-                                                                              static_cast<float>(ky * a->step), sigmaZ, inverseLum));
-          sumR = hn::MulAdd(w, hn::LoadU(d, a->r + j), sumR);
-          sumG = hn::MulAdd(w, hn::LoadU(d, a->g + j), sumG);
-          sumB = hn::MulAdd(w, hn::LoadU(d, a->b + j), sumB);
-          sumW = hn::Add(sumW, w);
-          sumV = hn::MulAdd(hn::Mul(w, w), hn::LoadU(d, a->variance + j), sumV);
+          for (const std::ptrdiff_t o : {offset, -offset}) {
+            const std::size_t j = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(c) + o);
+            const V w = hn::Mul(spline, EdgeStoppingWeight(d, g, centre, j, inverseDepth, inverseLum));
+            sumR = hn::MulAdd(w, hn::LoadU(d, a->r + j), sumR);
+            sumG = hn::MulAdd(w, hn::LoadU(d, a->g + j), sumG);
+            sumB = hn::MulAdd(w, hn::LoadU(d, a->b + j), sumB);
+            sumW = hn::Add(sumW, w);
+            sumV = hn::MulAdd(hn::Mul(w, w), hn::LoadU(d, a->variance + j), sumV);
+          }
         }
       const auto surface = hn::Gt(hitC, zero);
       // Where the centre is not a hit the sums may be 0: divide by 1 there, the result is not used.
@@ -118,7 +147,7 @@ void MomentsRows(const MomentsArgs* a, int y0, int y1) {
   constexpr int kRadius = 3;  // [S17] §4.2: 7x7
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0f), four = hn::Set(d, 4.0f);
   const V sigmaZ = hn::Set(d, a->sigmaZ), inverseSigmaL = hn::Set(d, 1.0f / a->sigmaL);
-  const Geometry g{a->depth, a->nx, a->ny, a->nz, a->hit, a->gradX, a->gradY, a->luminance};
+  const Geometry g{a->depth, a->nx, a->ny, a->nz, a->gradX, a->gradY, a->luminance};
   const int pad = AtrousPlanes::kPad;
   for (int y = y0; y < y1; ++y)
     for (int x = 0; x < a->width; x += static_cast<int>(lanes)) {
@@ -134,16 +163,20 @@ void MomentsRows(const MomentsArgs* a, int y0, int y1) {
         // (computed in double), Var(m1) of m1 - m1(centre): the same number without single
         // precision's cancellation of two large second moments.
         V sumV = vc, sumD = zero, sumD2 = zero, sumW = one;  // the centre weighs 1
-        for (int dy = -kRadius; dy <= kRadius; ++dy)
-          for (int dx = -kRadius; dx <= kRadius; ++dx) {
-            if (dx == 0 && dy == 0) continue;
-            const std::size_t j = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(c) + static_cast<std::ptrdiff_t>(dy) * a->stride + dx);
-            const V w = EdgeStoppingWeight(d, g, centre, j, static_cast<float>(dx), static_cast<float>(dy), sigmaZ, inverseSigmaL);
-            const V deviation = hn::Sub(hn::LoadU(d, a->moment1 + j), m1c);
-            sumV = hn::MulAdd(w, hn::LoadU(d, a->temporalVariance + j), sumV);
-            sumD = hn::MulAdd(w, deviation, sumD);
-            sumD2 = hn::MulAdd(w, hn::Mul(deviation, deviation), sumD2);
-            sumW = hn::Add(sumW, w);
+        // Taps in pairs o, -o sharing a depth scale, as in AtrousRows.
+        for (int dy = 0; dy <= kRadius; ++dy)
+          for (int dx = dy == 0 ? 1 : -kRadius; dx <= kRadius; ++dx) {
+            const V inverseDepth = InverseDepthScale(d, centre, static_cast<float>(dx), static_cast<float>(dy), sigmaZ);
+            const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(dy) * a->stride + dx;
+            for (const std::ptrdiff_t o : {offset, -offset}) {
+              const std::size_t j = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(c) + o);
+              const V w = EdgeStoppingWeight(d, g, centre, j, inverseDepth, inverseSigmaL);
+              const V deviation = hn::Sub(hn::LoadU(d, a->moment1 + j), m1c);
+              sumV = hn::MulAdd(w, hn::LoadU(d, a->temporalVariance + j), sumV);
+              sumD = hn::MulAdd(w, deviation, sumD);
+              sumD2 = hn::MulAdd(w, hn::Mul(deviation, deviation), sumD2);
+              sumW = hn::Add(sumW, w);
+            }
           }
         const V inverse = hn::Div(one, sumW);
         const V meanD = hn::Mul(sumD, inverse);
@@ -173,30 +206,31 @@ void AtrousPlanes::resize(int w, int h) {
   width = w, height = h, stride = w + 2 * kPad;
   // (+ kPad: the last row's lanes past its end, a vector at most, read taps up to 2 x 16 further.)
   const std::size_t n = static_cast<std::size_t>(stride) * static_cast<std::size_t>(h + 2 * kPad) + kPad;
-  for (auto* plane : {&depth, &nx, &ny, &nz, &hit, &gradX, &gradY, &r, &g, &b, &variance, &moment1, &temporalVariance, &historyLength})
+  for (auto* plane : {&depth, &nx, &ny, &nz, &hit, &gradX, &gradY, &r, &g, &b, &variance, &moment1, &temporalVariance, &historyLength, &luminance,
+                      &blurredVariance, &rowsOfBlur})
     plane->assign(n, 0.0f);
 }
 
-void atrousIteration(const AtrousPlanes& p, int step, const AtrousWeights& weights, AtrousPlanes& out) {
+void atrousIteration(AtrousPlanes& p, int step, const AtrousWeights& weights, AtrousPlanes& out) {
   if (out.width != p.width || out.height != p.height) out.resize(p.width, p.height);
   const int w = p.width, h = p.height;
   // The illumination's luminance (Rec. 709) and the variance's 3x3 Gaussian (1, 2, 1)^2 / 16 at
   // clamped coordinates, once per iteration rather than once per tap; the Gaussian separably, rows
   // then columns, each a loop the compiler vectorises (with a clamped index per tap it took most of
   // the iteration's time).
-  std::vector<float> luminance(p.r.size(), 0.0f), rows(p.r.size(), 0.0f), blurred(p.r.size(), 0.0f);
+  std::vector<float> &luminance = p.luminance, &blurRows = p.rowsOfBlur, &blurred = p.blurredVariance;
   tbb::parallel_for(0, h, [&](int y) {
     const std::size_t row = p.at(0, y);
     const float *r = p.r.data() + row, *g = p.g.data() + row, *b = p.b.data() + row, *v = p.variance.data() + row;
-    float *l = luminance.data() + row, *out = rows.data() + row;
+    float *l = luminance.data() + row, *out = blurRows.data() + row;
     for (int x = 0; x < w; ++x) l[x] = 0.2126f * r[x] + 0.7152f * g[x] + 0.0722f * b[x];
     for (int x = 1; x < w - 1; ++x) out[x] = 0.25f * v[x - 1] + 0.5f * v[x] + 0.25f * v[x + 1];
     out[0] = 0.75f * v[0] + 0.25f * v[std::min(1, w - 1)];
     if (w > 1) out[w - 1] = 0.25f * v[w - 2] + 0.75f * v[w - 1];
   });
   tbb::parallel_for(0, h, [&](int y) {
-    const float *above = rows.data() + p.at(0, std::max(y - 1, 0)), *centre = rows.data() + p.at(0, y);
-    const float* below = rows.data() + p.at(0, std::min(y + 1, h - 1));
+    const float *above = blurRows.data() + p.at(0, std::max(y - 1, 0)), *centre = blurRows.data() + p.at(0, y);
+    const float* below = blurRows.data() + p.at(0, std::min(y + 1, h - 1));
     float* out = blurred.data() + p.at(0, y);
     for (int x = 0; x < w; ++x) out[x] = 0.25f * above[x] + 0.5f * centre[x] + 0.25f * below[x];
   });
@@ -211,7 +245,7 @@ void atrousIteration(const AtrousPlanes& p, int step, const AtrousWeights& weigh
 
 void estimateVariance(AtrousPlanes& p, float sigmaZ, float momentsSigmaL) {
   const int w = p.width, h = p.height;
-  std::vector<float> luminance(p.r.size(), 0.0f);
+  std::vector<float>& luminance = p.luminance;
   tbb::parallel_for(0, h, [&](int y) {
     for (int x = 0; x < w; ++x) {
       const std::size_t i = p.at(x, y);

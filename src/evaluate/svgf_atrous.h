@@ -4,7 +4,7 @@
 // render/bsdf_batch.cpp). Their 25 and 49 taps a pixel with two exponentials each, in double
 // precision and one pixel at a time, were nearly all of `svgf`'s time (5 s a 1080p frame; issue 34).
 //
-// The planes are structure of arrays, padded by kPad pixels on every side whose `hit` is 0, so a
+// The planes are structure of arrays, padded by kPad pixels on every side whose `hit` and normal are 0, so a
 // tap outside the image weighs nothing, as the scalar filter skipped it, and a row of lanes reads
 // its taps with plain unaligned loads.
 #include <cstddef>
@@ -15,13 +15,18 @@ namespace dynbench::evaluate::svgf {
 struct AtrousPlanes {
   static constexpr int kPad = 32;  // two taps of the largest step, 16
   int width = 0, height = 0, stride = 0;
-  // Per frame: depth, shading normal, hit (1 or 0), depth gradient (per pixel, a pixel's step).
+  // Per frame: depth, shading normal (0 where the pixel hit nothing: the filters' normal weight
+  // is then 0, which is how they skip such taps), hit (1 or 0), depth gradient (per pixel, a
+  // pixel's step).
   std::vector<float> depth, nx, ny, nz, hit, gradX, gradY;
   // Per iteration: the illumination being filtered and its variance.
   std::vector<float> r, g, b, variance;
   // For the variance estimate: the temporally accumulated luminance moment m1, the variance
   // m2 - m1^2 of the accumulated moments (computed in double) and the history length.
   std::vector<float> moment1, temporalVariance, historyLength;
+  // Scratch of the filters (kept to save their allocation): the illumination's luminance, the
+  // variance's Gaussian prefilter and its rows.
+  std::vector<float> luminance, blurredVariance, rowsOfBlur;
 
   void resize(int w, int h);
   std::size_t at(int x, int y) const {
@@ -34,10 +39,10 @@ struct AtrousWeights {
 };
 
 // One iteration with taps `step` pixels apart: r, g, b and variance of `planes` filtered into
-// those of `out` (resized to match; its geometry planes are not touched). Pixels that hit nothing
+// those of `out` (resized to match; its geometry planes are not touched; `planes`' scratch is). Pixels that hit nothing
 // are copied. The variance's 3x3 Gaussian prefilter of the luminance weight ([S17] Eq. 5) reads
 // clamped coordinates, as the scalar filter did.
-void atrousIteration(const AtrousPlanes& planes, int step, const AtrousWeights& weights, AtrousPlanes& out);
+void atrousIteration(AtrousPlanes& planes, int step, const AtrousWeights& weights, AtrousPlanes& out);
 
 // The variance estimate of [S17] §4.2 into `planes.variance`: where the history is 4 frames or
 // longer, the temporal moments' m2 - m1^2; where shorter, the moments of the 7x7 neighbourhood
