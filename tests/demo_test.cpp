@@ -14,6 +14,7 @@
 #include "core/files.h"
 #include "core/math.h"
 #include "pipeline/demo.h"
+#include "pipeline/flythrough.h"
 #include "render/raytracing_scene.h"
 #include "scene/evaluate.h"
 #include "scene/load.h"
@@ -41,12 +42,8 @@ std::vector<std::array<double, 8>> readPoses(const fs::path& csv) {
   return rows;
 }
 
-TEST(Demo, FlythroughFollowsTheBotsLongestStretchAroundAWallAndTurnsGently) {
-  // A wall in the plane x = 0 for z in [-100, 5]. The camera walks a U around its end: from
-  // (-10, 0, -60) up to z = 10, across to x = 10, back down to z = -60 (160 units, keys every 10
-  // units, 16 s), then jumps (a cut) to (200, 0, 200) and walks 5 units. A 64-unit moving average
-  // pulls the U's apex to z = 2.4, behind the wall's end; the path must stay out of it.
-  const fs::path dir = test::freshDir("demo_fly");
+// The U-turn of the fly-through tests (described there): its dataset and the stretch's end time.
+std::pair<fs::path, double> writeUTurn(const fs::path& dir) {
   test::GltfBuilder b;
   const int wallPositions = b.accessor({0, -50, -100, 0, 50, -100, 0, 50, 5, 0, -50, 5}, "VEC3");
   b.doc["meshes"] = nlohmann::json::array({{{"primitives", nlohmann::json::array({{{"attributes", {{"POSITION", wallPositions}}},
@@ -68,8 +65,18 @@ TEST(Demo, FlythroughFollowsTheBotsLongestStretchAroundAWallAndTurnsGently) {
                           {"camera", b.perspectiveCamera()},
                           {"extras", {{"dynbench_camera_cuts", {{{"from", stretchEnd}, {"time", t}, {"reason", "respawn"}}}}}}});
   b.channel(cam, "translation", times, values);
-  const fs::path dataset = b.write(dir, "u_turn");
-  const auto report = demo::writeFlythroughCsv(dataset, dir / "fly.csv");
+  return {b.write(dir, "u_turn"), stretchEnd};
+}
+
+TEST(Demo, FlythroughFollowsTheBotsLongestStretchAroundAWallAndTurnsGently) {
+  // A wall in the plane x = 0 for z in [-100, 5]. The camera walks a U around its end: from
+  // (-10, 0, -60) up to z = 10, across to x = 10, back down to z = -60 (160 units, keys every 10
+  // units, 16 s), then jumps (a cut) to (200, 0, 200) and walks 5 units. A 64-unit moving average
+  // pulls the U's apex to z = 2.4, behind the wall's end; the path must stay out of it.
+  const fs::path dir = test::freshDir("demo_fly");
+  const auto [dataset, stretchEnd] = writeUTurn(dir);
+  const double t = stretchEnd + 1.0;
+  const auto report = flythrough::writeFlythroughCsv(dataset, dir / "fly.csv");
   ASSERT_TRUE(report) << report.error().message;
   EXPECT_NEAR(report->stretchStart, 0.0, 1e-9);
   EXPECT_NEAR(report->stretchEnd, stretchEnd, 1.0 / 60);
@@ -113,25 +120,75 @@ TEST(Demo, FlythroughFollowsTheBotsLongestStretchAroundAWallAndTurnsGently) {
   // Per frame at 24 fps the yaw turns about turned / (24 duration) degrees on average; the bounds
   // hold unless even a window as long as the flight could not meet them.
   EXPECT_NEAR(report->yawMean, turned / (24.0 * duration), 0.1 * report->yawMean);
-  const demo::FlythroughOptions bounds;
+  const flythrough::FlythroughOptions bounds;
   if (report->headingWindow <= duration) {
     EXPECT_LE(report->yawMean, bounds.maxYawMean);
     EXPECT_LE(report->yawVariance, bounds.maxYawVariance);
   }
-  EXPECT_LE(report->pitchMean, 1e-9);  // a flat path: no pitch
+  // A flat path has no pitch of its own: the nod gives it ORCA's (at least the least row's 0.014°
+  // a frame, about the target 0.03).
+  const flythrough::FlythroughOptions defaults;
+  EXPECT_GT(report->nodAmplitude, 0.0);
+  EXPECT_GE(report->pitchMean, defaults.pitchTarget);
+  EXPECT_LT(report->pitchMean, 1.2 * defaults.pitchTarget);
+  EXPECT_LE(report->pitchVariance, defaults.maxPitchVariance);
   EXPECT_GT(turned, 170.0);
   EXPECT_LT(turned, 190.0);
   auto forward = [](const std::array<double, 8>& r) { return glm::dquat(r[7], r[4], r[5], r[6]) * glm::dvec3(0, 0, -1); };
   EXPECT_GT(forward(rows.front()).z, 0.9);  // up the first leg, towards +Z
   EXPECT_LT(forward(rows.back()).z, -0.9);  // down the second leg, towards -Z
-  for (const auto& r : rows) EXPECT_NEAR(forward(r).y, 0.0, 1e-9);
+  for (const auto& r : rows) EXPECT_LE(std::abs(forward(r).y), std::sin(radians(report->nodAmplitude)) + 1e-9);
+  // Without the nod the flat path is flown level.
+  flythrough::FlythroughOptions level;
+  level.pitchTarget = 0;
+  const auto flat = flythrough::writeFlythroughCsv(dataset, dir / "level.csv", level);
+  ASSERT_TRUE(flat) << flat.error().message;
+  EXPECT_EQ(flat->nodAmplitude, 0.0);
+  EXPECT_LE(flat->pitchMean, 1e-9);
+  for (const auto& r : readPoses(dir / "level.csv")) EXPECT_NEAR(forward(r).y, 0.0, 1e-9);
+  // Of the two stretches the U is flown: the 5-unit one after the cut neither turns nor is long.
+  EXPECT_EQ(report->stretchesCompared, 1 + (report->insideOrca() ? 0 : 1));
   // An empty dataset (no camera animation) is an error naming the file.
   test::GltfBuilder still;
   still.node({{"name", "eye"}, {"camera", still.perspectiveCamera()}});
-  const auto none = demo::writeFlythroughCsv(still.write(dir, "still"), dir / "none.csv");
+  const auto none = flythrough::writeFlythroughCsv(still.write(dir, "still"), dir / "none.csv");
   ASSERT_FALSE(none);
   EXPECT_NE(none.error().message.find("still.gltf"), std::string::npos) << none.error().message;
   EXPECT_FALSE(fs::exists(dir / "none.csv"));
+}
+
+TEST(Demo, FlythroughCommandWritesTheDatasetAndChecksItAgainstOrca) {
+  const fs::path dir = test::freshDir("demo_fly_cli");
+  const auto [dataset, stretchEnd] = writeUTurn(dir);
+  const auto r = dynbench(fmt::format("flythrough {} -o {} --json {}", dataset.string(), (dir / "fly.gltf").string(), (dir / "fly.json").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  // The new dataset's camera follows the pose log written beside it, and its motion is measured
+  // from the dataset: the checks' position mean is the flight's speed (units/s, 24 fps, 1/8 m).
+  EXPECT_TRUE(fs::exists(dir / "fly.csv"));
+  auto fly = scene::loadScene(dir / "fly.gltf");
+  ASSERT_TRUE(fly) << fly.error().message;
+  const auto doc = nlohmann::json::parse(test::slurp(dir / "fly.json"));
+  ASSERT_EQ(doc["checks"].size(), 12u);
+  EXPECT_EQ(doc["checks"][0]["measure"], "Table 6.4 position mean (m)");
+  EXPECT_NEAR(doc["checks"][0]["value"].get<double>(), doc["speed"].get<double>() / 24.0 * 0.125, 2e-3);
+  bool inside = true;
+  for (const auto& c : doc["checks"]) {
+    const bool in = c["value"].get<double>() >= c["low"].get<double>() - 5e-4 && c["value"].get<double>() <= c["high"].get<double>() + 5e-4;
+    EXPECT_EQ(c["inside"].get<bool>(), in) << c.dump();
+    inside = inside && in;
+    // Each check is printed, marked when outside.
+    EXPECT_NE(r.out.find(c["measure"].get<std::string>()), std::string::npos);
+  }
+  EXPECT_EQ(doc["inside_orca"].get<bool>(), inside);
+  // --require-orca fails (status 5) exactly when a check is outside.
+  const auto strict = dynbench(fmt::format("flythrough {} -o {} --require-orca", dataset.string(), (dir / "fly2.gltf").string()), dir);
+  EXPECT_EQ(strict.status, inside ? 0 : 5) << strict.err;
+  // Bad input: a missing dataset names the file (status 3); a negative speed is a usage error.
+  const auto missing = dynbench(fmt::format("flythrough {} -o {}", (dir / "nope.gltf").string(), (dir / "x.gltf").string()), dir);
+  EXPECT_EQ(missing.status, 3);
+  EXPECT_NE(missing.err.find("nope.gltf"), std::string::npos) << missing.err;
+  EXPECT_FALSE(fs::exists(dir / "x.gltf"));
+  EXPECT_EQ(dynbench(fmt::format("flythrough {} -o {} --speed -1", dataset.string(), (dir / "y.gltf").string()), dir).status, 2);
 }
 
 TEST(Demo, WholeChainOnAShortMatch) {
@@ -152,7 +209,7 @@ TEST(Demo, WholeChainOnAShortMatch) {
   double pitchMean = 0, pitchVariance = 0, yawMean = 0, yawVariance = 0;
   ASSERT_EQ(std::sscanf(md.c_str() + md.find('|', row + 2), "| %lf | %lf | %lf | %lf", &pitchMean, &pitchVariance, &yawMean, &yawVariance), 4)
       << md.substr(row, 80);
-  const demo::FlythroughOptions orca;
+  const flythrough::FlythroughOptions orca;
   EXPECT_LE(yawMean, orca.maxYawMean + 1e-3);
   EXPECT_LE(yawVariance, orca.maxYawVariance + 1e-3);
   EXPECT_LE(pitchMean, orca.maxPitchMean + 1e-3);

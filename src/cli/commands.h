@@ -25,6 +25,9 @@ void addConvertCommand(CLI::App& app, CommandRun& run);
 // Registers `merge-camera`.
 void addMergeCameraCommand(CLI::App& app, CommandRun& run);
 
+// Registers `flythrough`.
+void addFlythroughCommand(CLI::App& app, CommandRun& run);
+
 // Registers `render`.
 void addRenderCommand(CLI::App& app, CommandRun& run);
 

@@ -60,6 +60,7 @@ int runCommandLine(int argc, char** argv) {
   cli::addCaptureCheckCommand(app, run);
   cli::addConvertCommand(app, run);
   cli::addMergeCameraCommand(app, run);
+  cli::addFlythroughCommand(app, run);
   cli::addRenderCommand(app, run);
   cli::addDiscardCommand(app, run);
   cli::addReportCommand(app, run);

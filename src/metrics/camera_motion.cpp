@@ -25,6 +25,42 @@ Summary summarize(const std::vector<double>& values) {
   return s;
 }
 
+namespace {
+
+void setPose(CameraFrame& f, const glm::dvec3& position, const glm::dquat& rotation) {
+  f.position = position;
+  f.rotation = rotation;
+  const EulerYawPitchRoll euler = eulerYawPitchRoll(rotation);
+  f.yawDegrees = degrees(euler.yaw);
+  f.pitchDegrees = degrees(euler.pitch);
+  f.rollDegrees = degrees(euler.roll);
+}
+
+void setChange(const CameraFrame& prev, CameraFrame& f) {
+  f.positionDelta = glm::length(f.position - prev.position);                      // Eq. (3.1)
+  f.rotationDelta = degrees(geodesicAngle(prev.rotation, f.rotation));            // Eq. (2.4)
+  f.yawDelta = std::abs(wrapDegrees(f.yawDegrees - prev.yawDegrees));             // Eq. (3.2)
+  f.pitchDelta = std::abs(wrapDegrees(f.pitchDegrees - prev.pitchDegrees));
+  f.rollDelta = std::abs(wrapDegrees(f.rollDegrees - prev.rollDegrees));
+}
+
+}  // namespace
+
+CameraMotionSummary measurePoses(const std::vector<glm::dvec3>& positions, const std::vector<glm::dquat>& rotations) {
+  std::vector<double> dPosition, dRotation, dPitch, dYaw, dRoll;
+  CameraFrame prev, f;
+  for (std::size_t i = 0; i < std::min(positions.size(), rotations.size()); ++i) {
+    setPose(f, positions[i], rotations[i]);
+    if (i > 0) {
+      setChange(prev, f);
+      dPosition.push_back(f.positionDelta), dRotation.push_back(f.rotationDelta);
+      dPitch.push_back(f.pitchDelta), dYaw.push_back(f.yawDelta), dRoll.push_back(f.rollDelta);
+    }
+    prev = f;
+  }
+  return {summarize(dPosition), summarize(dRotation), summarize(dPitch), summarize(dYaw), summarize(dRoll)};
+}
+
 Expected<CameraMotion> measureCameraMotion(const Scene& scene, double fps, const std::optional<std::string>& cameraSelector) {
   if (!(fps > 0)) return fail(ErrorCode::kUsage, "--fps must be positive (got {})", fps);
   auto node = selectCameraNode(scene, cameraSelector);
@@ -48,19 +84,10 @@ Expected<CameraMotion> measureCameraMotion(const Scene& scene, double fps, const
     f.frame = i;
     f.time = range.start + static_cast<double>(i) / fps;
     const RigidPose pose = decomposeRigid(evaluator.worldMatrix(*node, f.time));
-    f.position = pose.position;
-    f.rotation = pose.rotation;
-    const EulerYawPitchRoll euler = eulerYawPitchRoll(pose.rotation);
-    f.yawDegrees = degrees(euler.yaw);
-    f.pitchDegrees = degrees(euler.pitch);
-    f.rollDegrees = degrees(euler.roll);
+    setPose(f, pose.position, pose.rotation);
     if (i == 0) continue;
     const CameraFrame& prev = motion.frames[i - 1];
-    f.positionDelta = glm::length(f.position - prev.position);                      // Eq. (3.1)
-    f.rotationDelta = degrees(geodesicAngle(prev.rotation, f.rotation));            // Eq. (2.4)
-    f.yawDelta = std::abs(wrapDegrees(f.yawDegrees - prev.yawDegrees));             // Eq. (3.2)
-    f.pitchDelta = std::abs(wrapDegrees(f.pitchDegrees - prev.pitchDegrees));
-    f.rollDelta = std::abs(wrapDegrees(f.rollDegrees - prev.rollDegrees));
+    setChange(prev, f);
     f.cut = cameraCutBetween(cameraNode, prev.time, f.time);
     motion.cuts += f.cut ? 1 : 0;
     for (int all = f.cut ? 1 : 0; all < 2; ++all) {

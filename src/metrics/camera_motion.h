@@ -32,25 +32,29 @@ struct CameraFrame {
   bool cut = false;  // the camera cut (jumped) since the previous frame: scene::cameraCutBetween
 };
 
-struct CameraMotion {
+// Tables 6.4-6.6 of a camera: summaries of its per-frame changes.
+struct CameraMotionSummary {
+  Summary position;  // Table 6.4, scene units per frame
+  Summary rotation;  // Table 6.5, degrees per frame
+  Summary pitch, yaw, roll;  // Table 6.6, degrees per frame
+};
+
+// Over the changes of frames 1..N-1 that are not cuts (a cut is a jump, not motion).
+struct CameraMotion : CameraMotionSummary {
   bool hasCamera = false;
   int cameraNode = -1;
   std::string cameraName;
   double fps = 0.0;
   std::vector<CameraFrame> frames;
   std::size_t cuts = 0;  // frames 1..N-1 that are cuts
-  // Over the changes of frames 1..N-1 that are not cuts (a cut is a jump, not motion):
-  Summary position;  // Table 6.4, scene units per frame
-  Summary rotation;  // Table 6.5, degrees per frame
-  Summary pitch, yaw, roll;  // Table 6.6, degrees per frame
   // The same over all N-1 changes, cuts included.
-  struct {
-    Summary position, rotation, pitch, yaw, roll;
-  } includingCuts;
+  CameraMotionSummary includingCuts;
 };
-
 
 Expected<CameraMotion> measureCameraMotion(const scene::Scene& scene, double fps,
                                            const std::optional<std::string>& cameraSelector);
+// The same tables of a sequence of camera poses one frame apart, with no cuts (a camera path
+// before it is written to a dataset: the fly-through's candidates).
+CameraMotionSummary measurePoses(const std::vector<glm::dvec3>& positions, const std::vector<glm::dquat>& rotations);
 
 }  // namespace dynbench::metrics
