@@ -11,6 +11,8 @@ packages=(
   nlohmann-json3-dev libassimp-dev libglm-dev libopenimageio-dev
   libembree-dev libtbb-dev libhwy-dev
   libcli11-dev libfmt-dev libspdlog-dev
+  # SHA-256 of a suite's datasets and frames (core/checksum.cpp)
+  libssl-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev googletest libbenchmark-dev zlib1g-dev
   # plots

@@ -53,6 +53,9 @@ void addEvaluateCommand(CLI::App& app, CommandRun& run);
 // perTask adds --frames-per-task.
 void addSlurmOptions(CLI::App* cmd, bool& slurm, pipeline::slurm::Options& options, const std::string& what, bool perTask);
 
+// Registers `suite` and `suite verify`.
+void addSuiteCommand(CLI::App& app, CommandRun& run);
+
 // Registers `demo`.
 void addDemoCommand(CLI::App& app, CommandRun& run);
 

@@ -69,6 +69,7 @@ int runCommandLine(int argc, char** argv) {
   cli::addFidelityCommand(app, run);
   cli::addEvaluateCommand(app, run);
   cli::addDemoCommand(app, run);
+  cli::addSuiteCommand(app, run);
 
   // `dynbench help [COMMAND]`
   std::string helpTopic;

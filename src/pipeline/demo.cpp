@@ -10,6 +10,7 @@
 #include "core/files.h"
 #include "core/math.h"
 #include "evaluate/evaluate.h"
+#include "pipeline/dataset_run.h"
 #include "pipeline/flythrough.h"
 #include "pipeline/stages.h"
 
@@ -29,101 +30,6 @@ constexpr int kCaptureAdapterVersion = 3;
 std::string captureKey(const DemoOptions& o) {
   return fmt::format("{{\"map\": \"{}\", \"bots\": {}, \"seconds\": {}, \"seed\": {}, \"adapter\": {}}}\n", o.map, o.bots, o.seconds,
                      o.seed, kCaptureAdapterVersion);
-}
-
-// The two renders of a dataset: converged reference frames (RUN/frames) and the temporal methods'
-// input (RUN/input), of the same window of frames around the middle of the dataset.
-struct DatasetRenders {
-  RenderStage reference, input;
-};
-DatasetRenders datasetRenders(const fs::path& dataset, const fs::path& run, const DemoOptions& o, long animationFrames) {
-  RenderStage render;
-  render.job.dataset = dataset;
-  render.job.output = run / "frames";
-  render.job.fps = o.fps;
-  render.job.settings.width = o.width;
-  render.job.settings.height = o.height;
-  render.job.settings.samplesPerPixel = o.samplesPerPixel;
-  render.job.settings.bounces = o.bounces;
-  render.job.settings.seed = o.seed;
-  render.job.settings.converge = true;
-  render.job.settings.tolerance = o.tolerance;
-  render.job.settings.maxSamplesPerPixel = o.maxSamplesPerPixel;
-  render.job.threads = o.threads;
-  {
-    // The window: renderFrames consecutive frames around the middle of the dataset (its frame
-    // count at o.fps, as stats measures it).
-    const long window = std::min<long>(animationFrames, std::max(2, o.renderFrames));
-    render.job.frames.first = (animationFrames - window) / 2;
-    render.job.frames.last = render.job.frames.first + window - 1;
-  }
-  // The temporal methods' input: the same window rendered as a real-time renderer would: a few
-  // paths per pixel from its G-buffer's hit (the pixel centre, no filter), the projection jittered
-  // from frame to frame (the Halton sequence TAA needs to turn aliasing into anti-aliasing), and
-  // another seed so its noise is independent of the reference's. The reference is the converged
-  // radiance through the pixel filter: what a method should reconstruct.
-  RenderStage input = render;
-  input.job.output = run / "input";
-  input.job.settings.converge = false;
-  input.job.settings.samplesPerPixel = o.inputSamplesPerPixel;
-  input.job.settings.seed = o.seed + 1;
-  input.job.settings.jitter = true;
-  input.job.settings.pixelFilter = {render::PixelFilterType::kCentre, 0.0};
-  return {render, input};
-}
-
-// The dataset's frame count at o.fps (Table 6.1's), from stats; with `json`, its stats files too.
-Expected<long> measureStats(const fs::path& dataset, const fs::path& run, const DemoOptions& o, bool files) {
-  StatsStage stats;
-  stats.inputs = {dataset};
-  stats.fps = o.fps;
-  if (files) {
-    stats.json = run / "stats.json";
-    stats.seriesDir = run;
-  }
-  auto measured = runStats(stats);
-  if (!measured) return std::unexpected(measured.error());
-  return static_cast<long>(measured->rows.front().properties.animationFrames);
-}
-
-// stats, render, discard for one dataset into RUN.
-Expected<void> measureDataset(const fs::path& dataset, const fs::path& run, const DemoOptions& o, const DemoLog& log) {
-  auto frames = measureStats(dataset, run, o, true);
-  if (!frames) return std::unexpected(frames.error());
-  const auto [render, input] = datasetRenders(dataset, run, o, *frames);
-  auto rendered = runRender(render);
-  if (!rendered) return std::unexpected(rendered.error());
-  log(fmt::format("  rendered {} frames ({} already there) in {:.0f} s", rendered->rendered.size(), rendered->skipped.size(), rendered->seconds));
-
-  DiscardStage discard;
-  discard.frames = render.job.output;
-  // discard's defaults: the per-tap geometry test (docs/metrics.md), radiance relative to the frame.
-  discard.json = run / "discard.json";
-  discard.csv = run / "discard.csv";
-  discard.masks = run / "masks";
-  auto discarded = runDiscard(discard);
-  if (!discarded) return std::unexpected(discarded.error());
-  const auto& mean = discarded->run.mean;
-  log(fmt::format("  discard: frustum {:.2f} %, world position {:.2f} %, shading normal {:.2f} %, direct {:.2f} ± {:.2f} %, indirect {:.2f} ± {:.2f} %",
-                  mean.frustum, mean.position, mean.normal, mean.direct, mean.directInterval ? mean.directInterval->halfWidth() : 0.0,
-                  mean.indirect, mean.indirectInterval ? mean.indirectInterval->halfWidth() : 0.0));
-
-  // Temporal methods: each run over the input window and scored against the converged frames above.
-  auto renderedInput = runRender(input);
-  if (!renderedInput) return std::unexpected(renderedInput.error());
-  evaluate::EvaluateOptions evaluation;
-  evaluation.frames = input.job.output;
-  evaluation.reference = render.job.output;
-  evaluation.methods = o.methods;
-  evaluation.json = run / "evaluate.json";
-  evaluation.csv = run / "evaluate.csv";
-  evaluation.outDir = run / "evaluate";
-  auto evaluated = evaluate::runEvaluate(evaluation);
-  if (!evaluated) return std::unexpected(evaluated.error());
-  for (const auto& m : evaluated->methods)
-    log(fmt::format("  {} ({} spp input): FLIP {:.4f} ± {:.4f}, PSNR {:.2f} dB, history use {:.3f}", m.name, o.inputSamplesPerPixel, m.flip.mean,
-                    m.flip.standardError, m.psnr.mean, m.historyUse.mean));
-  return {};
 }
 
 }  // namespace
@@ -194,9 +100,9 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
     std::vector<std::pair<RenderStage, long>> items;
     for (const fs::path& dataset : {bot, fly}) {
       const fs::path run = o.output / "runs" / dataset.stem();
-      auto frames = measureStats(dataset, run, o, false);
-      if (!frames) return std::unexpected(frames.error());
-      const auto renders = datasetRenders(dataset, run, o, *frames);
+      auto stats = measureStats(dataset, run, static_cast<const DatasetRunSettings&>(o), false);
+      if (!stats) return std::unexpected(stats.error());
+      const auto renders = datasetRenders(dataset, run, static_cast<const DatasetRunSettings&>(o), static_cast<long>(stats->rows.front().properties.animationFrames));
       for (const RenderStage* stage : {&renders.reference, &renders.input})
         for (long f = stage->job.frames.first; f <= stage->job.frames.last; ++f) items.emplace_back(*stage, f);
     }
@@ -223,7 +129,7 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
     const fs::path run = o.output / "runs" / dataset.stem();
     log(fmt::format("{}: stats, render ({}x{}, {} frames, converged to tolerance {} with {}-{} spp, {} bounces, {} fps), discard -> {}", name,
                     o.width, o.height, o.renderFrames, o.tolerance, o.samplesPerPixel, o.maxSamplesPerPixel, o.bounces, o.fps, run.string()));
-    if (auto ok = measureDataset(dataset, run, o, log); !ok) return std::unexpected(ok.error());
+    if (auto ok = measureDataset(dataset, run, static_cast<const DatasetRunSettings&>(o), log); !ok) return std::unexpected(ok.error());
     runs.push_back(run);
   }
   report::ReportOptions r;

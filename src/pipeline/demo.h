@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "pipeline/dataset_run.h"
 
 namespace dynbench::demo {
 
@@ -20,25 +21,15 @@ enum class DemoPart {
   kRenderTask,  // only task renderTask's frames of the renders (framesPerTask frame renders a task)
 };
 
-struct DemoOptions {
+// The demo's datasets are measured with DatasetRunSettings' defaults: converged feature buffers
+// (render --converge) of 48 frames in the middle of the match at 96x54, a resolution two cores
+// render in about two minutes a dataset (fewer pixels rather than less convergence, so Table 6.7
+// describes the match, not the noise), and the methods' 4-spp input.
+struct DemoOptions : pipeline::DatasetRunSettings {
   std::filesystem::path output = "dynbench-demo";
   std::string map = "colos";
   int bots = 6;
   double seconds = 10.0;  // game time captured
-  unsigned seed = 1;
-  double fps = 24.0;      // stats, render and discard sample the datasets at this rate
-  // Converged feature buffers (render --converge) of a window of renderFrames consecutive frames
-  // in the middle of the match, at a resolution two cores render in about two minutes a dataset:
-  // fewer pixels rather than less convergence, so Table 6.7 describes the match, not the noise.
-  int width = 96, height = 54, samplesPerPixel = 16, bounces = 2;
-  double tolerance = 0.5;
-  int maxSamplesPerPixel = 512;
-  int renderFrames = 48;
-  // Temporal methods evaluated on each dataset: the window rendered again at this many samples per
-  // pixel (the input a real-time method gets), scored against the converged frames.
-  int inputSamplesPerPixel = 4;
-  std::vector<std::string> methods{"none", "accumulate", "taa", "svgf"};
-  int threads = 0;  // render threads (0: all cores)
   DemoPart part = DemoPart::kAll;
   int renderTask = 0, framesPerTask = 8;  // with kRenderTask
 };

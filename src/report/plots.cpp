@@ -52,7 +52,7 @@ Expected<std::vector<fs::path>> writeLineFigures(const fs::path& dir, const std:
   for (const auto& figure : figures) {
     for (const auto& [terminal, ext] : {std::pair{fmt::format("pngcairo noenhanced size 1200,{} font ',10'", height), ".png"},
                                         std::pair{fmt::format("svg noenhanced size 1200,{} dynamic font ',10'", height), ".svg"}}) {
-      const fs::path target = dir / (stem + "_" + figure.name + ext);
+      const fs::path target = dir / (stem + (figure.name.empty() ? std::string() : "_" + figure.name) + ext);
       const fs::path tmp = temporarySibling(target);
       std::string plot = figure.plot;
       for (std::size_t at; (at = plot.find("{data}")) != std::string::npos;) plot.replace(at, 6, d);
@@ -136,6 +136,21 @@ Expected<std::vector<fs::path>> writeMethodsPlot(const std::vector<std::pair<std
     plot += fmt::format("{}{{data}} using 1:{} with lines lw 1.5 dt {} title columnhead", column ? ", " : "", column + 2, 1 + column / 8);
   plot += "\nset xlabel 'frame'";
   return writeLineFigures(dir, stem, csv, {{"methods_flip", "ꟻLIP per frame of each temporal method (lower is better)", "mean ꟻLIP", plot}});
+}
+
+Expected<std::vector<fs::path>> writeScatterPlot(const std::vector<ScatterPoint>& points, const std::string& xLabel, const std::string& yLabel,
+                                                 const std::string& title, const fs::path& dir, const std::string& stem) {
+  std::string csv = "dataset,x,y\n";
+  for (const ScatterPoint& p : points) {
+    std::string label = p.label;
+    std::replace(label.begin(), label.end(), ',', ' ');
+    csv += fmt::format("{},{},{}\n", label, p.x, p.y);
+  }
+  const std::string plot = fmt::format(
+      "set xlabel {}\nplot {{data}} using 2:3 with points pt 7 ps 1.2 notitle, {{data}} using 2:3:1 with labels offset 0.6,0.6 left font ',8' "
+      "notitle\nset xlabel 'frame'",
+      quoted(xLabel));
+  return writeLineFigures(dir, stem, csv, {{"", title, yLabel, plot}}, 700);
 }
 
 namespace {

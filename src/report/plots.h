@@ -47,6 +47,16 @@ struct ComparisonSeries {
 Expected<std::vector<std::filesystem::path>> writeComparisonPlots(const std::vector<ComparisonSeries>& series,
                                                                   const std::filesystem::path& dir, const std::string& stem);
 
+// A scatter plot's point: one dataset.
+struct ScatterPoint {
+  std::string label;
+  double x = 0, y = 0;
+};
+// Writes <dir>/<stem>.png and .svg: the points, each labelled, on axes xLabel and yLabel.
+Expected<std::vector<std::filesystem::path>> writeScatterPlot(const std::vector<ScatterPoint>& points, const std::string& xLabel,
+                                                              const std::string& yLabel, const std::string& title,
+                                                              const std::filesystem::path& dir, const std::string& stem);
+
 Expected<std::vector<std::filesystem::path>> writeDiscardPlot(const std::vector<discard::FramePercentages>& frames,
                                                               const std::string& title, const std::filesystem::path& dir,
                                                               const std::string& stem);

@@ -1,0 +1,63 @@
+// `dynbench suite MANIFEST -o DIR` and `dynbench suite verify DIR` (pipeline/suite.h).
+#include "cli/commands.h"
+#include "pipeline/suite.h"
+
+namespace dynbench::cli {
+namespace {
+
+struct SuiteCli {
+  std::string manifest, output, verifyDir;
+  int threads = 0;
+};
+
+void printLine(const std::string& line) { fmt::print("{}\n", line); }
+
+Expected<void> runSuiteCli(const SuiteCli& cli) {
+  suite::SuiteOptions options;
+  options.manifest = cli.manifest;
+  options.output = cli.output;
+  options.threads = cli.threads;
+  auto outcome = suite::runSuite(options, printLine);
+  if (!outcome) return std::unexpected(outcome.error());
+  fmt::print("suite: {} datasets; {} and {}\n", outcome->datasets.size(), outcome->json.string(), outcome->markdown.string());
+  return {};
+}
+
+Expected<void> runVerify(const SuiteCli& cli) {
+  auto outcome = suite::verifySuite(cli.verifyDir, printLine);
+  if (!outcome) return std::unexpected(outcome.error());
+  for (const std::string& d : outcome->differences) fmt::print("differs: {}\n", d);
+  fmt::print("verify: {} files and {} numbers checked, {} differ\n", outcome->files, outcome->numbers, outcome->differences.size());
+  if (!outcome->differences.empty())
+    return fail(ErrorCode::kInvalidData, "{}: {} of the recorded files and numbers differ from what the files give now", cli.verifyDir,
+                outcome->differences.size());
+  return {};
+}
+
+}  // namespace
+
+void addSuiteCommand(CLI::App& app, CommandRun& run) {
+  auto cli = std::make_shared<SuiteCli>();
+  auto* cmd = app.add_subcommand("suite", "A benchmark of many datasets from one manifest: capture to method scores, and their validity");
+  cmd->footer(
+      "Captures, converts, flies through, renders (converged reference and real-time input), discards and evaluates every\n"
+      "dataset of MANIFEST into DIR (resuming what is complete), then writes DIR/suite.json (tool version, manifest,\n"
+      "numbers, SHA-256 of every file they come from) and DIR/suite.md (the validity table: Spearman's rho of each\n"
+      "difficulty measure with each method's error, bootstrap 95 % intervals). Format and definitions: docs/suite.md.\n"
+      "Example: dynbench suite suites/smoke.json -o smoke && dynbench suite verify smoke");
+  cmd->add_option("MANIFEST", cli->manifest, "The suite manifest (JSON, docs/suite.md)");
+  cmd->add_option("-o,--output", cli->output, "The suite's folder");
+  cmd->add_option("--threads", cli->threads, "Render threads (0: all cores)")->check(CLI::Range(0, 1024));
+  auto* verify = cmd->add_subcommand("verify", "Recompute every number of DIR/suite.json from its files and report any that differ");
+  verify->add_option("DIR", cli->verifyDir, "The suite's folder")->required();
+  cmd->callback([cmd, verify, cli, &run] {
+    if (verify->parsed()) {
+      run = [cli] { return runVerify(*cli); };
+      return;
+    }
+    if (cli->manifest.empty() || cli->output.empty()) throw CLI::RequiredError("MANIFEST and --output");
+    run = [cli] { return runSuiteCli(*cli); };
+  });
+}
+
+}  // namespace dynbench::cli

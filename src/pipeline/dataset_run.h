@@ -1,0 +1,61 @@
+#pragma once
+// One dataset measured end to end, as the demo and the suite do it: stats (Tables 6.1-6.6), a
+// converged reference render of a window of frames, discard (Table 6.7), the same window rendered
+// as a real-time renderer's input, and evaluate (the temporal methods against the reference). The
+// files are those the commands write, in one RUN folder (docs/cli.md, `demo`).
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "discard/discard.h"
+#include "evaluate/evaluate.h"
+#include "metrics/camera_motion.h"
+#include "pipeline/stages.h"
+
+namespace dynbench::pipeline {
+
+struct DatasetRunSettings {
+  double fps = 24.0;  // stats, render and discard sample the dataset at this rate
+  // Converged feature buffers (render --converge) of a window of renderFrames consecutive frames
+  // in the middle of the dataset: fewer pixels rather than less convergence, so Table 6.7
+  // describes the dataset, not the noise.
+  int width = 96, height = 54, samplesPerPixel = 16, bounces = 2;
+  double tolerance = 0.5;
+  int maxSamplesPerPixel = 512;
+  int renderFrames = 48;
+  // The temporal methods' input: the window again at this many samples per pixel, scored against
+  // the converged frames.
+  int inputSamplesPerPixel = 4;
+  std::vector<std::string> methods{"none", "accumulate", "taa", "svgf"};
+  unsigned seed = 1;  // the reference's; the input's is seed + 1
+  int threads = 0;    // render threads (0: all cores)
+};
+
+// The two renders of a dataset: converged reference frames (RUN/frames) and the temporal methods'
+// input (RUN/input), of the same window of frames around the middle of the dataset.
+struct DatasetRenders {
+  RenderStage reference, input;
+};
+DatasetRenders datasetRenders(const std::filesystem::path& dataset, const std::filesystem::path& run, const DatasetRunSettings& settings,
+                              long animationFrames);
+
+// The dataset's stats at settings.fps; with `files`, RUN/stats.json and the camera series too.
+Expected<StatsOutcome> measureStats(const std::filesystem::path& dataset, const std::filesystem::path& run, const DatasetRunSettings& settings,
+                                    bool files);
+
+struct DatasetRunOutcome {
+  metrics::CameraMotion motion;   // Tables 6.4-6.6 (every frame of the dataset at settings.fps)
+  long firstFrame = 0, lastFrame = 0;  // the rendered window
+  discard::FramePercentages discard;  // Table 6.7 (the window's mean)
+  std::vector<evaluate::MethodScores> methods;
+};
+// One line per stage (for the terminal and logs).
+using RunLog = std::function<void(const std::string&)>;
+// stats, render, discard, input render and evaluate of one dataset into RUN; renders already
+// complete with the same settings are reused.
+Expected<DatasetRunOutcome> measureDataset(const std::filesystem::path& dataset, const std::filesystem::path& run, const DatasetRunSettings& settings,
+                                           const RunLog& log);
+
+}  // namespace dynbench::pipeline

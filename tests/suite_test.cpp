@@ -1,0 +1,184 @@
+// `dynbench suite` and `suite verify` (pipeline/suite.h): the manifest's errors, and the smoke suite
+// run for real (Cube 2, the renderer, discard, evaluate), resumed, verified, and caught when a frame
+// is edited by hand.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fmt/format.h>
+
+#include "core/files.h"
+#include "frames/frame_io.h"
+#include "metrics/rank_correlation.h"
+#include "pipeline/suite.h"
+#include "external_tools.h"
+#include "gltf_builder.h"
+#include "run_cli.h"
+
+namespace dynbench {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSmoke = fs::path(DYNBENCH_SOURCE_DIR) / "suites" / "smoke.json";
+
+TEST(Suite, ManifestErrorsNameTheFileAndPointer) {
+  const fs::path dir = test::freshDir("suite_manifest");
+  // The repository's manifests read.
+  for (const char* name : {"smoke.json", "v1.json"}) {
+    auto m = suite::readManifest(fs::path(DYNBENCH_SOURCE_DIR) / "suites" / name);
+    ASSERT_TRUE(m) << m.error().message;
+    EXPECT_GE(m->datasets.size(), 4u);
+  }
+  const auto good = nlohmann::json::parse(test::slurp(kSmoke));
+  struct Case {
+    std::string pointer;
+    nlohmann::json value;  // null: remove the member
+    std::string expected;  // in the message
+  };
+  const std::vector<Case> cases{
+      {"/dynbench_suite", 2, "/dynbench_suite: expected 1"},
+      {"/datasets", nlohmann::json::array(), "/datasets: expected a non-empty array"},
+      {"/datasets/0/camera", "drone", "/datasets/0/camera: expected \"bot\" or \"flythrough\""},
+      {"/datasets/1/name", "fps-1-bot", "/datasets/1/name: expected a name no other dataset has"},
+      {"/datasets/0/preset", "frantic", "/datasets/0/preset"},
+      {"/datasets/0/engine", "openarena", "/datasets/0/engine: expected \"cube2\""},
+      {"/datasets/2/seconds", -3, "/datasets/2/seconds"},
+      {"/datasets/0/seed", nullptr, "/datasets/0/seed: missing"},
+      {"/render/width", 3, "/render/width: expected a whole number in [8, 7680]"},
+      {"/render/max_spp", 0, "/render/max_spp"},
+      {"/methods/1", 7, "/methods/1: expected a string"},
+      {"/name", "../up", "/name"},
+  };
+  for (const Case& c : cases) {
+    nlohmann::json doc = good;
+    const nlohmann::json::json_pointer p(c.pointer);
+    if (c.value.is_null()) doc[p.parent_pointer()].erase(p.back());
+    else doc[p] = c.value;
+    const fs::path file = dir / "bad.json";
+    ASSERT_TRUE(writeFileAtomic(file, doc.dump()));
+    auto m = suite::readManifest(file);
+    ASSERT_FALSE(m) << c.pointer;
+    EXPECT_EQ(m.error().code, ErrorCode::kInvalidData) << c.pointer;
+    EXPECT_NE(m.error().message.find("bad.json"), std::string::npos) << m.error().message;
+    EXPECT_NE(m.error().message.find(c.expected), std::string::npos) << m.error().message;
+    // Through the command: status 5, and nothing written.
+    const auto r = dynbench(fmt::format("suite {} -o {}", file.string(), (dir / "out").string()), dir);
+    EXPECT_EQ(r.status, 5) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out" / "suite.json"));
+  }
+  ASSERT_TRUE(writeFileAtomic(dir / "syntax.json", "{\"dynbench_suite\": 1,"));
+  EXPECT_EQ(dynbench(fmt::format("suite {} -o {}", (dir / "syntax.json").string(), (dir / "out").string()), dir).status, 4);
+  EXPECT_EQ(dynbench(fmt::format("suite {}", kSmoke.string()), dir).status, 2);  // no -o
+  EXPECT_EQ(dynbench(fmt::format("suite verify {}", (dir / "nowhere").string()), dir).status, 3);
+}
+
+TEST(Suite, ValidityRanksEachMeasureAgainstEachMethodsError) {
+  // Three datasets whose direct discard orders taa's cost of history exactly, and frustum the
+  // other way round.
+  std::vector<suite::DatasetResult> datasets;
+  for (int k = 0; k < 3; ++k) {
+    suite::DatasetResult d;
+    d.name = fmt::format("d{}", k);
+    d.measures = {{"direct", 10.0 * k}, {"frustum", 5.0 - k}};
+    d.errors["none"] = {{"flip", 0.2}, {"warped_error_change", 0.1}, {"flip_over_none", 0.0}};
+    d.errors["taa"] = {{"flip", 0.1 + 0.01 * k}, {"warped_error_change", 0.05}, {"flip_over_none", -0.1 + 0.01 * k}};
+    datasets.push_back(d);
+  }
+  const auto cells = suite::validity(datasets);
+  auto cell = [&](const std::string& measure, const std::string& method, const std::string& error) {
+    for (const auto& c : cells)
+      if (c.measure == measure && c.method == method && c.error == error) return c;
+    ADD_FAILURE() << measure << " " << method << " " << error;
+    return suite::ValidityCell{};
+  };
+  EXPECT_DOUBLE_EQ(*cell("direct", "taa", "flip_over_none").correlation.rho, 1.0);
+  EXPECT_DOUBLE_EQ(*cell("frustum", "taa", "flip_over_none").correlation.rho, -1.0);
+  EXPECT_EQ(cell("direct", "taa", "flip_over_none").datasets, 3);
+  EXPECT_FALSE(cell("direct", "none", "flip").correlation.rho);  // none's error is constant: no ranking
+  EXPECT_EQ(suite::rankingError("taa"), "flip_over_none");
+  EXPECT_EQ(suite::rankingError("none"), "flip");
+}
+
+TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
+  DYNBENCH_NEEDS(test::missingCube2());
+  const fs::path dir = test::freshDir("suite_smoke");
+  const fs::path out = dir / "smoke";
+  const auto r = dynbench(fmt::format("suite {} -o {}", kSmoke.string(), out.string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  const auto doc = nlohmann::json::parse(test::slurp(out / "suite.json"));
+  EXPECT_EQ(doc["dynbench_suite_results"], 1);
+  EXPECT_EQ(doc["manifest"], nlohmann::json::parse(test::slurp(kSmoke)));
+  ASSERT_EQ(doc["datasets"].size(), 4u);
+  // Each dataset's numbers are those its stages wrote: Table 6.7 from discard.json's mean, the
+  // methods' ꟻLIP from evaluate.json, flip_over_none their difference with none's.
+  for (const auto& d : doc["datasets"]) {
+    const fs::path run = out / d["run"].get<std::string>();
+    const auto discard = nlohmann::json::parse(test::slurp(run / "discard.json"));
+    EXPECT_NEAR(d["measures"]["direct"].get<double>(), discard["mean"]["direct_radiance"].get<double>(), 1e-9) << d["name"];
+    EXPECT_NEAR(d["measures"]["frustum"].get<double>(), discard["mean"]["frustum"].get<double>(), 1e-9) << d["name"];
+    const auto evaluation = nlohmann::json::parse(test::slurp(run / "evaluate.json"));
+    double noneFlip = -1;
+    for (const auto& m : evaluation["methods"])
+      if (m["name"] == "none") noneFlip = m["mean"]["flip"]["mean"].get<double>();
+    for (const auto& m : evaluation["methods"]) {
+      const std::string name = m["name"];
+      EXPECT_NEAR(d["errors"][name]["flip"].get<double>(), m["mean"]["flip"]["mean"].get<double>(), 1e-12);
+      EXPECT_NEAR(d["errors"][name]["flip_over_none"].get<double>(), m["mean"]["flip"]["mean"].get<double>() - noneFlip, 1e-12);
+    }
+    // Every frame of the window is recorded with its checksum.
+    EXPECT_TRUE(doc["files"].contains(d["dataset"].get<std::string>()));
+    const long window = d["window"]["last"].get<long>() - d["window"]["first"].get<long>() + 1;
+    EXPECT_EQ(window, 6);
+    EXPECT_TRUE(doc["files"].contains(fmt::format("{}/input/frame_{:05d}.exr", d["run"].get<std::string>(), d["window"]["first"].get<long>())));
+  }
+  // The fly-throughs share their bot's capture: two captures for four datasets.
+  EXPECT_EQ(std::distance(fs::directory_iterator(out / "captures"), fs::directory_iterator()), 2);
+  // The validity table: a cell per measure, method and error, rho from the recorded numbers.
+  ASSERT_FALSE(doc["validity"].empty());
+  for (const auto& c : doc["validity"]) {
+    if (c["measure"] != "direct" || c["method"] != "taa" || c["error"] != "flip_over_none") continue;
+    std::vector<double> x, y;
+    for (const auto& d : doc["datasets"]) x.push_back(d["measures"]["direct"]), y.push_back(d["errors"]["taa"]["flip_over_none"]);
+    EXPECT_NEAR(c["rho"].get<double>(), *metrics::spearman(x, y), 1e-12);
+  }
+  const std::string md = test::slurp(out / "suite.md");
+  EXPECT_NE(md.find("## Validity"), std::string::npos);
+  EXPECT_NE(md.find("| fps-2-flythrough "), std::string::npos);
+  for (const char* method : {"none", "accumulate", "taa", "svgf"}) EXPECT_TRUE(fs::exists(out / "plots" / fmt::format("scatter_{}.png", method)));
+
+  // Resumed: nothing captured again, the same numbers.
+  const auto again = dynbench(fmt::format("suite {} -o {}", kSmoke.string(), out.string()), dir);
+  ASSERT_EQ(again.status, 0) << again.err;
+  EXPECT_EQ(again.out.find("capture:"), std::string::npos) << again.out;
+  const auto doc2 = nlohmann::json::parse(test::slurp(out / "suite.json"));
+  EXPECT_EQ(doc2["datasets"], doc["datasets"]);
+  EXPECT_EQ(doc2["files"], doc["files"]);
+
+  // A clean run verifies.
+  const auto clean = dynbench(fmt::format("suite verify {}", out.string()), dir);
+  EXPECT_EQ(clean.status, 0) << clean.err << clean.out;
+  EXPECT_NE(clean.out.find(", 0 differ"), std::string::npos) << clean.out;
+
+  // One input frame edited by hand (its direct radiance doubled): verify names the file and the
+  // numbers that changed with it, and fails.
+  const std::string run = doc["datasets"][2]["run"];
+  const long first = doc["datasets"][2]["window"]["first"];
+  const fs::path inputDir = out / run / "input";
+  auto frames = frames::listFrames(inputDir);
+  ASSERT_TRUE(frames && frames->size() == 6);
+  auto frame = frames::readFrame((*frames)[3]);
+  ASSERT_TRUE(frame) << frame.error().message;
+  for (float& v : frame->direct) v *= 2.0f;
+  auto sidecar = frames::readSidecar((*frames)[3].sidecar);
+  ASSERT_TRUE(sidecar);
+  ASSERT_TRUE(frames::writeFrame(inputDir, *frame, sidecar->render));
+  const auto edited = dynbench(fmt::format("suite verify {}", out.string()), dir);
+  EXPECT_EQ(edited.status, 5) << edited.out;
+  EXPECT_NE(edited.out.find(fmt::format("{}/input/frame_{:05d}.exr: SHA-256 differs", run, first + 3)), std::string::npos) << edited.out;
+  EXPECT_NE(edited.out.find(fmt::format("{}: taa flip: recorded", doc["datasets"][2]["name"].get<std::string>())), std::string::npos) << edited.out;
+  // The reference frames and the other datasets did not change: their Table 6.7 numbers verify.
+  EXPECT_EQ(edited.out.find(": direct: recorded"), std::string::npos) << edited.out;
+}
+
+}  // namespace
+}  // namespace dynbench
