@@ -1,4 +1,6 @@
 // `dynbench suite MANIFEST -o DIR` and `dynbench suite verify DIR` (pipeline/suite.h).
+#include <cstdio>
+
 #include "cli/commands.h"
 #include "pipeline/suite.h"
 
@@ -10,7 +12,12 @@ struct SuiteCli {
   int threads = 0;
 };
 
-void printLine(const std::string& line) { fmt::print("{}\n", line); }
+// One line per stage, flushed: a suite runs for an hour, and its log (redirected, so fully
+// buffered) should show where it is.
+void printLine(const std::string& line) {
+  fmt::print("{}\n", line);
+  std::fflush(stdout);
+}
 
 Expected<void> runSuiteCli(const SuiteCli& cli) {
   suite::SuiteOptions options;

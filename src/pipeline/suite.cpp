@@ -1,6 +1,7 @@
 #include "pipeline/suite.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <set>
 
@@ -410,9 +411,15 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
                         {"ranking_error", "flip_over_none (flip for none)"},
                         {"datasets", nlohmann::json::array()},
                         {"files", nlohmann::json::object()}};
+  const auto start = std::chrono::steady_clock::now();
   for (std::size_t i = 0; i < manifest->datasets.size(); ++i) {
     const DatasetSpec& spec = manifest->datasets[i];
-    log(fmt::format("[{}/{}] {}", i + 1, manifest->datasets.size(), spec.name));
+    // Progress: datasets done, and the time left at the mean time a dataset has taken so far.
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const std::string pace = i == 0 ? std::string()
+                                    : fmt::format(" ({} done in {:.1f} min, about {:.0f} min left)", i, elapsed / 60.0,
+                                                  elapsed / static_cast<double>(i) * static_cast<double>(manifest->datasets.size() - i) / 60.0);
+    log(fmt::format("[{}/{}] {}{}", i + 1, manifest->datasets.size(), spec.name, pace));
     auto dataset = prepareDataset(spec, root, log);
     if (!dataset) return std::unexpected(dataset.error());
     const fs::path run = root / "runs" / spec.name;
