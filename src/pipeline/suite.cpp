@@ -257,7 +257,7 @@ bool newer(const fs::path& a, const fs::path& b) {
 }
 
 // The dataset (bot or fly-through) for one spec, captured, converted and flown as needed.
-Expected<fs::path> prepareDataset(const DatasetSpec& d, const fs::path& root, const pipeline::RunLog& log) {
+Expected<fs::path> prepareDataset(const DatasetSpec& d, const fs::path& root, double fps, const pipeline::RunLog& log) {
   auto plan = capturePlan(d, root);
   if (!plan) return std::unexpected(plan.error());
   const fs::path folder = root / "captures" / plan->key;
@@ -285,7 +285,7 @@ Expected<fs::path> prepareDataset(const DatasetSpec& d, const fs::path& root, co
   const fs::path fly = folder / "flythrough.gltf";
   if (!newer(fly, bot)) {
     flythrough::FlythroughOptions o;
-    o.frameRate = 24.0;
+    o.frameRate = fps;  // the rate the suite renders and measures at
     auto made = flythrough::makeFlythroughDataset(bot, fly, folder / "flythrough.csv", o);
     if (!made) return std::unexpected(made.error());
     log("  fly-through: " + flythrough::describe(*made));
@@ -420,7 +420,7 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
                                     : fmt::format(" ({} done in {:.1f} min, about {:.0f} min left)", i, elapsed / 60.0,
                                                   elapsed / static_cast<double>(i) * static_cast<double>(manifest->datasets.size() - i) / 60.0);
     log(fmt::format("[{}/{}] {}{}", i + 1, manifest->datasets.size(), spec.name, pace));
-    auto dataset = prepareDataset(spec, root, log);
+    auto dataset = prepareDataset(spec, root, settings.fps, log);
     if (!dataset) return std::unexpected(dataset.error());
     const fs::path run = root / "runs" / spec.name;
     DatasetRunSettings s = settings;
