@@ -2,6 +2,7 @@
 // cluster with scripts/slurm-local.sh (Debian's slurm-wlm and munge; its own folder and ports),
 // submits real job arrays, watches them with Slurm's own squeue and scontrol, and stops it.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <unistd.h>
 
@@ -301,6 +302,36 @@ TEST_F(Slurm, DemoAsAChainOfJobsGivesTheLocalDemosTables) {
   const std::string local = tables(test::slurp(dir / "local" / "report.md"));
   EXPECT_GT(std::count(local.begin(), local.end(), '\n'), 30);
   EXPECT_EQ(local, tables(test::slurp(dir / "cluster" / "report.md")));
+}
+
+TEST_F(Slurm, SuiteAsAChainOfJobsGivesTheLocalSuitesNumbers) {
+  DYNBENCH_NEEDS(test::missingCube2());
+  const auto dir = test::freshDir("slurm_suite");
+  const fs::path smoke = fs::path(DYNBENCH_SOURCE_DIR) / "suites" / "smoke.json";
+  auto r = dynbench(fmt::format("suite {} -o {} --slurm --frames-per-task 12", smoke.string(), (dir / "cluster").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  // Three jobs chained: the datasets, an array of 4 render tasks (4 datasets x 2 renders x 6
+  // frames = 48 frame renders, 12 a task), the whole suite.
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.out, m, std::regex("Slurm jobs: datasets (\\d+) .*render (\\d+) \\(4 tasks.*suite (\\d+) "))) << r.out;
+  EXPECT_NE(test::slurp(dir / "cluster" / "slurm" / "render.sbatch").find("#SBATCH --array=0-3\n"), std::string::npos);
+  r = dynbench(fmt::format("suite {} -o {}", smoke.string(), (dir / "local").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  // The same numbers and the same frames, byte for byte: the renders are seeded, whoever runs them.
+  // (Sidecars name the dataset's absolute path, so only the images are compared.)
+  const auto local = nlohmann::json::parse(test::slurp(dir / "local" / "suite.json"));
+  const auto cluster = nlohmann::json::parse(test::slurp(dir / "cluster" / "suite.json"));
+  EXPECT_EQ(local["datasets"], cluster["datasets"]);
+  EXPECT_EQ(local["validity"], cluster["validity"]);
+  std::size_t frames = 0;
+  for (const auto& [file, sum] : local["files"].items()) {
+    if (!file.ends_with(".exr")) continue;
+    ++frames;
+    EXPECT_EQ(sum, cluster["files"][file]) << file;
+  }
+  EXPECT_EQ(frames, 4u * 2 * 6);
+  // The cluster's suite verifies.
+  EXPECT_EQ(dynbench(fmt::format("suite verify {}", (dir / "cluster").string()), dir).status, 0);
 }
 
 TEST(SlurmScript, TimesAndQuotingAsSlurmAndTheShellRead) {

@@ -10,6 +10,10 @@ namespace {
 struct SuiteCli {
   std::string manifest, output, verifyDir;
   int threads = 0;
+  std::string part = "all";
+  int renderTask = 0, framesPerTask = 8;
+  bool slurm = false;
+  pipeline::slurm::Options slurmOptions;
 };
 
 // One line per stage, flushed: a suite runs for an hour, and its log (redirected, so fully
@@ -19,14 +23,42 @@ void printLine(const std::string& line) {
   std::fflush(stdout);
 }
 
+// suite --slurm: the chain of jobs, its changes of state printed once each.
+Expected<void> suiteOnSlurm(const suite::SuiteOptions& options, pipeline::slurm::Options slurm) {
+  slurm.framesPerTask = options.framesPerTask;
+  std::string last;
+  auto outcome = suite::runSuiteOnSlurm(options, slurm, [&](const pipeline::slurm::ChainStatus& s) {
+    const std::string line = fmt::format("datasets {}, render tasks {} pending, {} running, {} done, suite {}", s.datasets, s.render.pending,
+                                         s.render.running, s.render.done, s.report);
+    if (line != last) printLine(line);
+    last = line;
+  });
+  if (!outcome) return std::unexpected(outcome.error());
+  fmt::print("Slurm jobs: datasets {} ({}), render {} ({} tasks, {}), suite {} ({})\n", outcome->datasetsJob, outcome->datasetsScript.string(),
+             outcome->renderJob, outcome->renderTasks, outcome->renderScript.string(), outcome->reportJob, outcome->reportScript.string());
+  if (!outcome->waited) return {};
+  if (!outcome->failure.empty())
+    return fail(ErrorCode::kIncomplete, "suite --slurm: {}. Rerun `dynbench suite ... --slurm`: every part reuses what is complete", outcome->failure);
+  fmt::print("suite: {}\n", outcome->report.string());
+  return {};
+}
+
 Expected<void> runSuiteCli(const SuiteCli& cli) {
   suite::SuiteOptions options;
   options.manifest = cli.manifest;
   options.output = cli.output;
   options.threads = cli.threads;
+  options.part = cli.part == "datasets" ? suite::SuitePart::kDatasets : cli.part == "render" ? suite::SuitePart::kRenderTask : suite::SuitePart::kAll;
+  options.renderTask = cli.renderTask;
+  options.framesPerTask = cli.framesPerTask;
+  if (cli.slurm) {
+    if (options.part != suite::SuitePart::kAll) return fail(ErrorCode::kUsage, "--part: not with --slurm (the jobs it submits run the parts)");
+    return suiteOnSlurm(options, cli.slurmOptions);
+  }
   auto outcome = suite::runSuite(options, printLine);
   if (!outcome) return std::unexpected(outcome.error());
-  fmt::print("suite: {} datasets; {} and {}\n", outcome->datasets.size(), outcome->json.string(), outcome->markdown.string());
+  if (options.part == suite::SuitePart::kAll)
+    fmt::print("suite: {} datasets; {} and {}\n", outcome->datasets.size(), outcome->json.string(), outcome->markdown.string());
   return {};
 }
 
@@ -55,6 +87,14 @@ void addSuiteCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("MANIFEST", cli->manifest, "The suite manifest (JSON, docs/suite.md)");
   cmd->add_option("-o,--output", cli->output, "The suite's folder");
   cmd->add_option("--threads", cli->threads, "Render threads (0: all cores)")->check(CLI::Range(0, 1024));
+  cmd->add_option("--frames-per-task", cli->framesPerTask, "Frame renders per render task (with --slurm, or --part render)")->check(positive());
+  cmd->add_option("--part", cli->part, "Run one part, as `suite --slurm`'s jobs do: datasets (capture, convert, fly-through of every "
+                                       "dataset) or render (task --render-task's frame renders); all: everything")
+      ->check(CLI::IsMember({"all", "datasets", "render"}));
+  cmd->add_option("--render-task", cli->renderTask, "With --part render: which task's frame renders")->check(nonNegative());
+  addSlurmOptions(cmd, cli->slurm, cli->slurmOptions,
+                  "DIR/slurm: the datasets, then an array of render tasks of --frames-per-task frame renders, then the whole suite, chained with afterok",
+                  false);
   auto* verify = cmd->add_subcommand("verify", "Recompute every number of DIR/suite.json from its files and report any that differ");
   verify->add_option("DIR", cli->verifyDir, "The suite's folder")->required();
   cmd->callback([cmd, verify, cli, &run] {

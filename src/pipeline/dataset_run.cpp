@@ -101,4 +101,31 @@ Expected<DatasetRunOutcome> measureDataset(const fs::path& dataset, const fs::pa
 }
 
 
+Expected<void> renderTask(const std::vector<DatasetJob>& datasets, int task, int perTask, const std::string& what, const RunLog& log) {
+  std::vector<std::pair<RenderStage, long>> items;
+  for (const DatasetJob& d : datasets) {
+    auto stats = measureStats(d.dataset, d.run, d.settings, false);
+    if (!stats) return std::unexpected(stats.error());
+    const auto renders = datasetRenders(d.dataset, d.run, d.settings, static_cast<long>(stats->rows.front().properties.animationFrames));
+    for (const RenderStage* stage : {&renders.reference, &renders.input})
+      for (long f = stage->job.frames.first; f <= stage->job.frames.last; ++f) items.emplace_back(*stage, f);
+  }
+  const std::size_t first = static_cast<std::size_t>(task) * static_cast<std::size_t>(perTask);
+  const std::size_t last = std::min(items.size(), first + static_cast<std::size_t>(perTask));
+  if (first >= items.size()) log(fmt::format("render task {}: nothing to render ({} has {} frame renders)", task, what, items.size()));
+  for (std::size_t i = first; i < last;) {
+    std::size_t j = i;
+    while (j + 1 < last && items[j + 1].first.job.output == items[i].first.job.output) ++j;
+    RenderStage chunk = items[i].first;
+    chunk.job.frames.first = items[i].second;
+    chunk.job.frames.last = items[j].second;
+    auto rendered = runRender(chunk);
+    if (!rendered) return std::unexpected(rendered.error());
+    log(fmt::format("render task {}: {} frames {}-{}: {} rendered, {} already complete", task, chunk.job.output.string(), chunk.job.frames.first,
+                    chunk.job.frames.last, rendered->rendered.size(), rendered->skipped.size()));
+    i = j + 1;
+  }
+  return {};
+}
+
 }  // namespace dynbench::pipeline

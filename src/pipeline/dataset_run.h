@@ -58,4 +58,15 @@ using RunLog = std::function<void(const std::string&)>;
 Expected<DatasetRunOutcome> measureDataset(const std::filesystem::path& dataset, const std::filesystem::path& run, const DatasetRunSettings& settings,
                                            const RunLog& log);
 
+// One dataset of a render array: where it is, its RUN folder, and its settings.
+struct DatasetJob {
+  std::filesystem::path dataset, run;
+  DatasetRunSettings settings;
+};
+// One task of a render array over several datasets (demo --slurm, suite --slurm): item i of the
+// datasets' frame renders (dataset by dataset, reference before input, frame by frame), and task
+// `task` renders items task*perTask .. task*perTask+perTask-1, grouped by render into frame
+// ranges. Frames already complete are kept. `what` names the command in the log.
+Expected<void> renderTask(const std::vector<DatasetJob>& datasets, int task, int perTask, const std::string& what, const RunLog& log);
+
 }  // namespace dynbench::pipeline

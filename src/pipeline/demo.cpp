@@ -95,32 +95,9 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
   if (o.part == DemoPart::kDatasets) return fly;
 
   if (o.part == DemoPart::kRenderTask) {
-    // Item i of the demo's renders (dataset, then reference before input, then frame), and task k
-    // renders items k*F .. k*F+F-1, grouped by render into frame ranges.
-    std::vector<std::pair<RenderStage, long>> items;
-    for (const fs::path& dataset : {bot, fly}) {
-      const fs::path run = o.output / "runs" / dataset.stem();
-      auto stats = measureStats(dataset, run, static_cast<const DatasetRunSettings&>(o), false);
-      if (!stats) return std::unexpected(stats.error());
-      const auto renders = datasetRenders(dataset, run, static_cast<const DatasetRunSettings&>(o), static_cast<long>(stats->rows.front().properties.animationFrames));
-      for (const RenderStage* stage : {&renders.reference, &renders.input})
-        for (long f = stage->job.frames.first; f <= stage->job.frames.last; ++f) items.emplace_back(*stage, f);
-    }
-    const std::size_t first = static_cast<std::size_t>(o.renderTask) * static_cast<std::size_t>(o.framesPerTask);
-    const std::size_t last = std::min(items.size(), first + static_cast<std::size_t>(o.framesPerTask));
-    if (first >= items.size()) log(fmt::format("render task {}: nothing to render (the demo has {} frame renders)", o.renderTask, items.size()));
-    for (std::size_t i = first; i < last;) {
-      std::size_t j = i;
-      while (j + 1 < last && items[j + 1].first.job.output == items[i].first.job.output) ++j;
-      RenderStage chunk = items[i].first;
-      chunk.job.frames.first = items[i].second;
-      chunk.job.frames.last = items[j].second;
-      auto rendered = runRender(chunk);
-      if (!rendered) return std::unexpected(rendered.error());
-      log(fmt::format("render task {}: {} frames {}-{}: {} rendered, {} already complete", o.renderTask, chunk.job.output.string(),
-                      chunk.job.frames.first, chunk.job.frames.last, rendered->rendered.size(), rendered->skipped.size()));
-      i = j + 1;
-    }
+    std::vector<DatasetJob> datasets;
+    for (const fs::path& dataset : {bot, fly}) datasets.push_back({dataset, o.output / "runs" / dataset.stem(), o});
+    if (auto ok = renderTask(datasets, o.renderTask, o.framesPerTask, "the demo", log); !ok) return std::unexpected(ok.error());
     return o.output;
   }
 

@@ -473,40 +473,36 @@ std::vector<std::string> demoArguments(const demo::DemoOptions& o) {
           std::to_string(o.bounces), "--input-spp", std::to_string(o.inputSamplesPerPixel), "--methods", fmt::format("{}", fmt::join(o.methods, ","))};
 }
 
-Expected<DemoChainOutcome> demoChain(const demo::DemoOptions& demoIn, const Options& options,
-                                     const std::function<void(const DemoChainStatus&)>& progress) {
+Expected<ChainOutcome> chainOfJobs(const ChainSpec& spec, const Options& options, const std::function<void(const ChainStatus&)>& progress) {
   if (auto ok = checkCluster(options); !ok) return std::unexpected(ok.error());
-  demo::DemoOptions demo = demoIn;
-  demo.output = fs::absolute(demo.output).lexically_normal();
-  const fs::path jobDir = demo.output / "slurm";
+  const fs::path jobDir = spec.output / "slurm";
   std::error_code ec;
   fs::create_directories(jobDir, ec);
   if (ec) return fail(ErrorCode::kIo, "{}: cannot create the jobs' folder: {}", jobDir.string(), ec.message());
-  DemoChainOutcome out;
-  out.renderTasks = (demo::demoFrameRenders(demo) + options.framesPerTask - 1) / options.framesPerTask;
-  const std::string command = jobCommand(options, "demo", demoArguments(demo));
-  // Every part is the demo itself, run in the background so the signal trap can stop it; its
+  ChainOutcome out;
+  out.renderTasks = (spec.frameRenders + options.framesPerTask - 1) / options.framesPerTask;
+  const std::string command = jobCommand(options, spec.name, spec.arguments);
+  // Every part is the command itself, run in the background so the signal trap can stop it; its
   // outputs are written through temporary names, so a stopped part leaves nothing to clean.
   auto script = [&](const std::string& name, int tasks, const std::string& part, const std::string& what) {
-    std::string text = scriptHeader("dynbench-demo-" + name, tasks, jobDir, options);
-    text += fmt::format("#\n# Part of `dynbench demo --slurm` (docs/cluster.md): {}.\nset -u\n", what);
-    text += signalTrap("the demo's " + name, ":");
+    std::string text = scriptHeader(fmt::format("dynbench-{}-{}", spec.name, name), tasks, jobDir, options);
+    text += fmt::format("#\n# Part of `dynbench {} --slurm` (docs/cluster.md): {}.\nset -u\n", spec.name, what);
+    text += signalTrap(fmt::format("the {}'s {}", spec.name, name), ":");
     text += command + part + " &\nchild=$!\nwait \"$child\"\n";
     return text;
   };
   out.datasetsScript = jobDir / "datasets.sbatch";
   out.renderScript = jobDir / "render.sbatch";
   out.reportScript = jobDir / "report.sbatch";
-  Options single = options;
   for (const auto& [path, text] :
-       {std::pair{out.datasetsScript, script("datasets", 1, " --part datasets", "capture, convert and the fly-through")},
+       {std::pair{out.datasetsScript, script("datasets", 1, " --part datasets", spec.datasetsWhat)},
         std::pair{out.renderScript,
                   script("render", out.renderTasks,
                          fmt::format(" --part render --render-task \"$SLURM_ARRAY_TASK_ID\" --frames-per-task {} --threads \"${{SLURM_CPUS_PER_TASK:-1}}\"",
                                      options.framesPerTask),
-                         fmt::format("task k renders frame renders {0}k to {0}k+{1} of the demo's {2}", options.framesPerTask,
-                                     options.framesPerTask - 1, demo::demoFrameRenders(demo)))},
-        std::pair{out.reportScript, script("report", 1, "", "the whole demo, reusing the datasets and frames: stats, discard, evaluate, report")}})
+                         fmt::format("task k renders frame renders {0}k to {0}k+{1} of the {2}'s {3}", options.framesPerTask,
+                                     options.framesPerTask - 1, spec.name, spec.frameRenders))},
+        std::pair{out.reportScript, script("report", 1, "", spec.finalWhat)}})
     if (auto ok = writeScript(path, text); !ok) return std::unexpected(ok.error());
   auto datasets = submit(out.datasetsScript);
   if (!datasets) return std::unexpected(datasets.error());
@@ -520,10 +516,9 @@ Expected<DemoChainOutcome> demoChain(const demo::DemoOptions& demoIn, const Opti
   if (options.submitOnly) return out;
 
   const auto submitted = fs::file_time_type::clock::now();
-  const fs::path reportFile = demo.output / "report.html";
   auto reportWritten = [&] {
     std::error_code e;
-    return fs::is_regular_file(reportFile, e) && fs::last_write_time(reportFile, e) >= submitted;
+    return fs::is_regular_file(spec.finalFile, e) && fs::last_write_time(spec.finalFile, e) >= submitted;
   };
   // One-task jobs by their squeue state; the render array by its tasks.
   auto state = [&](const std::string& job, const std::function<bool()>& complete) -> Expected<std::string> {
@@ -532,10 +527,9 @@ Expected<DemoChainOutcome> demoChain(const demo::DemoOptions& demoIn, const Opti
     if (!q->empty()) return q->front().state;
     return complete() ? std::string("done") : std::string("failed");
   };
-  const fs::path fly = demo.output / "datasets" / (demo.map + "_flythrough.gltf");
   for (;;) {
-    DemoChainStatus status;
-    auto a = state(out.datasetsJob, [&] { return fs::is_regular_file(fly); });
+    ChainStatus status;
+    auto a = state(out.datasetsJob, [&] { return fs::is_regular_file(spec.datasetsDone); });
     if (!a) return std::unexpected(a.error());
     status.datasets = *a;
     auto r = queuedTasks(out.renderJob);
@@ -551,7 +545,7 @@ Expected<DemoChainOutcome> demoChain(const demo::DemoOptions& demoIn, const Opti
   }
   out.waited = true;
   if (reportWritten()) {
-    out.report = reportFile;
+    out.report = spec.finalFile;
     return out;
   }
   // Which part failed: the first whose job did not complete.
@@ -567,8 +561,24 @@ Expected<DemoChainOutcome> demoChain(const demo::DemoOptions& demoIn, const Opti
       break;
     }
   }
-  if (out.failure.empty()) out.failure = fmt::format("the report job ({}) ended without writing {}", out.reportJob, reportFile.string());
+  if (out.failure.empty()) out.failure = fmt::format("the last job ({}) ended without writing {}", out.reportJob, spec.finalFile.string());
   return out;
+}
+
+Expected<DemoChainOutcome> demoChain(const demo::DemoOptions& demoIn, const Options& options,
+                                     const std::function<void(const DemoChainStatus&)>& progress) {
+  demo::DemoOptions demo = demoIn;
+  demo.output = fs::absolute(demo.output).lexically_normal();
+  ChainSpec spec;
+  spec.name = "demo";
+  spec.output = demo.output;
+  spec.arguments = demoArguments(demo);
+  spec.frameRenders = demo::demoFrameRenders(demo);
+  spec.datasetsWhat = "capture, convert and the fly-through";
+  spec.finalWhat = "the whole demo, reusing the datasets and frames: stats, discard, evaluate, report";
+  spec.datasetsDone = demo.output / "datasets" / (demo.map + "_flythrough.gltf");
+  spec.finalFile = demo.output / "report.html";
+  return chainOfJobs(spec, options, progress);
 }
 
 }  // namespace dynbench::pipeline::slurm

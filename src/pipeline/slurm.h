@@ -136,18 +136,36 @@ Expected<CaptureArrayOutcome> captureArray(const capture::Cube2Options& capture,
 // The demo's command-line options but its part (the inverse of `dynbench demo`'s parsing).
 std::vector<std::string> demoArguments(const demo::DemoOptions& options);
 
-struct DemoChainStatus {
+// A chain of three jobs (demo --slurm, suite --slurm): the datasets, an array of render tasks, and
+// the whole command again, which reuses both and writes the final file.
+struct ChainStatus {
   std::string datasets, report;  // the one-task jobs' states: PENDING, RUNNING, done, failed
   ArrayStatus render;
 };
-struct DemoChainOutcome {
+struct ChainOutcome {
   std::string datasetsJob, renderJob, reportJob;
   std::filesystem::path datasetsScript, renderScript, reportScript;
   int renderTasks = 0;
-  std::filesystem::path report;  // OUT/report.html when the chain completed
+  std::filesystem::path report;  // the final file (OUT/report.html, OUT/suite.json) when the chain completed
   std::string failure;           // which job failed and where its log is; empty when complete
   bool waited = false;
 };
+using DemoChainStatus = ChainStatus;
+using DemoChainOutcome = ChainOutcome;
+struct ChainSpec {
+  std::string name;                     // the command: "demo" or "suite"
+  std::filesystem::path output;         // OUT, absolute: OUT/slurm holds the scripts and logs
+  std::vector<std::string> arguments;   // the command's arguments but its part
+  int frameRenders = 0;                 // divided among the render tasks
+  std::string datasetsWhat, finalWhat;  // what the first and last jobs do (script comments)
+  std::filesystem::path datasetsDone;   // a file the datasets job has written when it completed
+  std::filesystem::path finalFile;      // the file the last job writes
+};
+// Writes OUT/slurm/{datasets,render,report}.sbatch, each the command with `--part datasets`,
+// `--part render --render-task K --frames-per-task F`, and nothing, chained with
+// --dependency=afterok and --kill-on-invalid-dep=yes; waits for the last unless submitOnly.
+Expected<ChainOutcome> chainOfJobs(const ChainSpec& spec, const Options& options, const std::function<void(const ChainStatus&)>& progress = {});
+
 // `demo --slurm`: three jobs in OUT/slurm, each the demo itself: datasets.sbatch (capture, convert,
 // fly-through), render.sbatch (an array: the frame renders, options.framesPerTask a task) after it,
 // and report.sbatch (the whole demo, reusing everything, so only stats, discard, evaluate and the

@@ -395,6 +395,10 @@ Expected<std::string> suiteMarkdown(const Manifest& manifest, const std::vector<
 
 }  // namespace
 
+int suiteFrameRenders(const Manifest& manifest) {
+  return static_cast<int>(manifest.datasets.size()) * 2 * std::max(2, manifest.run.renderFrames);
+}
+
 Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::RunLog& log) {
   auto manifest = readManifest(options.manifest);
   if (!manifest) return std::unexpected(manifest.error());
@@ -405,6 +409,25 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
   DatasetRunSettings settings = manifest->run;
   settings.threads = options.threads;
   SuiteOutcome outcome;
+  if (options.part == SuitePart::kDatasets) {
+    for (std::size_t i = 0; i < manifest->datasets.size(); ++i) {
+      log(fmt::format("[{}/{}] {}", i + 1, manifest->datasets.size(), manifest->datasets[i].name));
+      if (auto dataset = prepareDataset(manifest->datasets[i], root, settings.fps, log); !dataset) return std::unexpected(dataset.error());
+    }
+    return outcome;
+  }
+  if (options.part == SuitePart::kRenderTask) {
+    std::vector<pipeline::DatasetJob> jobs;
+    for (const DatasetSpec& spec : manifest->datasets) {
+      auto plan = capturePlan(spec, root);
+      if (!plan) return std::unexpected(plan.error());
+      DatasetRunSettings s = settings;
+      s.seed = spec.seed;
+      jobs.push_back({root / "captures" / plan->key / (spec.camera == "bot" ? "bot.gltf" : "flythrough.gltf"), root / "runs" / spec.name, s});
+    }
+    if (auto ok = pipeline::renderTask(jobs, options.renderTask, options.framesPerTask, "the suite", log); !ok) return std::unexpected(ok.error());
+    return outcome;
+  }
   nlohmann::json doc = {{"dynbench_suite_results", kResultsVersion},
                         {"tool_version", kVersion},
                         {"manifest", manifest->document},
@@ -451,6 +474,26 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
   // suite.json last: its presence says the run is complete.
   if (auto ok = writeFileAtomic(outcome.json, doc.dump(2) + "\n"); !ok) return std::unexpected(ok.error());
   return outcome;
+}
+
+Expected<pipeline::slurm::ChainOutcome> runSuiteOnSlurm(const SuiteOptions& options, const pipeline::slurm::Options& slurm,
+                                                        const std::function<void(const pipeline::slurm::ChainStatus&)>& progress) {
+  auto manifest = readManifest(options.manifest);
+  if (!manifest) return std::unexpected(manifest.error());
+  const fs::path root = fs::absolute(options.output).lexically_normal();
+  pipeline::slurm::ChainSpec spec;
+  spec.name = "suite";
+  spec.output = root;
+  spec.arguments = {fs::absolute(options.manifest).lexically_normal().string(), "-o", root.string()};
+  spec.frameRenders = suiteFrameRenders(*manifest);
+  spec.datasetsWhat = "every dataset's capture, convert and fly-through";
+  spec.finalWhat = "the whole suite, reusing the datasets and frames: stats, discard, evaluate, suite.json";
+  const DatasetSpec& lastSpec = manifest->datasets.back();
+  auto plan = capturePlan(lastSpec, root);
+  if (!plan) return std::unexpected(plan.error());
+  spec.datasetsDone = root / "captures" / plan->key / (lastSpec.camera == "bot" ? "bot.gltf" : "flythrough.gltf");
+  spec.finalFile = root / "suite.json";
+  return pipeline::slurm::chainOfJobs(spec, slurm, progress);
 }
 
 Expected<VerifyOutcome> verifySuite(const fs::path& root, const pipeline::RunLog& log) {

@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "metrics/rank_correlation.h"
 #include "pipeline/dataset_run.h"
+#include "pipeline/slurm.h"
 
 namespace dynbench::suite {
 
@@ -68,10 +69,22 @@ std::string rankingError(const std::string& method);
 // Every (measure, method, error) cell, over the datasets' numbers.
 std::vector<ValidityCell> validity(const std::vector<DatasetResult>& datasets);
 
+// What one run of `suite` does: all of it, or one part of `suite --slurm`'s chain (each part reuses
+// what the parts before it made), as the demo's parts.
+enum class SuitePart {
+  kAll,         // every dataset end to end, then suite.json and suite.md
+  kDatasets,    // capture, convert and fly-through of every dataset only
+  kRenderTask,  // only task renderTask's frame renders (framesPerTask a task)
+};
 struct SuiteOptions {
   std::filesystem::path manifest, output;
   int threads = 0;  // render threads (0: all cores)
+  SuitePart part = SuitePart::kAll;
+  int renderTask = 0, framesPerTask = 8;  // with kRenderTask
 };
+// The most frame renders a suite makes (every dataset's reference and input window): what
+// `suite --slurm` divides among its render tasks.
+int suiteFrameRenders(const Manifest& manifest);
 struct SuiteOutcome {
   std::filesystem::path json, markdown;
   std::vector<DatasetResult> datasets;
@@ -82,6 +95,13 @@ struct SuiteOutcome {
 // and a fly-through when newer than their sources, rendered frames when complete with the same
 // settings.
 Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::RunLog& log);
+
+// `suite --slurm`: the chain of three jobs (pipeline/slurm.h's chainOfJobs) in DIR/slurm: every
+// dataset's capture, convert and fly-through; an array of render tasks (slurm.framesPerTask frame
+// renders each); and the whole suite again, which reuses both and writes suite.json. Waits for
+// suite.json unless slurm.submitOnly.
+Expected<pipeline::slurm::ChainOutcome> runSuiteOnSlurm(const SuiteOptions& options, const pipeline::slurm::Options& slurm,
+                                                        const std::function<void(const pipeline::slurm::ChainStatus&)>& progress = {});
 
 struct VerifyOutcome {
   std::size_t files = 0, numbers = 0;    // checked
