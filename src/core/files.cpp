@@ -43,6 +43,12 @@ Expected<void> commitTemporary(const std::filesystem::path& temporary,
   return {};
 }
 
+bool isNewerThan(const std::filesystem::path& a, const std::filesystem::path& b) {
+  std::error_code e1, e2;
+  const auto ta = std::filesystem::last_write_time(a, e1), tb = std::filesystem::last_write_time(b, e2);
+  return !e1 && !e2 && ta > tb;
+}
+
 Expected<void> writeFileAtomic(const std::filesystem::path& path, std::string_view contents) {
   std::error_code ec;
   if (path.has_parent_path()) {

@@ -14,6 +14,8 @@ Expected<std::string> readWholeFile(const std::filesystem::path& path);
 
 // Writes `contents` to `<path>.tmp-<pid>` and renames it over `path`. Creates parent folders.
 Expected<void> writeFileAtomic(const std::filesystem::path& path, std::string_view contents);
+// Whether `a` and `b` both exist and `a` was modified after `b` (an output newer than its source).
+bool isNewerThan(const std::filesystem::path& a, const std::filesystem::path& b);
 
 // Size in bytes, or an error naming the file.
 Expected<std::uint64_t> fileSize(const std::filesystem::path& path);

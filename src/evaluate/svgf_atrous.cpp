@@ -212,7 +212,11 @@ void AtrousPlanes::resize(int w, int h) {
 }
 
 void atrousIteration(AtrousPlanes& p, int step, const AtrousWeights& weights, AtrousPlanes& out) {
-  if (out.width != p.width || out.height != p.height) out.resize(p.width, p.height);
+  if (out.width != p.width || out.height != p.height) {
+    // Only the planes an iteration writes (r, g, b, variance): the rest would be 13 idle planes.
+    out.width = p.width, out.height = p.height, out.stride = p.stride;
+    for (auto* plane : {&out.r, &out.g, &out.b, &out.variance}) plane->assign(p.r.size(), 0.0f);
+  }
   const int w = p.width, h = p.height;
   // The illumination's luminance (Rec. 709) and the variance's 3x3 Gaussian (1, 2, 1)^2 / 16 at
   // clamped coordinates, once per iteration rather than once per tap; the Gaussian separably, rows

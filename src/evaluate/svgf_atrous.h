@@ -39,9 +39,9 @@ struct AtrousWeights {
 };
 
 // One iteration with taps `step` pixels apart: r, g, b and variance of `planes` filtered into
-// those of `out` (resized to match; its geometry planes are not touched; `planes`' scratch is). Pixels that hit nothing
-// are copied. The variance's 3x3 Gaussian prefilter of the luminance weight ([S17] Eq. 5) reads
-// clamped coordinates, as the scalar filter did.
+// those of `out` (those four planes resized to match, its others left alone; `planes`' scratch is
+// written). Pixels that hit nothing are copied. The variance's 3x3 Gaussian prefilter of the
+// luminance weight ([S17] Eq. 5) reads clamped coordinates, as the scalar filter did.
 void atrousIteration(AtrousPlanes& planes, int step, const AtrousWeights& weights, AtrousPlanes& out);
 
 // The variance estimate of [S17] §4.2 into `planes.variance`: where the history is 4 frames or

@@ -4,9 +4,74 @@
 
 #include <fmt/format.h>
 
+#include "convert/convert.h"
+#include "core/files.h"
+
 namespace dynbench::pipeline {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+// What makes a capture: the match options, compared as text with the record beside a capture.
+// Raised whenever the Cube 2 adapter changes what it records (2: the map's normals decoded as the
+// signed bytes they are; 3: lights keep their identity across frames, camera cuts), so that
+// captures an older adapter made are not reused.
+constexpr int kCaptureAdapterVersion = 3;
+
+std::string captureRecord(const capture::Cube2Options& c) {
+  return fmt::format("{{\"map\": \"{}\", \"mode\": \"{}\", \"bots\": {}, \"skill\": {}, \"follow\": \"{}\", \"seconds\": {}, \"seed\": {}, "
+                     "\"adapter\": {}}}\n",
+                     c.map, c.mode, c.bots, c.skill, c.follow, c.seconds, c.seed, kCaptureAdapterVersion);
+}
+
+}  // namespace
+
+Expected<void> captureAndConvert(const capture::Cube2Options& options, const fs::path& record, const fs::path& dataset, const RunLog& log) {
+  const fs::path& capture = options.output;
+  const std::string wanted = captureRecord(options);
+  auto recorded = readWholeFile(record);
+  std::error_code ec;
+  if (!(fs::exists(capture / "Capture.txt", ec) && recorded && *recorded == wanted)) {
+    if (fs::exists(capture, ec)) {
+      log(fmt::format("capture: {} was made with other options, capturing again", capture.string()));
+      fs::remove_all(capture, ec);
+      if (ec) return fail(ErrorCode::kIo, "{}: cannot remove the old capture: {}", capture.string(), ec.message());
+    }
+    fs::create_directories(record.parent_path(), ec);
+    log(fmt::format("capture: {} s of a {}-bot match on {} (seed {})", options.seconds, options.bots, options.map, options.seed));
+    auto captured = capture::captureCube2(options);
+    if (!captured) return std::unexpected(captured.error());
+    log(fmt::format("  {} frames in {:.0f} s{}", captured->frames, captured->wallSeconds,
+                    captured->clientStoppedAfterCapture ? " (the client did not exit after closing the capture; stopped)" : ""));
+    if (auto ok = writeFileAtomic(record, wanted); !ok) return std::unexpected(ok.error());
+  } else {
+    log(fmt::format("the capture {} exists, reused", (capture / "Capture.txt").string()));
+  }
+  if (!isNewerThan(dataset, capture / "Capture.txt")) {
+    log("convert: capture -> " + dataset.string());
+    convert::ConvertOptions convertOptions;
+    convertOptions.capture = capture;
+    convertOptions.output = dataset;
+    if (auto converted = convert::convertCapture(convertOptions); !converted) return std::unexpected(converted.error());
+  } else {
+    log("convert: " + dataset.string() + " is newer than the capture, reused");
+  }
+  return {};
+}
+
+Expected<void> flyThroughUnlessNewer(const fs::path& bot, const fs::path& fly, const fs::path& csv, const flythrough::FlythroughOptions& options,
+                                     const RunLog& log) {
+  if (isNewerThan(fly, bot)) {
+    log("fly-through: " + fly.string() + " is newer than its source, reused");
+    return {};
+  }
+  log("fly-through: a smooth camera over the same match -> " + fly.string());
+  auto flown = flythrough::makeFlythroughDataset(bot, fly, csv, options);
+  if (!flown) return std::unexpected(flown.error());
+  log("  " + flythrough::describe(*flown));
+  return {};
+}
 
 DatasetRenders datasetRenders(const fs::path& dataset, const fs::path& run, const DatasetRunSettings& o, long animationFrames) {
   RenderStage render;

@@ -8,10 +8,12 @@
 #include <string>
 #include <vector>
 
+#include "capture/cube2.h"
 #include "core/error.h"
 #include "discard/discard.h"
 #include "evaluate/evaluate.h"
 #include "metrics/camera_motion.h"
+#include "pipeline/flythrough.h"
 #include "pipeline/stages.h"
 
 namespace dynbench::pipeline {
@@ -33,6 +35,20 @@ struct DatasetRunSettings {
   int threads = 0;    // render threads (0: all cores)
 };
 
+// One line per stage (for the terminal and logs).
+using RunLog = std::function<void(const std::string&)>;
+
+// ---- a match's datasets (demo and suite) ------------------------------------------------------
+// A Cube 2 capture into options.output and the dataset converted from it, each made only when
+// stale: the capture unless `record` (a file) holds its match options and the adapter version, the
+// dataset unless it is newer than the capture. Anything made after a capture follows from it.
+Expected<void> captureAndConvert(const capture::Cube2Options& options, const std::filesystem::path& record, const std::filesystem::path& dataset,
+                                 const RunLog& log);
+// The fly-through of `bot` as the dataset `fly` (its pose log `csv`), made unless `fly` is newer
+// than `bot`.
+Expected<void> flyThroughUnlessNewer(const std::filesystem::path& bot, const std::filesystem::path& fly, const std::filesystem::path& csv,
+                                     const flythrough::FlythroughOptions& options, const RunLog& log);
+
 // The two renders of a dataset: converged reference frames (RUN/frames) and the temporal methods'
 // input (RUN/input), of the same window of frames around the middle of the dataset.
 struct DatasetRenders {
@@ -51,8 +67,6 @@ struct DatasetRunOutcome {
   discard::FramePercentages discard;  // Table 6.7 (the window's mean)
   std::vector<evaluate::MethodScores> methods;
 };
-// One line per stage (for the terminal and logs).
-using RunLog = std::function<void(const std::string&)>;
 // stats, render, discard, input render and evaluate of one dataset into RUN; renders already
 // complete with the same settings are reused.
 Expected<DatasetRunOutcome> measureDataset(const std::filesystem::path& dataset, const std::filesystem::path& run, const DatasetRunSettings& settings,

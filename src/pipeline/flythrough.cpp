@@ -111,15 +111,19 @@ class Flyer {
       : o_(o), duration_(duration), samples_(samples), walls_(walls) {}
 
   double poseTime(std::size_t n) const { return duration_ * static_cast<double>(n) / static_cast<double>(samples_ - 1); }
+  // Time t (from the start) between poses k and k + 1, at fraction a of the way.
+  std::pair<std::size_t, double> between(double t) const {
+    const double u = std::clamp(t / duration_, 0.0, 1.0) * static_cast<double>(samples_ - 1);
+    const auto k = std::min(static_cast<std::size_t>(u), samples_ - 2);
+    return {k, u - static_cast<double>(k)};
+  }
 
   // Tables 6.4-6.6 of the flight's poses at the frame rate (linear interpolation between poses).
   metrics::CameraMotionSummary motion(const Flight& f) const {
     std::vector<glm::dvec3> positions;
     std::vector<glm::dquat> rotations;
     for (double t = 0; t <= duration_ + 1e-9; t += 1.0 / o_.frameRate) {
-      const double u = std::clamp(t / duration_, 0.0, 1.0) * static_cast<double>(samples_ - 1);
-      const auto k = std::min(static_cast<std::size_t>(u), samples_ - 2);
-      const double a = u - static_cast<double>(k);
+      const auto [k, a] = between(t);
       positions.push_back(glm::mix(f.positions[k], f.positions[k + 1], a));
       rotations.push_back(orientation(f.yaw[k] + a * (f.yaw[k + 1] - f.yaw[k]), f.pitch[k] + a * (f.pitch[k + 1] - f.pitch[k])));
     }
@@ -175,9 +179,8 @@ class Flyer {
     auto perFrame = [&](const std::vector<double>& angle) {
       std::vector<double> changes;
       auto at = [&](double t) {
-        const double u = std::clamp(t / duration_, 0.0, 1.0) * static_cast<double>(samples_ - 1);
-        const auto k = std::min(static_cast<std::size_t>(u), samples_ - 2);
-        return angle[k] + (u - static_cast<double>(k)) * (angle[k + 1] - angle[k]);
+        const auto [k, a] = between(t);
+        return angle[k] + a * (angle[k + 1] - angle[k]);
       };
       for (double t = 1.0 / o_.frameRate; t <= duration_ + 1e-9; t += 1.0 / o_.frameRate)
         changes.push_back(std::abs(degrees(at(t) - at(t - 1.0 / o_.frameRate))));

@@ -8,7 +8,6 @@
 #include <fmt/format.h>
 
 #include "capture/cube2.h"
-#include "convert/convert.h"
 #include "core/checksum.h"
 #include "core/files.h"
 #include "core/json_fields.h"
@@ -59,12 +58,11 @@ Expected<Manifest> readManifest(const fs::path& path) {
 Expected<Manifest> parseManifest(const nlohmann::json& document, const fs::path& path) {
   Manifest m;
   m.document = document;
-  const nlohmann::json* doc = &m.document;
   const JsonFields f(m.document, path);
   auto bad = [&](const std::string& pointer, const std::string& expected) {
     return fail(ErrorCode::kInvalidData, "{}: {}: expected {}", path.string(), pointer, expected);
   };
-  if (!doc->is_object()) return bad("", "an object");
+  if (!m.document.is_object()) return bad("", "an object");
   auto version = f.integer("/dynbench_suite");
   if (!version) return std::unexpected(version.error());
   if (*version != kManifestVersion) return bad("/dynbench_suite", fmt::format("{} (the manifest version this dynbench reads), found {}", kManifestVersion, *version));
@@ -244,52 +242,25 @@ Expected<CapturePlan> capturePlan(const DatasetSpec& d, const fs::path& root) {
   return plan;
 }
 
-// What makes a capture, recorded beside it and compared as text (as the demo does).
-std::string captureRecord(const capture::Cube2Options& c) {
-  return fmt::format("{{\"map\": \"{}\", \"mode\": \"{}\", \"bots\": {}, \"skill\": {}, \"follow\": \"{}\", \"seconds\": {}, \"seed\": {}}}\n", c.map, c.mode,
-                     c.bots, c.skill, c.follow, c.seconds, c.seed);
-}
-
-bool newer(const fs::path& a, const fs::path& b) {
-  std::error_code e1, e2;
-  const auto ta = fs::last_write_time(a, e1), tb = fs::last_write_time(b, e2);
-  return !e1 && !e2 && ta > tb;
+// Where a spec's dataset lives: its capture's folder, bot.gltf or flythrough.gltf.
+Expected<fs::path> datasetPath(const DatasetSpec& d, const fs::path& root) {
+  auto plan = capturePlan(d, root);
+  if (!plan) return std::unexpected(plan.error());
+  return root / "captures" / plan->key / (d.camera == "bot" ? "bot.gltf" : "flythrough.gltf");
 }
 
 // The dataset (bot or fly-through) for one spec, captured, converted and flown as needed.
 Expected<fs::path> prepareDataset(const DatasetSpec& d, const fs::path& root, double fps, const pipeline::RunLog& log) {
   auto plan = capturePlan(d, root);
   if (!plan) return std::unexpected(plan.error());
-  const fs::path folder = root / "captures" / plan->key;
-  const fs::path capture = plan->options.output, record = folder / "capture-options.json";
-  const std::string wanted = captureRecord(plan->options);
-  auto recorded = readWholeFile(record);
-  std::error_code ec;
-  if (!(fs::exists(capture / "Capture.txt", ec) && recorded && *recorded == wanted)) {
-    fs::remove_all(capture, ec);
-    fs::create_directories(folder, ec);
-    log(fmt::format("  capture: {} s of {} with {} bots (seed {}) -> {}", d.seconds, plan->options.map, plan->options.bots, d.seed, capture.string()));
-    auto captured = capture::captureCube2(plan->options);
-    if (!captured) return std::unexpected(captured.error());
-    if (auto ok = writeFileAtomic(record, wanted); !ok) return std::unexpected(ok.error());
-  }
-  const fs::path bot = folder / "bot.gltf";
-  if (!newer(bot, capture / "Capture.txt")) {
-    log("  convert -> " + bot.string());
-    convert::ConvertOptions c;
-    c.capture = capture;
-    c.output = bot;
-    if (auto converted = convert::convertCapture(c); !converted) return std::unexpected(converted.error());
-  }
+  const fs::path folder = root / "captures" / plan->key, bot = folder / "bot.gltf";
+  auto indented = [&](const std::string& line) { log("  " + line); };
+  if (auto ok = pipeline::captureAndConvert(plan->options, folder / "capture-options.json", bot, indented); !ok) return std::unexpected(ok.error());
   if (d.camera == "bot") return bot;
+  flythrough::FlythroughOptions o;
+  o.frameRate = fps;  // the rate the suite renders and measures at
   const fs::path fly = folder / "flythrough.gltf";
-  if (!newer(fly, bot)) {
-    flythrough::FlythroughOptions o;
-    o.frameRate = fps;  // the rate the suite renders and measures at
-    auto made = flythrough::makeFlythroughDataset(bot, fly, folder / "flythrough.csv", o);
-    if (!made) return std::unexpected(made.error());
-    log("  fly-through: " + flythrough::describe(*made));
-  }
+  if (auto ok = pipeline::flyThroughUnlessNewer(bot, fly, folder / "flythrough.csv", o, indented); !ok) return std::unexpected(ok.error());
   return fly;
 }
 
@@ -419,11 +390,11 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
   if (options.part == SuitePart::kRenderTask) {
     std::vector<pipeline::DatasetJob> jobs;
     for (const DatasetSpec& spec : manifest->datasets) {
-      auto plan = capturePlan(spec, root);
-      if (!plan) return std::unexpected(plan.error());
+      auto dataset = datasetPath(spec, root);
+      if (!dataset) return std::unexpected(dataset.error());
       DatasetRunSettings s = settings;
       s.seed = spec.seed;
-      jobs.push_back({root / "captures" / plan->key / (spec.camera == "bot" ? "bot.gltf" : "flythrough.gltf"), root / "runs" / spec.name, s});
+      jobs.push_back({*dataset, root / "runs" / spec.name, s});
     }
     if (auto ok = pipeline::renderTask(jobs, options.renderTask, options.framesPerTask, "the suite", log); !ok) return std::unexpected(ok.error());
     return outcome;
@@ -488,10 +459,9 @@ Expected<pipeline::slurm::ChainOutcome> runSuiteOnSlurm(const SuiteOptions& opti
   spec.frameRenders = suiteFrameRenders(*manifest);
   spec.datasetsWhat = "every dataset's capture, convert and fly-through";
   spec.finalWhat = "the whole suite, reusing the datasets and frames: stats, discard, evaluate, suite.json";
-  const DatasetSpec& lastSpec = manifest->datasets.back();
-  auto plan = capturePlan(lastSpec, root);
-  if (!plan) return std::unexpected(plan.error());
-  spec.datasetsDone = root / "captures" / plan->key / (lastSpec.camera == "bot" ? "bot.gltf" : "flythrough.gltf");
+  auto lastDataset = datasetPath(manifest->datasets.back(), root);
+  if (!lastDataset) return std::unexpected(lastDataset.error());
+  spec.datasetsDone = *lastDataset;
   spec.finalFile = root / "suite.json";
   return pipeline::slurm::chainOfJobs(spec, slurm, progress);
 }
