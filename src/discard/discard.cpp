@@ -27,18 +27,6 @@ double meanLuminance(const std::vector<float>& rgb) {
 
 }  // namespace
 
-BilinearTaps bilinearTaps(double x, double y, int width, int height) {
-  // Texel space: pixel (i, j)'s centre is at (i + 0.5, j + 0.5).
-  const double u = std::clamp(x - 0.5, 0.0, static_cast<double>(width - 1));
-  const double v = std::clamp(y - 0.5, 0.0, static_cast<double>(height - 1));
-  const int x0 = std::min(static_cast<int>(u), width - 1), y0 = std::min(static_cast<int>(v), height - 1);
-  const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
-  const double tx = u - x0, ty = v - y0;
-  auto index = [width](int px, int py) { return static_cast<std::size_t>(py) * static_cast<std::size_t>(width) + static_cast<std::size_t>(px); };
-  return BilinearTaps{{index(x0, y0), index(x1, y0), index(x0, y1), index(x1, y1)},
-                      {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty}};
-}
-
 namespace {
 
 // Sum of weight x value over a set of taps (bilinear or cubic).

@@ -5,6 +5,8 @@
 // buffers are sampled bilinearly there and compared feature by feature (the discard functions of
 // §3.2.2). Percentages are of all w x h pixels (Eq. 3.4), averaged over the frames (Eq. 3.5).
 // docs/metrics.md states every definition, default and the treatment of pixels that hit nothing.
+#include <algorithm>
+#include <cstddef>
 #include <functional>
 #include <optional>
 #include <string>
@@ -106,7 +108,20 @@ struct BilinearTaps {
   std::size_t index[4];
   double weight[4];
 };
-BilinearTaps bilinearTaps(double x, double y, int width, int height);
+// The indices are into a buffer whose rows are `rowStride` apart from `origin` (a padded plane's);
+// by default the image's own. Inline: SVGF's temporal pass calls it per pixel (issue 34).
+inline BilinearTaps bilinearTaps(double x, double y, int width, int height, std::size_t rowStride = 0, std::size_t origin = 0) {
+  // Texel space: pixel (i, j)'s centre is at (i + 0.5, j + 0.5).
+  const double u = std::clamp(x - 0.5, 0.0, static_cast<double>(width - 1));
+  const double v = std::clamp(y - 0.5, 0.0, static_cast<double>(height - 1));
+  const int x0 = std::min(static_cast<int>(u), width - 1), y0 = std::min(static_cast<int>(v), height - 1);
+  const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
+  const double tx = u - x0, ty = v - y0;
+  const std::size_t stride = rowStride ? rowStride : static_cast<std::size_t>(width);
+  auto index = [&](int px, int py) { return origin + static_cast<std::size_t>(py) * stride + static_cast<std::size_t>(px); };
+  return BilinearTaps{{index(x0, y0), index(x1, y0), index(x0, y1), index(x1, y1)},
+                      {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty}};
+}
 glm::dvec3 sample3(const std::vector<float>& buffer, const BilinearTaps& taps);
 double sample1(const std::vector<float>& buffer, const BilinearTaps& taps);
 // The Catmull-Rom cubic's 4 x 4 taps around continuous pixel coordinates (x, y) (Keys' a = -0.5,

@@ -35,99 +35,18 @@ class SvgfMethod final : public TemporalMethod {
     return {{"alpha_colour", kAlphaColour}, {"alpha_moments", kAlphaMoments}, {"iterations", kIterations}, {"sigma_z", kSigmaZ},
             {"sigma_n", kSigmaN}, {"sigma_l", kSigmaL}, {"history_cap", kHistoryCap}};
   }
-  void reset() override { history_.width = history_.height = 0; }
+  void reset() override { hasHistory_ = false; }
 
   // Every plane in single precision and kept from frame to frame (fresh vectors cost a page fault
   // every 4 KiB: at 1080p a third of the method's time when it was in double, issue 34).
   Expected<MethodOutput> process(const frames::FeatureFrame& f) override {
     const int w = f.width, h = f.height;
     const std::size_t n = f.pixelCount();
-    const bool hasHistory = history_.width == w && history_.height == h;
+    const bool hasHistory = hasHistory_ && previous_.width == w && previous_.height == h;
     planes_.resize(w, h);
-    next_.resize(n);
 
-    // 1-2. Per pixel, rows in parallel (each pixel reads the inputs and the history alone):
-    // the depth gradient; demodulation; temporal accumulation; the à-trous planes.
-    const long kept = sumOverRows(h, [&](int y) {
-      long keptInRow = 0;
-      for (int x = 0; x < w; ++x) {
-        const std::size_t i = static_cast<std::size_t>(y) * w + x, j = planes_.at(x, y);
-        const bool surface = f.hit[i] > 0;
-        // Depth gradient: central differences where the neighbours are surfaces (the depth weight's
-        // scale).
-        auto dz = [&](int x0, int y0, int x1, int y1) {
-          const std::size_t a = static_cast<std::size_t>(std::clamp(y0, 0, h - 1)) * w + std::clamp(x0, 0, w - 1);
-          const std::size_t b = static_cast<std::size_t>(std::clamp(y1, 0, h - 1)) * w + std::clamp(x1, 0, w - 1);
-          return f.hit[a] > 0 && f.hit[b] > 0 ? (f.depth[b] - f.depth[a]) / static_cast<float>(std::max(1, (x1 - x0) + (y1 - y0))) : 0.0f;
-        };
-        // 1. Demodulate: illumination = radiance / albedo ([S17] §3). The radiance buffer holds the
-        // specular reflection too, which is not proportional to the base colour: a glTF dielectric
-        // reflects 0.96 base colour diffusely plus a 4 % (F0) white specular lobe (glTF 2.0,
-        // Appendix B), so the demodulating albedo is 0.96 base + 0.04. Dividing by the base colour
-        // alone magnifies the specular part of dark texels and spreads it over bright ones.
-        const float gradX = dz(x - 1, y, x + 1, y), gradY = dz(x, y - 1, x, y + 1);
-        float c[3], m1 = 0.0f, variance = 0.0f, length = 1.0f;
-        for (int k = 0; k < 3; ++k) c[k] = (f.direct[3 * i + k] + f.indirect[3 * i + k]) / albedo(f, i, k);
-        m1 = luminance(c[0], c[1], c[2]);
-        // 2. Temporal accumulation of the illumination and its luminance moments ([S17] §4.1). The
-        // moments are kept as the mean m1 and the variance v = m2 - m1^2 rather than m2, so single
-        // precision does not cancel two large second moments: blending history taps gives
-        // v = sum w v_k + sum w (m1_k - m1)^2 (weights normalised), and the exponential average
-        // m2 <- m2 + a (l^2 - m2) becomes v <- (1 - a) v + a (1 - a) (l - m1)^2.
-        if (surface && hasHistory) {
-          const History& p = history_;
-          // The motion vector starts at this pixel's sample; the previous buffers are at its samples.
-          const glm::dvec2 q = glm::dvec2(x + 0.5, y + 0.5) + f.camera.jitter + glm::dvec2(f.motion[2 * i], f.motion[2 * i + 1]) - p.jitter;
-          if (std::abs(f.motion[2 * i]) < 1e8 && q.x >= 0 && q.y >= 0 && q.x <= w && q.y <= h) {
-            const discard::BilinearTaps taps = discard::bilinearTaps(q.x, q.y, w, h);
-            const float fwidthZ = std::abs(gradX) + std::abs(gradY);
-            const glm::vec3 normal(f.normal[3 * i], f.normal[3 * i + 1], f.normal[3 * i + 2]);
-            float weight[4], sumW = 0.0f;
-            for (int k = 0; k < 4; ++k) {
-              const std::size_t t = taps.index[k];
-              weight[k] = 0.0f;
-              if (taps.weight[k] <= 0 || p.hit[t] <= 0 || p.id[t] != f.id[i]) continue;  // the same instance
-              if (std::abs(p.depth[t] - f.depth[i]) / (fwidthZ + 1e-2f) > kDepthReject) continue;
-              // [Falcor]'s normal test distance / (fwidth(n) + 0.01) > 16, with fwidth(n) taken as 0.
-              const glm::vec3 previousNormal(p.normal[3 * t], p.normal[3 * t + 1], p.normal[3 * t + 2]);
-              if (glm::length(previousNormal - normal) / 1e-2f > kNormalReject) continue;
-              weight[k] = static_cast<float>(taps.weight[k]), sumW += weight[k];
-            }
-            if (sumW >= 0.01f) {  // [Falcor] too little valid history below
-              float colour[3] = {0, 0, 0}, mean = 0.0f, len = 0.0f;
-              for (int k = 0; k < 4; ++k) {
-                const float wk = weight[k] / sumW;
-                const std::size_t t = taps.index[k];
-                colour[0] += wk * p.r[t], colour[1] += wk * p.g[t], colour[2] += wk * p.b[t];
-                mean += wk * p.moment1[t], len += wk * p.length[t];
-              }
-              float spread = 0.0f;
-              for (int k = 0; k < 4; ++k) {
-                const float d = p.moment1[taps.index[k]] - mean;
-                spread += weight[k] / sumW * (p.variance[taps.index[k]] + d * d);
-              }
-              length = static_cast<float>(std::min(kHistoryCap, static_cast<int>(std::lround(len)) + 1));
-              const float a = std::max(static_cast<float>(kAlphaColour), 1.0f / length);
-              const float am = std::max(static_cast<float>(kAlphaMoments), 1.0f / length);
-              for (int k = 0; k < 3; ++k) c[k] = colour[k] + a * (c[k] - colour[k]);
-              const float deviation = m1 - mean;
-              m1 = mean + am * deviation;
-              variance = (1.0f - am) * spread + am * (1.0f - am) * deviation * deviation;
-              ++keptInRow;
-            }
-          }
-        }
-        next_.moment1[i] = m1, next_.variance[i] = variance, next_.length[i] = length;
-        planes_.depth[j] = f.depth[i], planes_.hit[j] = surface ? 1.0f : 0.0f;
-        // The normal is 0 where nothing was hit (AtrousPlanes).
-        planes_.nx[j] = surface ? f.normal[3 * i] : 0.0f, planes_.ny[j] = surface ? f.normal[3 * i + 1] : 0.0f;
-        planes_.nz[j] = surface ? f.normal[3 * i + 2] : 0.0f;
-        planes_.gradX[j] = gradX, planes_.gradY[j] = gradY;
-        planes_.r[j] = c[0], planes_.g[j] = c[1], planes_.b[j] = c[2];
-        planes_.moment1[j] = m1, planes_.temporalVariance[j] = variance, planes_.historyLength[j] = length;
-      }
-      return keptInRow;
-    });
+    // 1-2. Per pixel, rows in parallel (each pixel reads the inputs and the history alone).
+    const long kept = sumOverRows(h, [&](int y) { return temporalRow(f, y, hasHistory); });
 
     // 3. Variance: from the temporal moments, or where the history is short (< 4 frames) from the
     // 7x7 bilateral neighbourhood's moments, boosted by 4 / length ([S17] §4.2, [Falcor]); then
@@ -138,51 +57,145 @@ class SvgfMethod final : public TemporalMethod {
     for (int iteration = 0; iteration < kIterations; ++iteration) {
       svgf::atrousIteration(planes_, 1 << iteration, {static_cast<float>(kSigmaZ), static_cast<float>(kSigmaL)}, filtered_);
       std::swap(planes_.r, filtered_.r), std::swap(planes_.g, filtered_.g), std::swap(planes_.b, filtered_.b);
-      std::swap(planes_.variance, filtered_.variance);
+      std::swap(planes_.variance, filtered_.variance), std::swap(planes_.luminance, filtered_.luminance);
       if (iteration == 0)
         tbb::parallel_for(0, h, [&](int y) {
           const std::size_t row = static_cast<std::size_t>(y) * w, j = planes_.at(0, y);
-          std::copy_n(planes_.r.data() + j, w, next_.r.data() + row);
-          std::copy_n(planes_.g.data() + j, w, next_.g.data() + row);
-          std::copy_n(planes_.b.data() + j, w, next_.b.data() + row);
+          std::copy_n(planes_.r.data() + j, w, planes_.historyR.data() + j);
+          std::copy_n(planes_.g.data() + j, w, planes_.historyG.data() + j);
+          std::copy_n(planes_.b.data() + j, w, planes_.historyB.data() + j);
         });
     }
 
-    // 5. Remodulate with the albedo; keep this frame's history.
+    // 5. Remodulate with the albedo; keep this frame's history (its geometry was written in step 1).
     RgbImage out{w, h, std::vector<float>(3 * n)};
     tbb::parallel_for(0, h, [&](int y) {
+      const std::size_t row = static_cast<std::size_t>(y) * w, j = planes_.at(0, y);
+      const float *r = planes_.r.data() + j, *g = planes_.g.data() + j, *b = planes_.b.data() + j;
+      const float *hit = f.hit.data() + row, *albedo = f.albedo.data() + 3 * row;
+      float* o = out.rgb.data() + 3 * row;
       for (int x = 0; x < w; ++x) {
-        const std::size_t i = static_cast<std::size_t>(y) * w + x, j = planes_.at(x, y);
-        const float c[3] = {planes_.r[j], planes_.g[j], planes_.b[j]};
-        for (int k = 0; k < 3; ++k) out.rgb[3 * i + k] = c[k] * albedo(f, i, k);
+        const bool surface = hit[x] > 0;
+        o[3 * x] = r[x] * demodulatingAlbedo(surface, albedo[3 * x]);
+        o[3 * x + 1] = g[x] * demodulatingAlbedo(surface, albedo[3 * x + 1]);
+        o[3 * x + 2] = b[x] * demodulatingAlbedo(surface, albedo[3 * x + 2]);
       }
     });
-    next_.width = w, next_.height = h, next_.jitter = f.camera.jitter;
-    next_.depth.assign(f.depth.begin(), f.depth.end()), next_.id.assign(f.id.begin(), f.id.end());
-    next_.hit.assign(f.hit.begin(), f.hit.end()), next_.normal.assign(f.normal.begin(), f.normal.end());
-    std::swap(history_, next_);
+    // This frame's planes are the next one's history.
+    hasHistory_ = true, previousJitter_ = f.camera.jitter;
+    std::swap(planes_, previous_);
     return MethodOutput{std::move(out), static_cast<double>(kept) / static_cast<double>(n)};
   }
 
  private:
-  // The demodulating albedo of channel k (step 1): 1 where nothing was hit.
-  static float albedo(const frames::FeatureFrame& f, std::size_t i, int k) {
-    if (f.hit[i] <= 0) return 1.0f;
-    return std::max(static_cast<float>(kDiffuseShare) * f.albedo[3 * i + k] + static_cast<float>(1.0 - kDiffuseShare), static_cast<float>(kAlbedoFloor));
+  // The demodulating albedo of a channel whose base colour is `base` (step 1): 1 where nothing was hit.
+  static float demodulatingAlbedo(bool surface, float base) {
+    if (!surface) return 1.0f;
+    return std::max(static_cast<float>(kDiffuseShare) * base + static_cast<float>(1.0 - kDiffuseShare), static_cast<float>(kAlbedoFloor));
   }
-  // The à-trous planes, kept between frames to save their allocation.
-  svgf::AtrousPlanes planes_, filtered_;
-  // The previous frame's illumination (after the first à-trous iteration), moments (mean and
-  // variance, step 2), history length and geometry; `next_` is filled while `history_` is read.
-  struct History {
-    int width = 0, height = 0;
-    glm::dvec2 jitter{0.0};
-    std::vector<float> r, g, b, moment1, variance, length, depth, id, hit, normal;
-    void resize(std::size_t n) {
-      for (auto* plane : {&r, &g, &b, &moment1, &variance, &length}) plane->resize(n);
+
+  // Steps 1-2 for row y: the depth gradient, the demodulation, the temporal accumulation; writes
+  // the à-trous planes (with the illumination's luminance) and the next frame's history. Returns
+  // the pixels whose history was kept.
+  long temporalRow(const frames::FeatureFrame& f, int y, bool hasHistory) {
+    const int w = f.width, h = f.height;
+    const std::size_t row = static_cast<std::size_t>(y) * w, j0 = planes_.at(0, y);
+    const std::size_t above = static_cast<std::size_t>(std::max(y - 1, 0)) * w, below = static_cast<std::size_t>(std::min(y + 1, h - 1)) * w;
+    const float *hit = f.hit.data(), *depth = f.depth.data(), *id = f.id.data() + row, *normal = f.normal.data() + 3 * row;
+    const float *albedo = f.albedo.data() + 3 * row, *direct = f.direct.data() + 3 * row, *indirect = f.indirect.data() + 3 * row;
+    const float* motion = f.motion.data() + 2 * row;
+    float *pz = planes_.depth.data() + j0, *phit = planes_.hit.data() + j0, *pnx = planes_.nx.data() + j0, *pny = planes_.ny.data() + j0;
+    float *pnz = planes_.nz.data() + j0, *pgx = planes_.gradX.data() + j0, *pgy = planes_.gradY.data() + j0;
+    float *pr = planes_.r.data() + j0, *pg = planes_.g.data() + j0, *pb = planes_.b.data() + j0;
+    float *pl = planes_.luminance.data() + j0, *pm1 = planes_.moment1.data() + j0, *pv = planes_.temporalVariance.data() + j0, *plen = planes_.historyLength.data() + j0;
+    float* pid = planes_.id.data() + j0;
+    // The previous frame's planes, read at the reprojected taps (padded indices).
+    const svgf::AtrousPlanes& p = previous_;
+    const float *histR = p.historyR.data(), *histG = p.historyG.data(), *histB = p.historyB.data(), *histM1 = p.moment1.data();
+    const float *histV = p.temporalVariance.data(), *histLength = p.historyLength.data(), *histZ = p.depth.data(), *histHit = p.hit.data();
+    const float *histId = p.id.data(), *histNx = p.nx.data(), *histNy = p.ny.data(), *histNz = p.nz.data();
+    const glm::dvec2 jitterShift = f.camera.jitter - previousJitter_;
+    long keptInRow = 0;
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = row + x;
+      const bool surface = hit[i] > 0;
+      // Depth gradient: central differences (half the difference of the clamped neighbours) where
+      // both neighbours are surfaces (the depth weight's scale).
+      const std::size_t left = row + std::max(x - 1, 0), right = row + std::min(x + 1, w - 1);
+      const float gradX = hit[left] > 0 && hit[right] > 0 ? (depth[right] - depth[left]) * 0.5f : 0.0f;
+      const float gradY = hit[above + x] > 0 && hit[below + x] > 0 ? (depth[below + x] - depth[above + x]) * 0.5f : 0.0f;
+      // 1. Demodulate: illumination = radiance / albedo ([S17] §3). The radiance buffer holds the
+      // specular reflection too, which is not proportional to the base colour: a glTF dielectric
+      // reflects 0.96 base colour diffusely plus a 4 % (F0) white specular lobe (glTF 2.0,
+      // Appendix B), so the demodulating albedo is 0.96 base + 0.04. Dividing by the base colour
+      // alone magnifies the specular part of dark texels and spreads it over bright ones.
+      float c[3], m1 = 0.0f, variance = 0.0f, length = 1.0f;
+      for (int k = 0; k < 3; ++k) c[k] = (direct[3 * x + k] + indirect[3 * x + k]) / demodulatingAlbedo(surface, albedo[3 * x + k]);
+      m1 = luminance(c[0], c[1], c[2]);
+      // The normal is 0 where nothing was hit (AtrousPlanes).
+      const float n[3] = {surface ? normal[3 * x] : 0.0f, surface ? normal[3 * x + 1] : 0.0f, surface ? normal[3 * x + 2] : 0.0f};
+      // 2. Temporal accumulation of the illumination and its luminance moments ([S17] §4.1). The
+      // moments are kept as the mean m1 and the variance v = m2 - m1^2 rather than m2, so single
+      // precision does not cancel two large second moments: blending history taps gives
+      // v = sum w v_k + sum w (m1_k - m1)^2 (weights normalised), and the exponential average
+      // m2 <- m2 + a (l^2 - m2) becomes v <- (1 - a) v + a (1 - a) (l - m1)^2.
+      if (surface && hasHistory && std::abs(motion[2 * x]) < 1e8) {
+        // The motion vector starts at this pixel's sample; the previous buffers are at its samples.
+        const glm::dvec2 q = glm::dvec2(x + 0.5, y + 0.5) + jitterShift + glm::dvec2(motion[2 * x], motion[2 * x + 1]);
+        if (q.x >= 0 && q.y >= 0 && q.x <= w && q.y <= h) {
+          const discard::BilinearTaps taps = discard::bilinearTaps(q.x, q.y, w, h, p.stride, p.at(0, 0));
+          const float fwidthZ = std::abs(gradX) + std::abs(gradY);
+          float weight[4], sumW = 0.0f;
+          for (int k = 0; k < 4; ++k) {
+            const std::size_t t = taps.index[k];
+            weight[k] = 0.0f;
+            if (taps.weight[k] <= 0 || histHit[t] <= 0 || histId[t] != id[x]) continue;  // the same instance
+            if (std::abs(histZ[t] - depth[i]) / (fwidthZ + 1e-2f) > kDepthReject) continue;
+            // [Falcor]'s normal test distance / (fwidth(n) + 0.01) > 16, with fwidth(n) taken as 0:
+            // |n' - n| > 0.16, compared squared.
+            const float dx = histNx[t] - n[0], dy = histNy[t] - n[1], dz = histNz[t] - n[2];
+            if (dx * dx + dy * dy + dz * dz > static_cast<float>(kNormalReject * 1e-2 * kNormalReject * 1e-2)) continue;
+            weight[k] = static_cast<float>(taps.weight[k]), sumW += weight[k];
+          }
+          if (sumW >= 0.01f) {  // [Falcor] too little valid history below
+            float colour[3] = {0, 0, 0}, mean = 0.0f, len = 0.0f;
+            for (int k = 0; k < 4; ++k) {
+              const float wk = weight[k] / sumW;
+              const std::size_t t = taps.index[k];
+              colour[0] += wk * histR[t], colour[1] += wk * histG[t], colour[2] += wk * histB[t];
+              mean += wk * histM1[t], len += wk * histLength[t];
+            }
+            float spread = 0.0f;
+            for (int k = 0; k < 4; ++k) {
+              const float d = histM1[taps.index[k]] - mean;
+              spread += weight[k] / sumW * (histV[taps.index[k]] + d * d);
+            }
+            // (len >= 0: adding 0.5 and truncating rounds half up, as lround.)
+            length = static_cast<float>(std::min(kHistoryCap, static_cast<int>(static_cast<double>(len) + 0.5) + 1));
+            const float a = std::max(static_cast<float>(kAlphaColour), 1.0f / length);
+            const float am = std::max(static_cast<float>(kAlphaMoments), 1.0f / length);
+            for (int k = 0; k < 3; ++k) c[k] = colour[k] + a * (c[k] - colour[k]);
+            const float deviation = m1 - mean;
+            m1 = mean + am * deviation;
+            variance = (1.0f - am) * spread + am * (1.0f - am) * deviation * deviation;
+            ++keptInRow;
+          }
+        }
+      }
+      pid[x] = id[x], pz[x] = depth[i], phit[x] = surface ? 1.0f : 0.0f, pnx[x] = n[0], pny[x] = n[1], pnz[x] = n[2];
+      pgx[x] = gradX, pgy[x] = gradY;
+      pr[x] = c[0], pg[x] = c[1], pb[x] = c[2], pl[x] = luminance(c[0], c[1], c[2]);
+      pm1[x] = m1, pv[x] = variance, plen[x] = length;
     }
-  };
-  History history_, next_;
+    return keptInRow;
+  }
+
+  // This frame's à-trous planes and the previous frame's (the history: its geometry, moments,
+  // history length and illumination after the first iteration), swapped after each frame; the
+  // iterations' scratch. Kept between frames to save their allocation.
+  svgf::AtrousPlanes planes_, previous_, filtered_;
+  bool hasHistory_ = false;
+  glm::dvec2 previousJitter_{0.0};
 };
 
 }  // namespace

@@ -11,12 +11,12 @@
 #ifndef DYNBENCH_SVGF_ATROUS_ARGS
 #define DYNBENCH_SVGF_ATROUS_ARGS
 namespace dynbench::evaluate::svgf {
-// What the kernel reads and writes: the padded planes (AtrousPlanes' layout), the prefiltered
-// variance and the luminance of the illumination.
+// What the kernel reads and writes: the padded planes (AtrousPlanes' layout) and the luminance of
+// the illumination, read and written.
 struct AtrousArgs {
-  const float *depth, *nx, *ny, *nz, *hit, *gradX, *gradY, *r, *g, *b, *variance, *luminance, *blurredVariance;
-  float *outR, *outG, *outB, *outVariance;
-  int width, stride, step;
+  const float *depth, *nx, *ny, *nz, *hit, *gradX, *gradY, *r, *g, *b, *variance, *luminance;
+  float *outR, *outG, *outB, *outVariance, *outLuminance;
+  int width, height, stride, step;
   float sigmaZ, sigmaL;
 };
 struct MomentsArgs {
@@ -88,9 +88,28 @@ HWY_INLINE V InverseDepthScale(D d, const Centre& c, float ox, float oy, V sigma
   return hn::Div(hn::Set(d, 1.0f), scale);
 }
 
+// The 3x3 Gaussian (1, 2, 1)^2 / 16 of the variance around c ([S17] Eq. 5's g(Var)): rows then
+// columns as a separable filter sums them. `above` and `below` are the rows' offsets, 0 at the
+// image's top and bottom edge (clamped coordinates); the padding's columns next to the image hold
+// the edge's values (atrousIteration), so the columns clamp too.
+HWY_INLINE V BlurredVariance(D d, const float* variance, std::size_t c, std::ptrdiff_t above, std::ptrdiff_t below) {
+  const V quarter = hn::Set(d, 0.25f), half = hn::Set(d, 0.5f);
+  auto row = [&](std::size_t centre) {
+    return hn::Add(hn::Add(hn::Mul(quarter, hn::LoadU(d, variance + centre - 1)), hn::Mul(half, hn::LoadU(d, variance + centre))),
+                   hn::Mul(quarter, hn::LoadU(d, variance + centre + 1)));
+  };
+  return hn::Add(hn::Add(hn::Mul(quarter, row(c - above)), hn::Mul(half, row(c))), hn::Mul(quarter, row(c + below)));
+}
+
+// Rec. 709 luminance.
+HWY_INLINE V Luminance(D d, V r, V g, V b) {
+  return hn::Add(hn::Add(hn::Mul(hn::Set(d, 0.2126f), r), hn::Mul(hn::Set(d, 0.7152f), g)), hn::Mul(hn::Set(d, 0.0722f), b));
+}
+
 // Rows [y0, y1): for each pixel the 5x5 taps `step` apart, weighted by the B3 spline times the
 // edge-stopping weight, the luminance's scale sigma_l sqrt(g(Var)) + 1e-10; the centre tap by the
-// spline alone; the variance by the squared weights ([S17] Eq. 2).
+// spline alone; the variance by the squared weights ([S17] Eq. 2). Also the output's luminance,
+// the next iteration's edge-stopping input (a pass of its own read three planes more).
 void AtrousRows(const AtrousArgs* a, int y0, int y1) {
   const D d;
   const std::size_t lanes = hn::Lanes(d);
@@ -100,13 +119,14 @@ void AtrousRows(const AtrousArgs* a, int y0, int y1) {
   const Geometry g{a->depth, a->nx, a->ny, a->nz, a->gradX, a->gradY, a->luminance};
   const int pad = AtrousPlanes::kPad;
   for (int y = y0; y < y1; ++y) {
+    const std::ptrdiff_t above = y > 0 ? a->stride : 0, below = y + 1 < a->height ? a->stride : 0;
     // Lanes beyond the row's last pixel read and write the padding (at least kPad wide, more than
     // a vector): their centre is not a hit, so they copy their input.
     for (int x = 0; x < a->width; x += static_cast<int>(lanes)) {
       const std::size_t c = static_cast<std::size_t>(y + pad) * static_cast<std::size_t>(a->stride) + static_cast<std::size_t>(x + pad);
       const V hitC = hn::LoadU(d, a->hit + c);
       const Centre centre = LoadCentre(d, g, c);
-      const V inverseLum = hn::Div(hn::Set(d, 1.0f), hn::MulAdd(sigmaL, hn::Sqrt(hn::Max(zero, hn::LoadU(d, a->blurredVariance + c))), lumEpsilon));
+      const V inverseLum = hn::Div(hn::Set(d, 1.0f), hn::MulAdd(sigmaL, hn::Sqrt(hn::Max(zero, BlurredVariance(d, a->variance, c, above, below))), lumEpsilon));
       // The centre tap weighs the spline alone; the others come in pairs o, -o sharing a depth scale.
       const V centreSpline = hn::Set(d, kSpline[0] * kSpline[0]);
       V sumR = hn::Mul(centreSpline, hn::LoadU(d, a->r + c)), sumG = hn::Mul(centreSpline, hn::LoadU(d, a->g + c));
@@ -131,9 +151,11 @@ void AtrousRows(const AtrousArgs* a, int y0, int y1) {
       // Where the centre is not a hit the sums may be 0: divide by 1 there, the result is not used.
       const V safeW = hn::IfThenElse(surface, sumW, hn::Set(d, 1.0f));
       const V inverse = hn::Div(hn::Set(d, 1.0f), safeW);
-      hn::StoreU(hn::IfThenElse(surface, hn::Mul(sumR, inverse), hn::LoadU(d, a->r + c)), d, a->outR + c);
-      hn::StoreU(hn::IfThenElse(surface, hn::Mul(sumG, inverse), hn::LoadU(d, a->g + c)), d, a->outG + c);
-      hn::StoreU(hn::IfThenElse(surface, hn::Mul(sumB, inverse), hn::LoadU(d, a->b + c)), d, a->outB + c);
+      const V outR = hn::IfThenElse(surface, hn::Mul(sumR, inverse), hn::LoadU(d, a->r + c));
+      const V outG = hn::IfThenElse(surface, hn::Mul(sumG, inverse), hn::LoadU(d, a->g + c));
+      const V outB = hn::IfThenElse(surface, hn::Mul(sumB, inverse), hn::LoadU(d, a->b + c));
+      hn::StoreU(outR, d, a->outR + c), hn::StoreU(outG, d, a->outG + c), hn::StoreU(outB, d, a->outB + c);
+      hn::StoreU(Luminance(d, outR, outG, outB), d, a->outLuminance + c);
       hn::StoreU(hn::IfThenElse(surface, hn::Mul(sumV, hn::Mul(inverse, inverse)), hn::LoadU(d, a->variance + c)), d, a->outVariance + c);
     }
   }
@@ -203,45 +225,33 @@ HWY_EXPORT(AtrousRows);
 HWY_EXPORT(MomentsRows);
 
 void AtrousPlanes::resize(int w, int h) {
+  // Only a new size allocates (and zeroes the padding): every pass writes the interior alone, or
+  // the padding's own value (AtrousRows), so the padding stays 0. Zeroing 17 planes every frame was
+  // 7 ms of a 1080p frame.
+  if (w == width && h == height && depth.size() > 0) return;
   width = w, height = h, stride = w + 2 * kPad;
   // (+ kPad: the last row's lanes past its end, a vector at most, read taps up to 2 x 16 further.)
   const std::size_t n = static_cast<std::size_t>(stride) * static_cast<std::size_t>(h + 2 * kPad) + kPad;
   for (auto* plane : {&depth, &nx, &ny, &nz, &hit, &gradX, &gradY, &r, &g, &b, &variance, &moment1, &temporalVariance, &historyLength, &luminance,
-                      &blurredVariance, &rowsOfBlur})
+                      &id, &historyR, &historyG, &historyB})
     plane->assign(n, 0.0f);
 }
 
 void atrousIteration(AtrousPlanes& p, int step, const AtrousWeights& weights, AtrousPlanes& out) {
   if (out.width != p.width || out.height != p.height) {
-    // Only the planes an iteration writes (r, g, b, variance): the rest would be 13 idle planes.
+    // Only the planes an iteration writes: the rest would be 12 idle planes.
     out.width = p.width, out.height = p.height, out.stride = p.stride;
-    for (auto* plane : {&out.r, &out.g, &out.b, &out.variance}) plane->assign(p.r.size(), 0.0f);
+    for (auto* plane : {&out.r, &out.g, &out.b, &out.variance, &out.luminance}) plane->assign(p.r.size(), 0.0f);
   }
   const int w = p.width, h = p.height;
-  // The illumination's luminance (Rec. 709) and the variance's 3x3 Gaussian (1, 2, 1)^2 / 16 at
-  // clamped coordinates, once per iteration rather than once per tap; the Gaussian separably, rows
-  // then columns, each a loop the compiler vectorises (with a clamped index per tap it took most of
-  // the iteration's time).
-  std::vector<float> &luminance = p.luminance, &blurRows = p.rowsOfBlur, &blurred = p.blurredVariance;
-  tbb::parallel_for(0, h, [&](int y) {
-    const std::size_t row = p.at(0, y);
-    const float *r = p.r.data() + row, *g = p.g.data() + row, *b = p.b.data() + row, *v = p.variance.data() + row;
-    float *l = luminance.data() + row, *out = blurRows.data() + row;
-    for (int x = 0; x < w; ++x) l[x] = 0.2126f * r[x] + 0.7152f * g[x] + 0.0722f * b[x];
-    for (int x = 1; x < w - 1; ++x) out[x] = 0.25f * v[x - 1] + 0.5f * v[x] + 0.25f * v[x + 1];
-    out[0] = 0.75f * v[0] + 0.25f * v[std::min(1, w - 1)];
-    if (w > 1) out[w - 1] = 0.25f * v[w - 2] + 0.75f * v[w - 1];
-  });
-  tbb::parallel_for(0, h, [&](int y) {
-    const float *above = blurRows.data() + p.at(0, std::max(y - 1, 0)), *centre = blurRows.data() + p.at(0, y);
-    const float* below = blurRows.data() + p.at(0, std::min(y + 1, h - 1));
-    float* out = blurred.data() + p.at(0, y);
-    for (int x = 0; x < w; ++x) out[x] = 0.25f * above[x] + 0.5f * centre[x] + 0.25f * below[x];
-  });
-  const AtrousArgs args{p.depth.data(), p.nx.data(),       p.ny.data(),       p.nz.data(),       p.hit.data(),       p.gradX.data(),
-                        p.gradY.data(), p.r.data(),        p.g.data(),        p.b.data(),        p.variance.data(),  luminance.data(),
-                        blurred.data(), out.r.data(),      out.g.data(),      out.b.data(),      out.variance.data(), w,
-                        p.stride,       step,              weights.sigmaZ,    weights.sigmaL};
+  // The variance's prefilter reads clamped coordinates: the padding's columns next to the image
+  // repeat its edge (the kernel's taps there weigh 0, whatever they hold).
+  float* variance = p.variance.data();
+  for (int y = 0; y < h; ++y) variance[p.at(-1, y)] = variance[p.at(0, y)], variance[p.at(w, y)] = variance[p.at(w - 1, y)];
+  const AtrousArgs args{p.depth.data(), p.nx.data(),   p.ny.data(),       p.nz.data(),         p.hit.data(),       p.gradX.data(),
+                        p.gradY.data(), p.r.data(),    p.g.data(),        p.b.data(),          p.variance.data(),  p.luminance.data(),
+                        out.r.data(),   out.g.data(),  out.b.data(),      out.variance.data(), out.luminance.data(), w,
+                        h,              p.stride,      step,              weights.sigmaZ,      weights.sigmaL};
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& rows) {
     HWY_DYNAMIC_DISPATCH(AtrousRows)(&args, rows.begin(), rows.end());
   });
@@ -249,15 +259,8 @@ void atrousIteration(AtrousPlanes& p, int step, const AtrousWeights& weights, At
 
 void estimateVariance(AtrousPlanes& p, float sigmaZ, float momentsSigmaL) {
   const int w = p.width, h = p.height;
-  std::vector<float>& luminance = p.luminance;
-  tbb::parallel_for(0, h, [&](int y) {
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = p.at(x, y);
-      luminance[i] = 0.2126f * p.r[i] + 0.7152f * p.g[i] + 0.0722f * p.b[i];
-    }
-  });
   const MomentsArgs args{p.depth.data(),    p.nx.data(),      p.ny.data(),         p.nz.data(),       p.hit.data(),
-                         p.gradX.data(),    p.gradY.data(),   luminance.data(),    p.moment1.data(),  p.temporalVariance.data(),
+                         p.gradX.data(),    p.gradY.data(),   p.luminance.data(),    p.moment1.data(),  p.temporalVariance.data(),
                          p.historyLength.data(), p.variance.data(), w,             p.stride,          sigmaZ,
                          momentsSigmaL};
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& rows) {

@@ -19,14 +19,14 @@ struct AtrousPlanes {
   // is then 0, which is how they skip such taps), hit (1 or 0), depth gradient (per pixel, a
   // pixel's step).
   std::vector<float> depth, nx, ny, nz, hit, gradX, gradY;
-  // Per iteration: the illumination being filtered and its variance.
-  std::vector<float> r, g, b, variance;
+  // Per iteration: the illumination being filtered, its variance and its luminance (Rec. 709).
+  std::vector<float> r, g, b, variance, luminance;
   // For the variance estimate: the temporally accumulated luminance moment m1, the variance
   // m2 - m1^2 of the accumulated moments (computed in double) and the history length.
   std::vector<float> moment1, temporalVariance, historyLength;
-  // Scratch of the filters (kept to save their allocation): the illumination's luminance, the
-  // variance's Gaussian prefilter and its rows.
-  std::vector<float> luminance, blurredVariance, rowsOfBlur;
+  // For the next frame's temporal pass: the instance id and the illumination after the first
+  // iteration ([S17] §4.1: the colour history).
+  std::vector<float> id, historyR, historyG, historyB;
 
   void resize(int w, int h);
   std::size_t at(int x, int y) const {
@@ -39,16 +39,19 @@ struct AtrousWeights {
 };
 
 // One iteration with taps `step` pixels apart: r, g, b and variance of `planes` filtered into
-// those of `out` (those four planes resized to match, its others left alone; `planes`' scratch is
-// written). Pixels that hit nothing are copied. The variance's 3x3 Gaussian prefilter of the
-// luminance weight ([S17] Eq. 5) reads clamped coordinates, as the scalar filter did.
+// those of `out`, with the luminance of the result (those five planes resized to match, its others
+// left alone; `planes`' variance padding is written). Pixels that hit nothing are copied. The
+// variance's 3x3 Gaussian prefilter of the luminance weight ([S17] Eq. 5) reads clamped
+// coordinates, as the scalar filter did. `planes.luminance` must be that of r, g, b (each
+// iteration writes its output's).
 void atrousIteration(AtrousPlanes& planes, int step, const AtrousWeights& weights, AtrousPlanes& out);
 
 // The variance estimate of [S17] §4.2 into `planes.variance`: where the history is 4 frames or
 // longer, the temporal moments' m2 - m1^2; where shorter, the moments of the 7x7 neighbourhood
 // weighted by the depth, normal and luminance edge-stopping weights (sigma_l = 10 on the
 // illumination's luminance, [Falcor] SVGFFilterMoments; the centre weighs 1), boosted by
-// 4 / length. Pixels that hit nothing get 0.
+// 4 / length. Pixels that hit nothing get 0. Reads `planes.luminance`, which the caller fills
+// with that of r, g, b.
 void estimateVariance(AtrousPlanes& planes, float sigmaZ, float momentsSigmaL);
 
 }  // namespace dynbench::evaluate::svgf
