@@ -52,35 +52,28 @@ class SvgfMethod final : public TemporalMethod {
     // 7x7 bilateral neighbourhood's moments, boosted by 4 / length ([S17] §4.2, [Falcor]); then
     // 4. the à-trous wavelet filter, 5 iterations with steps 1, 2, 4, 8, 16 ([S17] §4.3-4.4). Both
     // over SIMD lanes (svgf_atrous.h); the first iteration's output is the colour history of the
-    // next frame. Pixels that hit nothing pass through (their albedo is 1: the radiance).
+    // next frame. Pixels that hit nothing pass through (their albedo is 1: the radiance). The filters
+    // read `planes_.luminance`, written in step 1.
     svgf::estimateVariance(planes_, static_cast<float>(kSigmaZ), static_cast<float>(kMomentsSigmaL));
+    // The last iteration writes the output, remodulated with the albedo (5.).
+    RgbImage out{w, h, std::vector<float>(3 * n)};
+    const svgf::Remodulation remodulation{f.albedo.data(), static_cast<float>(kDiffuseShare), static_cast<float>(1.0 - kDiffuseShare),
+                                          static_cast<float>(kAlbedoFloor), out.rgb.data()};
+    static_assert(kIterations >= 2, "the colour history is kept after the second iteration");
     for (int iteration = 0; iteration < kIterations; ++iteration) {
-      svgf::atrousIteration(planes_, 1 << iteration, {static_cast<float>(kSigmaZ), static_cast<float>(kSigmaL)}, filtered_);
+      const bool last = iteration + 1 == kIterations;
+      svgf::atrousIteration(planes_, 1 << iteration, {static_cast<float>(kSigmaZ), static_cast<float>(kSigmaL)}, filtered_,
+                            last ? &remodulation : nullptr);
+      if (last) break;
       std::swap(planes_.r, filtered_.r), std::swap(planes_.g, filtered_.g), std::swap(planes_.b, filtered_.b);
       std::swap(planes_.variance, filtered_.variance), std::swap(planes_.luminance, filtered_.luminance);
-      if (iteration == 0)
-        tbb::parallel_for(0, h, [&](int y) {
-          const std::size_t row = static_cast<std::size_t>(y) * w, j = planes_.at(0, y);
-          std::copy_n(planes_.r.data() + j, w, planes_.historyR.data() + j);
-          std::copy_n(planes_.g.data() + j, w, planes_.historyG.data() + j);
-          std::copy_n(planes_.b.data() + j, w, planes_.historyB.data() + j);
-        });
+      // After the second iteration's swap the scratch holds the first's output: the next frame's
+      // colour history, swapped in rather than copied (the history planes' old contents, two
+      // frames old, become scratch).
+      if (iteration == 1)
+        std::swap(filtered_.r, planes_.historyR), std::swap(filtered_.g, planes_.historyG), std::swap(filtered_.b, planes_.historyB);
     }
 
-    // 5. Remodulate with the albedo; keep this frame's history (its geometry was written in step 1).
-    RgbImage out{w, h, std::vector<float>(3 * n)};
-    tbb::parallel_for(0, h, [&](int y) {
-      const std::size_t row = static_cast<std::size_t>(y) * w, j = planes_.at(0, y);
-      const float *r = planes_.r.data() + j, *g = planes_.g.data() + j, *b = planes_.b.data() + j;
-      const float *hit = f.hit.data() + row, *albedo = f.albedo.data() + 3 * row;
-      float* o = out.rgb.data() + 3 * row;
-      for (int x = 0; x < w; ++x) {
-        const bool surface = hit[x] > 0;
-        o[3 * x] = r[x] * demodulatingAlbedo(surface, albedo[3 * x]);
-        o[3 * x + 1] = g[x] * demodulatingAlbedo(surface, albedo[3 * x + 1]);
-        o[3 * x + 2] = b[x] * demodulatingAlbedo(surface, albedo[3 * x + 2]);
-      }
-    });
     // This frame's planes are the next one's history.
     hasHistory_ = true, previousJitter_ = f.camera.jitter;
     std::swap(planes_, previous_);
@@ -115,77 +108,79 @@ class SvgfMethod final : public TemporalMethod {
     const float *histV = p.temporalVariance.data(), *histLength = p.historyLength.data(), *histZ = p.depth.data(), *histHit = p.hit.data();
     const float *histId = p.id.data(), *histNx = p.nx.data(), *histNy = p.ny.data(), *histNz = p.nz.data();
     const glm::dvec2 jitterShift = f.camera.jitter - previousJitter_;
-    long keptInRow = 0;
+    // Step 1 for every pixel of the row, then step 2 for those with history, reading back what
+    // step 1 wrote.
     for (int x = 0; x < w; ++x) {
       const std::size_t i = row + x;
       const bool surface = hit[i] > 0;
       // Depth gradient: central differences (half the difference of the clamped neighbours) where
       // both neighbours are surfaces (the depth weight's scale).
       const std::size_t left = row + std::max(x - 1, 0), right = row + std::min(x + 1, w - 1);
-      const float gradX = hit[left] > 0 && hit[right] > 0 ? (depth[right] - depth[left]) * 0.5f : 0.0f;
-      const float gradY = hit[above + x] > 0 && hit[below + x] > 0 ? (depth[below + x] - depth[above + x]) * 0.5f : 0.0f;
+      pgx[x] = hit[left] > 0 && hit[right] > 0 ? (depth[right] - depth[left]) * 0.5f : 0.0f;
+      pgy[x] = hit[above + x] > 0 && hit[below + x] > 0 ? (depth[below + x] - depth[above + x]) * 0.5f : 0.0f;
       // 1. Demodulate: illumination = radiance / albedo ([S17] §3). The radiance buffer holds the
       // specular reflection too, which is not proportional to the base colour: a glTF dielectric
       // reflects 0.96 base colour diffusely plus a 4 % (F0) white specular lobe (glTF 2.0,
       // Appendix B), so the demodulating albedo is 0.96 base + 0.04. Dividing by the base colour
       // alone magnifies the specular part of dark texels and spreads it over bright ones.
-      float c[3], m1 = 0.0f, variance = 0.0f, length = 1.0f;
+      float c[3];
       for (int k = 0; k < 3; ++k) c[k] = (direct[3 * x + k] + indirect[3 * x + k]) / demodulatingAlbedo(surface, albedo[3 * x + k]);
-      m1 = luminance(c[0], c[1], c[2]);
+      pr[x] = c[0], pg[x] = c[1], pb[x] = c[2], pl[x] = pm1[x] = luminance(c[0], c[1], c[2]);
+      pv[x] = 0.0f, plen[x] = 1.0f;
       // The normal is 0 where nothing was hit (AtrousPlanes).
-      const float n[3] = {surface ? normal[3 * x] : 0.0f, surface ? normal[3 * x + 1] : 0.0f, surface ? normal[3 * x + 2] : 0.0f};
+      pnx[x] = surface ? normal[3 * x] : 0.0f, pny[x] = surface ? normal[3 * x + 1] : 0.0f, pnz[x] = surface ? normal[3 * x + 2] : 0.0f;
+      pid[x] = id[x], pz[x] = depth[i], phit[x] = surface ? 1.0f : 0.0f;
+    }
+    if (!hasHistory) return 0;
+    long keptInRow = 0;
+    for (int x = 0; x < w; ++x) {
       // 2. Temporal accumulation of the illumination and its luminance moments ([S17] §4.1). The
       // moments are kept as the mean m1 and the variance v = m2 - m1^2 rather than m2, so single
       // precision does not cancel two large second moments: blending history taps gives
       // v = sum w v_k + sum w (m1_k - m1)^2 (weights normalised), and the exponential average
       // m2 <- m2 + a (l^2 - m2) becomes v <- (1 - a) v + a (1 - a) (l - m1)^2.
-      if (surface && hasHistory && std::abs(motion[2 * x]) < 1e8) {
-        // The motion vector starts at this pixel's sample; the previous buffers are at its samples.
-        const glm::dvec2 q = glm::dvec2(x + 0.5, y + 0.5) + jitterShift + glm::dvec2(motion[2 * x], motion[2 * x + 1]);
-        if (q.x >= 0 && q.y >= 0 && q.x <= w && q.y <= h) {
-          const discard::BilinearTaps taps = discard::bilinearTaps(q.x, q.y, w, h, p.stride, p.at(0, 0));
-          const float fwidthZ = std::abs(gradX) + std::abs(gradY);
-          float weight[4], sumW = 0.0f;
-          for (int k = 0; k < 4; ++k) {
-            const std::size_t t = taps.index[k];
-            weight[k] = 0.0f;
-            if (taps.weight[k] <= 0 || histHit[t] <= 0 || histId[t] != id[x]) continue;  // the same instance
-            if (std::abs(histZ[t] - depth[i]) / (fwidthZ + 1e-2f) > kDepthReject) continue;
-            // [Falcor]'s normal test distance / (fwidth(n) + 0.01) > 16, with fwidth(n) taken as 0:
-            // |n' - n| > 0.16, compared squared.
-            const float dx = histNx[t] - n[0], dy = histNy[t] - n[1], dz = histNz[t] - n[2];
-            if (dx * dx + dy * dy + dz * dz > static_cast<float>(kNormalReject * 1e-2 * kNormalReject * 1e-2)) continue;
-            weight[k] = static_cast<float>(taps.weight[k]), sumW += weight[k];
-          }
-          if (sumW >= 0.01f) {  // [Falcor] too little valid history below
-            float colour[3] = {0, 0, 0}, mean = 0.0f, len = 0.0f;
-            for (int k = 0; k < 4; ++k) {
-              const float wk = weight[k] / sumW;
-              const std::size_t t = taps.index[k];
-              colour[0] += wk * histR[t], colour[1] += wk * histG[t], colour[2] += wk * histB[t];
-              mean += wk * histM1[t], len += wk * histLength[t];
-            }
-            float spread = 0.0f;
-            for (int k = 0; k < 4; ++k) {
-              const float d = histM1[taps.index[k]] - mean;
-              spread += weight[k] / sumW * (histV[taps.index[k]] + d * d);
-            }
-            // (len >= 0: adding 0.5 and truncating rounds half up, as lround.)
-            length = static_cast<float>(std::min(kHistoryCap, static_cast<int>(static_cast<double>(len) + 0.5) + 1));
-            const float a = std::max(static_cast<float>(kAlphaColour), 1.0f / length);
-            const float am = std::max(static_cast<float>(kAlphaMoments), 1.0f / length);
-            for (int k = 0; k < 3; ++k) c[k] = colour[k] + a * (c[k] - colour[k]);
-            const float deviation = m1 - mean;
-            m1 = mean + am * deviation;
-            variance = (1.0f - am) * spread + am * (1.0f - am) * deviation * deviation;
-            ++keptInRow;
-          }
-        }
+      if (phit[x] <= 0 || !(std::abs(motion[2 * x]) < 1e8)) continue;
+      // The motion vector starts at this pixel's sample; the previous buffers are at its samples.
+      const glm::dvec2 q = glm::dvec2(x + 0.5, y + 0.5) + jitterShift + glm::dvec2(motion[2 * x], motion[2 * x + 1]);
+      if (!(q.x >= 0 && q.y >= 0 && q.x <= w && q.y <= h)) continue;
+      const discard::BilinearTaps taps = discard::bilinearTaps(q.x, q.y, w, h, p.stride, p.at(0, 0));
+      const float fwidthZ = std::abs(pgx[x]) + std::abs(pgy[x]);
+      float weight[4], sumW = 0.0f;
+      for (int k = 0; k < 4; ++k) {
+        const std::size_t t = taps.index[k];
+        weight[k] = 0.0f;
+        if (taps.weight[k] <= 0 || histHit[t] <= 0 || histId[t] != pid[x]) continue;  // the same instance
+        if (std::abs(histZ[t] - pz[x]) / (fwidthZ + 1e-2f) > kDepthReject) continue;  // [Falcor]
+        // [Falcor]'s normal test distance / (fwidth(n) + 0.01) > 16, with fwidth(n) taken as 0:
+        // |n' - n| > 0.16, compared squared.
+        const float dx = histNx[t] - pnx[x], dy = histNy[t] - pny[x], dz = histNz[t] - pnz[x];
+        if (dx * dx + dy * dy + dz * dz > static_cast<float>(kNormalReject * 1e-2 * kNormalReject * 1e-2)) continue;
+        weight[k] = static_cast<float>(taps.weight[k]), sumW += weight[k];
       }
-      pid[x] = id[x], pz[x] = depth[i], phit[x] = surface ? 1.0f : 0.0f, pnx[x] = n[0], pny[x] = n[1], pnz[x] = n[2];
-      pgx[x] = gradX, pgy[x] = gradY;
+      if (sumW < 0.01f) continue;  // [Falcor] too little valid history below
+      float colour[3] = {0, 0, 0}, mean = 0.0f, len = 0.0f;
+      for (int k = 0; k < 4; ++k) {
+        weight[k] /= sumW;
+        const std::size_t t = taps.index[k];
+        colour[0] += weight[k] * histR[t], colour[1] += weight[k] * histG[t], colour[2] += weight[k] * histB[t];
+        mean += weight[k] * histM1[t], len += weight[k] * histLength[t];
+      }
+      float spread = 0.0f;
+      for (int k = 0; k < 4; ++k) {
+        const float d = histM1[taps.index[k]] - mean;
+        spread += weight[k] * (histV[taps.index[k]] + d * d);
+      }
+      // (len >= 0: adding 0.5 and truncating rounds half up, as lround.)
+      const float length = static_cast<float>(std::min(kHistoryCap, static_cast<int>(static_cast<double>(len) + 0.5) + 1));
+      const float a = std::max(static_cast<float>(kAlphaColour), 1.0f / length);
+      const float am = std::max(static_cast<float>(kAlphaMoments), 1.0f / length);
+      const float c[3] = {colour[0] + a * (pr[x] - colour[0]), colour[1] + a * (pg[x] - colour[1]), colour[2] + a * (pb[x] - colour[2])};
+      const float deviation = pm1[x] - mean;
       pr[x] = c[0], pg[x] = c[1], pb[x] = c[2], pl[x] = luminance(c[0], c[1], c[2]);
-      pm1[x] = m1, pv[x] = variance, plen[x] = length;
+      pm1[x] = mean + am * deviation;
+      pv[x] = (1.0f - am) * spread + am * (1.0f - am) * deviation * deviation;
+      plen[x] = length;
+      ++keptInRow;
     }
     return keptInRow;
   }

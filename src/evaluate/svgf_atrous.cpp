@@ -6,6 +6,8 @@
 
 #include <hwy/highway.h>
 
+#include <algorithm>
+
 #include "evaluate/svgf_atrous.h"
 
 #ifndef DYNBENCH_SVGF_ATROUS_ARGS
@@ -18,6 +20,7 @@ struct AtrousArgs {
   float *outR, *outG, *outB, *outVariance, *outLuminance;
   int width, height, stride, step;
   float sigmaZ, sigmaL;
+  const Remodulation* remodulation;  // when set, the output instead of out*
 };
 struct MomentsArgs {
   const float *depth, *nx, *ny, *nz, *hit, *gradX, *gradY, *luminance, *moment1, *temporalVariance, *historyLength;
@@ -106,6 +109,31 @@ HWY_INLINE V Luminance(D d, V r, V g, V b) {
   return hn::Add(hn::Add(hn::Mul(hn::Set(d, 0.2126f), r), hn::Mul(hn::Set(d, 0.7152f), g)), hn::Mul(hn::Set(d, 0.0722f), b));
 }
 
+// The lanes' colours remodulated (Remodulation) into pixels i, i + 1, ... of `m.rgb`, `valid` of them
+// (the row's last vector may reach past its end: those lanes go through a buffer).
+template <class M>
+HWY_INLINE void Remodulate(D d, const Remodulation& m, M surface, V r, V g, V b, std::size_t i, std::size_t valid) {
+  constexpr std::size_t kMaxLanes = HWY_MAX_BYTES / sizeof(float);
+  V baseR, baseG, baseB;
+  HWY_ALIGN float buffer[3 * kMaxLanes] = {};
+  const bool whole = valid == hn::Lanes(d);
+  if (whole) {
+    hn::LoadInterleaved3(d, m.baseColour + 3 * i, baseR, baseG, baseB);
+  } else {
+    std::copy_n(m.baseColour + 3 * i, 3 * valid, buffer);
+    hn::LoadInterleaved3(d, buffer, baseR, baseG, baseB);
+  }
+  const V diffuse = hn::Set(d, m.diffuseShare), specular = hn::Set(d, m.specularShare), floor = hn::Set(d, m.floor), one = hn::Set(d, 1.0f);
+  auto factor = [&](V base) { return hn::IfThenElse(surface, hn::Max(hn::Add(hn::Mul(diffuse, base), specular), floor), one); };
+  r = hn::Mul(r, factor(baseR)), g = hn::Mul(g, factor(baseG)), b = hn::Mul(b, factor(baseB));
+  if (whole) {
+    hn::StoreInterleaved3(r, g, b, d, m.rgb + 3 * i);
+  } else {
+    hn::StoreInterleaved3(r, g, b, d, buffer);
+    std::copy_n(buffer, 3 * valid, m.rgb + 3 * i);
+  }
+}
+
 // Rows [y0, y1): for each pixel the 5x5 taps `step` apart, weighted by the B3 spline times the
 // edge-stopping weight, the luminance's scale sigma_l sqrt(g(Var)) + 1e-10; the centre tap by the
 // spline alone; the variance by the squared weights ([S17] Eq. 2). Also the output's luminance,
@@ -154,6 +182,11 @@ void AtrousRows(const AtrousArgs* a, int y0, int y1) {
       const V outR = hn::IfThenElse(surface, hn::Mul(sumR, inverse), hn::LoadU(d, a->r + c));
       const V outG = hn::IfThenElse(surface, hn::Mul(sumG, inverse), hn::LoadU(d, a->g + c));
       const V outB = hn::IfThenElse(surface, hn::Mul(sumB, inverse), hn::LoadU(d, a->b + c));
+      if (a->remodulation) {
+        Remodulate(d, *a->remodulation, surface, outR, outG, outB, static_cast<std::size_t>(y) * static_cast<std::size_t>(a->width) + x,
+                   std::min(lanes, static_cast<std::size_t>(a->width - x)));
+        continue;
+      }
       hn::StoreU(outR, d, a->outR + c), hn::StoreU(outG, d, a->outG + c), hn::StoreU(outB, d, a->outB + c);
       hn::StoreU(Luminance(d, outR, outG, outB), d, a->outLuminance + c);
       hn::StoreU(hn::IfThenElse(surface, hn::Mul(sumV, hn::Mul(inverse, inverse)), hn::LoadU(d, a->variance + c)), d, a->outVariance + c);
@@ -216,6 +249,10 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 #include <algorithm>
 
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -223,6 +260,26 @@ namespace dynbench::evaluate::svgf {
 
 HWY_EXPORT(AtrousRows);
 HWY_EXPORT(MomentsRows);
+
+// Denormal floats flushed to 0 (and read as 0) in this thread while in scope. The filters' weights
+// reach 1e-35 (exp(-80)) and their squares, the variance's weights, underflow: x86 computes with a
+// denormal in about a hundred cycles, which made the iterations of wide steps, whose taps differ
+// most, up to half as slow again as the first (issue 34). What is lost is below 1.2e-38 of sums
+// near 1.
+class FlushDenormals {
+ public:
+#if defined(__SSE__)
+  FlushDenormals() : saved_(_mm_getcsr()) { _mm_setcsr(saved_ | 0x8040); }  // FTZ (bit 15), DAZ (bit 6)
+  ~FlushDenormals() { _mm_setcsr(saved_); }
+#else
+  FlushDenormals() = default;
+#endif
+  FlushDenormals(const FlushDenormals&) = delete;
+  FlushDenormals& operator=(const FlushDenormals&) = delete;
+
+ private:
+  [[maybe_unused]] unsigned saved_ = 0;
+};
 
 void AtrousPlanes::resize(int w, int h) {
   // Only a new size allocates (and zeroes the padding): every pass writes the interior alone, or
@@ -237,7 +294,7 @@ void AtrousPlanes::resize(int w, int h) {
     plane->assign(n, 0.0f);
 }
 
-void atrousIteration(AtrousPlanes& p, int step, const AtrousWeights& weights, AtrousPlanes& out) {
+void atrousIteration(AtrousPlanes& p, int step, const AtrousWeights& weights, AtrousPlanes& out, const Remodulation* remodulation) {
   if (out.width != p.width || out.height != p.height) {
     // Only the planes an iteration writes: the rest would be 12 idle planes.
     out.width = p.width, out.height = p.height, out.stride = p.stride;
@@ -251,8 +308,9 @@ void atrousIteration(AtrousPlanes& p, int step, const AtrousWeights& weights, At
   const AtrousArgs args{p.depth.data(), p.nx.data(),   p.ny.data(),       p.nz.data(),         p.hit.data(),       p.gradX.data(),
                         p.gradY.data(), p.r.data(),    p.g.data(),        p.b.data(),          p.variance.data(),  p.luminance.data(),
                         out.r.data(),   out.g.data(),  out.b.data(),      out.variance.data(), out.luminance.data(), w,
-                        h,              p.stride,      step,              weights.sigmaZ,      weights.sigmaL};
+                        h,              p.stride,      step,              weights.sigmaZ,      weights.sigmaL,      remodulation};
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& rows) {
+    const FlushDenormals flush;
     HWY_DYNAMIC_DISPATCH(AtrousRows)(&args, rows.begin(), rows.end());
   });
 }
@@ -264,6 +322,7 @@ void estimateVariance(AtrousPlanes& p, float sigmaZ, float momentsSigmaL) {
                          p.historyLength.data(), p.variance.data(), w,             p.stride,          sigmaZ,
                          momentsSigmaL};
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& rows) {
+    const FlushDenormals flush;
     HWY_DYNAMIC_DISPATCH(MomentsRows)(&args, rows.begin(), rows.end());
   });
 }

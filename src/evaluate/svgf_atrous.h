@@ -38,13 +38,24 @@ struct AtrousWeights {
   float sigmaZ = 1.0f, sigmaL = 4.0f;  // [S17] §4.4 (sigma_n = 128 is fixed: seven squarings)
 };
 
+// The last iteration's output remodulated with the albedo ([S17] §3), instead of its planes: RGB
+// interleaved and unpadded (width x height x 3), each channel times max(diffuseShare x base +
+// specularShare, floor) where the pixel hit a surface, times 1 elsewhere (the method's demodulation,
+// method_svgf.cpp, whose constants these are).
+struct Remodulation {
+  const float* baseColour;  // RGB interleaved, unpadded
+  float diffuseShare, specularShare, floor;
+  float* rgb;
+};
+
 // One iteration with taps `step` pixels apart: r, g, b and variance of `planes` filtered into
 // those of `out`, with the luminance of the result (those five planes resized to match, its others
 // left alone; `planes`' variance padding is written). Pixels that hit nothing are copied. The
 // variance's 3x3 Gaussian prefilter of the luminance weight ([S17] Eq. 5) reads clamped
 // coordinates, as the scalar filter did. `planes.luminance` must be that of r, g, b (each
 // iteration writes its output's).
-void atrousIteration(AtrousPlanes& planes, int step, const AtrousWeights& weights, AtrousPlanes& out);
+// With `remodulation`, the result goes there and `out` is not written.
+void atrousIteration(AtrousPlanes& planes, int step, const AtrousWeights& weights, AtrousPlanes& out, const Remodulation* remodulation = nullptr);
 
 // The variance estimate of [S17] §4.2 into `planes.variance`: where the history is 4 frames or
 // longer, the temporal moments' m2 - m1^2; where shorter, the moments of the 7x7 neighbourhood
