@@ -104,6 +104,48 @@ TEST(Methods, TaaAndSvgfReduceNoiseOnAStaticScene) {
   EXPECT_FALSE(createMethod("external:/no/such/dir", MethodContext{}).has_value());
 }
 
+TEST(Methods, SvgfReturnsAConstantIlluminationUnderAnyAlbedoAtAnyWidth) {
+  // Known answer: radiance = demodulating albedo (0.96 base + 0.04) x a constant illumination, so
+  // the demodulated image is constant, every filter's weighted mean of it is that constant, and the
+  // remodulated output is the input radiance. A width of 37 (not a multiple of any SIMD width)
+  // exercises the row's last partial vector; pixels that hit nothing pass their radiance through.
+  constexpr int w = 37, h = 11;
+  const glm::vec3 illumination(1.3f, 0.9f, 0.4f);
+  auto frame = [&](long index) {
+    frames::FeatureFrame f;
+    f.frame = index, f.time = index / 24.0;
+    f.resize(w, h);
+    frames::FrameCamera& c = f.camera;
+    c.view = glm::lookAt(glm::dvec3(0.0), glm::dvec3(0, 0, -1), glm::dvec3(0, 1, 0));
+    c.world = glm::inverse(c.view);
+    c.projection = glm::perspective(glm::radians(60.0), static_cast<double>(w) / h, 0.1, 100.0);
+    c.yfov = glm::radians(60.0), c.znear = 0.1, c.zfar = 100.0, c.width = w, c.height = h;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * w + x;
+        const bool sky = x == w - 1 && y % 3 == 0;
+        for (int k = 0; k < 3; ++k) {
+          const float base = 0.2f + 0.7f * static_cast<float>((x * 7 + y * 3 + k * 5) % 11) / 10.0f;
+          f.albedo[3 * i + k] = base;
+          f.normal[3 * i + k] = k == 2 && !sky ? 1.0f : 0.0f;
+          f.direct[3 * i + k] = sky ? 2.0f + k : (0.96f * base + 0.04f) * illumination[k];
+        }
+        f.depth[i] = sky ? 0.0f : 5.0f, f.hit[i] = sky ? 0.0f : 1.0f;
+      }
+    return f;
+  };
+  auto method = createMethod("svgf", MethodContext{});
+  ASSERT_TRUE(method.has_value());
+  for (long n = 1; n <= 3; ++n) {  // the first frame (no history) and two with history
+    const frames::FeatureFrame f = frame(n);
+    auto out = (*method)->process(f);
+    ASSERT_TRUE(out.has_value());
+    double worst = 0.0;
+    for (std::size_t j = 0; j < f.direct.size(); ++j) worst = std::max(worst, std::abs(out->image.rgb[j] / f.direct[j] - 1.0));
+    EXPECT_LT(worst, 1e-5) << "frame " << n;
+  }
+}
+
 // Stripes with sharp edges across the image, 1.65 pixels wide: finer than a pixel can resolve, so
 // a sample at a pixel's centre aliases and the pixel's integral is a blend.
 double stripes(double x, double y) {
