@@ -25,6 +25,9 @@ packages=(
   # the magma colour map of FLIP heatmaps, read from matplotlib's tables at build time
   # (tools/colormap/magma_header.py)
   python3-matplotlib
+  # the Python module (docs/python.md): pybind11 with its nlohmann::json bridge; its tests run
+  # pytest and compare frames with OpenImageIO's own Python binding
+  pybind11-dev pybind11-json-dev python3-dev python3-pytest python3-openimageio
   # headless Chromium: the tests open `dynbench report`'s HTML in a real browser
   chromium
   # ffmpeg: `dynbench report` encodes each run's video (VP9 WebM) with it

@@ -21,11 +21,7 @@ struct DiscardCli {
 };
 
 Expected<void> runDiscard(const DiscardCli& cli) {
-  discard::Thresholds thresholds = cli.thresholds;
-  // --relative-position sizes the bilinear test's threshold: it asks for the thesis's test.
-  if (thresholds.relativePosition) thresholds.geometryTest = discard::Thresholds::GeometryTest::kBilinear;
-  const bool bilinear = thresholds.geometryTest == discard::Thresholds::GeometryTest::kBilinear;
-  thresholds.position = cli.position.value_or(bilinear ? discard::kBilinearPositionThreshold : discard::Thresholds{}.position);
+  const discard::Thresholds thresholds = discard::withPositionDefault(cli.thresholds, cli.position);
   std::optional<Progress> progress;
   auto outcome = pipeline::runDiscard({cli.frames, thresholds, cli.includeCuts, cli.json, cli.csv, cli.masks, cli.plots},
                                       [&](std::size_t done, std::size_t total) {

@@ -131,6 +131,13 @@ Thresholds absoluteThresholds(const Thresholds& t, const FeatureFrame& current, 
   return a;
 }
 
+Thresholds withPositionDefault(Thresholds thresholds, std::optional<double> position) {
+  if (thresholds.relativePosition) thresholds.geometryTest = Thresholds::GeometryTest::kBilinear;
+  const bool bilinear = thresholds.geometryTest == Thresholds::GeometryTest::kBilinear;
+  thresholds.position = position.value_or(bilinear ? kBilinearPositionThreshold : Thresholds{}.position);
+  return thresholds;
+}
+
 const char* radianceTestName(Thresholds::RadianceTest test) {
   switch (test) {
     case Thresholds::RadianceTest::kExpected: return "expected";

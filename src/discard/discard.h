@@ -65,6 +65,10 @@ const char* radianceTestName(Thresholds::RadianceTest test);  // "expected", "no
 const char* geometryTestName(Thresholds::GeometryTest test);  // "taps", "bilinear"
 // The thesis's default world-position threshold of the bilinear test: 0.05 scene units.
 inline constexpr double kBilinearPositionThreshold = 0.05;
+// `thresholds` as `discard` (the CLI and the Python module) takes them: relativePosition asks for
+// the thesis's bilinear test; the position threshold is `position` or else the geometry test's
+// default (0.01 of the view depth for taps, kBilinearPositionThreshold for bilinear).
+Thresholds withPositionDefault(Thresholds thresholds, std::optional<double> position);
 
 // A 95 % interval of a percentage.
 struct Interval {

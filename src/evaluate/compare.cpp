@@ -189,6 +189,7 @@ Expected<CompareResult> runCompare(const CompareOptions& options) {
     auto written = writeFileAtomic(options.json, doc.dump(2) + "\n");
     if (!written) return std::unexpected(written.error());
   }
+  result.document = std::move(doc);
   return result;
 }
 

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "core/error.h"
 #include "evaluate/flip.h"
 
@@ -57,6 +59,7 @@ struct CompareOptions {
 struct CompareResult {
   std::vector<ImageScores> scores;  // one per test, in order
   std::string markdown;             // a table of the scores
+  nlohmann::json document;          // the --json document (docs/cli.md)
 };
 Expected<CompareResult> runCompare(const CompareOptions& options);
 

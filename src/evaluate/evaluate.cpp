@@ -138,7 +138,8 @@ Expected<EvaluateRun> runEvaluate(const EvaluateOptions& options, const Evaluate
     if (!referenceByFrame.count(e.frame))
       return fail(ErrorCode::kInvalidData, "{}: no reference for frame {} of {} (expected {})", options.reference.string(), e.frame,
                   options.frames.string(), frames::frameImagePath(options.reference, e.frame).string());
-  if (options.methods.empty()) return fail(ErrorCode::kUsage, "no methods to evaluate (expected some of {})", builtInMethodNames());
+  if (options.methods.empty() && options.callerMethods.empty())
+    return fail(ErrorCode::kUsage, "no methods to evaluate (expected some of {})", builtInMethodNames());
 
   EvaluateRun run;
   run.frames = options.frames, run.reference = options.reference;
@@ -147,14 +148,17 @@ Expected<EvaluateRun> runEvaluate(const EvaluateOptions& options, const Evaluate
   if (!first) return std::unexpected(first.error());
   run.width = first->width, run.height = first->height;
   MethodContext context{options.thresholds, discard::sceneSize(*first)};
-  std::vector<std::unique_ptr<TemporalMethod>> methods;
+  std::vector<std::shared_ptr<TemporalMethod>> methods;
   for (const std::string& spec : options.methods) {
     auto m = createMethod(spec, context);
     if (!m) return std::unexpected(m.error());
-    MethodScores scores;
-    scores.name = (*m)->name(), scores.parameters = (*m)->parameters();
-    run.methods.push_back(std::move(scores));
     methods.push_back(std::move(*m));
+  }
+  methods.insert(methods.end(), options.callerMethods.begin(), options.callerMethods.end());
+  for (const auto& m : methods) {
+    MethodScores scores;
+    scores.name = m->name(), scores.parameters = m->parameters();
+    run.methods.push_back(std::move(scores));
   }
   if (!options.outDir.empty())
     for (const auto& m : run.methods) {

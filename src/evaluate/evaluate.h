@@ -3,6 +3,7 @@
 // scored against the converged render of the same frames (docs/metrics.md, "Temporal methods").
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "core/error.h"
 #include "discard/discard.h"
 #include "evaluate/flip.h"
+#include "evaluate/method.h"
 
 namespace dynbench::evaluate {
 
@@ -19,6 +21,9 @@ struct EvaluateOptions {
   std::filesystem::path frames;     // the input: noisy radiance, G-buffers, motion
   std::filesystem::path reference;  // converged frames of the same frame numbers and size
   std::vector<std::string> methods{"none", "accumulate", "taa", "svgf"};
+  // Methods the caller made (the Python module's), scored after `methods` exactly as they are: reset
+  // at the first frame and at every cut, then given every frame in order.
+  std::vector<std::shared_ptr<TemporalMethod>> callerMethods;
   // The history tests of `accumulate` and of the warped-error mask: discard's default geometry
   // test (per tap: plane distance 1 % of the view depth, normal 0.1).
   discard::Thresholds thresholds;

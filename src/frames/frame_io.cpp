@@ -185,10 +185,28 @@ Expected<Sidecar> readSidecar(const fs::path& path) {
   return s;
 }
 
+namespace {
+const std::regex& frameFilePattern() {
+  static const std::regex pattern(R"(frame_(\d{1,18})\.(exr|json))");
+  return pattern;
+}
+}  // namespace
+
+Expected<FrameEntry> frameEntry(const fs::path& file) {
+  std::smatch m;
+  const std::string name = file.filename().string();
+  if (!std::regex_match(name, m, frameFilePattern()))
+    return fail(ErrorCode::kUsage, "{}: not a frame (expected frame_NNNNN.exr or frame_NNNNN.json, docs/feature-buffers.md)", file.string());
+  FrameEntry entry;
+  entry.frame = std::stol(m[1].str());
+  entry.image = fs::path(file).replace_extension(".exr"), entry.sidecar = fs::path(file).replace_extension(".json");
+  return entry;
+}
+
 Expected<std::vector<FrameEntry>> listFrames(const fs::path& dir) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) return fail(ErrorCode::kIo, "{}: not a folder of frames", dir.string());
-  const std::regex pattern(R"(frame_(\d{1,18})\.(exr|json))");
+  const std::regex& pattern = frameFilePattern();
   std::map<long, FrameEntry> frames;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
     std::smatch m;

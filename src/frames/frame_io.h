@@ -41,6 +41,9 @@ struct FrameEntry {
   long frame = 0;
   std::filesystem::path image, sidecar;
 };
+// The frame a file frame_NNNNN.exr or frame_NNNNN.json names, with both its files' paths (which
+// need not exist); errors name a file that is not a frame's.
+Expected<FrameEntry> frameEntry(const std::filesystem::path& file);
 // The frames of a folder in frame order; every frame_NNNNN.exr must have its frame_NNNNN.json and
 // the other way round. An empty list is not an error here (callers say how many they need).
 Expected<std::vector<FrameEntry>> listFrames(const std::filesystem::path& dir);

@@ -14,7 +14,8 @@ prefix=$work/prefix
 
 cmake --install "$build" --prefix "$prefix" >/dev/null
 for f in bin/dynbench lib/libdynbench_capture.so include/dynbench/capture.h lib/pkgconfig/dynbench-capture.pc \
-         lib/cmake/dynbench/dynbench-config.cmake lib/dynbench/libdynbench_image.so share/dynbench/blender/render_cycles.py; do
+         lib/cmake/dynbench/dynbench-config.cmake lib/dynbench/libdynbench_image.so share/dynbench/blender/render_cycles.py \
+         "$(/usr/bin/python3 -c "import sys; print('lib/python%d.%d/dist-packages' % sys.version_info[:2])")/dynbench/__init__.py"; do
   [[ -e "$prefix/$f" ]] || { echo "install_test: $prefix/$f was not installed"; exit 1; }
 done
 
@@ -39,4 +40,21 @@ LD_DEBUG=libs "$prefix/bin/dynbench" convert "$work/capture_consumer_sdk_example
 grep -q "calling init: $prefix/lib/dynbench/libdynbench_image.so" "$work/ld.log" ||
   { echo "install_test: the installed dynbench did not load $prefix/lib/dynbench/libdynbench_image.so"; grep image "$work/ld.log"; exit 1; }
 "$prefix/bin/dynbench" stats "$work/dataset/crate.gltf" | grep -q "| crate.gltf " || { echo "install_test: stats of the converted dataset failed"; exit 1; }
+# The installed Python package (docs/python.md), imported from here with PYTHONPATH into the
+# prefix: its stats equal the installed CLI's, and it reads images through the installed image module.
+site=$prefix/$(/usr/bin/python3 -c "import sys; print('lib/python%d.%d/dist-packages' % sys.version_info[:2])")
+[[ -f "$site/dynbench/__init__.py" ]] || { echo "install_test: the Python package is not in $site/dynbench"; exit 1; }
+sky=$(find "$work/dataset" -name '*.exr' -o -name '*.hdr' | head -n 1)
+[[ -n "$sky" ]] || { echo "install_test: the converted dataset has no HDR image to read"; ls -R "$work/dataset"; exit 1; }
+"$prefix/bin/dynbench" stats "$work/dataset/crate.gltf" --json "$work/stats_cli.json" >/dev/null
+LD_DEBUG=libs PYTHONPATH=$site /usr/bin/python3 - "$work/dataset/crate.gltf" "$work/stats_cli.json" "$sky" 2>"$work/ld_python.log" <<'PYTHON'
+import json, os, sys
+import dynbench
+dataset, cli, sky = sys.argv[1:]
+assert dynbench.__file__.startswith(os.environ["PYTHONPATH"]), f"imported {dynbench.__file__}, not the installed package"
+assert dynbench.stats([dataset]) == json.load(open(cli)), "the installed module's stats differ from the installed CLI's"
+assert dynbench.compare(sky, sky)["images"][0]["flip"]["mean"] == 0.0
+PYTHON
+grep -q "calling init: $prefix/lib/dynbench/libdynbench_image.so" "$work/ld_python.log" ||
+  { echo "install_test: the installed Python module did not load $prefix/lib/dynbench/libdynbench_image.so"; grep -i "image\|Error" "$work/ld_python.log" | tail; exit 1; }
 echo "install_test: both SDK builds wrote captures the installed dynbench accepts"

@@ -1,0 +1,43 @@
+"""A temporal method in NumPy, scored by dynbench: an exponential moving average of the radiance
+with motion-vector reprojection (the nearest previous pixel), history kept only on the same object
+with the same normal and clamped to the current 3x3 neighbourhood's range (as TAA does).
+
+    python3 examples/python/ema.py dynbench-demo/runs/colos_bot/input dynbench-demo/runs/colos_bot/frames
+"""
+import sys
+
+import numpy as np
+
+import dynbench
+
+
+class Ema:
+    name, parameters = "ema", {"alpha": 0.2, "normal_dot": 0.9}
+
+    def reset(self):
+        self.history = None
+
+    def process(self, frame):
+        c = frame.channels
+        colour = c["direct"] + c["indirect"]
+        if self.history is not None:
+            # Where this pixel's sample was in the previous frame (docs/feature-buffers.md, motion).
+            y, x = np.mgrid[0 : frame.height, 0 : frame.width] + 0.5
+            jitter = frame.camera["jitter"] - self.jitter
+            px = np.floor(x + jitter[0] + c["motion"][..., 0]).clip(0, frame.width - 1).astype(int)
+            py = np.floor(y + jitter[1] + c["motion"][..., 1]).clip(0, frame.height - 1).astype(int)
+            same = (c["hit"][..., 0] > 0) & (self.id[py, px] == c["id"][..., 0]) & ((self.normal[py, px] * c["N"]).sum(-1) > 0.9)
+            padded = np.pad(colour, ((1, 1), (1, 1), (0, 0)), mode="edge")
+            shifts = [padded[dy : dy + frame.height, dx : dx + frame.width] for dy in range(3) for dx in range(3)]
+            history = self.history[py, px].clip(np.min(shifts, axis=0), np.max(shifts, axis=0))
+            colour = np.where(same[..., None], 0.2 * colour + 0.8 * history, colour)
+        self.history, self.jitter, self.id, self.normal = colour, frame.camera["jitter"], c["id"][..., 0], c["N"]
+        return colour
+
+
+if __name__ == "__main__":
+    scores = dynbench.evaluate(sys.argv[1], sys.argv[2], methods=["none", "accumulate", Ema()])
+    print(f"{'method':<12} {'HDR-FLIP':>9} {'PSNR (dB)':>10} {'warped error change':>20}   (means over frames)")
+    for method in scores["methods"]:
+        mean = method["mean"]
+        print(f"{method['name']:<12} {mean['flip']['mean']:9.4f} {mean['psnr']['mean']:10.2f} {mean['warped_error_change']['mean']:20.4f}")
