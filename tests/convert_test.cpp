@@ -6,11 +6,13 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "capture/reader.h"
 #include "capture_fixture.h"
 #include "convert/convert.h"
 #include "convert/merge_camera.h"
 #include "core/files.h"
 #include "core/image_io.h"
+#include "frames/frame_io.h"
 #include "gltf_builder.h"
 #include "external_tools.h"
 #include "run_cli.h"
@@ -236,16 +238,26 @@ TEST(Convert, MaskMapBecomesMetallicRoughness) {
 }
 
 // Blender's own glTF importer reads the dataset (the thesis rendered its datasets with Blender).
+// What Blender's glTF importer makes of a dataset (tools/blender/import_gltf.py's summary), or
+// null after a test failure naming its output.
+nlohmann::json blenderImport(const fs::path& dataset) {
+  const std::string cmd = fmt::format("blender --background --factory-startup --python {}/tools/blender/import_gltf.py -- '{}' 2>&1",
+                                      DYNBENCH_SOURCE_DIR, dataset.string());
+  std::string out;
+  const int status = runShell(cmd, out);
+  const auto at = out.find("DYNBENCH_IMPORT ");
+  if (status != 0 || at == std::string::npos) {
+    ADD_FAILURE() << "blender exited " << status << ":\n" << out;
+    return nullptr;
+  }
+  return nlohmann::json::parse(out.substr(at + 16, out.find('\n', at) - at - 16));
+}
+
 TEST(Convert, BlenderImportsTheDataset) {
   DYNBENCH_NEEDS(test::missingBlender());
   const Converted c = convertFixture("convert_blender");
-  const std::string cmd = fmt::format("blender --background --factory-startup --python {}/tools/blender/import_gltf.py -- '{}' 2>&1",
-                                      DYNBENCH_SOURCE_DIR, c.dataset.string());
-  std::string out;
-  ASSERT_EQ(runShell(cmd, out), 0) << out;
-  const auto at = out.find("DYNBENCH_IMPORT ");
-  ASSERT_NE(at, std::string::npos) << out;
-  const auto summary = nlohmann::json::parse(out.substr(at + 16, out.find('\n', at) - at - 16));
+  const nlohmann::json summary = blenderImport(c.dataset);
+  ASSERT_FALSE(summary.is_null());
   EXPECT_EQ(summary["result"], "FINISHED");
   EXPECT_EQ(summary["armatures"], 1);  // the arm
   EXPECT_EQ(summary["cameras"], 1);
@@ -685,6 +697,161 @@ TEST(MergeCamera, BadRunsAndPaths) {
   r = mergeCamera(options);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("nobody"), std::string::npos);
+}
+
+// A vertex-animated model through the SDK (dbc_model_mesh_frames, dbc_vertex_frames): a "flag" of
+// two meshes, a quad with 3 key frames (key frame k: the base raised by k units in y) and a
+// triangle without key frames, seen over 9 frames at 24 fps stepping a quarter key frame a frame.
+fs::path writeVertexAnimatedCapture(const std::string& name, uint64_t& flagId) {
+  const fs::path dir = freshDir(name);
+  dbc_session* s = nullptr;
+  EXPECT_EQ(dbc_open(dir.c_str(), "vertex animation test", &s), DBC_OK) << dbc_last_error();
+  EXPECT_EQ(dbc_set_camera_settings(s, 16.0f / 9, 60, 0.1f, 100), DBC_OK);
+  EXPECT_EQ(dbc_model_begin(s, "models/flag"), DBC_OK);
+  const float quad[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, normals[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+  const uint32_t quadIndices[6] = {0, 1, 2, 0, 2, 3};
+  dbc_mesh mesh{0, "cloth", nullptr, nullptr, 4, quad, normals, nullptr, nullptr, nullptr, 2, quadIndices};
+  EXPECT_EQ(dbc_model_mesh(s, &mesh), DBC_OK) << dbc_last_error();
+  float keys[3 * 12], keyNormals[3 * 12];
+  for (int k = 0; k < 3; ++k)
+    for (int v = 0; v < 4; ++v)
+      for (int c = 0; c < 3; ++c) {
+        keys[(k * 4 + v) * 3 + c] = quad[v * 3 + c] + (c == 1 ? static_cast<float>(k) : 0.0f);
+        keyNormals[(k * 4 + v) * 3 + c] = normals[v * 3 + c];
+      }
+  EXPECT_EQ(dbc_model_mesh_frames(s, 0, 3, keys, keyNormals), DBC_OK) << dbc_last_error();
+  const float tri[9] = {0, 0, 1, 1, 0, 1, 0, 1, 1};
+  const uint32_t triIndices[3] = {0, 1, 2};
+  dbc_mesh pole{1, "pole", nullptr, nullptr, 3, tri, nullptr, nullptr, nullptr, nullptr, 1, triIndices};
+  EXPECT_EQ(dbc_model_mesh(s, &pole), DBC_OK) << dbc_last_error();
+  EXPECT_EQ(dbc_model_end(s), DBC_OK) << dbc_last_error();
+  const uint64_t camera = dbc_new_id(s);
+  flagId = dbc_new_id(s);
+  for (int f = 0; f < 9; ++f) {
+    EXPECT_EQ(dbc_frame_begin(s, static_cast<uint64_t>(f), f / 24.0), DBC_OK);
+    const float eye[3] = {0.5f, 1.0f, 6.0f};
+    EXPECT_EQ(dbc_camera(s, camera, eye, 0, 0, 0), DBC_OK);
+    EXPECT_EQ(dbc_model(s, flagId, "models/flag", toC(DualQuaternion{})), DBC_OK);
+    const uint32_t from = static_cast<uint32_t>(f / 4), to = std::min<uint32_t>(from + 1, 2);
+    EXPECT_EQ(dbc_vertex_frames(s, flagId, "models/flag", from, to, static_cast<float>(f % 4) / 4), DBC_OK) << dbc_last_error();
+    EXPECT_EQ(dbc_frame_end(s), DBC_OK);
+  }
+  EXPECT_EQ(dbc_close(s), DBC_OK);
+  return dir;
+}
+
+TEST(Convert, VertexAnimationBecomesMorphTargetsWithAnimatedWeights) {
+  uint64_t flag = 0;
+  const fs::path capture = writeVertexAnimatedCapture("vertex_animation_capture", flag);
+  ConvertOptions options;
+  options.capture = capture;
+  options.output = freshDir("vertex_animation_out") / "flag.gltf";
+  auto report = convertCapture(options);
+  ASSERT_TRUE(report) << report.error().message;
+  EXPECT_EQ(report->morphTargets, 3u);
+  int status = -1;
+  const std::string validation = validate(options.output, status);
+  EXPECT_EQ(status, 0) << validation;
+  auto loaded = scene::loadScene(options.output);
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  const scene::Evaluator e(*loaded);
+  const int node = nodeNamed(*loaded, fmt::format("model_{}_models/flag", flag));
+  ASSERT_GE(node, 0);
+  // Frame f is key frame f / 4 (a quarter a frame): every quad vertex raised by f / 4; the pole
+  // (zero targets) stays.
+  for (int f = 0; f < 9; ++f) {
+    const std::vector<glm::dvec3> quad = e.worldPositions(node, 0, f / 24.0), pole = e.worldPositions(node, 1, f / 24.0);
+    ASSERT_EQ(quad.size(), 4u);
+    expectClose(quad[2], {1, 1 + f / 4.0, 0}, fmt::format("quad vertex 2 at frame {}", f));
+    expectClose(quad[0], {0, f / 4.0, 0}, fmt::format("quad vertex 0 at frame {}", f));
+    expectClose(pole[2], {0, 1, 1}, fmt::format("pole vertex 2 at frame {}", f));
+  }
+  // Between frames the weights interpolate linearly: halfway between frames 5 and 6, 1.375.
+  expectClose(e.worldPositions(node, 0, 5.5 / 24.0)[0], {0, 1.375, 0}, "halfway between frames 5 and 6");
+  // The renderer draws the morphed quad: at frame 8 (key frame 2, raised by 2) the highest point
+  // it hits is above y = 2, where at frame 0 nothing is above y = 1.
+  const fs::path frames = freshDir("vertex_animation_frames");
+  std::string out;
+  ASSERT_EQ(runShell(fmt::format("{} render '{}' -o '{}' --res 64x36 --spp 1 --frames 0:8:8 2>&1", DYNBENCH_EXE, options.output.string(),
+                                 frames.string()), out), 0) << out;
+  for (const auto& [frame, low, high] : {std::tuple{0L, 0.5, 1.0}, std::tuple{8L, 2.5, 3.0}}) {
+    auto read = frames::readFrame({frame, frames::frameImagePath(frames, frame), frames::frameSidecarPath(frames, frame)});
+    ASSERT_TRUE(read) << read.error().message;
+    float top = -1e9f;
+    for (std::size_t i = 0; i < read->pixelCount(); ++i)
+      if (read->hit[i] > 0) top = std::max(top, read->position[3 * i + 1]);
+    EXPECT_GT(top, low) << "frame " << frame;
+    EXPECT_LE(top, high + 1e-4) << "frame " << frame;
+  }
+}
+
+TEST(Convert, BlenderImportsTheMorphTargetsAsShapeKeys) {
+  DYNBENCH_NEEDS(test::missingBlender());
+  uint64_t flag = 0;
+  ConvertOptions options;
+  options.capture = writeVertexAnimatedCapture("vertex_animation_blender_capture", flag);
+  options.output = freshDir("vertex_animation_blender_out") / "flag.gltf";
+  auto report = convertCapture(options);
+  ASSERT_TRUE(report) << report.error().message;
+  const nlohmann::json summary = blenderImport(options.output);
+  ASSERT_FALSE(summary.is_null());
+  EXPECT_EQ(summary["result"], "FINISHED");
+  EXPECT_EQ(summary["meshes"], 1);      // the flag (its two primitives in one mesh)
+  EXPECT_EQ(summary["shape_keys"], 3);  // one per key frame, as convert reports
+  EXPECT_EQ(summary["shape_keys"], report->morphTargets);
+}
+
+TEST(Capture, VertexAnimationIsCheckedBySdkAndReader) {
+  const fs::path dir = freshDir("vertex_animation_bad");
+  dbc_session* s = nullptr;
+  ASSERT_EQ(dbc_open(dir.c_str(), "bad", &s), DBC_OK);
+  const float p[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0}, keys[18] = {};
+  const uint32_t idx[3] = {0, 1, 2};
+  dbc_mesh mesh{0, "m", nullptr, nullptr, 3, p, nullptr, nullptr, nullptr, nullptr, 1, idx};
+  EXPECT_EQ(dbc_model_mesh_frames(s, 0, 2, keys, nullptr), DBC_ERROR_ORDER);  // outside a model
+  ASSERT_EQ(dbc_model_begin(s, "models/m"), DBC_OK);
+  ASSERT_EQ(dbc_model_mesh(s, &mesh), DBC_OK);
+  EXPECT_EQ(dbc_model_mesh_frames(s, 1, 2, keys, nullptr), DBC_ERROR_ORDER);  // not the last mesh
+  EXPECT_EQ(dbc_model_mesh_frames(s, 0, 0, keys, nullptr), DBC_ERROR_ARGUMENT);
+  ASSERT_EQ(dbc_model_mesh_frames(s, 0, 2, keys, nullptr), DBC_OK) << dbc_last_error();
+  EXPECT_EQ(dbc_model_mesh_frames(s, 0, 2, keys, nullptr), DBC_ERROR_ORDER);  // twice
+  EXPECT_EQ(dbc_model_joint(s, 0, "j", -1, toC(DualQuaternion{}), toC(DualQuaternion{})), DBC_ERROR_ARGUMENT);  // joints and key frames
+  ASSERT_EQ(dbc_model_end(s), DBC_OK);
+  const uint64_t id = dbc_new_id(s);
+  ASSERT_EQ(dbc_frame_begin(s, 0, 0.0), DBC_OK);
+  EXPECT_EQ(dbc_vertex_frames(s, id, "models/m", 0, 1, 0.5f), DBC_ERROR_ORDER);  // before its dbc_model
+  ASSERT_EQ(dbc_model(s, id, "models/m", toC(DualQuaternion{})), DBC_OK);
+  EXPECT_EQ(dbc_vertex_frames(s, id, "models/m", 0, 2, 0.5f), DBC_ERROR_ARGUMENT);  // key frame 2 of 2
+  EXPECT_EQ(dbc_vertex_frames(s, id, "models/m", 0, 1, 1.5f), DBC_ERROR_ARGUMENT);
+  EXPECT_NE(std::string(dbc_last_error()).find("fraction"), std::string::npos);
+  EXPECT_EQ(dbc_vertex_frames(s, id, "models/m", 1, 0, 0.25f), DBC_OK) << dbc_last_error();
+  ASSERT_EQ(dbc_frame_end(s), DBC_OK);
+  ASSERT_EQ(dbc_close(s), DBC_OK);
+  auto reader = capture::CaptureReader::open(dir);
+  ASSERT_TRUE(reader) << reader.error().message;
+  ASSERT_EQ((*reader)->models().size(), 1u);
+  EXPECT_EQ((*reader)->models()[0].keyFrames, 2u);
+  capture::CaptureFrame frame;
+  ASSERT_TRUE((*reader)->next(frame).value_or(false));
+  ASSERT_EQ(frame.vertexFrames.size(), 1u);
+  EXPECT_EQ(frame.vertexFrames[0].from, 1u);
+  EXPECT_DOUBLE_EQ(frame.vertexFrames[0].fraction, 0.25);
+  // The reader refuses what the SDK would not write, naming file:line.
+  auto capture = readWholeFile(dir / "Capture.txt");
+  ASSERT_TRUE(capture);
+  const std::string good = *capture;
+  for (const auto& [from, to, expected] : {std::tuple{":1:0:0.25:", ":1:0:1.25:", "Capture.txt:5: fraction 1.25 is not in [0, 1]"},
+                                           std::tuple{":1:0:0.25:", ":1:7:0.25:", "Capture.txt:5: key frames 1 and 7 of model 'models/m', which has 2"}}) {
+    std::string text = good;
+    text.replace(text.find(from), std::string(from).size(), to);
+    ASSERT_TRUE(writeFileAtomic(dir / "Capture.txt", text));
+    auto bad = capture::CaptureReader::open(dir);
+    ASSERT_TRUE(bad);
+    capture::CaptureFrame f;
+    auto next = (*bad)->next(f);
+    ASSERT_FALSE(next) << to;
+    EXPECT_NE(next.error().message.find(expected), std::string::npos) << next.error().message;
+  }
 }
 
 }  // namespace

@@ -92,6 +92,12 @@ int dbc_set_lighting(dbc_session* session, const float sun_direction[3], const f
 int dbc_has_model(const dbc_session* session, const char* model_path);
 int dbc_model_begin(dbc_session* session, const char* model_path);
 int dbc_model_mesh(dbc_session* session, const dbc_mesh* mesh);
+/* Vertex animation (key-framed meshes such as id Tech 3's MD3): the positions of every vertex of
+ * mesh `mesh_id` at each of frame_count key frames, key frame after key frame (3 x vertex_count
+ * floats each), and their normals the same way (may be NULL). Right after that mesh's
+ * dbc_model_mesh; every vertex-animated mesh of a model has the same frame_count. A model may not
+ * have both joints and key frames. */
+int dbc_model_mesh_frames(dbc_session* session, int mesh_id, size_t frame_count, const float* positions, const float* normals);
 /* Joints in order 0..J-1, parents first (parent -1 for a root). */
 int dbc_model_joint(dbc_session* session, int joint_id, const char* name, int parent, dbc_dual_quat bind_pose,
                     dbc_dual_quat inverse_bind_pose);
@@ -112,6 +118,10 @@ int dbc_static_model(dbc_session* session, uint64_t id, const char* model_path, 
 int dbc_model(dbc_session* session, uint64_t id, const char* model_path, dbc_dual_quat pose);
 int dbc_joints(dbc_session* session, uint64_t id, const char* model_path, size_t joint_count,
                const dbc_dual_quat* joints);
+/* The key-frame pose of a vertex-animated model this frame: every vertex at (1 - fraction) x key
+ * frame `from` + fraction x key frame `to` (MD3's interpolation), fraction in [0, 1]. After the
+ * capturable's dbc_model in the same frame. */
+int dbc_vertex_frames(dbc_session* session, uint64_t id, const char* model_path, uint32_t from, uint32_t to, float fraction);
 /* A light. rgb: its colour as the engine has it (1: the engine's full light); range: the distance
  * (capture units) at which the engine's light falls to nothing (its radius), with `falloff` on
  * the way; 0 when it has none: the engine does not attenuate it at all (falloff is ignored; the

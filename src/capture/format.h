@@ -8,10 +8,15 @@
 
 namespace dynbench::capture {
 
-// Version 2 (this one) added the lights' range and the map's lighting (`L`); captures of version 1
-// also predate the adapters' signed normals, so they are refused, not converted.
-inline constexpr std::string_view kCaptureVersionLine = "dynbench-capture:2";
-inline constexpr std::string_view kModelMeshVersionLine = "dynbench-modelmesh:1";
+// Version 2 added the lights' range and the map's lighting (`L`); captures of version 1 also
+// predate the adapters' signed normals, so they are refused, not converted. Version 3 (this one)
+// added vertex animation: a mesh's key frames (ModelMesh version 2: `K`, `P`, `N`) and a
+// capturable's key-frame pose each frame (`v`); version 2 captures and version 1 ModelMesh files
+// read as before.
+inline constexpr std::string_view kCaptureVersionLine = "dynbench-capture:3";
+inline constexpr std::string_view kCaptureVersion2Line = "dynbench-capture:2";
+inline constexpr std::string_view kModelMeshVersionLine = "dynbench-modelmesh:2";
+inline constexpr std::string_view kModelMeshVersion1Line = "dynbench-modelmesh:1";
 inline constexpr std::string_view kCaptureFile = "Capture.txt";
 inline constexpr std::string_view kModelsFolder = "models";
 

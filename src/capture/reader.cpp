@@ -122,8 +122,9 @@ CapturedModel parseModelMesh(const fs::path& path) {
   model.file = path;
   std::string text;
   bool complete = true;
-  if (!source.next(text, complete) || text != kModelMeshVersionLine)
-    throw Failure{Error{ErrorCode::kParse, fmt::format("{}:1: expected the version line '{}'", file, kModelMeshVersionLine)}};
+  if (!source.next(text, complete) || (text != kModelMeshVersionLine && text != kModelMeshVersion1Line))
+    throw Failure{Error{ErrorCode::kParse, fmt::format("{}:1: expected the version line '{}' (or '{}')", file, kModelMeshVersionLine,
+                                                       kModelMeshVersion1Line)}};
   std::vector<std::size_t> declaredVertices, declaredTriangles;
   std::vector<std::vector<int>> influenceCounts;  // per mesh, per vertex: joints listed by `j`
   std::set<int> bound, inverseBound;
@@ -185,6 +186,24 @@ CapturedModel parseModelMesh(const fs::path& path) {
     } else if (token == "a" || token == "g") {
       l.expectFields(2, "mesh_id:texture");
       (token == "a" ? meshAt(1).texture : meshAt(1).maskTexture) = l.text(2);
+    } else if (token == "K") {
+      l.expectFields(2, "mesh_id:frame_count");
+      auto& mesh = meshAt(1);
+      const auto count = l.integer<std::size_t>(2, "frame_count");
+      if (!mesh.keyPositions.empty()) l.fail(fmt::format("mesh {} has a second 'K' record", mesh.id));
+      if (count == 0) l.fail("frame_count must be at least 1");
+      if (model.keyFrames != 0 && count != model.keyFrames)
+        l.fail(fmt::format("mesh {}: {} key frames, but the model's other meshes have {}", mesh.id, count, model.keyFrames));
+      model.keyFrames = count;
+      mesh.keyPositions.resize(count);
+    } else if (token == "P" || token == "N") {
+      l.expectFields(5, "mesh_id:frame:x:y:z");
+      auto& mesh = meshAt(1);
+      const auto frame = l.integer<std::size_t>(2, "frame");
+      if (frame >= mesh.keyPositions.size())
+        l.fail(fmt::format("key frame {} of mesh {}, which declares {} ('K' record first)", frame, mesh.id, mesh.keyPositions.size()));
+      if (token == "N" && mesh.keyNormals.empty()) mesh.keyNormals.resize(mesh.keyPositions.size());
+      (token == "P" ? mesh.keyPositions : mesh.keyNormals)[frame].push_back(glm::vec3(l.real(3, "x"), l.real(4, "y"), l.real(5, "z")));
     } else if (token == "b" || token == "x") {
       l.expectFields(11, "joint_id:parent:rx:ry:rz:rw:dx:dy:dz:dw:name");
       const int id = l.integer<int>(1, "joint_id");
@@ -206,12 +225,14 @@ CapturedModel parseModelMesh(const fs::path& path) {
         inverseBound.insert(id);
       }
     } else {
-      l.fail(fmt::format("unknown record '{}'; a ModelMesh file has o, M, p, n, t, j, w, i, a, g, b, x", token), ErrorCode::kParse);
+      l.fail(fmt::format("unknown record '{}'; a ModelMesh file has o, M, p, n, t, j, w, i, a, g, b, x, K, P, N", token), ErrorCode::kParse);
     }
   }
   const auto where = fmt::format("{}:{}", file, source.number());
   if (model.path.empty()) throw Failure{Error{ErrorCode::kInvalidData, where + ": no 'o' record naming the model"}};
   if (bound != inverseBound) throw Failure{Error{ErrorCode::kInvalidData, where + ": every joint needs both a 'b' and an 'x' record"}};
+  if (model.keyFrames > 0 && !model.joints.empty())
+    throw Failure{Error{ErrorCode::kInvalidData, where + ": a model has joints or key frames ('K'), not both"}};
   for (const auto& mesh : model.meshes) {
     const std::size_t n = declaredVertices[static_cast<std::size_t>(mesh.id)];
     auto check = [&](std::size_t count, const char* what, bool optional) {
@@ -226,6 +247,10 @@ CapturedModel parseModelMesh(const fs::path& path) {
     if (mesh.indices.size() != 3 * declaredTriangles[static_cast<std::size_t>(mesh.id)])
       throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} declares {} triangles but has {} 'i' records", where, mesh.id,
                                                               declaredTriangles[static_cast<std::size_t>(mesh.id)], mesh.indices.size() / 3)}};
+    for (std::size_t f = 0; f < mesh.keyPositions.size(); ++f) {
+      check(mesh.keyPositions[f].size(), fmt::format("'P' (key frame {})", f).c_str(), false);
+      if (!mesh.keyNormals.empty()) check(mesh.keyNormals[f].size(), fmt::format("'N' (key frame {})", f).c_str(), false);
+    }
     for (std::uint32_t index : mesh.indices)
       if (index >= n) throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} has a triangle using vertex {} of {}", where, mesh.id, index, n)}};
     for (std::size_t v = 0; v < mesh.joints.size(); ++v)
@@ -248,6 +273,7 @@ void CaptureFrame::clear() {
   staticModels.clear();
   models.clear();
   joints.clear();
+  vertexFrames.clear();
   lights.clear();
 }
 
@@ -304,7 +330,7 @@ Expected<std::unique_ptr<CaptureReader>> CaptureReader::open(const fs::path& dir
     reader->impl_ = std::make_unique<Impl>(capture);
     Impl& impl = *reader->impl_;
     bool complete = true;
-    if (!impl.source.next(impl.text, complete) || impl.text != kCaptureVersionLine) {
+    if (!impl.source.next(impl.text, complete) || (impl.text != kCaptureVersionLine && impl.text != kCaptureVersion2Line)) {
       if (impl.text.starts_with("dynbench-capture:"))
         return fail(ErrorCode::kParse,
                     "{}:1: capture format version {} is not supported; this dynbench reads version {} (version 1 captures lack the "
@@ -489,6 +515,23 @@ Expected<bool> CaptureReader::next(CaptureFrame& frame) {
         r.joints.reserve(count);
         for (std::size_t k = 0; k < count; ++k) r.joints.push_back(l.dualQuat(3 + 8 * k));
         frame.joints.push_back(std::move(r));
+      } else if (token == "v") {
+        l.expectFields(5, "id:from:to:fraction:model_path");
+        VertexFramesRecord r;
+        r.id = l.integer<std::uint64_t>(1, "id");
+        r.from = l.integer<std::uint32_t>(2, "from"), r.to = l.integer<std::uint32_t>(3, "to");
+        r.fraction = l.real(4, "fraction");
+        r.model = modelAt(5);
+        const auto& model = models_[static_cast<std::size_t>(r.model)];
+        if (model.keyFrames == 0) l.fail(fmt::format("key frames of model '{}', which has none ('K' records)", model.path));
+        if (r.from >= model.keyFrames || r.to >= model.keyFrames)
+          l.fail(fmt::format("key frames {} and {} of model '{}', which has {}", r.from, r.to, model.path, model.keyFrames));
+        if (!(r.fraction >= 0 && r.fraction <= 1)) l.fail(fmt::format("fraction {} is not in [0, 1]", r.fraction));
+        if (!impl.modelsThisFrame.contains(r.id))
+          l.fail(fmt::format("key frames of capturable {}, which has no model transform ('m') earlier in this frame", r.id));
+        if (impl.capturables.at(r.id).second != r.model)
+          l.fail(fmt::format("key frames of capturable {} name model '{}', its transform another", r.id, model.path));
+        frame.vertexFrames.push_back(r);
       } else if (token == "l") {
         l.expectFields(12, "id:x:y:z:r:g:b:range:falloff:type:dynamic:model_type");
         LightRecord r;
@@ -516,7 +559,7 @@ Expected<bool> CaptureReader::next(CaptureFrame& frame) {
       } else if (token == "C") {
         frame.cameraSettings = cameraSettings(l);
       } else {
-        l.fail(fmt::format("unknown record '{}' in a frame; expected t, c, p, m, j, l, C or e", token), ErrorCode::kParse);
+        l.fail(fmt::format("unknown record '{}' in a frame; expected t, c, p, m, j, v, l, C or e", token), ErrorCode::kParse);
       }
     }
   } catch (const Failure& f) {

@@ -26,6 +26,9 @@ struct CapturedMesh {
   std::vector<glm::u16vec4> joints;  // up to 4 influences; unused ones have weight 0
   std::vector<glm::vec4> weights;
   std::vector<std::uint32_t> indices;  // 3 per triangle
+  // Vertex animation (`K`, `P`, `N`): per key frame, every vertex's position (and normal, or none
+  // for any key frame); empty for a mesh that is not vertex-animated.
+  std::vector<std::vector<glm::vec3>> keyPositions, keyNormals;
 };
 
 struct CapturedJoint {
@@ -41,6 +44,7 @@ struct CapturedModel {
   std::filesystem::path file;  // its ModelMesh file
   std::vector<CapturedMesh> meshes;
   std::vector<CapturedJoint> joints;  // empty for a rigid model
+  std::size_t keyFrames = 0;          // of its vertex-animated meshes (0: none; never with joints)
 };
 
 Expected<CapturedModel> readModelMesh(const std::filesystem::path& file);
@@ -91,6 +95,13 @@ struct JointsRecord {
   std::vector<DualQuaternion> joints;  // model space, after blending, before the inverse bind pose
 };
 
+struct VertexFramesRecord {  // `v`: a vertex-animated model's key-frame pose this frame
+  std::uint64_t id = 0;
+  int model = -1;
+  std::uint32_t from = 0, to = 0;  // key frames
+  double fraction = 0.0;           // every vertex at (1 - fraction) x from + fraction x to
+};
+
 struct LightRecord {
   std::uint64_t id = 0;
   glm::dvec3 position{0.0};
@@ -111,6 +122,7 @@ struct CaptureFrame {
   std::vector<CameraCutRecord> cuts;
   std::vector<ModelRecord> staticModels, models;
   std::vector<JointsRecord> joints;
+  std::vector<VertexFramesRecord> vertexFrames;
   std::vector<LightRecord> lights;
   void clear();
 };

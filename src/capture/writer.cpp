@@ -48,11 +48,15 @@ struct dbc_session {
   fs::path directory;
   std::FILE* capture = nullptr;
   std::map<std::string, int> modelJoints;  // complete models and their joint counts
+  std::map<std::string, std::size_t> modelKeyFrames;  // complete models and their key-frame counts (0: none)
   int modelFiles = 0;
   // The model being recorded.
   bool inModel = false;
   std::string modelPath, modelText;
   int nextMesh = 0, nextJoint = 0;
+  std::size_t lastMeshVertices = 0;  // of mesh nextMesh - 1
+  int lastMeshWithFrames = -1;
+  std::size_t keyFrames = 0;  // of the model being recorded (0: none yet)
   // Frames.
   bool inFrame = false, anyFrame = false;
   std::uint64_t lastFrame = 0, frameCount = 0;
@@ -192,6 +196,7 @@ int dbc_model_begin(dbc_session* s, const char* model_path) {
   s->modelPath = model_path;
   s->modelText = fmt::format("{}\no:{}\n", kModelMeshVersionLine, escapeField(model_path));
   s->nextMesh = s->nextJoint = 0;
+  s->lastMeshVertices = 0, s->lastMeshWithFrames = -1, s->keyFrames = 0;
   return DBC_OK;
 }
 
@@ -241,6 +246,38 @@ int dbc_model_mesh(dbc_session* s, const dbc_mesh* m) {
   }
   s->modelText += text;
   ++s->nextMesh;
+  s->lastMeshVertices = m->vertex_count;
+  return DBC_OK;
+}
+
+int dbc_model_mesh_frames(dbc_session* s, int mesh_id, size_t frame_count, const float* positions, const float* normals) {
+  if (!s || !positions) return error(DBC_ERROR_ARGUMENT, "dbc_model_mesh_frames: NULL argument");
+  if (!s->inModel) return error(DBC_ERROR_ORDER, "dbc_model_mesh_frames outside dbc_model_begin/end");
+  if (mesh_id != s->nextMesh - 1 || mesh_id == s->lastMeshWithFrames)
+    return error(DBC_ERROR_ORDER, fmt::format("dbc_model_mesh_frames for mesh {}: call it once, right after that mesh's dbc_model_mesh", mesh_id));
+  if (s->nextJoint > 0) return error(DBC_ERROR_ARGUMENT, "a model has joints or key frames, not both");
+  if (frame_count == 0) return error(DBC_ERROR_ARGUMENT, fmt::format("mesh {}: frame_count must be at least 1", mesh_id));
+  if (s->keyFrames != 0 && frame_count != s->keyFrames)
+    return error(DBC_ERROR_ARGUMENT, fmt::format("mesh {}: {} key frames, but the model's other meshes have {}", mesh_id, frame_count, s->keyFrames));
+  const std::size_t n = s->lastMeshVertices;
+  std::string text = fmt::format("K:{}:{}\n", mesh_id, frame_count);
+  for (std::size_t f = 0; f < frame_count; ++f)
+    for (auto [token, data] : {std::pair{'P', positions}, std::pair{'N', normals}}) {
+      if (!data) continue;
+      for (std::size_t v = 0; v < n; ++v) {
+        std::string line = fmt::format("{}:{}:{}", token, mesh_id, f);
+        for (int c = 0; c < 3; ++c) {
+          const float value = data[(f * n + v) * 3 + static_cast<std::size_t>(c)];
+          if (!std::isfinite(value)) return error(DBC_ERROR_ARGUMENT, fmt::format("mesh {}: key frame {} vertex {} is not finite", mesh_id, f, v));
+          appendFloat(line, value);
+        }
+        text += line;
+        text += '\n';
+      }
+    }
+  s->modelText += text;
+  s->keyFrames = frame_count;
+  s->lastMeshWithFrames = mesh_id;
   return DBC_OK;
 }
 
@@ -249,6 +286,7 @@ int dbc_model_joint(dbc_session* s, int joint_id, const char* name, int parent, 
   if (!s->inModel) return error(DBC_ERROR_ORDER, "dbc_model_joint outside dbc_model_begin/end");
   if (joint_id != s->nextJoint) return error(DBC_ERROR_ARGUMENT, fmt::format("joint_id {} given; expected {} (joints in order)", joint_id, s->nextJoint));
   if (parent < -1 || parent >= joint_id) return error(DBC_ERROR_ARGUMENT, fmt::format("joint {}: parent {} must be -1 or an earlier joint", joint_id, parent));
+  if (s->keyFrames > 0) return error(DBC_ERROR_ARGUMENT, "a model has joints or key frames, not both");
   if (!finite(bind) || !finite(inverse_bind)) return error(DBC_ERROR_ARGUMENT, fmt::format("joint {}: pose is not finite", joint_id));
   for (auto [token, q] : {std::pair{'b', bind}, std::pair{'x', inverse_bind}}) {
     std::string line = fmt::format("{}:{}:{}", token, joint_id, parent);
@@ -267,6 +305,7 @@ int dbc_model_end(dbc_session* s) {
   if (auto ok = dynbench::writeFileAtomic(file, s->modelText); !ok) return error(DBC_ERROR_IO, ok.error().message);
   ++s->modelFiles;
   s->modelJoints[s->modelPath] = s->nextJoint;
+  s->modelKeyFrames[s->modelPath] = s->keyFrames;
   s->modelText.clear();
   return DBC_OK;
 }
@@ -348,6 +387,24 @@ int dbc_joints(dbc_session* s, uint64_t id, const char* model_path, size_t joint
     if (!finite(joints[k])) return error(DBC_ERROR_ARGUMENT, fmt::format("capturable {}: joint {} is not finite", id, k));
     appendDualQuat(line, joints[k]);
   }
+  return s->writeRecord(line + ":" + escapeField(model_path));
+}
+
+int dbc_vertex_frames(dbc_session* s, uint64_t id, const char* model_path, uint32_t from, uint32_t to, float fraction) {
+  if (!s) return error(DBC_ERROR_ARGUMENT, "dbc_vertex_frames: NULL session");
+  if (int rc = s->requireFrame("dbc_vertex_frames"); rc != DBC_OK) return rc;
+  if (int rc = s->requireModel(model_path); rc != DBC_OK) return rc;
+  const std::size_t frames = s->modelKeyFrames.at(model_path);
+  if (frames == 0) return error(DBC_ERROR_ARGUMENT, fmt::format("model '{}' has no key frames (dbc_model_mesh_frames)", model_path));
+  if (from >= frames || to >= frames)
+    return error(DBC_ERROR_ARGUMENT, fmt::format("capturable {}: key frames {} and {} of model '{}', which has {}", id, from, to, model_path, frames));
+  if (!(fraction >= 0.0f && fraction <= 1.0f)) return error(DBC_ERROR_ARGUMENT, fmt::format("capturable {}: fraction {} is not in [0, 1]", id, fraction));
+  if (!s->modelsThisFrame.contains(id))
+    return error(DBC_ERROR_ORDER, fmt::format("capturable {}: record its model transform (dbc_model) before its key frames", id));
+  if (s->capturables.at(id).second != model_path)
+    return error(DBC_ERROR_ARGUMENT, fmt::format("capturable {} is a '{}', not a '{}'", id, s->capturables.at(id).second, model_path));
+  std::string line = fmt::format("v:{}:{}:{}", id, from, to);
+  appendFloat(line, fraction);
   return s->writeRecord(line + ":" + escapeField(model_path));
 }
 

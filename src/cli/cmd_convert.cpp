@@ -52,10 +52,11 @@ Expected<void> runConvert(const ConvertCliOptions& cli) {
   progress.reset();
   if (!report) return std::unexpected(report.error());
   for (const auto& w : report->warnings) spdlog::warn("{}", w);
-  fmt::print("{}: {} frames, {} capturables -> {} nodes, {} meshes, {} materials, {} textures, {} skins, {} lights, {} channels, "
-             "{} camera cuts, {:.1f} MiB of buffer\n",
+  fmt::print("{}: {} frames, {} capturables -> {} nodes, {} meshes, {} materials, {} textures, {} skins, {} morph targets, {} lights, "
+             "{} channels, {} camera cuts, {:.1f} MiB of buffer\n",
              cli.output, report->frames, report->capturables, report->nodes, report->meshes, report->materials, report->textures,
-             report->skins, report->lights, report->channels, report->cameraCuts, static_cast<double>(report->binBytes) / (1024.0 * 1024.0));
+             report->skins, report->morphTargets, report->lights, report->channels, report->cameraCuts,
+             static_cast<double>(report->binBytes) / (1024.0 * 1024.0));
   return {};
 }
 

@@ -41,6 +41,7 @@ struct ConvertReport {
   std::size_t capturables = 0;
   std::size_t nodes = 0, meshes = 0, materials = 0, textures = 0, skins = 0, lights = 0, channels = 0;
   std::size_t cameraCuts = 0;  // cuts carried into the camera node's extras
+  std::size_t morphTargets = 0;  // of vertex-animated models' meshes (one per key frame)
   std::uint64_t binBytes = 0;
   std::vector<std::filesystem::path> written;  // the dataset's files
   std::vector<std::string> warnings;

@@ -141,6 +141,15 @@ void Converter::buildDocument() {
       }
     }
     if (t.skinned) buildSkin(t, mesh, input, channel, region);
+    // A vertex-animated model's morph weights, a key frame's worth per capture frame (key frame 0
+    // until its first `v` record).
+    if (const std::size_t keyFrames = t.kind == Kind::kModel ? reader_->models()[static_cast<std::size_t>(t.model)].keyFrames : 0;
+        keyFrames > 0 && mesh >= 0) {
+      region(t.span() * keyFrames, 4, t.weightsOffset, view);
+      channel(input, accessor(view, 0, kFloat, t.span() * keyFrames, "SCALAR"), "LINEAR", t.node, "weights");
+      t.heldWeights.assign(keyFrames, 0.0f);
+      t.heldWeights[0] = 1.0f;
+    }
   }
   report_.channels = channels.size();
   if (!channels.empty()) doc_["animations"] = {{{"name", "capture"}, {"samplers", samplers}, {"channels", channels}}};

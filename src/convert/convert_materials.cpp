@@ -105,6 +105,45 @@ int Converter::material(const CapturedMesh& mesh) {
   return index;
 }
 
+// A vertex-animated model's key frames as morph targets (docs/dataset.md): target k displaces the
+// mesh's vertices to key frame k, so weights (1 - f) at key frame a and f at b (summing to 1) give
+// (1 - f) x a + f x b, MD3's interpolation. glTF wants every primitive of a mesh to have the same
+// targets: a mesh of the model without key frames gets targets of zeros (accessors without a
+// buffer view, which glTF defines as zeros).
+json Converter::morphTargets(const CapturedModel& model, const CapturedMesh& mesh) {
+  json targets = json::array();
+  const std::size_t n = mesh.positions.size();
+  auto unit = [](glm::vec3 v) {
+    const float len = glm::length(v);
+    return len > 0 ? v / len : glm::vec3(0, 1, 0);
+  };
+  for (std::size_t k = 0; k < model.keyFrames; ++k) {
+    if (mesh.keyPositions.empty()) {
+      targets.push_back({{"POSITION", accessor(-1, 0, kFloat, n, "VEC3", std::vector<float>{0, 0, 0}, std::vector<float>{0, 0, 0})}});
+      continue;
+    }
+    std::vector<float> displacement;
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (std::size_t v = 0; v < n; ++v) {
+      const glm::vec3 d = mesh.keyPositions[k][v] - mesh.positions[v];
+      lo = glm::min(lo, d), hi = glm::max(hi, d);
+      displacement.insert(displacement.end(), {d.x, d.y, d.z});
+    }
+    json target = {{"POSITION", dataAccessor(displacement, kFloat, "VEC3", kArrayBuffer, std::vector<float>{lo.x, lo.y, lo.z},
+                                             std::vector<float>{hi.x, hi.y, hi.z})}};
+    if (!mesh.keyNormals.empty() && !mesh.normals.empty()) {
+      std::vector<float> normals;
+      for (std::size_t v = 0; v < n; ++v) {
+        const glm::vec3 d = unit(mesh.keyNormals[k][v]) - unit(mesh.normals[v]);
+        normals.insert(normals.end(), {d.x, d.y, d.z});
+      }
+      target["NORMAL"] = dataAccessor(normals, kFloat, "VEC3", kArrayBuffer);
+    }
+    targets.push_back(std::move(target));
+  }
+  return targets;
+}
+
 void Converter::buildMeshes() {
   for (const auto& model : reader_->models()) {
     json primitives = json::array();
@@ -147,15 +186,25 @@ void Converter::buildMeshes() {
         attributes["JOINTS_0"] = dataAccessor(joints, kUnsignedShort, "VEC4", kArrayBuffer);
         attributes["WEIGHTS_0"] = dataAccessor(weights, kFloat, "VEC4", kArrayBuffer);
       }
-      primitives.push_back({{"attributes", attributes},
-                            {"indices", dataAccessor(mesh.indices, kUnsignedInt, "SCALAR", kElementArrayBuffer)},
-                            {"material", material(mesh)}});
+      json primitive = {{"attributes", attributes},
+                        {"indices", dataAccessor(mesh.indices, kUnsignedInt, "SCALAR", kElementArrayBuffer)},
+                        {"material", material(mesh)}};
+      if (model.keyFrames > 0) primitive["targets"] = morphTargets(model, mesh);
+      primitives.push_back(std::move(primitive));
     }
     if (primitives.empty()) {
       meshOfModel_.push_back(-1);
       continue;
     }
-    doc_["meshes"].push_back({{"name", model.path}, {"primitives", primitives}});
+    json gltfMesh = {{"name", model.path}, {"primitives", primitives}};
+    if (model.keyFrames > 0) {
+      // Without an animation (a static instance) the mesh shows key frame 0.
+      std::vector<float> weights(model.keyFrames, 0.0f);
+      weights[0] = 1.0f;
+      gltfMesh["weights"] = weights;
+      report_.morphTargets += model.keyFrames;
+    }
+    doc_["meshes"].push_back(std::move(gltfMesh));
     meshOfModel_.push_back(static_cast<int>(doc_["meshes"].size()) - 1);
     ++report_.meshes;
     // Inverse bind matrices, shared by every instance of the model.

@@ -119,6 +119,7 @@ void Converter::passTwo() {
     if (t.colorOffset) t.color = RegionWriter(bin_, t.colorOffset);
     if (t.intensityOffset) t.intensity = RegionWriter(bin_, t.intensityOffset);
     if (t.rangeOffset) t.range = RegionWriter(bin_, t.rangeOffset);
+    if (t.weightsOffset) t.weights = RegionWriter(bin_, t.weightsOffset);
     for (auto o : t.jointTranslationOffsets) t.jointTranslation.emplace_back(bin_, o);
     for (auto o : t.jointRotationOffsets) t.jointRotation.emplace_back(bin_, o);
   }
@@ -159,6 +160,13 @@ void Converter::passTwo() {
       t.heldRange = l.range;
       if (!t.appeared) active.push_back(&t);
     }
+    for (const auto& v : frame.vertexFrames) {
+      Track& t = tracks_.at(v.id);
+      if (t.heldWeights.empty()) continue;  // a model without a mesh
+      std::fill(t.heldWeights.begin(), t.heldWeights.end(), 0.0f);
+      t.heldWeights[v.from] += static_cast<float>(1.0 - v.fraction);
+      t.heldWeights[v.to] += static_cast<float>(v.fraction);
+    }
     for (const auto& j : frame.joints) {
       Track& t = tracks_.at(j.id);
       // Model-space joints to parent-local: L_j = M_parent^-1 M_j (rigid, so exact).
@@ -185,6 +193,8 @@ void Converter::passTwo() {
       if (t->translationOffset) t->translation.put(std::array<float, 3>{static_cast<float>(t->heldTranslation.x),
                                                                          static_cast<float>(t->heldTranslation.y),
                                                                          static_cast<float>(t->heldTranslation.z)});
+      if (t->weightsOffset)
+        for (float w : t->heldWeights) t->weights.put(w);
       if (t->colorOffset) {
         const auto [color, intensity] = lightColorIntensity(t->heldColor, t->heldRange, t->light.falloff, t->light.modelType, t->lightShare, 0.0);
         t->color.put(std::array<float, 3>{static_cast<float>(color.r), static_cast<float>(color.g), static_cast<float>(color.b)});
@@ -212,7 +222,8 @@ void Converter::passTwo() {
     if (options_.onProgress) options_.onProgress(2, i + 1, times_.size());
   }
   for (auto& [id, t] : tracks_) {
-    for (RegionWriter* w : {&t.translation, &t.rotation, &t.visTime, &t.visValue, &t.scale, &t.color, &t.intensity, &t.range}) w->flush();
+    for (RegionWriter* w : {&t.translation, &t.rotation, &t.visTime, &t.visValue, &t.scale, &t.color, &t.intensity, &t.range, &t.weights})
+      w->flush();
     for (auto& w : t.jointTranslation) w.flush();
     for (auto& w : t.jointRotation) w.flush();
   }

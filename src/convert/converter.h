@@ -62,7 +62,9 @@ struct Track {
   std::vector<std::uint64_t> jointTranslationOffsets, jointRotationOffsets;
   // Pass 2.
   std::uint64_t colorOffset = 0, intensityOffset = 0, rangeOffset = 0;
-  RegionWriter translation, rotation, visTime, visValue, scale, color, intensity, range;
+  std::uint64_t weightsOffset = 0;  // a vertex-animated model's morph weights, one per key frame per key
+  RegionWriter translation, rotation, visTime, visValue, scale, color, intensity, range, weights;
+  std::vector<float> heldWeights;
   std::vector<RegionWriter> jointTranslation, jointRotation;
   glm::dvec3 heldTranslation{0.0};
   glm::dvec3 heldColor{0.0};
@@ -166,6 +168,7 @@ class Converter {
   // metallic and roughness from the mask map, or dielectric with roughness 0.8 without one.
   int material(const CapturedMesh& mesh);
 
+  json morphTargets(const CapturedModel& model, const CapturedMesh& mesh);
   void buildMeshes();
 
   // KHR_lights_punctual colour (the captured colour over its largest channel) and intensity of a

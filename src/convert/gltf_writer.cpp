@@ -86,7 +86,8 @@ int addBufferView(json& document, std::uint64_t offset, std::uint64_t length, in
 
 int addAccessor(json& document, int view, std::uint64_t byteOffset, int componentType, std::size_t count, const char* type, json min,
                 json max) {
-  json a = {{"bufferView", view}, {"componentType", componentType}, {"count", count}, {"type", type}};
+  json a = {{"componentType", componentType}, {"count", count}, {"type", type}};
+  if (view >= 0) a["bufferView"] = view;  // none: zeros (glTF 2.0, 3.6.2.1)
   if (byteOffset) a["byteOffset"] = byteOffset;
   if (!min.is_null()) a["min"] = std::move(min);
   if (!max.is_null()) a["max"] = std::move(max);

@@ -29,6 +29,8 @@ summary = {
     "lights": sum(1 for o in objects if o.type == "LIGHT"),
     "actions": len(bpy.data.actions),
     "images": len(bpy.data.images),
+    # Morph targets become shape keys: the non-basis keys of every mesh object.
+    "shape_keys": sum(len(o.data.shape_keys.key_blocks) - 1 for o in objects if o.type == "MESH" and o.data.shape_keys),
 }
 print("DYNBENCH_IMPORT " + json.dumps(summary))
 sys.stdout.flush()
