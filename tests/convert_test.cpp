@@ -740,6 +740,32 @@ fs::path writeVertexAnimatedCapture(const std::string& name, uint64_t& flagId) {
   return dir;
 }
 
+// The highest world-space y the renderer's P buffer hits in frame `frame` of `dataset` at 64x36,
+// and how many pixels hit.
+struct RenderedTop {
+  double y = -1e9;
+  std::size_t hits = 0;
+};
+RenderedTop renderedTop(const fs::path& dataset, const std::string& engine, long frame) {
+  const fs::path frames = freshDir(fmt::format("{}_{}_{}", dataset.stem().string(), engine, frame));
+  std::string out;
+  if (runShell(fmt::format("{} render '{}' -o '{}' --res 64x36 --spp 1 --frames {} --engine {} 2>&1", DYNBENCH_EXE, dataset.string(),
+                           frames.string(), frame, engine), out) != 0) {
+    ADD_FAILURE() << out;
+    return {};
+  }
+  auto read = frames::readFrame({frame, frames::frameImagePath(frames, frame), frames::frameSidecarPath(frames, frame)});
+  if (!read) {
+    ADD_FAILURE() << read.error().message;
+    return {};
+  }
+  RenderedTop top;
+  for (std::size_t i = 0; i < read->pixelCount(); ++i)
+    if (read->hit.empty() ? glm::length(glm::vec3(read->position[3 * i], read->position[3 * i + 1], read->position[3 * i + 2])) > 0 : read->hit[i] > 0)
+      top.y = std::max(top.y, static_cast<double>(read->position[3 * i + 1])), ++top.hits;
+  return top;
+}
+
 TEST(Convert, VertexAnimationBecomesMorphTargetsWithAnimatedWeights) {
   uint64_t flag = 0;
   const fs::path capture = writeVertexAnimatedCapture("vertex_animation_capture", flag);
@@ -770,18 +796,10 @@ TEST(Convert, VertexAnimationBecomesMorphTargetsWithAnimatedWeights) {
   expectClose(e.worldPositions(node, 0, 5.5 / 24.0)[0], {0, 1.375, 0}, "halfway between frames 5 and 6");
   // The renderer draws the morphed quad: at frame 8 (key frame 2, raised by 2) the highest point
   // it hits is above y = 2, where at frame 0 nothing is above y = 1.
-  const fs::path frames = freshDir("vertex_animation_frames");
-  std::string out;
-  ASSERT_EQ(runShell(fmt::format("{} render '{}' -o '{}' --res 64x36 --spp 1 --frames 0:8:8 2>&1", DYNBENCH_EXE, options.output.string(),
-                                 frames.string()), out), 0) << out;
   for (const auto& [frame, low, high] : {std::tuple{0L, 0.5, 1.0}, std::tuple{8L, 2.5, 3.0}}) {
-    auto read = frames::readFrame({frame, frames::frameImagePath(frames, frame), frames::frameSidecarPath(frames, frame)});
-    ASSERT_TRUE(read) << read.error().message;
-    float top = -1e9f;
-    for (std::size_t i = 0; i < read->pixelCount(); ++i)
-      if (read->hit[i] > 0) top = std::max(top, read->position[3 * i + 1]);
-    EXPECT_GT(top, low) << "frame " << frame;
-    EXPECT_LE(top, high + 1e-4) << "frame " << frame;
+    const RenderedTop top = renderedTop(options.output, "embree", frame);
+    EXPECT_GT(top.y, low) << "frame " << frame;
+    EXPECT_LE(top.y, high + 1e-4) << "frame " << frame;
   }
 }
 
@@ -799,6 +817,11 @@ TEST(Convert, BlenderImportsTheMorphTargetsAsShapeKeys) {
   EXPECT_EQ(summary["meshes"], 1);      // the flag (its two primitives in one mesh)
   EXPECT_EQ(summary["shape_keys"], 3);  // one per key frame, as convert reports
   EXPECT_EQ(summary["shape_keys"], report->morphTargets);
+  // Cycles (through that import) draws the morphed quad where dynbench's renderer does.
+  const RenderedTop embree = renderedTop(options.output, "embree", 8), cycles = renderedTop(options.output, "cycles", 8);
+  EXPECT_GT(cycles.y, 2.5);
+  EXPECT_NEAR(cycles.y, embree.y, 1e-3);
+  EXPECT_EQ(cycles.hits, embree.hits);
 }
 
 TEST(Capture, VertexAnimationIsCheckedBySdkAndReader) {
