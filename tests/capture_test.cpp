@@ -307,7 +307,7 @@ TEST(BadCapture, OrderAndVersion) {
   expectCaptureError(handCapture("bad_version_header", "capture\n"), ErrorCode::kParse, {"Capture.txt:1:", "expected the version line"});
   // A version 1 capture (before the lights' range and the signed normals) is named as such.
   expectCaptureError(handCapture("old_version", "dynbench-capture:1\ns:hand\n" + kGoodFrame), ErrorCode::kParse,
-                     {"Capture.txt:1:", "version 1 is not supported", "reads version 2", "capture again"});
+                     {"Capture.txt:1:", "version 1 is not supported", "reads versions 2 and 3", "capture again"});
   expectCaptureError(handCapture("bad_order", kHeader + "f:2:0\ne:2\nf:1:1\ne:1\n"), ErrorCode::kInvalidData,
                      {"Capture.txt:5:", "frame numbers must increase"});
   expectCaptureError(handCapture("bad_nested", kHeader + "f:1:0\nf:2:0\n"), ErrorCode::kInvalidData, {"Capture.txt:4:", "before frame 1"});

@@ -333,9 +333,9 @@ Expected<std::unique_ptr<CaptureReader>> CaptureReader::open(const fs::path& dir
     if (!impl.source.next(impl.text, complete) || (impl.text != kCaptureVersionLine && impl.text != kCaptureVersion2Line)) {
       if (impl.text.starts_with("dynbench-capture:"))
         return fail(ErrorCode::kParse,
-                    "{}:1: capture format version {} is not supported; this dynbench reads version {} (version 1 captures lack the "
-                    "lights' range and predate the signed normals: capture again)",
-                    impl.file, impl.text.substr(17), kCaptureVersionLine.substr(17));
+                    "{}:1: capture format version {} is not supported; this dynbench reads versions {} and {} (version 1 captures lack "
+                    "the lights' range and predate the signed normals: capture again)",
+                    impl.file, impl.text.substr(17), kCaptureVersion2Line.substr(17), kCaptureVersionLine.substr(17));
       return fail(ErrorCode::kParse, "{}:1: expected the version line '{}'", impl.file, kCaptureVersionLine);
     }
     while (impl.source.next(impl.text, complete)) {
