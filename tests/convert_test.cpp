@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "capture/check.h"
 #include "capture/reader.h"
 #include "capture_fixture.h"
 #include "convert/convert.h"
@@ -769,6 +770,13 @@ RenderedTop renderedTop(const fs::path& dataset, const std::string& engine, long
 TEST(Convert, VertexAnimationBecomesMorphTargetsWithAnimatedWeights) {
   uint64_t flag = 0;
   const fs::path capture = writeVertexAnimatedCapture("vertex_animation_capture", flag);
+  auto summary = capture::checkCapture(capture);
+  ASSERT_TRUE(summary) << summary.error().message;
+  EXPECT_EQ(summary->vertexAnimatedModels, 1u);
+  EXPECT_EQ(summary->rigidModels, 0u);
+  EXPECT_EQ(summary->vertexAnimatedModelFiles, 1u);
+  EXPECT_EQ(summary->keyFrames, 3u);
+  EXPECT_EQ(summary->vertexFrameRecords, 9u);
   ConvertOptions options;
   options.capture = capture;
   options.output = freshDir("vertex_animation_out") / "flag.gltf";

@@ -17,13 +17,15 @@ Expected<CaptureSummary> checkCapture(const std::filesystem::path& directory, co
     ++s.models;
     s.skinnedModelFiles += m.joints.empty() ? 0 : 1;
     s.joints += m.joints.size();
+    s.vertexAnimatedModelFiles += m.keyFrames > 0 ? 1 : 0;
+    s.keyFrames += m.keyFrames;
     for (const auto& mesh : m.meshes) {
       ++s.meshes;
       s.vertices += mesh.positions.size();
       s.triangles += mesh.indices.size() / 3;
     }
   }
-  std::set<std::uint64_t> cameras, staticModels, models, skinned, staticLights, dynamicLights;
+  std::set<std::uint64_t> cameras, staticModels, models, skinned, vertexAnimated, staticLights, dynamicLights;
   std::map<std::uint64_t, std::string> lightType;
   CaptureFrame frame;
   while (true) {
@@ -41,6 +43,7 @@ Expected<CaptureSummary> checkCapture(const std::filesystem::path& directory, co
     for (const auto& m : frame.staticModels) staticModels.insert(m.id);
     for (const auto& m : frame.models) models.insert(m.id);
     for (const auto& j : frame.joints) skinned.insert(j.id);
+    for (const auto& v : frame.vertexFrames) vertexAnimated.insert(v.id);
     for (const auto& l : frame.lights) {
       (l.dynamic ? dynamicLights : staticLights).insert(l.id);
       lightType[l.id] = l.modelType;
@@ -48,6 +51,7 @@ Expected<CaptureSummary> checkCapture(const std::filesystem::path& directory, co
     s.cameraRecords += frame.cameras.size();
     s.modelRecords += frame.models.size() + frame.staticModels.size();
     s.jointRecords += frame.joints.size();
+    s.vertexFrameRecords += frame.vertexFrames.size();
     s.lightRecords += frame.lights.size();
     for (const auto& c : frame.cuts) ++s.cutsByReason[c.reason];
     if (onFrame) onFrame(s.frames);
@@ -57,7 +61,8 @@ Expected<CaptureSummary> checkCapture(const std::filesystem::path& directory, co
   s.cameras = cameras.size();
   s.staticModels = staticModels.size();
   s.skinnedModels = skinned.size();
-  s.rigidModels = models.size() - skinned.size();
+  s.vertexAnimatedModels = vertexAnimated.size();
+  s.rigidModels = models.size() - skinned.size() - vertexAnimated.size();
   s.staticLights = staticLights.size();
   s.dynamicLights = dynamicLights.size();
   s.capturables = s.cameras + s.staticModels + models.size() + lightType.size();
@@ -77,8 +82,10 @@ std::string summaryText(const std::filesystem::path& directory, const CaptureSum
   out += fmt::format("frames:      {} (numbers {}..{}), {:.3f} s to {:.3f} s, span {:.3f} s", s.frames, s.firstFrame, s.lastFrame,
                      s.startTime, s.endTime, span);
   if (s.frames > 1 && span > 0) out += fmt::format(", {:.2f} frames/s", static_cast<double>(s.frames - 1) / span);
-  out += fmt::format("\ncapturables: {} ({} cameras, {} static map models, {} rigid models, {} skinned models, {} lights)\n",
-                     s.capturables, s.cameras, s.staticModels, s.rigidModels, s.skinnedModels, s.staticLights + s.dynamicLights);
+  out += fmt::format("\ncapturables: {} ({} cameras, {} static map models, {} rigid models, {} skinned models, {} vertex-animated models, "
+                     "{} lights)\n",
+                     s.capturables, s.cameras, s.staticModels, s.rigidModels, s.skinnedModels, s.vertexAnimatedModels,
+                     s.staticLights + s.dynamicLights);
   std::string types;
   for (const auto& [type, n] : s.lightsByModelType) types += fmt::format("{}{} {}", types.empty() ? "" : ", ", n, type);
   out += fmt::format("lights:      {} static, {} dynamic{}\n", s.staticLights, s.dynamicLights, types.empty() ? "" : " (" + types + ")");
@@ -86,8 +93,8 @@ std::string summaryText(const std::filesystem::path& directory, const CaptureSum
   std::string reasons;
   for (const auto& [reason, n] : s.cutsByReason) cuts += n, reasons += fmt::format("{}{} {}", reasons.empty() ? "" : ", ", n, reason);
   out += fmt::format("camera cuts: {}{}\n", cuts, reasons.empty() ? "" : " (" + reasons + ")");
-  out += fmt::format("models:      {} ({} skinned), {} meshes, {} vertices, {} triangles, {} joints\n", s.models, s.skinnedModelFiles,
-                     s.meshes, s.vertices, s.triangles, s.joints);
+  out += fmt::format("models:      {} ({} skinned, {} vertex-animated), {} meshes, {} vertices, {} triangles, {} joints, {} key frames\n",
+                     s.models, s.skinnedModelFiles, s.vertexAnimatedModelFiles, s.meshes, s.vertices, s.triangles, s.joints, s.keyFrames);
   out += fmt::format("closed:      {}\n", s.closed ? "yes" : "no (the host stopped before closing the session)");
   return out;
 }
@@ -106,11 +113,14 @@ std::string summaryJson(const std::filesystem::path& directory, const CaptureSum
       {"start_time_s", s.startTime}, {"end_time_s", s.endTime},
       {"capturables", {{"total", s.capturables}, {"cameras", s.cameras}, {"static_models", s.staticModels},
                        {"rigid_models", s.rigidModels}, {"skinned_models", s.skinnedModels},
+                       {"vertex_animated_models", s.vertexAnimatedModels},
                        {"static_lights", s.staticLights}, {"dynamic_lights", s.dynamicLights},
                        {"lights_by_model_type", s.lightsByModelType}}},
-      {"models", {{"files", s.models}, {"skinned", s.skinnedModelFiles}, {"meshes", s.meshes}, {"vertices", s.vertices},
-                  {"triangles", s.triangles}, {"joints", s.joints}}},
-      {"records", {{"camera", s.cameraRecords}, {"model", s.modelRecords}, {"joints", s.jointRecords}, {"light", s.lightRecords}}},
+      {"models", {{"files", s.models}, {"skinned", s.skinnedModelFiles}, {"vertex_animated", s.vertexAnimatedModelFiles},
+                  {"meshes", s.meshes}, {"vertices", s.vertices}, {"triangles", s.triangles}, {"joints", s.joints},
+                  {"key_frames", s.keyFrames}}},
+      {"records", {{"camera", s.cameraRecords}, {"model", s.modelRecords}, {"joints", s.jointRecords},
+                   {"vertex_frames", s.vertexFrameRecords}, {"light", s.lightRecords}}},
       {"camera_cuts", s.cutsByReason},
       {"warnings", s.warnings}};
   return j.dump(2) + "\n";
