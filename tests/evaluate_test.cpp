@@ -25,16 +25,24 @@ glm::dvec3 truth(int x, int y) { return glm::dvec3(1.0 + 0.3 * std::sin(0.2 * x)
 
 // Frame `index` of a static camera at the origin looking down -Z at the plane z = -5; the direct
 // radiance is the truth plus Gaussian noise of standard deviation `sigma` (0: the reference).
-frames::FeatureFrame planeFrame(long index, double sigma, std::uint32_t seed) {
+// Frame `index` (at 24 fps) of w x h pixels, zero-filled, seen by a static camera at the origin
+// looking down -Z (60 degrees vertical field of view).
+frames::FeatureFrame staticCameraFrame(long index, int w, int h) {
   frames::FeatureFrame f;
   f.frame = index;
   f.time = index / 24.0;
-  f.resize(kW, kH);
+  f.resize(w, h);
   frames::FrameCamera& c = f.camera;
   c.view = glm::lookAt(glm::dvec3(0.0), glm::dvec3(0, 0, -1), glm::dvec3(0, 1, 0));
   c.world = glm::inverse(c.view);
-  c.projection = glm::perspective(glm::radians(60.0), static_cast<double>(kW) / kH, 0.1, 100.0);
-  c.yfov = glm::radians(60.0), c.znear = 0.1, c.zfar = 100.0, c.width = kW, c.height = kH;
+  c.projection = glm::perspective(glm::radians(60.0), static_cast<double>(w) / h, 0.1, 100.0);
+  c.yfov = glm::radians(60.0), c.znear = 0.1, c.zfar = 100.0, c.width = w, c.height = h;
+  return f;
+}
+
+frames::FeatureFrame planeFrame(long index, double sigma, std::uint32_t seed) {
+  frames::FeatureFrame f = staticCameraFrame(index, kW, kH);
+  const frames::FrameCamera& c = f.camera;
   std::mt19937 rng(seed * 7919u + static_cast<std::uint32_t>(index));
   std::normal_distribution<double> noise(0.0, 1.0);
   for (int y = 0; y < kH; ++y)
@@ -112,14 +120,7 @@ TEST(Methods, SvgfReturnsAConstantIlluminationUnderAnyAlbedoAtAnyWidth) {
   constexpr int w = 37, h = 11;
   const glm::vec3 illumination(1.3f, 0.9f, 0.4f);
   auto frame = [&](long index) {
-    frames::FeatureFrame f;
-    f.frame = index, f.time = index / 24.0;
-    f.resize(w, h);
-    frames::FrameCamera& c = f.camera;
-    c.view = glm::lookAt(glm::dvec3(0.0), glm::dvec3(0, 0, -1), glm::dvec3(0, 1, 0));
-    c.world = glm::inverse(c.view);
-    c.projection = glm::perspective(glm::radians(60.0), static_cast<double>(w) / h, 0.1, 100.0);
-    c.yfov = glm::radians(60.0), c.znear = 0.1, c.zfar = 100.0, c.width = w, c.height = h;
+    frames::FeatureFrame f = staticCameraFrame(index, w, h);
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
         const std::size_t i = static_cast<std::size_t>(y) * w + x;

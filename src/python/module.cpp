@@ -52,8 +52,10 @@ void warnAll(const std::vector<std::string>& warnings) {
     if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) < 0) throw py::error_already_set();
 }
 
-// A JSON document as the CLI writes it and json.load reads it back (non-finite numbers as None).
-py::object document(const nlohmann::json& json) { return pyjson::from_json(nlohmann::json::parse(json.dump())); }
+// A JSON document as the CLI writes it and json.load reads it back (non-finite numbers as None):
+// from the text the CLI writes, or from the document it dumps.
+py::object document(const std::string& text) { return pyjson::from_json(nlohmann::json::parse(text)); }
+py::object document(const nlohmann::json& json) { return document(json.dump()); }
 
 Frame readFrame(const fs::path& path) {
   const frames::FrameEntry entry = unwrap(frames::frameEntry(path));
@@ -93,7 +95,7 @@ py::object measureStats(const std::vector<fs::path>& paths, double fps, std::opt
   }
   const pipeline::StatsOutcome result = unwrap(std::move(outcome));
   warnAll(result.warnings);
-  return document(nlohmann::json::parse(report::statsJson(result.rows, fps)));
+  return document(report::statsJson(result.rows, fps));
 }
 
 template <typename Enum>
@@ -129,7 +131,7 @@ py::object discardFrames(const fs::path& frames, const std::string& geometryTest
   }
   const pipeline::DiscardOutcome result = unwrap(std::move(outcome));
   warnAll(result.run.warnings);
-  return document(nlohmann::json::parse(discard::discardJson(result.run, frames.string())));
+  return document(discard::discardJson(result.run, frames.string()));
 }
 
 // compare(reference, test): paths as `dynbench compare REF TEST... --json`; arrays (H, W, 3) of
@@ -158,7 +160,7 @@ py::object compareImages(const py::object& reference, const py::object& test, do
   }
   nlohmann::json entry = nlohmann::json::parse(evaluate::scoresJson(scored.scores));
   entry["test"] = nullptr;
-  return document({{"reference", nullptr}, {"pixels_per_degree", ppd}, {"images", nlohmann::json::array({entry})}});
+  return document(nlohmann::json{{"reference", nullptr}, {"pixels_per_degree", ppd}, {"images", nlohmann::json::array({entry})}});
 }
 
 py::object evaluateMethods(const fs::path& input, const fs::path& reference, const py::list& methods, double ppd, std::optional<fs::path> outDir) {
