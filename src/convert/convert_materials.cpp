@@ -9,7 +9,22 @@ int Converter::image(const std::string& texture) {
   std::string ext = fs::path(texture).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   if (ext != ".png" && ext != ".jpg" && ext != ".jpeg") {
-    report_.warnings.push_back(fmt::format("texture '{}' is neither PNG nor JPEG (glTF's image formats); left out", texture));
+    // glTF's images are PNG or JPEG; another format OpenImageIO reads (id Tech 3's TGA) is
+    // rewritten as PNG beside the others, its 8-bit values unchanged (read as float, written 8-bit).
+    if (const fs::path source = textureSource(texture); !source.empty()) {
+      auto pixels = readImage(source);
+      if (!pixels) {
+        report_.warnings.push_back(fmt::format("texture '{}': {}; left out", texture, pixels.error().message));
+      } else {
+        const fs::path relative = fs::path(texture).lexically_normal().replace_extension(".png");
+        const fs::path target = outDir_ / (stem_ + "_textures") / relative;
+        std::error_code ec;
+        fs::create_directories(target.parent_path(), ec);
+        if (auto ok = writeImage(target, *pixels); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
+        report_.written.push_back(target);
+        index = addTexture(relative.generic_string(), "image/png");
+      }
+    }
   } else if (const fs::path source = textureSource(texture); !source.empty()) {
     const fs::path relative = fs::path(texture).lexically_normal();
     const fs::path target = outDir_ / (stem_ + "_textures") / relative;

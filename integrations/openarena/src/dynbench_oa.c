@@ -1,0 +1,1091 @@
+/* dynbench capture adapter for OpenArena (id Tech 3 game code, ioquake3 engine), built into the
+ * client game module (cgame) by integrations/openarena/build.sh and linked with the *installed*
+ * capture SDK (pkg-config dynbench-capture).
+ *
+ * What it records, all from the game's own render calls (the hooks in dynbench_oa.h):
+ *   - the world: the BSP's drawn surfaces (planar faces, triangle soups, Bezier patches
+ *     tessellated here) as one static model with a mesh per shader; brush entities (doors, lifts)
+ *     as their own models, moved as the game moves them;
+ *   - every drawn model entity (players as their three tagged MD3 parts, weapons, projectiles,
+ *     items, gibs): its transform and its MD3 key frames (frame, oldframe, backlerp: `v` records),
+ *     the MD3's every key frame once, as vertex animation (capture format 3);
+ *   - dynamic lights (muzzle flashes, rockets, explosions) and the map's lighting (its sky
+ *     shader's sun, its light grid's mean ambient, its light-emitting shaders' surfaces as lights);
+ *   - the camera (the view the game renders: the followed bot's eyes) and its cuts.
+ * Coordinates: id Tech 3 is Z-up, X forward at yaw 0, Y to the left. The capture format is Y-up
+ * and right-handed; the adapter uses (x, y, z) -> (-y, z, -x), a rotation, under which the game's
+ * forward (+x) is the camera's -Z and its left (+y) is -X: what the player saw is kept.
+ * Triangles: id Tech 3 draws clockwise faces as front faces; glTF's are counter-clockwise, so each
+ * triangle's winding is reversed.
+ */
+#include "cg_local.h"
+#include "../qcommon/qfiles.h"
+#include "dynbench_oa.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include <dynbench/capture.h>
+
+#define MAX_HANDLES 4096
+#define MAX_PENDING 2048
+#define ID_TABLE_SIZE (1 << 16)
+#define SHADER_TABLE_SIZE (1 << 14)
+#define PATCH_LEVEL 8 /* each 3x3 Bezier sub-patch becomes 8 x 8 quads */
+#define UNOWNED_SLOT (DYNBENCH_LOCAL_SLOT * 2 - 1) /* drawn outside an entity (effects) */
+#define MAX_STATIC_LIGHTS 4096
+
+typedef struct {
+  refEntity_t entity;
+  int slot, serial, occurrence;
+} pending_entity_t;
+
+typedef struct {
+  float origin[3], intensity, rgb[3];
+  int slot, serial, occurrence, entity_type;
+} pending_light_t;
+
+typedef struct {
+  int used;
+  int slot, serial, model, skin, occurrence; /* model -1: a light */
+  uint64_t id;
+} identity_t;
+
+typedef struct {
+  char name[MAX_QPATH];
+  char image[MAX_QPATH];
+  float surface_light;   /* q3map_surfacelight */
+  float light_rgb[3];    /* q3map_lightRGB, or white */
+  int has_sun;
+  float sun[6];          /* q3map_sun r g b intensity degrees elevation */
+  int nodraw, sky, fog;
+  int used;
+} shader_info_t;
+
+typedef struct {
+  int key_frames; /* 0 for a rigid model */
+} model_info_t;
+
+static struct {
+  int active;
+  dbc_session* session;
+  char dir[1024];
+  double seconds, warmup;
+  char follow[32];
+  int total_frames;
+  int frame;
+  int frame_ms, clock_base, clock_frames, clock_resets;
+  int started;
+  int start_time;
+  int finished;
+  int spectate_sent_at, follow_sent_at, next_sent_for_death;
+  int follow_target;
+  uint64_t camera_id;
+  int last_client, last_teleport, last_dead, have_last;
+  float last_position[3];
+  float camera_fov;
+  int last_camera_width, last_camera_height;
+  char map[MAX_QPATH];        /* "oa_dm1" */
+  char world_path[MAX_QPATH]; /* "maps/oa_dm1" */
+  char model_names[MAX_HANDLES][MAX_QPATH];
+  char skin_names[MAX_HANDLES][MAX_QPATH];
+  /* who draws */
+  int owner_slot, owner_type;
+  int owner_serial[DYNBENCH_LOCAL_SLOT * 2];
+  int owner_signature[DYNBENCH_LOCAL_SLOT * 2];
+  int owner_last_frame[DYNBENCH_LOCAL_SLOT * 2];
+  int owner_seen[DYNBENCH_LOCAL_SLOT * 2]; /* render pass the slot was last drawn in */
+  int owner_models[DYNBENCH_LOCAL_SLOT * 2][8];
+  int owner_model_count[DYNBENCH_LOCAL_SLOT * 2][8];
+  int owner_lights[DYNBENCH_LOCAL_SLOT * 2];
+  int pass;
+  pending_entity_t entities[MAX_PENDING];
+  int entity_count;
+  pending_light_t lights[MAX_PENDING];
+  int light_count;
+  identity_t ids[ID_TABLE_SIZE];
+  shader_info_t* shaders; /* hash table, SHADER_TABLE_SIZE */
+  /* the map's surface lights, recorded in the first frame (lights are frame records) */
+  float static_lights[MAX_STATIC_LIGHTS][7]; /* position, rgb, range */
+  int static_light_count;
+} g_db;
+
+/* ---------------------------------------------------------------------------------------------- */
+/* small helpers */
+
+static void db_fail(const char* what) {
+  fprintf(stderr, "dynbench-capture: error: %s: %s\n", what, dbc_last_error());
+  fflush(stderr);
+  g_db.active = 0;
+  trap_SendConsoleCommand("quit\n");
+}
+
+static void to_capture(const float in[3], float out[3]) {
+  const float x = in[0], y = in[1], z = in[2];
+  out[0] = -y;
+  out[1] = z;
+  out[2] = -x;
+}
+
+static uint32_t hash_string(const char* s) {
+  uint32_t h = 2166136261u;
+  for (; *s; ++s) h = (h ^ (uint32_t)(unsigned char)tolower((unsigned char)*s)) * 16777619u;
+  return h;
+}
+
+static int make_directories(const char* path) { /* mkdir -p of path's parent directories */
+  char buffer[1400];
+  Q_strncpyz(buffer, path, sizeof(buffer));
+  for (char* p = buffer + 1; *p; ++p) {
+    if (*p != '/') continue;
+    *p = 0;
+    if (mkdir(buffer, 0755) != 0 && errno != EEXIST) return 0;
+    *p = '/';
+  }
+  return 1;
+}
+
+/* The whole of a file in the game's file system (pk3 archives included), NUL-terminated; NULL if
+ * there is none. Free with free(). */
+static char* read_game_file(const char* path, int* length) {
+  fileHandle_t f;
+  const int size = trap_FS_FOpenFile(path, &f, FS_READ);
+  if (size <= 0 || !f) {
+    if (f) trap_FS_FCloseFile(f);
+    return NULL;
+  }
+  char* data = malloc((size_t)size + 1);
+  trap_FS_Read(data, size, f);
+  trap_FS_FCloseFile(f);
+  data[size] = 0;
+  if (length) *length = size;
+  return data;
+}
+
+static int game_file_exists(const char* path) {
+  fileHandle_t f;
+  const int size = trap_FS_FOpenFile(path, &f, FS_READ);
+  if (f) trap_FS_FCloseFile(f);
+  return size > 0;
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* shaders: the scripts' first image stage and light parameters; textures copied out of the paks */
+
+static shader_info_t* shader_slot(const char* name, int create) {
+  uint32_t h = hash_string(name) & (SHADER_TABLE_SIZE - 1);
+  for (int probe = 0; probe < SHADER_TABLE_SIZE; ++probe, h = (h + 1) & (SHADER_TABLE_SIZE - 1)) {
+    shader_info_t* s = &g_db.shaders[h];
+    if (!s->used) {
+      if (!create) return NULL;
+      memset(s, 0, sizeof(*s));
+      s->used = 1;
+      Q_strncpyz(s->name, name, sizeof(s->name));
+      s->light_rgb[0] = s->light_rgb[1] = s->light_rgb[2] = 1.0f;
+      return s;
+    }
+    if (!Q_stricmp(s->name, name)) return s;
+  }
+  return NULL;
+}
+
+static void parse_shader_script(char* text) {
+  char* p = text;
+  for (;;) {
+    char* token = COM_ParseExt(&p, qtrue);
+    if (!token[0]) return;
+    shader_info_t* shader = shader_slot(token, 1);
+    token = COM_ParseExt(&p, qtrue);
+    if (strcmp(token, "{")) return; /* not a shader script the game could read either */
+    if (!shader) return;
+    const int defined_before = shader->image[0] != 0; /* the first definition wins, as in the renderer */
+    int depth = 1, stage = 0;
+    while (depth > 0) {
+      token = COM_ParseExt(&p, qtrue);
+      if (!token[0]) return;
+      if (!strcmp(token, "{")) { ++depth; ++stage; continue; }
+      if (!strcmp(token, "}")) { --depth; continue; }
+      if (defined_before) { SkipRestOfLine(&p); continue; }
+      if (depth == 2) {
+        if ((!Q_stricmp(token, "map") || !Q_stricmp(token, "clampmap")) && !shader->image[0]) {
+          token = COM_ParseExt(&p, qfalse);
+          if (token[0] && token[0] != '$') Q_strncpyz(shader->image, token, sizeof(shader->image));
+        } else if (!Q_stricmp(token, "animmap") && !shader->image[0]) {
+          COM_ParseExt(&p, qfalse); /* frequency */
+          token = COM_ParseExt(&p, qfalse);
+          if (token[0]) Q_strncpyz(shader->image, token, sizeof(shader->image));
+        }
+      } else if (depth == 1) {
+        if (!Q_stricmp(token, "q3map_surfacelight")) {
+          shader->surface_light = atof(COM_ParseExt(&p, qfalse));
+        } else if (!Q_stricmp(token, "q3map_lightrgb")) {
+          for (int i = 0; i < 3; ++i) shader->light_rgb[i] = atof(COM_ParseExt(&p, qfalse));
+        } else if (!Q_stricmp(token, "q3map_sun") || !Q_stricmp(token, "q3map_sunext")) {
+          for (int i = 0; i < 6; ++i) shader->sun[i] = atof(COM_ParseExt(&p, qfalse));
+          shader->has_sun = 1;
+        } else if (!Q_stricmp(token, "surfaceparm")) {
+          token = COM_ParseExt(&p, qfalse);
+          if (!Q_stricmp(token, "nodraw")) shader->nodraw = 1;
+          if (!Q_stricmp(token, "sky")) shader->sky = 1;
+          if (!Q_stricmp(token, "fog")) shader->fog = 1;
+        } else if (!Q_stricmp(token, "qer_editorimage") && !shader->image[0] && stage == 0) {
+          /* a fallback only: an image stage, when one follows, replaces it */
+        }
+      }
+      SkipRestOfLine(&p);
+    }
+  }
+}
+
+/* The shader scripts the game module listed (qagame has the file list the client game lacks). */
+static void load_shader_scripts(void) {
+  g_db.shaders = calloc(SHADER_TABLE_SIZE, sizeof(shader_info_t));
+  char* list = read_game_file("dynbench-shader-scripts.txt", NULL);
+  if (!list) {
+    fprintf(stderr, "dynbench-capture: warning: no shader script list from the game module; textures from shader names only\n");
+    return;
+  }
+  int scripts = 0;
+  for (char* line = strtok(list, "\n"); line; line = strtok(NULL, "\n")) {
+    char path[MAX_QPATH * 2];
+    Com_sprintf(path, sizeof(path), "scripts/%s", line);
+    char* text = read_game_file(path, NULL);
+    if (!text) continue;
+    parse_shader_script(text);
+    free(text);
+    ++scripts;
+  }
+  free(list);
+  fprintf(stderr, "dynbench-capture: %d shader scripts read\n", scripts);
+}
+
+/* The image file the renderer would load for `name` (it tries .tga, then .jpg, then .png,
+ * whatever the name's extension), as a path in the game's file system, or "" when none exists. */
+static void find_image(const char* name, char out[MAX_QPATH]) {
+  static const char* extensions[] = {".tga", ".jpg", ".png", ".jpeg"};
+  char base[MAX_QPATH];
+  out[0] = 0;
+  Q_strncpyz(base, name, sizeof(base));
+  char* dot = strrchr(base, '.');
+  char* slash = strrchr(base, '/');
+  if (dot && (!slash || dot > slash)) *dot = 0;
+  for (int i = 0; i < 4; ++i) {
+    char candidate[MAX_QPATH];
+    Com_sprintf(candidate, sizeof(candidate), "%s%s", base, extensions[i]);
+    if (game_file_exists(candidate)) {
+      Q_strncpyz(out, candidate, MAX_QPATH);
+      return;
+    }
+  }
+}
+
+/* The texture of a shader, copied out of the paks under the capture's data root (data/), as the
+ * path the ModelMesh file names; NULL for none. */
+static const char* shader_texture(const char* shader_name) {
+  static char result[MAX_QPATH];
+  shader_info_t* shader = shader_slot(shader_name, 1);
+  if (!shader) return NULL;
+  if (shader->used == 2) return shader->image[0] ? shader->image : NULL; /* resolved before */
+  char file[MAX_QPATH];
+  find_image(shader->image[0] ? shader->image : shader_name, file);
+  if (!file[0] && shader->image[0]) find_image(shader_name, file);
+  shader->used = 2;
+  Q_strncpyz(shader->image, file, sizeof(shader->image));
+  if (!file[0]) return NULL;
+  char target[1400];
+  Com_sprintf(target, sizeof(target), "%s/data/%s", g_db.dir, file);
+  struct stat st;
+  if (stat(target, &st) != 0) {
+    int length = 0;
+    char* data = read_game_file(file, &length);
+    if (!data) return NULL;
+    char temporary[1500];
+    Com_sprintf(temporary, sizeof(temporary), "%s.part", target);
+    FILE* out = make_directories(target) ? fopen(temporary, "wb") : NULL;
+    const int ok = out && fwrite(data, 1, (size_t)length, out) == (size_t)length;
+    if (out) fclose(out);
+    free(data);
+    if (!ok || rename(temporary, target) != 0) {
+      fprintf(stderr, "dynbench-capture: warning: cannot write %s\n", target);
+      return NULL;
+    }
+  }
+  Q_strncpyz(result, file, sizeof(result));
+  return result;
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* growing arrays for meshes */
+
+typedef struct {
+  float* positions; float* normals; float* uvs; uint32_t* indices;
+  size_t vertices, vertex_capacity, triangles, triangle_capacity;
+} mesh_builder_t;
+
+static void mesh_reserve(mesh_builder_t* m, size_t vertices, size_t triangles) {
+  if (m->vertices + vertices > m->vertex_capacity) {
+    m->vertex_capacity = (m->vertices + vertices) * 2;
+    m->positions = realloc(m->positions, m->vertex_capacity * 3 * sizeof(float));
+    m->normals = realloc(m->normals, m->vertex_capacity * 3 * sizeof(float));
+    m->uvs = realloc(m->uvs, m->vertex_capacity * 2 * sizeof(float));
+  }
+  if (m->triangles + triangles > m->triangle_capacity) {
+    m->triangle_capacity = (m->triangles + triangles) * 2;
+    m->indices = realloc(m->indices, m->triangle_capacity * 3 * sizeof(uint32_t));
+  }
+}
+
+static void mesh_vertex(mesh_builder_t* m, const float xyz[3], const float normal[3], const float st[2]) {
+  to_capture(xyz, &m->positions[m->vertices * 3]);
+  float n[3] = {normal[0], normal[1], normal[2]};
+  const float length = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (length > 1e-6f) { n[0] /= length; n[1] /= length; n[2] /= length; } else { n[0] = 0; n[1] = 0; n[2] = 1; }
+  to_capture(n, &m->normals[m->vertices * 3]);
+  m->uvs[m->vertices * 2 + 0] = st[0];
+  m->uvs[m->vertices * 2 + 1] = st[1];
+  ++m->vertices;
+}
+
+/* id Tech 3's clockwise front faces become glTF's counter-clockwise ones. */
+static void mesh_triangle(mesh_builder_t* m, uint32_t a, uint32_t b, uint32_t c) {
+  m->indices[m->triangles * 3 + 0] = a;
+  m->indices[m->triangles * 3 + 1] = c;
+  m->indices[m->triangles * 3 + 2] = b;
+  ++m->triangles;
+}
+
+static void mesh_free(mesh_builder_t* m) {
+  free(m->positions); free(m->normals); free(m->uvs); free(m->indices);
+  memset(m, 0, sizeof(*m));
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* the BSP: world surfaces, brush models, lights */
+
+typedef struct {
+  char* data;
+  int length;
+  const dshader_t* shaders; int shader_count;
+  const dmodel_t* models; int model_count;
+  const drawVert_t* vertices; int vertex_count;
+  const int* indices; int index_count;
+  const dsurface_t* surfaces; int surface_count;
+  const unsigned char* grid; int grid_bytes;
+} bsp_t;
+
+static bsp_t g_bsp;
+
+static int load_bsp(void) {
+  char path[MAX_QPATH];
+  Com_sprintf(path, sizeof(path), "maps/%s.bsp", g_db.map);
+  g_bsp.data = read_game_file(path, &g_bsp.length);
+  if (!g_bsp.data || g_bsp.length < (int)sizeof(dheader_t)) return 0;
+  const dheader_t* header = (const dheader_t*)g_bsp.data;
+  if (header->ident != BSP_IDENT || header->version != BSP_VERSION) return 0;
+#define LUMP(index, type, pointer, count) \
+  pointer = (const type*)(g_bsp.data + header->lumps[index].fileofs); \
+  count = header->lumps[index].filelen / (int)sizeof(type)
+  LUMP(LUMP_SHADERS, dshader_t, g_bsp.shaders, g_bsp.shader_count);
+  LUMP(LUMP_MODELS, dmodel_t, g_bsp.models, g_bsp.model_count);
+  LUMP(LUMP_DRAWVERTS, drawVert_t, g_bsp.vertices, g_bsp.vertex_count);
+  LUMP(LUMP_DRAWINDEXES, int, g_bsp.indices, g_bsp.index_count);
+  LUMP(LUMP_SURFACES, dsurface_t, g_bsp.surfaces, g_bsp.surface_count);
+  LUMP(LUMP_LIGHTGRID, unsigned char, g_bsp.grid, g_bsp.grid_bytes);
+#undef LUMP
+  return 1;
+}
+
+static int surface_drawn(const dsurface_t* surface) {
+  if (surface->shaderNum < 0 || surface->shaderNum >= g_bsp.shader_count) return 0;
+  if (surface->surfaceType == MST_FLARE || surface->surfaceType == MST_BAD) return 0;
+  const dshader_t* shader = &g_bsp.shaders[surface->shaderNum];
+  if (shader->surfaceFlags & (SURF_NODRAW | SURF_SKY)) return 0;
+  if (shader->contentFlags & CONTENTS_FOG) return 0;
+  const shader_info_t* info = shader_slot(shader->shader, 0);
+  if (info && (info->nodraw || info->sky || info->fog)) return 0;
+  return 1;
+}
+
+/* A biquadratic Bezier patch's point from its 3x3 control points (id Tech 3's curved surfaces). */
+static void bezier(const drawVert_t* control[9], float u, float v, float xyz[3], float normal[3], float st[2]) {
+  const float bu[3] = {(1 - u) * (1 - u), 2 * u * (1 - u), u * u};
+  const float bv[3] = {(1 - v) * (1 - v), 2 * v * (1 - v), v * v};
+  memset(xyz, 0, 3 * sizeof(float)); memset(normal, 0, 3 * sizeof(float)); memset(st, 0, 2 * sizeof(float));
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) {
+      const float w = bu[i] * bv[j];
+      const drawVert_t* c = control[j * 3 + i];
+      for (int k = 0; k < 3; ++k) { xyz[k] += w * c->xyz[k]; normal[k] += w * c->normal[k]; }
+      st[0] += w * c->st[0]; st[1] += w * c->st[1];
+    }
+}
+
+static void add_surface(mesh_builder_t* m, const dsurface_t* s) {
+  if (s->surfaceType == MST_PATCH) {
+    const int w = s->patchWidth, h = s->patchHeight;
+    if (w < 3 || h < 3 || !(w & 1) || !(h & 1)) return;
+    for (int py = 0; py + 2 < h; py += 2)
+      for (int px = 0; px + 2 < w; px += 2) {
+        const drawVert_t* control[9];
+        for (int j = 0; j < 3; ++j)
+          for (int i = 0; i < 3; ++i) control[j * 3 + i] = &g_bsp.vertices[s->firstVert + (py + j) * w + (px + i)];
+        const uint32_t base = (uint32_t)m->vertices;
+        mesh_reserve(m, (PATCH_LEVEL + 1) * (PATCH_LEVEL + 1), 2 * PATCH_LEVEL * PATCH_LEVEL);
+        for (int j = 0; j <= PATCH_LEVEL; ++j)
+          for (int i = 0; i <= PATCH_LEVEL; ++i) {
+            float xyz[3], normal[3], st[2];
+            bezier(control, (float)i / PATCH_LEVEL, (float)j / PATCH_LEVEL, xyz, normal, st);
+            mesh_vertex(m, xyz, normal, st);
+          }
+        /* the patch's rows and columns run as the control grid's, whose triangles the renderer
+         * draws as (i, j), (i, j+1), (i+1, j): the same winding as a planar face's */
+        for (int j = 0; j < PATCH_LEVEL; ++j)
+          for (int i = 0; i < PATCH_LEVEL; ++i) {
+            const uint32_t a = base + j * (PATCH_LEVEL + 1) + i, b = a + 1, c = a + PATCH_LEVEL + 1, d = c + 1;
+            mesh_triangle(m, a, c, b);
+            mesh_triangle(m, b, c, d);
+          }
+      }
+    return;
+  }
+  /* planar faces and triangle soups: indices relative to the surface's first vertex */
+  if (s->firstVert < 0 || s->firstVert + s->numVerts > g_bsp.vertex_count) return;
+  if (s->firstIndex < 0 || s->firstIndex + s->numIndexes > g_bsp.index_count) return;
+  const uint32_t base = (uint32_t)m->vertices;
+  mesh_reserve(m, (size_t)s->numVerts, (size_t)s->numIndexes / 3);
+  for (int i = 0; i < s->numVerts; ++i) {
+    const drawVert_t* v = &g_bsp.vertices[s->firstVert + i];
+    mesh_vertex(m, v->xyz, v->normal, v->st);
+  }
+  for (int i = 0; i + 2 < s->numIndexes; i += 3) {
+    const int* t = &g_bsp.indices[s->firstIndex + i];
+    if (t[0] < 0 || t[1] < 0 || t[2] < 0 || t[0] >= s->numVerts || t[1] >= s->numVerts || t[2] >= s->numVerts) continue;
+    mesh_triangle(m, base + (uint32_t)t[0], base + (uint32_t)t[1], base + (uint32_t)t[2]);
+  }
+}
+
+/* BSP model `index` (0: the world, 1...: brush entities) as a capture model with a mesh per shader. */
+static int record_bsp_model(int index, const char* model_path) {
+  if (index < 0 || index >= g_bsp.model_count) return 0;
+  const dmodel_t* model = &g_bsp.models[index];
+  if (dbc_model_begin(g_db.session, model_path) != DBC_OK) { db_fail("model"); return 0; }
+  int mesh_id = 0;
+  char* done = calloc((size_t)g_bsp.shader_count, 1);
+  for (int first = model->firstSurface; first < model->firstSurface + model->numSurfaces; ++first) {
+    const dsurface_t* s = &g_bsp.surfaces[first];
+    if (!surface_drawn(s) || done[s->shaderNum]) continue;
+    done[s->shaderNum] = 1;
+    mesh_builder_t m;
+    memset(&m, 0, sizeof(m));
+    for (int k = first; k < model->firstSurface + model->numSurfaces; ++k)
+      if (g_bsp.surfaces[k].shaderNum == s->shaderNum && surface_drawn(&g_bsp.surfaces[k])) add_surface(&m, &g_bsp.surfaces[k]);
+    if (m.triangles > 0) {
+      dbc_mesh mesh;
+      memset(&mesh, 0, sizeof(mesh));
+      mesh.mesh_id = mesh_id;
+      mesh.name = g_bsp.shaders[s->shaderNum].shader;
+      mesh.texture = shader_texture(g_bsp.shaders[s->shaderNum].shader);
+      mesh.vertex_count = m.vertices;
+      mesh.positions = m.positions;
+      mesh.normals = m.normals;
+      mesh.uvs = m.uvs;
+      mesh.triangle_count = m.triangles;
+      mesh.indices = m.indices;
+      if (dbc_model_mesh(g_db.session, &mesh) != DBC_OK) { mesh_free(&m); free(done); db_fail("world mesh"); return 0; }
+      ++mesh_id;
+    }
+    mesh_free(&m);
+  }
+  free(done);
+  if (dbc_model_end(g_db.session) != DBC_OK) { db_fail("model end"); return 0; }
+  return 1;
+}
+
+/* The map's own lighting. id Tech 3 bakes it into light maps; the capture gets what made them:
+ * the sky shader's sun (q3map_sun), the light grid's mean ambient light, and a static point light
+ * per surface of a light-emitting shader (q3map_surfacelight), as q3map itself approximates area
+ * lights by point lights. Its light at distance d is value x area / 4 / d^2 in 0-255 units
+ * (q3map's areaScale 0.25), full light (1) at d_full = sqrt(value x area / 4 / 255): the light
+ * gets range 3 d_full with the quadratic falloff (1 at the light, 0.89 at d_full, 0 at the range). */
+static void record_map_lighting(void) {
+  float sun_direction[3] = {0, 1, 0}, sun_rgb[3] = {0, 0, 0}, ambient[3] = {0, 0, 0}, sky[3] = {0, 0, 0};
+  for (int i = 0; i < g_bsp.shader_count; ++i) {
+    const shader_info_t* info = shader_slot(g_bsp.shaders[i].shader, 0);
+    if (!info || !info->has_sun) continue;
+    const float azimuth = info->sun[4] * (float)M_PI / 180.0f, elevation = info->sun[5] * (float)M_PI / 180.0f;
+    const float towards[3] = {cosf(elevation) * cosf(azimuth), cosf(elevation) * sinf(azimuth), sinf(elevation)};
+    to_capture(towards, sun_direction);
+    float colour[3] = {info->sun[0], info->sun[1], info->sun[2]};
+    const float peak = fmaxf(colour[0], fmaxf(colour[1], colour[2]));
+    for (int k = 0; k < 3; ++k) sun_rgb[k] = peak > 0 ? colour[k] / peak * info->sun[3] / 100.0f : 0.0f;
+    break;
+  }
+  /* light grid cells: ambient rgb, directed rgb, direction (8 bytes), 0-255 */
+  const int cells = g_bsp.grid_bytes / 8;
+  double sum[3] = {0, 0, 0};
+  int lit = 0;
+  for (int c = 0; c < cells; ++c) {
+    const unsigned char* cell = g_bsp.grid + c * 8;
+    if (cell[0] + cell[1] + cell[2] + cell[3] + cell[4] + cell[5] == 0) continue; /* inside walls */
+    for (int k = 0; k < 3; ++k) sum[k] += cell[k];
+    ++lit;
+  }
+  if (lit > 0)
+    for (int k = 0; k < 3; ++k) ambient[k] = (float)(sum[k] / lit / 255.0);
+  if (dbc_set_lighting(g_db.session, sun_direction, sun_rgb, ambient, sky) != DBC_OK) { db_fail("map lighting"); return; }
+
+  int lights = 0;
+  for (int first = 0; first < g_bsp.surface_count; ++first) {
+    const dsurface_t* s = &g_bsp.surfaces[first];
+    if (s->shaderNum < 0 || s->shaderNum >= g_bsp.shader_count) continue;
+    const shader_info_t* info = shader_slot(g_bsp.shaders[s->shaderNum].shader, 0);
+    if (!info || info->surface_light <= 0 || info->sky) continue;
+    mesh_builder_t m;
+    memset(&m, 0, sizeof(m));
+    add_surface(&m, s);
+    double area = 0, centre[3] = {0, 0, 0};
+    for (size_t t = 0; t < m.triangles; ++t) {
+      const float* a = &m.positions[m.indices[t * 3] * 3];
+      const float* b = &m.positions[m.indices[t * 3 + 1] * 3];
+      const float* c = &m.positions[m.indices[t * 3 + 2] * 3];
+      const float u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      const float cross[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+      const double triangle = 0.5 * sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
+      area += triangle;
+      for (int k = 0; k < 3; ++k) centre[k] += triangle * (a[k] + b[k] + c[k]) / 3.0;
+    }
+    /* in front of its surface by half the surface's size (at least 16 units): q3map spreads an
+     * area light over the surface, and a point light against the wall would light a small spot of
+     * it thousands of times brighter than the game's light map (speckle in the indirect light) */
+    float normal[3] = {0, 0, 0};
+    for (size_t v = 0; v < m.vertices; ++v)
+      for (int k = 0; k < 3; ++k) normal[k] += m.normals[v * 3 + k];
+    mesh_free(&m);
+    if (area <= 0) continue;
+    const float length = sqrtf(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+    float position[3];
+    const float offset = (float)fmax(16.0, 0.5 * sqrt(area));
+    for (int k = 0; k < 3; ++k) position[k] = (float)(centre[k] / area) + (length > 0 ? offset * normal[k] / length : 0.0f);
+    const double full = sqrt(info->surface_light * area / 4.0 / 255.0);
+    const float range = (float)fmin(fmax(3.0 * full, 32.0), 4096.0);
+    if (g_db.static_light_count >= MAX_STATIC_LIGHTS) break;
+    float* light = g_db.static_lights[g_db.static_light_count++];
+    memcpy(light, position, sizeof(position));
+    memcpy(light + 3, info->light_rgb, 3 * sizeof(float));
+    light[6] = range;
+    ++lights;
+  }
+  fprintf(stderr, "dynbench-capture: %d surface lights, ambient %.3f %.3f %.3f\n", lights, ambient[0], ambient[1], ambient[2]);
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* MD3 models */
+
+static void md3_normal(short encoded, float out[3]) {
+  const float lat = ((encoded >> 8) & 0xff) * (2.0f * (float)M_PI / 255.0f);
+  const float lng = (encoded & 0xff) * (2.0f * (float)M_PI / 255.0f);
+  out[0] = cosf(lat) * sinf(lng);
+  out[1] = sinf(lat) * sinf(lng);
+  out[2] = cosf(lng);
+}
+
+/* The shader a skin file (lines "surface,shader") gives a surface, or NULL. */
+static int skin_shader(const char* skin_text, const char* surface, char out[MAX_QPATH]) {
+  if (!skin_text) return 0;
+  const size_t n = strlen(surface);
+  for (const char* line = skin_text; *line;) {
+    const char* end = strchr(line, '\n');
+    if (!end) end = line + strlen(line);
+    if ((size_t)(end - line) > n && !Q_stricmpn(line, surface, (int)n) && line[n] == ',') {
+      const char* shader = line + n + 1;
+      int length = (int)(end - shader);
+      while (length > 0 && (shader[length - 1] == '\r' || shader[length - 1] == ' ' || shader[length - 1] == '"')) --length;
+      while (length > 0 && (*shader == ' ' || *shader == '"')) { ++shader; --length; }
+      if (length <= 0 || length >= MAX_QPATH) return 0;
+      memcpy(out, shader, (size_t)length);
+      out[length] = 0;
+      return 1;
+    }
+    line = *end ? end + 1 : end;
+  }
+  return 0;
+}
+
+/* Records an MD3 (with a skin's shaders when `skin` is given) as `model_path`: a mesh per
+ * surface, and every key frame of a model with more than one. Returns the key-frame count (1 for a
+ * rigid model), 0 on failure. */
+static int record_md3(const char* file, const char* skin, const char* model_path) {
+  int length = 0;
+  char* data = read_game_file(file, &length);
+  if (!data) {
+    char md3[MAX_QPATH];
+    COM_StripExtension(file, md3, sizeof(md3));
+    Q_strcat(md3, sizeof(md3), ".md3");
+    data = read_game_file(md3, &length);
+  }
+  if (!data || length < (int)sizeof(md3Header_t) || ((md3Header_t*)data)->ident != MD3_IDENT) {
+    free(data);
+    return 0;
+  }
+  const md3Header_t* header = (const md3Header_t*)data;
+  char* skin_text = skin ? read_game_file(skin, NULL) : NULL;
+  const int frames = header->numFrames;
+  if (dbc_model_begin(g_db.session, model_path) != DBC_OK) { free(data); free(skin_text); db_fail("model"); return 0; }
+  const md3Surface_t* surface = (const md3Surface_t*)(data + header->ofsSurfaces);
+  int mesh_id = 0;
+  for (int s = 0; s < header->numSurfaces; ++s, surface = (const md3Surface_t*)((const char*)surface + surface->ofsEnd)) {
+    if ((const char*)surface + sizeof(md3Surface_t) > data + length || surface->ofsEnd <= 0) break;
+    const int nv = surface->numVerts, nt = surface->numTriangles;
+    if (nv <= 0 || nt <= 0 || surface->numFrames != frames) continue;
+    char shader[MAX_QPATH] = "";
+    if (!skin_shader(skin_text, surface->name, shader) && surface->numShaders > 0)
+      Q_strncpyz(shader, ((const md3Shader_t*)((const char*)surface + surface->ofsShaders))->name, sizeof(shader));
+    if (!Q_stricmp(shader, "nodraw") || strstr(shader, "nodraw")) continue;
+    mesh_builder_t m;
+    memset(&m, 0, sizeof(m));
+    mesh_reserve(&m, (size_t)nv, (size_t)nt);
+    const md3St_t* st = (const md3St_t*)((const char*)surface + surface->ofsSt);
+    const md3XyzNormal_t* xyz = (const md3XyzNormal_t*)((const char*)surface + surface->ofsXyzNormals);
+    const md3Triangle_t* triangles = (const md3Triangle_t*)((const char*)surface + surface->ofsTriangles);
+    float* key_positions = frames > 1 ? malloc((size_t)frames * nv * 3 * sizeof(float)) : NULL;
+    float* key_normals = frames > 1 ? malloc((size_t)frames * nv * 3 * sizeof(float)) : NULL;
+    for (int f = 0; f < frames; ++f)
+      for (int v = 0; v < nv; ++v) {
+        const md3XyzNormal_t* x = &xyz[f * nv + v];
+        const float p[3] = {x->xyz[0] * (float)MD3_XYZ_SCALE, x->xyz[1] * (float)MD3_XYZ_SCALE, x->xyz[2] * (float)MD3_XYZ_SCALE};
+        float n[3];
+        md3_normal(x->normal, n);
+        if (f == 0) mesh_vertex(&m, p, n, st[v].st);
+        if (key_positions) {
+          to_capture(p, &key_positions[((size_t)f * nv + v) * 3]);
+          to_capture(n, &key_normals[((size_t)f * nv + v) * 3]);
+        }
+      }
+    for (int t = 0; t < nt; ++t) {
+      const int* index = triangles[t].indexes;
+      if (index[0] < 0 || index[1] < 0 || index[2] < 0 || index[0] >= nv || index[1] >= nv || index[2] >= nv) continue;
+      mesh_triangle(&m, (uint32_t)index[0], (uint32_t)index[1], (uint32_t)index[2]);
+    }
+    dbc_mesh mesh;
+    memset(&mesh, 0, sizeof(mesh));
+    mesh.mesh_id = mesh_id;
+    mesh.name = surface->name;
+    mesh.texture = shader[0] ? shader_texture(shader) : NULL;
+    mesh.vertex_count = m.vertices;
+    mesh.positions = m.positions;
+    mesh.normals = m.normals;
+    mesh.uvs = m.uvs;
+    mesh.triangle_count = m.triangles;
+    mesh.indices = m.indices;
+    int ok = dbc_model_mesh(g_db.session, &mesh) == DBC_OK;
+    if (ok && key_positions) ok = dbc_model_mesh_frames(g_db.session, mesh_id, (size_t)frames, key_positions, key_normals) == DBC_OK;
+    free(key_positions);
+    free(key_normals);
+    mesh_free(&m);
+    if (!ok) { free(data); free(skin_text); db_fail("model mesh"); return 0; }
+    ++mesh_id;
+  }
+  free(data);
+  free(skin_text);
+  if (dbc_model_end(g_db.session) != DBC_OK) { db_fail("model end"); return 0; }
+  return frames > 1 ? frames : 1;
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* identities */
+
+static uint64_t identity(int slot, int serial, int model, int skin, int occurrence, int* fresh) {
+  uint32_t h = 2166136261u;
+  const int key[5] = {slot, serial, model, skin, occurrence};
+  for (int i = 0; i < 5; ++i) h = (h ^ (uint32_t)key[i]) * 16777619u;
+  for (int probe = 0; probe < ID_TABLE_SIZE; ++probe) {
+    identity_t* e = &g_db.ids[(h + (uint32_t)probe) & (ID_TABLE_SIZE - 1)];
+    if (!e->used) {
+      e->used = 1;
+      e->slot = slot; e->serial = serial; e->model = model; e->skin = skin; e->occurrence = occurrence;
+      e->id = dbc_new_id(g_db.session);
+      *fresh = 1;
+      return e->id;
+    }
+    if (e->slot == slot && e->serial == serial && e->model == model && e->skin == skin && e->occurrence == occurrence) {
+      *fresh = 0;
+      return e->id;
+    }
+  }
+  *fresh = 1;
+  return dbc_new_id(g_db.session); /* table full: a fresh id every frame, correct if wasteful */
+}
+
+/* ---------------------------------------------------------------------------------------------- */
+/* hooks */
+
+void dynbench_register_model(const char* name, qhandle_t handle) {
+  if (handle > 0 && handle < MAX_HANDLES && name) Q_strncpyz(g_db.model_names[handle], name, MAX_QPATH);
+}
+
+void dynbench_register_skin(const char* name, qhandle_t handle) {
+  if (handle > 0 && handle < MAX_HANDLES && name) Q_strncpyz(g_db.skin_names[handle], name, MAX_QPATH);
+}
+
+void dynbench_owner_begin(int slot, int entity_type, int signature) {
+  if (!g_db.active || slot < 0 || slot >= UNOWNED_SLOT) return;
+  g_db.owner_slot = slot;
+  g_db.owner_type = entity_type;
+  /* A slot's next lifetime: another thing in it, or the same slot after a frame without it
+   * (players keep theirs: their slot is their client). */
+  const int gap = g_db.owner_last_frame[slot] < g_db.pass - 1;
+  if (g_db.owner_signature[slot] != signature || (gap && entity_type != ET_PLAYER)) ++g_db.owner_serial[slot];
+  g_db.owner_signature[slot] = signature;
+  g_db.owner_last_frame[slot] = g_db.pass;
+  if (g_db.owner_seen[slot] != g_db.pass) {
+    g_db.owner_seen[slot] = g_db.pass;
+    memset(g_db.owner_model_count[slot], 0, sizeof(g_db.owner_model_count[slot]));
+    memset(g_db.owner_models[slot], 0, sizeof(g_db.owner_models[slot]));
+    g_db.owner_lights[slot] = 0;
+  }
+}
+
+void dynbench_owner_end(void) { g_db.owner_slot = UNOWNED_SLOT; g_db.owner_type = -1; }
+
+void dynbench_clear_scene(void) {
+  g_db.entity_count = 0;
+  g_db.light_count = 0;
+  g_db.owner_slot = UNOWNED_SLOT;
+  g_db.owner_type = -1;
+  g_db.owner_seen[UNOWNED_SLOT] = -1; /* its draws are counted afresh each frame */
+  g_db.owner_last_frame[UNOWNED_SLOT] = g_db.pass;
+  memset(g_db.owner_model_count[UNOWNED_SLOT], 0, sizeof(g_db.owner_model_count[UNOWNED_SLOT]));
+  memset(g_db.owner_models[UNOWNED_SLOT], 0, sizeof(g_db.owner_models[UNOWNED_SLOT]));
+  g_db.owner_lights[UNOWNED_SLOT] = 0;
+}
+
+/* The k-th draw of this model by the current owner in this pass. */
+static int occurrence_of(int slot, int model) {
+  for (int i = 0; i < 8; ++i) {
+    if (g_db.owner_models[slot][i] == model) return g_db.owner_model_count[slot][i]++;
+    if (g_db.owner_models[slot][i] == 0) {
+      g_db.owner_models[slot][i] = model;
+      g_db.owner_model_count[slot][i] = 1;
+      return 0;
+    }
+  }
+  return 8 + model; /* more models than tracked: still stable */
+}
+
+void dynbench_add_ref_entity(const refEntity_t* e) {
+  if (!g_db.active || !e || g_db.entity_count >= MAX_PENDING) return;
+  if (e->reType != RT_MODEL || e->hModel <= 0 || e->hModel >= MAX_HANDLES) return;
+  if (e->renderfx & (RF_THIRD_PERSON | RF_FIRST_PERSON | RF_DEPTHHACK)) return; /* not in the main view / the HUD gun */
+  if (e->customShader) return; /* an effect shell drawn over a model (quad damage, spawn, invisibility) */
+  pending_entity_t* p = &g_db.entities[g_db.entity_count++];
+  p->entity = *e;
+  p->slot = g_db.owner_slot;
+  p->serial = g_db.owner_serial[p->slot];
+  p->occurrence = occurrence_of(p->slot, e->hModel * MAX_HANDLES + e->customSkin);
+}
+
+void dynbench_add_light(const vec3_t origin, float intensity, float r, float g, float b) {
+  if (!g_db.active || g_db.light_count >= MAX_PENDING || intensity <= 0) return;
+  pending_light_t* l = &g_db.lights[g_db.light_count++];
+  VectorCopy(origin, l->origin);
+  l->intensity = intensity;
+  l->rgb[0] = r; l->rgb[1] = g; l->rgb[2] = b;
+  l->slot = g_db.owner_slot;
+  l->serial = g_db.owner_serial[l->slot];
+  l->occurrence = g_db.owner_lights[l->slot]++;
+  l->entity_type = g_db.owner_slot >= DYNBENCH_LOCAL_SLOT ? -2 : g_db.owner_type;
+}
+
+static dbc_dual_quat pose_of(const refEntity_t* e) {
+  /* the model's axes as the columns of its rotation, normalised (a scaled item is drawn rigid) */
+  float axis[3][3];
+  for (int i = 0; i < 3; ++i) {
+    float a[3] = {e->axis[i][0], e->axis[i][1], e->axis[i][2]};
+    const float length = sqrtf(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    if (length > 1e-6f) { a[0] /= length; a[1] /= length; a[2] /= length; }
+    to_capture(a, axis[i]);
+  }
+  /* capture-space rotation R' = C M C^T: column i of M (axis[i]) is the image of the game's basis
+   * vector i, which C sends to capture basis vector c(i): +x -> -z, +y -> -x, +z -> +y */
+  float R[3][3]; /* R[row][column] */
+  for (int r = 0; r < 3; ++r) {
+    R[r][2] = -axis[0][r]; /* capture +z is game -x */
+    R[r][0] = -axis[1][r]; /* capture +x is game -y */
+    R[r][1] = axis[2][r];  /* capture +y is game +z */
+  }
+  float q[4]; /* x y z w from the rotation matrix (Shoemake) */
+  const float trace = R[0][0] + R[1][1] + R[2][2];
+  if (trace > 0) {
+    const float s = sqrtf(trace + 1.0f) * 2;
+    q[3] = 0.25f * s; q[0] = (R[2][1] - R[1][2]) / s; q[1] = (R[0][2] - R[2][0]) / s; q[2] = (R[1][0] - R[0][1]) / s;
+  } else if (R[0][0] > R[1][1] && R[0][0] > R[2][2]) {
+    const float s = sqrtf(1.0f + R[0][0] - R[1][1] - R[2][2]) * 2;
+    q[3] = (R[2][1] - R[1][2]) / s; q[0] = 0.25f * s; q[1] = (R[0][1] + R[1][0]) / s; q[2] = (R[0][2] + R[2][0]) / s;
+  } else if (R[1][1] > R[2][2]) {
+    const float s = sqrtf(1.0f + R[1][1] - R[0][0] - R[2][2]) * 2;
+    q[3] = (R[0][2] - R[2][0]) / s; q[0] = (R[0][1] + R[1][0]) / s; q[1] = 0.25f * s; q[2] = (R[1][2] + R[2][1]) / s;
+  } else {
+    const float s = sqrtf(1.0f + R[2][2] - R[0][0] - R[1][1]) * 2;
+    q[3] = (R[1][0] - R[0][1]) / s; q[0] = (R[0][2] + R[2][0]) / s; q[1] = (R[1][2] + R[2][1]) / s; q[2] = 0.25f * s;
+  }
+  const float n = sqrtf(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  for (int i = 0; i < 4; ++i) q[i] /= n;
+  float t[3];
+  to_capture(e->origin, t);
+  /* d = 1/2 (t, 0) r */
+  dbc_dual_quat dq;
+  dq.rx = q[0]; dq.ry = q[1]; dq.rz = q[2]; dq.rw = q[3];
+  dq.dx = 0.5f * (t[0] * q[3] + t[1] * q[2] - t[2] * q[1]);
+  dq.dy = 0.5f * (-t[0] * q[2] + t[1] * q[3] + t[2] * q[0]);
+  dq.dz = 0.5f * (t[0] * q[1] - t[1] * q[0] + t[2] * q[3]);
+  dq.dw = 0.5f * (-t[0] * q[0] - t[1] * q[1] - t[2] * q[2]);
+  return dq;
+}
+
+/* Model paths: the MD3 with its skin, or a brush model of the map; the key-frame count of each
+ * recorded one (0 before it is recorded, -1 when it cannot be). */
+static int g_model_frames[MAX_HANDLES][8];
+static int g_model_skins[MAX_HANDLES][8];
+
+static const char* model_path_of(const refEntity_t* e, char out[3 * MAX_QPATH], int* frames) {
+  const char* name = g_db.model_names[e->hModel];
+  if (!name[0]) return NULL;
+  const char* skin = e->customSkin > 0 && e->customSkin < MAX_HANDLES && g_db.skin_names[e->customSkin][0] ? g_db.skin_names[e->customSkin] : NULL;
+  if (name[0] == '*') Com_sprintf(out, 3 * MAX_QPATH, "%s/%s", g_db.world_path, name);
+  else if (skin) Com_sprintf(out, 3 * MAX_QPATH, "%s@%s", name, skin);
+  else Q_strncpyz(out, name, 3 * MAX_QPATH);
+  int slot = -1;
+  for (int i = 0; i < 8; ++i)
+    if (g_model_skins[e->hModel][i] == e->customSkin + 1 || g_model_skins[e->hModel][i] == 0) { slot = i; break; }
+  if (slot < 0) return NULL;
+  if (g_model_skins[e->hModel][slot] == 0) {
+    g_model_skins[e->hModel][slot] = e->customSkin + 1;
+    int recorded;
+    if (name[0] == '*') recorded = record_bsp_model(atoi(name + 1), out);
+    else recorded = record_md3(name, skin, out);
+    g_model_frames[e->hModel][slot] = recorded > 0 ? recorded : -1;
+  }
+  *frames = g_model_frames[e->hModel][slot];
+  return *frames > 0 ? out : NULL;
+}
+
+static void camera_angles(const refdef_t* view, float* pitch, float* yaw, float* roll) {
+  float f[3], u[3];
+  to_capture(view->viewaxis[0], f);
+  to_capture(view->viewaxis[2], u);
+  /* R = Ry(yaw) Rx(pitch) Rz(roll) sends -Z to the forward vector and +Y to up (docs/metrics.md) */
+  *yaw = atan2f(-f[0], -f[2]);
+  *pitch = asinf(fmaxf(-1.0f, fminf(1.0f, f[1])));
+  /* up in the frame of Ry(yaw) Rx(pitch): (-sin roll, cos roll, 0) */
+  const float cy = cosf(*yaw), sy = sinf(*yaw), cp = cosf(*pitch), sp = sinf(*pitch);
+  const float x1 = cy * u[0] - sy * u[2], z1 = sy * u[0] + cy * u[2]; /* Ry(-yaw) u */
+  const float y2 = cp * u[1] + sp * z1;                              /* Rx(-pitch) */
+  *roll = atan2f(-x1, y2);
+  *pitch *= 180.0f / (float)M_PI;
+  *yaw *= 180.0f / (float)M_PI;
+  *roll *= 180.0f / (float)M_PI;
+}
+
+static int first_bot(void) {
+  for (int i = 0; i < MAX_CLIENTS; ++i)
+    if (i != cg.clientNum && cgs.clientinfo[i].infoValid) return i;
+  return -1;
+}
+
+/* Spectating: team spectator once, then `follow` until the server has us following. */
+static int ensure_following(void) {
+  const playerState_t* ps = &cg.snap->ps;
+  if (ps->pm_flags & PMF_FOLLOW) return 1;
+  if (ps->persistant[PERS_TEAM] != TEAM_SPECTATOR) {
+    if (!g_db.spectate_sent_at || cg.time - g_db.spectate_sent_at > 1000) {
+      trap_SendClientCommand("team spectator");
+      g_db.spectate_sent_at = cg.time;
+    }
+    return 0;
+  }
+  const int target = g_db.follow_target >= 0 ? g_db.follow_target : first_bot();
+  if (target >= 0 && (!g_db.follow_sent_at || cg.time - g_db.follow_sent_at > 500)) {
+    trap_SendClientCommand(va("follow %d", target));
+    g_db.follow_sent_at = cg.time;
+  }
+  return 0;
+}
+
+void dynbench_render_scene(const refdef_t* view) {
+  if (!g_db.active || (view->rdflags & RDF_NOWORLDMODEL) || !cg.snap) return;
+  ++g_db.pass;
+  const int following = ensure_following();
+  if (!g_db.started) {
+    if (!following || cg.time < cgs.levelStartTime + (int)(g_db.warmup * 1000)) {
+      if (cg.time > cgs.levelStartTime + (int)(g_db.warmup * 1000) + 20000) {
+        fprintf(stderr, "dynbench-capture: error: not following a bot 20 s after the warm-up (is one in the game?)\n");
+        g_db.active = 0;
+        trap_SendConsoleCommand("quit\n");
+      }
+      return;
+    }
+    g_db.started = 1;
+    g_db.start_time = cg.time;
+  }
+  const playerState_t* ps = &cg.snap->ps;
+  dbc_session* s = g_db.session;
+  if (view->width != g_db.last_camera_width || view->height != g_db.last_camera_height || view->fov_y != g_db.camera_fov) {
+    g_db.last_camera_width = view->width;
+    g_db.last_camera_height = view->height;
+    g_db.camera_fov = view->fov_y;
+    if (dbc_set_camera_settings(s, (float)view->width / (float)view->height, view->fov_y, 4.0f, 16384.0f) != DBC_OK) { db_fail("camera settings"); return; }
+  }
+  /* models are recorded between frames: every drawn one first */
+  static char paths[MAX_PENDING][3 * MAX_QPATH];
+  static int key_frames[MAX_PENDING];
+  for (int i = 0; i < g_db.entity_count; ++i) {
+    if (!model_path_of(&g_db.entities[i].entity, paths[i], &key_frames[i])) paths[i][0] = 0;
+    if (!g_db.active) return;
+  }
+  if (dbc_frame_begin(s, (uint64_t)g_db.frame, (cg.time - g_db.start_time) / 1000.0) != DBC_OK) { db_fail("frame"); return; }
+  float position[3], pitch, yaw, roll;
+  to_capture(view->vieworg, position);
+  camera_angles(view, &pitch, &yaw, &roll);
+  if (dbc_camera(s, g_db.camera_id, position, pitch, yaw, roll) != DBC_OK) { db_fail("camera"); return; }
+  /* cuts: another player followed, a respawn or a teleporter (the game toggles EF_TELEPORT_BIT
+   * when the view's origin jumps), or a jump the game did not mark */
+  const int dead = ps->stats[STAT_HEALTH] <= 0 || ps->pm_type == PM_DEAD;
+  const int teleport = ps->eFlags & EF_TELEPORT_BIT;
+  if (g_db.have_last) {
+    const float dx = position[0] - g_db.last_position[0], dy = position[1] - g_db.last_position[1], dz = position[2] - g_db.last_position[2];
+    const char* reason = NULL;
+    if (ps->clientNum != g_db.last_client) reason = "switch";
+    else if (teleport != g_db.last_teleport) reason = g_db.last_dead ? "respawn" : "teleport";
+    else if (dx * dx + dy * dy + dz * dz > 64.0f * 64.0f) reason = "teleport";
+    if (reason && dbc_camera_cut(s, g_db.camera_id, reason) != DBC_OK) { db_fail("camera cut"); return; }
+  }
+  g_db.have_last = 1;
+  g_db.last_client = ps->clientNum;
+  g_db.last_teleport = teleport;
+  g_db.last_dead = dead;
+  memcpy(g_db.last_position, position, sizeof(position));
+  if (dead && !strcmp(g_db.follow, "auto") && g_db.next_sent_for_death != ps->clientNum + 1) {
+    trap_SendClientCommand("follownext");
+    g_db.next_sent_for_death = ps->clientNum + 1;
+  }
+  if (!dead) g_db.next_sent_for_death = 0;
+
+  if (g_db.frame == 0) {
+    const dbc_dual_quat identity_pose = {0, 0, 0, 1, 0, 0, 0, 0};
+    if (dbc_static_model(s, dbc_new_id(s), g_db.world_path, identity_pose) != DBC_OK) { db_fail("world"); return; }
+    for (int i = 0; i < g_db.static_light_count; ++i) {
+      const float* light = g_db.static_lights[i];
+      if (dbc_light(s, dbc_new_id(s), light, light + 3, light[6], DBC_FALLOFF_QUADRATIC, DBC_LIGHT_POINT, 0, "surfacelight") != DBC_OK) {
+        db_fail("surface light");
+        return;
+      }
+    }
+  }
+  for (int i = 0; i < g_db.entity_count && g_db.active; ++i) {
+    const pending_entity_t* p = &g_db.entities[i];
+    const char* path = paths[i];
+    const int frames = key_frames[i];
+    if (!path[0]) continue;
+    int fresh;
+    const uint64_t id = identity(p->slot, p->serial, p->entity.hModel, p->entity.customSkin, p->occurrence, &fresh);
+    if (dbc_model(s, id, path, pose_of(&p->entity)) != DBC_OK) { db_fail("model transform"); return; }
+    if (frames > 1) {
+      const uint32_t from = (uint32_t)(p->entity.oldframe % frames), to = (uint32_t)(p->entity.frame % frames);
+      const float fraction = fminf(1.0f, fmaxf(0.0f, 1.0f - p->entity.backlerp));
+      if (dbc_vertex_frames(s, id, path, from, to, fraction) != DBC_OK) { db_fail("key frames"); return; }
+    }
+  }
+  for (int i = 0; i < g_db.light_count; ++i) {
+    const pending_light_t* l = &g_db.lights[i];
+    int fresh;
+    const uint64_t id = identity(l->slot, l->serial, -1, 0, l->occurrence, &fresh);
+    float at[3];
+    to_capture(l->origin, at);
+    const char* type = l->entity_type == ET_MISSILE ? "missile" : l->entity_type == ET_PLAYER ? "flash" : l->entity_type == -2 ? "explosion" : "effect";
+    /* the renderer's dynamic light reaches `intensity` units and fades towards it */
+    if (dbc_light(s, id, at, l->rgb, l->intensity, DBC_FALLOFF_QUADRATIC, DBC_LIGHT_POINT, 1, type) != DBC_OK) { db_fail("light"); return; }
+  }
+  if (dbc_frame_end(s) != DBC_OK) { db_fail("frame end"); return; }
+  ++g_db.frame;
+  printf("dynbench-capture: %d/%d frames\n", g_db.frame, g_db.total_frames);
+  fflush(stdout);
+  if (g_db.frame >= g_db.total_frames) {
+    if (dbc_close(s) != DBC_OK) { g_db.session = NULL; db_fail("close"); return; }
+    g_db.session = NULL;
+    g_db.active = 0;
+    printf("dynbench-capture: window of %d frames complete (%d clock resets)\n", g_db.frame, g_db.clock_resets);
+    fflush(stdout);
+    trap_SendConsoleCommand("quit\n");
+  }
+}
+
+int dynbench_frame_time(int server_time) {
+  if (!g_db.active || g_db.frame_ms <= 0) return server_time;
+  const int expected = g_db.clock_base + g_db.clock_frames * g_db.frame_ms;
+  if (g_db.clock_frames == 0 || abs(expected - server_time) > 2 * g_db.frame_ms) {
+    if (g_db.started) ++g_db.clock_resets;
+    g_db.clock_base = server_time;
+    g_db.clock_frames = 0;
+  }
+  return g_db.clock_base + g_db.clock_frames++ * g_db.frame_ms;
+}
+
+void dynbench_cg_init(void) {
+  const char* dir = getenv("DYNBENCH_CAPTURE_DIR");
+  if (!dir || !dir[0] || g_db.session) return;
+  Q_strncpyz(g_db.dir, dir, sizeof(g_db.dir));
+  g_db.seconds = getenv("DYNBENCH_CAPTURE_SECONDS") ? atof(getenv("DYNBENCH_CAPTURE_SECONDS")) : 10.0;
+  g_db.warmup = getenv("DYNBENCH_CAPTURE_WARMUP") ? atof(getenv("DYNBENCH_CAPTURE_WARMUP")) : 3.0;
+  const double fps = getenv("DYNBENCH_CAPTURE_FPS") ? atof(getenv("DYNBENCH_CAPTURE_FPS")) : 50.0;
+  g_db.total_frames = (int)(g_db.seconds * fps + 0.5);
+  Q_strncpyz(g_db.follow, getenv("DYNBENCH_CAPTURE_FOLLOW") ? getenv("DYNBENCH_CAPTURE_FOLLOW") : "auto", sizeof(g_db.follow));
+  g_db.follow_target = (g_db.follow[0] >= '0' && g_db.follow[0] <= '9') ? atoi(g_db.follow) : -1;
+  g_db.owner_slot = UNOWNED_SLOT;
+  /* the map: "maps/oa_dm1.bsp" */
+  COM_StripExtension(COM_SkipPath(cgs.mapname), g_db.map, sizeof(g_db.map));
+  Com_sprintf(g_db.world_path, sizeof(g_db.world_path), "maps/%s", g_db.map);
+  /* the fixed clock: every frame advances the game by exactly 1/fps (a cheat cvar: devmap) */
+  g_db.frame_ms = (int)(1000.0 / fps + 0.5);
+  trap_Cvar_Set("fixedtime", va("%d", g_db.frame_ms));
+  load_shader_scripts();
+  if (!load_bsp()) {
+    fprintf(stderr, "dynbench-capture: error: cannot read maps/%s.bsp\n", g_db.map);
+    trap_SendConsoleCommand("quit\n");
+    return;
+  }
+  if (dbc_open(dir, "OpenArena 0.8.8 (ioquake3 1.36)", &g_db.session) != DBC_OK) {
+    fprintf(stderr, "dynbench-capture: error: %s\n", dbc_last_error());
+    trap_SendConsoleCommand("quit\n");
+    return;
+  }
+  g_db.active = 1;
+  const float origin[3] = {0, 0, 0};
+  if (dbc_set_data_root(g_db.session, "data") != DBC_OK || dbc_set_metres_per_unit(g_db.session, 1.0f / 32.0f) != DBC_OK ||
+      dbc_set_map(g_db.session, g_db.map, origin) != DBC_OK) {
+    db_fail("settings");
+    return;
+  }
+  g_db.camera_id = dbc_new_id(g_db.session);
+  if (!record_bsp_model(0, g_db.world_path)) return;
+  record_map_lighting();
+  fprintf(stderr, "dynbench-capture: recording %d frames of %s after %.1f s\n", g_db.total_frames, g_db.map, g_db.warmup);
+}
+
+void dynbench_cg_shutdown(void) {
+  if (g_db.session) {
+    fprintf(stderr, "dynbench-capture: warning: the game ended after %d of %d frames\n", g_db.frame, g_db.total_frames);
+    dbc_close(g_db.session);
+    g_db.session = NULL;
+  }
+  g_db.active = 0;
+  free(g_bsp.data);
+  memset(&g_bsp, 0, sizeof(g_bsp));
+  free(g_db.shaders);
+  g_db.shaders = NULL;
+}

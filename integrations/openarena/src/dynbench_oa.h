@@ -1,0 +1,35 @@
+/* dynbench's capture adapter for OpenArena's client game module (cgame), the game's own render
+ * front end: every drawn entity, light and view goes through the trap_R_* calls this header's
+ * hooks sit in (capture-hooks.patch puts them there; integrations/openarena/README.md). */
+#ifndef DYNBENCH_OA_H
+#define DYNBENCH_OA_H
+
+#include "../renderer/tr_types.h"
+
+/* Capturing is on when DYNBENCH_CAPTURE_DIR is set; every hook is a no-op otherwise. */
+void dynbench_cg_init(void);
+void dynbench_cg_shutdown(void);
+
+/* The renderer's handles, with the names they were registered with (models, skins). */
+void dynbench_register_model(const char* name, qhandle_t handle);
+void dynbench_register_skin(const char* name, qhandle_t handle);
+
+/* Who draws the next entities and lights: a packet entity (slot = entity number) or a local
+ * entity (slot = DYNBENCH_LOCAL_SLOT + its index), with what tells one of its lifetimes from the
+ * next (the packet entity's type and model, the local entity's start time). */
+#define DYNBENCH_LOCAL_SLOT 1024
+void dynbench_owner_begin(int slot, int entity_type, int signature);
+void dynbench_owner_end(void);
+
+void dynbench_clear_scene(void);
+void dynbench_add_ref_entity(const refEntity_t* entity);
+void dynbench_add_light(const vec3_t origin, float intensity, float r, float g, float b);
+/* The client game's clock while capturing: exactly 1/fps per frame. The engine's estimate of the
+ * server's time (serverTime) drifts by -2/+1 ms at each snapshot (its time-delta correction);
+ * this follows it within two frames and is reset to it after a longer hitch. */
+int dynbench_frame_time(int server_time);
+
+/* The main view (not the HUD's 3D icons) is recorded here, as one frame. */
+void dynbench_render_scene(const refdef_t* view);
+
+#endif
