@@ -42,6 +42,9 @@ packages=(
   # a virtual X server with Mesa's software OpenGL to run it headless
   libsdl2-dev libsdl2-image-dev libsdl2-mixer-dev libenet-dev libgl-dev cube2-data xvfb xauth
   libgl1-mesa-dri
+  # OpenArena (`dynbench capture openarena`): Debian's ioquake3 engine and the game's data; its
+  # game code is rebuilt from the source package with the capture hooks (below)
+  openarena
 )
 
 missing=()
@@ -80,15 +83,20 @@ else
   echo "setup: glTF validator present"
 fi
 
-# The Cube 2 engine source: Debian's source package `cube2`, fetched once into a cache that
-# integrations/cube2/build.sh (run by the CMake build) reads. It needs a deb-src entry for bookworm.
-cube2_cache=/var/cache/dynbench/cube2
-cube2_orig=cube2_0.0.20201227+dfsg.orig.tar.xz
-if [[ ! -f "$cube2_cache/$cube2_orig" ]]; then
-  SUDO=""
+# Game source code from Debian's source packages, fetched once into caches that the CMake build
+# reads: Cube 2's engine (integrations/cube2/build.sh) and OpenArena's game code
+# (integrations/openarena/build.sh). apt-get source needs a deb-src entry for bookworm.
+fetch_source() {  # NAME PACKAGE=VERSION ORIG_TARBALL
+  local name=$1 package=$2 orig=$3
+  local cache=/var/cache/dynbench/$name
+  if [[ -f "$cache/$orig" ]]; then
+    echo "setup: $name source present"
+    return
+  fi
+  local SUDO=""
   [[ $(id -u) -eq 0 ]] || SUDO="sudo"
   if ! grep -rqs "^Types: deb-src\|^deb-src" /etc/apt/sources.list /etc/apt/sources.list.d/; then
-    echo "setup: adding a deb-src entry for bookworm (the Cube 2 engine source)"
+    echo "setup: adding a deb-src entry for bookworm (game source packages)"
     $SUDO tee /etc/apt/sources.list.d/dynbench-src.sources >/dev/null <<'SOURCES'
 Types: deb-src
 URIs: http://deb.debian.org/debian
@@ -98,15 +106,15 @@ Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg
 SOURCES
     $SUDO apt-get update -qq
   fi
-  $SUDO mkdir -p "$cube2_cache"
-  # The mirror has the .orig tarball but not always Debian's packaging tarball, and apt-get then
+  $SUDO mkdir -p "$cache"
+  # The mirror has the .orig tarballs but not always Debian's packaging tarballs, and apt-get then
   # exits 100 after fetching the one we need: judge by the file, not the exit status.
-  (cd "$cube2_cache" && $SUDO apt-get source --download-only "cube2=0.0.20201227+dfsg-2" >/dev/null 2>&1 || true)
-  if [[ ! -f "$cube2_cache/$cube2_orig" ]]; then
-    echo "setup: could not fetch $cube2_orig with apt-get source (is deb.debian.org reachable?)" >&2
+  (cd "$cache" && $SUDO apt-get source --download-only "$package" >/dev/null 2>&1 || true)
+  if [[ ! -f "$cache/$orig" ]]; then
+    echo "setup: could not fetch $orig with apt-get source (is deb.debian.org reachable?)" >&2
     exit 1
   fi
-  echo "setup: Cube 2 engine source in $cube2_cache"
-else
-  echo "setup: Cube 2 engine source present"
-fi
+  echo "setup: $name source in $cache"
+}
+fetch_source cube2 "cube2=0.0.20201227+dfsg-2" cube2_0.0.20201227+dfsg.orig.tar.xz
+fetch_source openarena "openarena=0.8.8+dfsg-6" openarena_0.8.8+dfsg.orig.tar.xz

@@ -116,6 +116,7 @@ void addCaptureCommand(CLI::App& app, CommandRun& run) {
       return runCube2(*o);
     };
   });
+  addCaptureOpenArenaCommand(capture, run);
 }
 
 }  // namespace dynbench::cli

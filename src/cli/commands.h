@@ -37,8 +37,9 @@ void addDiscardCommand(CLI::App& app, CommandRun& run);
 // Registers `report`.
 void addReportCommand(CLI::App& app, CommandRun& run);
 
-// Registers `capture cube2`.
+// Registers `capture cube2` and `capture openarena`.
 void addCaptureCommand(CLI::App& app, CommandRun& run);
+void addCaptureOpenArenaCommand(CLI::App* capture, CommandRun& run);
 
 // Registers `fidelity`.
 void addFidelityCommand(CLI::App& app, CommandRun& run);

@@ -40,6 +40,7 @@
 #define PATCH_LEVEL 8 /* each 3x3 Bezier sub-patch becomes 8 x 8 quads */
 #define UNOWNED_SLOT (DYNBENCH_LOCAL_SLOT * 2 - 1) /* drawn outside an entity (effects) */
 #define MAX_STATIC_LIGHTS 4096
+#define RESTART_AT 2000 /* ms of server time: the level restarts then, the client connected by then */
 
 typedef struct {
   refEntity_t entity;
@@ -80,11 +81,13 @@ static struct {
   char follow[32];
   int total_frames;
   int frame;
-  int frame_ms, clock_base, clock_frames, clock_resets;
+  int frame_ms, clock_base, clock_resets;
+  char bots[512]; /* "Sarge:3 Grism:3" */
   int started;
   int start_time;
   int finished;
   int spectate_sent_at, follow_sent_at, next_sent_for_death;
+  int restart_sent, restarted, connected_in_time, bots_added;
   int follow_target;
   uint64_t camera_id;
   int last_client, last_teleport, last_dead, have_last;
@@ -634,6 +637,10 @@ static int record_md3(const char* file, const char* skin, const char* model_path
     return 0;
   }
   const md3Header_t* header = (const md3Header_t*)data;
+  if (header->numSurfaces <= 0 || header->numFrames <= 0) { /* nothing drawn (Angelyss's upper.md3 in pak6-patch085) */
+    free(data);
+    return 0;
+  }
   char* skin_text = skin ? read_game_file(skin, NULL) : NULL;
   const int frames = header->numFrames;
   if (dbc_model_begin(g_db.session, model_path) != DBC_OK) { free(data); free(skin_text); db_fail("model"); return 0; }
@@ -694,7 +701,8 @@ static int record_md3(const char* file, const char* skin, const char* model_path
   free(data);
   free(skin_text);
   if (dbc_model_end(g_db.session) != DBC_OK) { db_fail("model end"); return 0; }
-  return frames > 1 ? frames : 1;
+  /* key frames only when some mesh has them (every recorded mesh has the model's count) */
+  return mesh_id > 0 && frames > 1 ? frames : 1;
 }
 
 /* ---------------------------------------------------------------------------------------------- */
@@ -724,6 +732,10 @@ static uint64_t identity(int slot, int serial, int model, int skin, int occurren
 
 /* ---------------------------------------------------------------------------------------------- */
 /* hooks */
+
+void dynbench_map_restart(void) {
+  if (g_db.active && g_db.restart_sent) g_db.restarted = 1;
+}
 
 void dynbench_register_model(const char* name, qhandle_t handle) {
   if (handle > 0 && handle < MAX_HANDLES && name) Q_strncpyz(g_db.model_names[handle], name, MAX_QPATH);
@@ -920,6 +932,35 @@ static int ensure_following(void) {
 void dynbench_render_scene(const refdef_t* view) {
   if (!g_db.active || (view->rdflags & RDF_NOWORLDMODEL) || !cg.snap) return;
   ++g_db.pass;
+  /* How many frames the client takes to connect and load depends on the machine's load, and the
+   * client shares the C library's random numbers with the game and the bots (native modules in
+   * one process), so a match that ran while the client connected would differ from run to run.
+   * The client joins as a spectator (userinfo team s) of an empty level; at a fixed server time
+   * the adapter restarts the level (map_restart 0: the game module re-seeds from
+   * DYNBENCH_CAPTURE_SEED, the client stays connected) and then adds the bots: the match starts in
+   * the same engine frame, with the same random numbers, on every run. */
+  if (!g_db.restarted) {
+    if (cg.snap->ps.persistant[PERS_TEAM] != TEAM_SPECTATOR) {
+      ensure_following();
+    } else if (!g_db.restart_sent && cg.snap->serverTime >= RESTART_AT) {
+      if (!g_db.connected_in_time)
+        fprintf(stderr, "dynbench-capture: warning: the client connected after %d ms of server time; the match may differ from run to run\n", RESTART_AT);
+      trap_SendConsoleCommand("map_restart 0\n");
+      g_db.restart_sent = 1;
+    }
+    if (cg.snap->serverTime < RESTART_AT) g_db.connected_in_time = 1;
+    return;
+  }
+  if (!g_db.bots_added) {
+    char bots[sizeof(g_db.bots)];
+    Q_strncpyz(bots, g_db.bots, sizeof(bots));
+    for (char* bot = strtok(bots, " "); bot; bot = strtok(NULL, " ")) {
+      char* skill = strchr(bot, ':');
+      if (skill) *skill++ = 0;
+      trap_SendConsoleCommand(va("addbot %s %s\n", bot, skill ? skill : "3"));
+    }
+    g_db.bots_added = 1;
+  }
   const int following = ensure_following();
   if (!g_db.started) {
     if (!following || cg.time < cgs.levelStartTime + (int)(g_db.warmup * 1000)) {
@@ -1019,7 +1060,7 @@ void dynbench_render_scene(const refdef_t* view) {
     if (dbc_close(s) != DBC_OK) { g_db.session = NULL; db_fail("close"); return; }
     g_db.session = NULL;
     g_db.active = 0;
-    printf("dynbench-capture: window of %d frames complete (%d clock resets)\n", g_db.frame, g_db.clock_resets);
+    printf("dynbench-capture: window of %d frames complete (%d frames off the fixed clock)\n", g_db.frame, g_db.clock_resets);
     fflush(stdout);
     trap_SendConsoleCommand("quit\n");
   }
@@ -1027,13 +1068,13 @@ void dynbench_render_scene(const refdef_t* view) {
 
 int dynbench_frame_time(int server_time) {
   if (!g_db.active || g_db.frame_ms <= 0) return server_time;
-  const int expected = g_db.clock_base + g_db.clock_frames * g_db.frame_ms;
-  if (g_db.clock_frames == 0 || abs(expected - server_time) > 2 * g_db.frame_ms) {
-    if (g_db.started) ++g_db.clock_resets;
-    g_db.clock_base = server_time;
-    g_db.clock_frames = 0;
-  }
-  return g_db.clock_base + g_db.clock_frames++ * g_db.frame_ms;
+  int snapshot = 0, latest = 0;
+  trap_GetCurrentSnapshotNumber(&snapshot, &latest);
+  if (snapshot <= 0) return server_time;
+  const int t = latest - g_db.frame_ms;
+  if (g_db.started && t != g_db.clock_base + g_db.frame_ms) ++g_db.clock_resets; /* a frame without its own snapshot */
+  g_db.clock_base = t;
+  return t;
 }
 
 void dynbench_cg_init(void) {
@@ -1052,6 +1093,7 @@ void dynbench_cg_init(void) {
   Com_sprintf(g_db.world_path, sizeof(g_db.world_path), "maps/%s", g_db.map);
   /* the fixed clock: every frame advances the game by exactly 1/fps (a cheat cvar: devmap) */
   g_db.frame_ms = (int)(1000.0 / fps + 0.5);
+  Q_strncpyz(g_db.bots, getenv("DYNBENCH_CAPTURE_BOTS") ? getenv("DYNBENCH_CAPTURE_BOTS") : "", sizeof(g_db.bots));
   trap_Cvar_Set("fixedtime", va("%d", g_db.frame_ms));
   load_shader_scripts();
   if (!load_bsp()) {

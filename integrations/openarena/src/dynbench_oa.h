@@ -24,10 +24,14 @@ void dynbench_owner_end(void);
 void dynbench_clear_scene(void);
 void dynbench_add_ref_entity(const refEntity_t* entity);
 void dynbench_add_light(const vec3_t origin, float intensity, float r, float g, float b);
-/* The client game's clock while capturing: exactly 1/fps per frame. The engine's estimate of the
- * server's time (serverTime) drifts by -2/+1 ms at each snapshot (its time-delta correction);
- * this follows it within two frames and is reset to it after a longer hitch. */
+/* The client game's clock while capturing: the latest snapshot's server time less one frame, so
+ * that each frame shows the server's previous frame exactly (the server runs at the capture's fps,
+ * one frame and one snapshot per engine frame). The engine's own estimate (serverTime) depends on
+ * when the client connected and drifts by -2/+1 ms at each snapshot. */
 int dynbench_frame_time(int server_time);
+
+/* The level restarted (map_restart; dynbench_oa.c says why the adapter restarts it). */
+void dynbench_map_restart(void);
 
 /* The main view (not the HUD's 3D icons) is recorded here, as one frame. */
 void dynbench_render_scene(const refdef_t* view);

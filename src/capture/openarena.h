@@ -1,0 +1,60 @@
+#pragma once
+// `dynbench capture openarena`: runs Debian's ioquake3 with OpenArena's game modules rebuilt with
+// dynbench's capture hooks (integrations/openarena) headless under Xvfb, starts a bot deathmatch,
+// spectates a bot in first person and records a fixed-clock, seeded capture.
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/error.h"
+
+namespace dynbench::capture {
+
+// Accepted ranges (the CLI's checks and captureOpenArena's are these).
+inline constexpr std::pair<int, int> kOpenArenaBotsRange{1, 16};
+inline constexpr std::pair<int, int> kOpenArenaSkillRange{1, 5};  // Quake 3's bot skills
+inline constexpr double kOpenArenaMinWarmup = 2.0;                // s: the camera follows a bot by then
+
+struct OpenArenaOptions {
+  std::filesystem::path output;  // the capture folder
+  std::string map = "oa_dm1";
+  int bots = 4;
+  int skill = 3;                 // kOpenArenaSkillRange
+  double seconds = 10.0;         // recorded game time
+  // The fixed clock: the engine's `fixedtime` is a whole number of milliseconds a frame, so fps
+  // must divide 1000 (50, 40, 25, 20, ...).
+  int fps = 50;
+  unsigned seed = 1;
+  // auto: the first bot, then the next whenever the followed one dies; one: the first bot for the
+  // whole capture (its respawns are cuts); or a client number (bots are 1, 2, ...)
+  std::string follow = "auto";
+  double warmup = 3.0;           // game seconds between the map loading and recording
+  int width = 640, height = 360;
+  bool window = false;           // on the user's display instead of Xvfb
+  std::filesystem::path modules;  // folder with cgamex86_64.so and qagamex86_64.so; empty: the build's
+  std::filesystem::path engine = "/usr/lib/ioquake3/ioquake3";  // Debian's ioquake3
+  std::filesystem::path data = "/usr/lib/openarena";             // Debian's openarena (baseoa/)
+};
+
+struct OpenArenaReport {
+  std::size_t frames = 0;
+  double wallSeconds = 0.0;
+};
+
+using OpenArenaProgress = std::function<void(std::size_t, std::size_t)>;  // (recorded, total)
+
+// The bots added, in order: `bots` names from OpenArena's bot list (scripts/bots.txt).
+Expected<std::vector<std::string>> openArenaBots(int bots);
+
+// The game modules the build made (integrations/openarena/build.sh), or an error saying how to get them.
+Expected<std::filesystem::path> findOpenArenaModules(const std::filesystem::path& requested);
+
+// The engine's command line after the executable (exposed for tests).
+Expected<std::vector<std::string>> openArenaArguments(const OpenArenaOptions& options, const std::filesystem::path& basePath,
+                                                      const std::filesystem::path& homePath);
+
+Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& options, const OpenArenaProgress& progress = {});
+
+}  // namespace dynbench::capture

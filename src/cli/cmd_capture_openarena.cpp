@@ -1,0 +1,55 @@
+// `dynbench capture openarena -o DIR`: record a headless, seeded OpenArena bot match
+// (integrations/openarena).
+#include <optional>
+
+#include "capture/openarena.h"
+#include "cli/commands.h"
+#include "core/progress.h"
+
+namespace dynbench::cli {
+
+void addCaptureOpenArenaCommand(CLI::App* capture, CommandRun& run) {
+  auto o = std::make_shared<capture::OpenArenaOptions>();
+  auto* cmd = capture->add_subcommand("openarena", "Record an OpenArena (id Tech 3) bot match, headless, at a fixed clock and seed");
+  cmd->footer("Runs Debian's ioquake3 with OpenArena's game modules rebuilt with dynbench's capture hooks under Xvfb, starts a\n"
+              "free-for-all with --bots bots, spectates one in first person and records --seconds of game time after --warmup.\n"
+              "The same --seed and options give a byte-identical capture. Then: dynbench convert DIR -o dataset.gltf\n"
+              "Example: dynbench capture openarena -o captures/dm1 --map oa_dm1 --bots 4 --seconds 10 --seed 3");
+  cmd->add_option("-o,--output", o->output, "Capture folder (new or empty)")->required();
+  cmd->add_option("--map", o->map, "Map (OpenArena's: oa_dm1 ... oa_dm7, aggressor, ...)");
+  cmd->add_option("--bots", o->bots, "Number of bots")->check(between(capture::kOpenArenaBotsRange.first, capture::kOpenArenaBotsRange.second));
+  cmd->add_option("--skill", o->skill, "Bot skill (Quake 3's 1 to 5)")
+      ->check(between(capture::kOpenArenaSkillRange.first, capture::kOpenArenaSkillRange.second));
+  cmd->add_option("--seconds", o->seconds, "Game seconds recorded")->check(positive());
+  cmd->add_option("--fps", o->fps, "Fixed clock, frames per game second (a divisor of 1000: the engine counts whole milliseconds)")
+      ->check(between(1, 1000));
+  cmd->add_option("--seed", o->seed, "Seed of every random choice");
+  cmd->add_option("--follow", o->follow, "auto (a bot, then the next whenever the followed one dies), one (the first bot throughout; its respawns are camera cuts) or a bot's client number (1, 2, ...)");
+  cmd->add_option("--warmup", o->warmup, "Game seconds after the map loads before recording")->check(between(capture::kOpenArenaMinWarmup, 3600.0));
+  cmd->add_option("--width", o->width, "Window width")->check(between(64, 16384));
+  cmd->add_option("--height", o->height, "Window height")->check(between(64, 16384));
+  cmd->add_flag("--window", o->window, "Use the current display instead of Xvfb");
+  cmd->add_option("--modules", o->modules, "Folder with the capture's cgamex86_64.so and qagamex86_64.so (empty: the build's)");
+  cmd->add_option("--engine", o->engine, "The ioquake3 executable (Debian's)");
+  cmd->add_option("--data", o->data, "OpenArena's base path, holding baseoa/ (Debian's openarena)");
+  cmd->callback([o, &run] {
+    run = [o]() -> Expected<void> {
+      std::optional<Progress> progress;
+      capture::OpenArenaProgress report;
+      if (Progress("capture", 0, "frames").enabled())
+        report = [&](std::size_t done, std::size_t total) {
+          if (!progress) progress.emplace("capture", total, "frames");
+          progress->update(done, "game time at the fixed clock");
+        };
+      auto result = capture::captureOpenArena(*o, report);
+      progress.reset();
+      if (!result) return std::unexpected(result.error());
+      fmt::print("{}: {} frames ({:.1f} s of game time at {} frames/s) in {:.1f} s; next: dynbench convert {} -o DATASET.gltf\n",
+                 o->output.string(), result->frames, static_cast<double>(result->frames) / o->fps, o->fps, result->wallSeconds,
+                 o->output.string());
+      return {};
+    };
+  });
+}
+
+}  // namespace dynbench::cli
