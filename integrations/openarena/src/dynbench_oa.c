@@ -66,6 +66,7 @@ typedef struct {
   int has_sun;
   float sun[6];          /* q3map_sun r g b intensity degrees elevation */
   int nodraw, sky, fog;
+  int translucent; /* its first stage blends onto what is behind (effects, glass, decals) */
   int used;
 } shader_info_t;
 
@@ -216,7 +217,16 @@ static void parse_shader_script(char* text) {
       if (!strcmp(token, "}")) { --depth; continue; }
       if (defined_before) { SkipRestOfLine(&p); continue; }
       if (depth == 2) {
-        if ((!Q_stricmp(token, "map") || !Q_stricmp(token, "clampmap")) && !shader->image[0]) {
+        if (stage == 1 && !Q_stricmp(token, "blendfunc")) {
+          /* id Tech 3 draws the first stage over the frame buffer with this blend: anything but
+           * (GL_ONE, GL_ZERO) shows what is behind it, which a path tracer of opaque surfaces
+           * cannot, so such surfaces are left out rather than drawn as solid (the health spheres,
+           * muzzle flashes, lightning, decals) */
+          char source[64];
+          Q_strncpyz(source, COM_ParseExt(&p, qfalse), sizeof(source));
+          const char* destination = COM_ParseExt(&p, qfalse);
+          shader->translucent = Q_stricmp(source, "gl_one") || Q_stricmp(destination, "gl_zero");
+        } else if ((!Q_stricmp(token, "map") || !Q_stricmp(token, "clampmap")) && !shader->image[0]) {
           token = COM_ParseExt(&p, qfalse);
           if (token[0] && token[0] != '$') Q_strncpyz(shader->image, token, sizeof(shader->image));
         } else if (!Q_stricmp(token, "animmap") && !shader->image[0]) {
@@ -411,7 +421,7 @@ static int surface_drawn(const dsurface_t* surface) {
   if (shader->surfaceFlags & (SURF_NODRAW | SURF_SKY)) return 0;
   if (shader->contentFlags & CONTENTS_FOG) return 0;
   const shader_info_t* info = shader_slot(shader->shader, 0);
-  if (info && (info->nodraw || info->sky || info->fog)) return 0;
+  if (info && (info->nodraw || info->sky || info->fog || info->translucent)) return 0;
   return 1;
 }
 
@@ -620,6 +630,16 @@ static int skin_shader(const char* skin_text, const char* surface, char out[MAX_
   return 0;
 }
 
+/* Whether an MD3 surface is drawn as an opaque surface, and its shader (the skin's, else its own). */
+static int md3_surface_drawn(const md3Surface_t* surface, const char* skin_text, char shader[MAX_QPATH]) {
+  shader[0] = 0;
+  if (!skin_shader(skin_text, surface->name, shader) && surface->numShaders > 0)
+    Q_strncpyz(shader, ((const md3Shader_t*)((const char*)surface + surface->ofsShaders))->name, MAX_QPATH);
+  if (strstr(shader, "nodraw")) return 0;
+  const shader_info_t* info = shader[0] ? shader_slot(shader, 0) : NULL;
+  return !(info && (info->nodraw || info->translucent));
+}
+
 /* Records an MD3 (with a skin's shaders when `skin` is given) as `model_path`: a mesh per
  * surface, and every key frame of a model with more than one. Returns the key-frame count (1 for a
  * rigid model), 0 on failure. */
@@ -643,6 +663,20 @@ static int record_md3(const char* file, const char* skin, const char* model_path
   }
   char* skin_text = skin ? read_game_file(skin, NULL) : NULL;
   const int frames = header->numFrames;
+  int drawn = 0; /* a model of effects only (a muzzle flash) is not recorded: nothing of it is drawn */
+  {
+    const md3Surface_t* surface = (const md3Surface_t*)(data + header->ofsSurfaces);
+    for (int s = 0; s < header->numSurfaces; ++s, surface = (const md3Surface_t*)((const char*)surface + surface->ofsEnd)) {
+      char shader[MAX_QPATH];
+      if ((const char*)surface + sizeof(md3Surface_t) > data + length || surface->ofsEnd <= 0) break;
+      if (surface->numVerts > 0 && surface->numTriangles > 0 && surface->numFrames == frames && md3_surface_drawn(surface, skin_text, shader)) ++drawn;
+    }
+  }
+  if (!drawn) {
+    free(data);
+    free(skin_text);
+    return 0;
+  }
   if (dbc_model_begin(g_db.session, model_path) != DBC_OK) { free(data); free(skin_text); db_fail("model"); return 0; }
   const md3Surface_t* surface = (const md3Surface_t*)(data + header->ofsSurfaces);
   int mesh_id = 0;
@@ -651,9 +685,7 @@ static int record_md3(const char* file, const char* skin, const char* model_path
     const int nv = surface->numVerts, nt = surface->numTriangles;
     if (nv <= 0 || nt <= 0 || surface->numFrames != frames) continue;
     char shader[MAX_QPATH] = "";
-    if (!skin_shader(skin_text, surface->name, shader) && surface->numShaders > 0)
-      Q_strncpyz(shader, ((const md3Shader_t*)((const char*)surface + surface->ofsShaders))->name, sizeof(shader));
-    if (!Q_stricmp(shader, "nodraw") || strstr(shader, "nodraw")) continue;
+    if (!md3_surface_drawn(surface, skin_text, shader)) continue;
     mesh_builder_t m;
     memset(&m, 0, sizeof(m));
     mesh_reserve(&m, (size_t)nv, (size_t)nt);
