@@ -199,6 +199,9 @@ static shader_info_t* shader_slot(const char* name, int create) {
   return NULL;
 }
 
+/* A shader script: shader name, then a block of keyword lines and stage blocks. A keyword's
+ * arguments are the tokens on its line; braces may share a line with them ("{ map x.tga }"), so
+ * they are counted wherever they appear. */
 static void parse_shader_script(char* text) {
   char* p = text;
   for (;;) {
@@ -206,52 +209,52 @@ static void parse_shader_script(char* text) {
     if (!token[0]) return;
     shader_info_t* shader = shader_slot(token, 1);
     token = COM_ParseExt(&p, qtrue);
-    if (strcmp(token, "{")) return; /* not a shader script the game could read either */
-    if (!shader) return;
-    const int defined_before = shader->image[0] != 0; /* the first definition wins, as in the renderer */
+    if (strcmp(token, "{") || !shader) return; /* not a shader script the game could read either */
+    const int defined_before = shader->image[0] != 0 || shader->surface_light > 0; /* the first definition wins, as in the renderer */
     int depth = 1, stage = 0;
     while (depth > 0) {
       token = COM_ParseExt(&p, qtrue);
       if (!token[0]) return;
       if (!strcmp(token, "{")) { ++depth; ++stage; continue; }
       if (!strcmp(token, "}")) { --depth; continue; }
-      if (defined_before) { SkipRestOfLine(&p); continue; }
-      if (depth == 2) {
-        if (stage == 1 && !Q_stricmp(token, "blendfunc")) {
+      char keyword[MAX_QPATH], args[8][MAX_QPATH];
+      int count = 0;
+      Q_strncpyz(keyword, token, sizeof(keyword));
+      for (;;) { /* the rest of the line */
+        token = COM_ParseExt(&p, qfalse);
+        if (!token[0]) break;
+        if (!strcmp(token, "{")) { ++depth; ++stage; break; }
+        if (!strcmp(token, "}")) { --depth; break; }
+        if (count < 8) Q_strncpyz(args[count++], token, MAX_QPATH);
+      }
+      if (defined_before) continue;
+      const int in_stage = depth == 2 || (depth == 1 && !strcmp(token, "}")); /* a stage closed on this line */
+      if (in_stage) {
+        if (stage == 1 && !Q_stricmp(keyword, "blendfunc")) {
           /* id Tech 3 draws the first stage over the frame buffer with this blend: anything but
            * (GL_ONE, GL_ZERO) shows what is behind it, which a path tracer of opaque surfaces
            * cannot, so such surfaces are left out rather than drawn as solid (the health spheres,
            * muzzle flashes, lightning, decals) */
-          char source[64];
-          Q_strncpyz(source, COM_ParseExt(&p, qfalse), sizeof(source));
-          const char* destination = COM_ParseExt(&p, qfalse);
-          shader->translucent = Q_stricmp(source, "gl_one") || Q_stricmp(destination, "gl_zero");
-        } else if ((!Q_stricmp(token, "map") || !Q_stricmp(token, "clampmap")) && !shader->image[0]) {
-          token = COM_ParseExt(&p, qfalse);
-          if (token[0] && token[0] != '$') Q_strncpyz(shader->image, token, sizeof(shader->image));
-        } else if (!Q_stricmp(token, "animmap") && !shader->image[0]) {
-          COM_ParseExt(&p, qfalse); /* frequency */
-          token = COM_ParseExt(&p, qfalse);
-          if (token[0]) Q_strncpyz(shader->image, token, sizeof(shader->image));
+          shader->translucent = count < 2 || Q_stricmp(args[0], "gl_one") || Q_stricmp(args[1], "gl_zero");
+        } else if ((!Q_stricmp(keyword, "map") || !Q_stricmp(keyword, "clampmap")) && !shader->image[0] && count >= 1) {
+          if (args[0][0] != '$') Q_strncpyz(shader->image, args[0], sizeof(shader->image));
+        } else if (!Q_stricmp(keyword, "animmap") && !shader->image[0] && count >= 2) {
+          Q_strncpyz(shader->image, args[1], sizeof(shader->image));
         }
-      } else if (depth == 1) {
-        if (!Q_stricmp(token, "q3map_surfacelight")) {
-          shader->surface_light = atof(COM_ParseExt(&p, qfalse));
-        } else if (!Q_stricmp(token, "q3map_lightrgb")) {
-          for (int i = 0; i < 3; ++i) shader->light_rgb[i] = atof(COM_ParseExt(&p, qfalse));
-        } else if (!Q_stricmp(token, "q3map_sun") || !Q_stricmp(token, "q3map_sunext")) {
-          for (int i = 0; i < 6; ++i) shader->sun[i] = atof(COM_ParseExt(&p, qfalse));
+      } else if (depth == 1 || depth == 0) {
+        if (!Q_stricmp(keyword, "q3map_surfacelight") && count >= 1) {
+          shader->surface_light = atof(args[0]);
+        } else if (!Q_stricmp(keyword, "q3map_lightrgb") && count >= 3) {
+          for (int i = 0; i < 3; ++i) shader->light_rgb[i] = atof(args[i]);
+        } else if ((!Q_stricmp(keyword, "q3map_sun") || !Q_stricmp(keyword, "q3map_sunext")) && count >= 6) {
+          for (int i = 0; i < 6; ++i) shader->sun[i] = atof(args[i]);
           shader->has_sun = 1;
-        } else if (!Q_stricmp(token, "surfaceparm")) {
-          token = COM_ParseExt(&p, qfalse);
-          if (!Q_stricmp(token, "nodraw")) shader->nodraw = 1;
-          if (!Q_stricmp(token, "sky")) shader->sky = 1;
-          if (!Q_stricmp(token, "fog")) shader->fog = 1;
-        } else if (!Q_stricmp(token, "qer_editorimage") && !shader->image[0] && stage == 0) {
-          /* a fallback only: an image stage, when one follows, replaces it */
+        } else if (!Q_stricmp(keyword, "surfaceparm") && count >= 1) {
+          if (!Q_stricmp(args[0], "nodraw")) shader->nodraw = 1;
+          if (!Q_stricmp(args[0], "sky")) shader->sky = 1;
+          if (!Q_stricmp(args[0], "fog")) shader->fog = 1;
         }
       }
-      SkipRestOfLine(&p);
     }
   }
 }
