@@ -177,6 +177,11 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
     }
     if (line.starts_with("dynbench-capture: window of ")) complete = true;
     if (line.starts_with("dynbench-capture: error")) adapterErrors += std::string(line) + "\n";
+    // The engine stays at its console after a map it cannot load; stop it then.
+    if (line.starts_with("Can't find map")) {
+      adapterErrors += std::string(line) + " (OpenArena's maps: oa_dm1 ... oa_dm7, aggressor, ...)\n";
+      return false;
+    }
     return true;
   };
   game.tailBytes = 3000;

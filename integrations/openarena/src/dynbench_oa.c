@@ -83,12 +83,11 @@ static struct {
   int total_frames;
   int frame;
   int frame_ms, clock_base, clock_resets;
-  char bots[512]; /* "Sarge:3 Grism:3" */
   int started;
   int start_time;
   int finished;
   int spectate_sent_at, follow_sent_at, next_sent_for_death;
-  int restart_sent, restarted, connected_in_time, bots_added;
+  int restart_sent, restarted, connected_in_time, connected_at, following_since;
   int follow_target;
   uint64_t camera_id;
   int last_client, last_teleport, last_dead, have_last;
@@ -459,8 +458,10 @@ static void add_surface(mesh_builder_t* m, const dsurface_t* s) {
             bezier(control, (float)i / PATCH_LEVEL, (float)j / PATCH_LEVEL, xyz, normal, st);
             mesh_vertex(m, xyz, normal, st);
           }
-        /* the patch's rows and columns run as the control grid's, whose triangles the renderer
-         * draws as (i, j), (i, j+1), (i+1, j): the same winding as a planar face's */
+        /* rows j and columns i as the control grid's. Unlike planar faces, a patch's control
+         * normals point along cross(P(i+1,j) - P(i,j), P(i,j+1) - P(i,j)) (all but 15 of 28,000
+         * grid cells of OpenArena's 25 maps with patches), so the counter-clockwise triangles
+         * (a, b, c) and (b, d, c) face the normals: mesh_triangle's turn is undone here */
         for (int j = 0; j < PATCH_LEVEL; ++j)
           for (int i = 0; i < PATCH_LEVEL; ++i) {
             const uint32_t a = base + j * (PATCH_LEVEL + 1) + i, b = a + 1, c = a + PATCH_LEVEL + 1, d = c + 1;
@@ -768,8 +769,22 @@ static uint64_t identity(int slot, int serial, int model, int skin, int occurren
 /* ---------------------------------------------------------------------------------------------- */
 /* hooks */
 
+/* The client game's random numbers (cg_local.h sends its rand() here): the C library's would
+ * interleave with the game module's and the bots' (one process), and the client draws a different
+ * number of them before the match on every run (how long it took to connect). Restarted with the
+ * level. A 32-bit linear congruential generator (Numerical Recipes' constants) is enough for
+ * effects; rand()'s 15 bits, as the game code expects. */
+static uint32_t g_cg_random = 1;
+
+int dynbench_cg_rand(void) {
+  g_cg_random = g_cg_random * 1664525u + 1013904223u;
+  return (int)((g_cg_random >> 16) & 0x7fff);
+}
+
 void dynbench_map_restart(void) {
-  if (g_db.active && g_db.restart_sent) g_db.restarted = 1;
+  if (!g_db.active || !g_db.restart_sent) return;
+  g_db.restarted = 1;
+  g_cg_random = (uint32_t)(getenv("DYNBENCH_CAPTURE_SEED") ? atoi(getenv("DYNBENCH_CAPTURE_SEED")) : 1);
 }
 
 void dynbench_register_model(const char* name, qhandle_t handle) {
@@ -972,9 +987,16 @@ void dynbench_render_scene(const refdef_t* view) {
    * one process), so a match that ran while the client connected would differ from run to run.
    * The client joins as a spectator (userinfo team s) of an empty level; at a fixed server time
    * the adapter restarts the level (map_restart 0: the game module re-seeds from
-   * DYNBENCH_CAPTURE_SEED, the client stays connected) and then adds the bots: the match starts in
-   * the same engine frame, with the same random numbers, on every run. */
+   * DYNBENCH_CAPTURE_SEED, the client stays connected, and the game module adds the bots of
+   * DYNBENCH_CAPTURE_BOTS in the same command pass): the match starts in the same engine frame,
+   * with the same random numbers, on every run. Recording starts at a fixed time after it. (Bots
+   * added from here, a frame after this module saw the restart, joined a frame apart from run to
+   * run; so does the moment the server starts answering `follow`.) */
   if (!g_db.restarted) {
+    if (!g_db.connected_at) {
+      g_db.connected_at = cg.snap->serverTime;
+      printf("dynbench-capture: client in at %d ms of server time\n", g_db.connected_at);
+    }
     if (cg.snap->ps.persistant[PERS_TEAM] != TEAM_SPECTATOR) {
       ensure_following();
     } else if (!g_db.restart_sent && cg.snap->serverTime >= RESTART_AT) {
@@ -986,17 +1008,8 @@ void dynbench_render_scene(const refdef_t* view) {
     if (cg.snap->serverTime < RESTART_AT) g_db.connected_in_time = 1;
     return;
   }
-  if (!g_db.bots_added) {
-    char bots[sizeof(g_db.bots)];
-    Q_strncpyz(bots, g_db.bots, sizeof(bots));
-    for (char* bot = strtok(bots, " "); bot; bot = strtok(NULL, " ")) {
-      char* skill = strchr(bot, ':');
-      if (skill) *skill++ = 0;
-      trap_SendConsoleCommand(va("addbot %s %s\n", bot, skill ? skill : "3"));
-    }
-    g_db.bots_added = 1;
-  }
   const int following = ensure_following();
+  if (following && !g_db.following_since) g_db.following_since = cg.time;
   if (!g_db.started) {
     if (!following || cg.time < cgs.levelStartTime + (int)(g_db.warmup * 1000)) {
       if (cg.time > cgs.levelStartTime + (int)(g_db.warmup * 1000) + 20000) {
@@ -1008,6 +1021,7 @@ void dynbench_render_scene(const refdef_t* view) {
     }
     g_db.started = 1;
     g_db.start_time = cg.time;
+    printf("dynbench-capture: level started at %d ms of server time, recording from %d (following since %d)\n", cgs.levelStartTime, cg.time, g_db.following_since);
   }
   const playerState_t* ps = &cg.snap->ps;
   dbc_session* s = g_db.session;
@@ -1128,7 +1142,6 @@ void dynbench_cg_init(void) {
   Com_sprintf(g_db.world_path, sizeof(g_db.world_path), "maps/%s", g_db.map);
   /* the fixed clock: every frame advances the game by exactly 1/fps (a cheat cvar: devmap) */
   g_db.frame_ms = (int)(1000.0 / fps + 0.5);
-  Q_strncpyz(g_db.bots, getenv("DYNBENCH_CAPTURE_BOTS") ? getenv("DYNBENCH_CAPTURE_BOTS") : "", sizeof(g_db.bots));
   trap_Cvar_Set("fixedtime", va("%d", g_db.frame_ms));
   load_shader_scripts();
   if (!load_bsp()) {

@@ -1,0 +1,262 @@
+// `dynbench capture openarena` end to end on Debian's OpenArena (ioquake3 with the game modules
+// rebuilt with dynbench's capture hooks): seeded matches on two maps are byte-identical twice; a
+// match converts to a dataset the Khronos validator accepts, that Blender imports with the counts
+// `stats` reports, whose players are MD3 key frames as morph targets posed where the game put them,
+// and whose map faces the way the game's does.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "capture/openarena.h"
+#include "core/files.h"
+#include "scene/evaluate.h"
+#include "scene/load.h"
+#include "gltf_builder.h"
+#include "external_tools.h"
+#include "run_cli.h"
+
+namespace dynbench {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string missingOpenArena() {
+  if (!capture::findOpenArenaModules({})) return "OpenArena's game modules are not built (scripts/setup.sh, then cmake --build)";
+  if (!fs::exists("/usr/lib/ioquake3/ioquake3") || !fs::exists("/usr/lib/openarena/baseoa"))
+    return "Debian's openarena is not installed (scripts/setup.sh)";
+  if (!test::onPath("Xvfb")) return "Xvfb is not installed (Debian package xvfb)";
+  return {};
+}
+
+// Every file under a folder, by relative path, with its bytes.
+std::map<std::string, std::string> filesUnder(const fs::path& root) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : fs::recursive_directory_iterator(root))
+    if (entry.is_regular_file()) files[fs::relative(entry.path(), root).generic_string()] = test::slurp(entry.path());
+  return files;
+}
+
+std::vector<std::string> splitFields(const std::string& line) {
+  std::vector<std::string> fields;
+  std::stringstream in(line);
+  for (std::string f; std::getline(in, f, ':');) fields.push_back(f);
+  return fields;
+}
+
+// The map faces the way the game's does: id Tech 3 winds planar faces clockwise in front, glTF
+// counter-clockwise, and the adapter turns them round (patches it tessellates the right way
+// itself), so at most `against` of the corners face against their BSP vertex normal; floors face
+// up (+Y).
+void expectFacesAlongNormals(const scene::Scene& dataset, const std::string& map, double against) {
+  const auto mapNode = std::find_if(dataset.nodes.begin(), dataset.nodes.end(), [&](const auto& n) { return n.name == "static_2_maps/" + map; });
+  ASSERT_NE(mapNode, dataset.nodes.end());
+  std::size_t corners = 0, alongFace = 0, againstFace = 0, upward = 0;
+  for (const auto& prim : dataset.meshes[static_cast<std::size_t>(mapNode->mesh)].primitives) {
+    ASSERT_EQ(prim.normals.size(), prim.positions.size());
+    for (std::size_t t = 0; t < prim.triangleCount(); ++t) {
+      const std::uint32_t* idx = &prim.indices[3 * t];
+      const glm::dvec3 a(prim.positions[idx[0]]), b(prim.positions[idx[1]]), c(prim.positions[idx[2]]);
+      const glm::dvec3 cross = glm::cross(b - a, c - a);
+      if (glm::length(cross) < 1e-9) continue;
+      const glm::dvec3 face = glm::normalize(cross);
+      upward += face.y > 0.99 ? 1 : 0;
+      for (int k = 0; k < 3; ++k, ++corners) {
+        const double along = glm::dot(glm::dvec3(prim.normals[idx[k]]), face);
+        alongFace += along > 0.9 ? 1 : 0;
+        againstFace += along < 0 ? 1 : 0;
+      }
+    }
+  }
+  std::printf("%s: of %zu corners, %zu within 25 degrees of their face normal, %zu facing against it; %zu up-facing triangles\n",
+              map.c_str(), corners, alongFace, againstFace, upward);
+  EXPECT_LT(static_cast<double>(againstFace), against * static_cast<double>(corners)) << map;
+  EXPECT_GT(static_cast<double>(alongFace), 0.6 * static_cast<double>(corners)) << map;
+  EXPECT_GT(upward, 200u) << map;
+}
+
+TEST(OpenArena, SeededMatchesOnTwoMapsAreByteIdentical) {
+  DYNBENCH_NEEDS(missingOpenArena());
+  const auto dir = test::freshDir("openarena_identical");
+  for (const auto& [map, seed] : {std::pair<std::string, int>{"oa_dm1", 3}, {"oa_dm3", 5}}) {
+    for (const char* run : {"a", "b"}) {
+      const auto r = dynbench(fmt::format("capture openarena -o {} --map {} --bots 4 --seconds 3 --seed {}", (dir / (map + run)).string(), map, seed), dir);
+      ASSERT_EQ(r.status, 0) << r.err;
+      EXPECT_NE(r.out.find("150 frames"), std::string::npos) << r.out;
+    }
+    const auto a = filesUnder(dir / (map + "a")), b = filesUnder(dir / (map + "b"));
+    ASSERT_GT(a.at("Capture.txt").size(), 10000u);
+    EXPECT_GT(a.size(), 20u) << "models and textures";
+    EXPECT_TRUE(a == b) << map << ": the same seed gave different captures";
+    // No run folder (private base and home) is left behind.
+    for (const auto& [name, bytes] : a) EXPECT_FALSE(name.starts_with(".openarena-")) << name;
+  }
+  // oa_dm3's curved patches, tessellated by the adapter, face along their normals too.
+  auto r3 = dynbench(fmt::format("convert {} -o {}", (dir / "oa_dm3a").string(), (dir / "ds" / "dm3.gltf").string()), dir);
+  ASSERT_EQ(r3.status, 0) << r3.err;
+  auto dm3 = scene::loadScene(dir / "ds" / "dm3.gltf");
+  ASSERT_TRUE(dm3) << dm3.error().message;
+  expectFacesAlongNormals(*dm3, "oa_dm3", 0.001);
+  // Another seed is another match.
+  const auto r = dynbench(fmt::format("capture openarena -o {} --map oa_dm1 --bots 4 --seconds 3 --seed 4", (dir / "other").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(test::slurp(dir / "other" / "Capture.txt"), test::slurp(dir / "oa_dm1a" / "Capture.txt"));
+}
+
+TEST(OpenArena, MatchConvertsWithMorphTargetsWhereTheGamePutThem) {
+  DYNBENCH_NEEDS(missingOpenArena());
+  DYNBENCH_NEEDS(test::missingGltfValidator());
+  const auto dir = test::freshDir("openarena_dataset");
+  auto r = dynbench(fmt::format("capture openarena -o {} --map oa_dm1 --bots 4 --seconds 6 --seed 3", (dir / "cap").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = dynbench(fmt::format("convert {} -o {}", (dir / "cap").string(), (dir / "ds" / "dm1.gltf").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("is neither PNG nor JPEG"), std::string::npos) << r.err;  // TGA textures become PNG
+  std::string validation;
+  const int status = runShell(fmt::format("node {}/tools/gltf-validator/validate.mjs {} 2>&1", DYNBENCH_SOURCE_DIR,
+                                          (dir / "ds" / "dm1.gltf").string()),
+                              validation);
+  EXPECT_EQ(status, 0) << validation;
+  EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
+  const std::string readme = test::slurp(dir / "ds" / "dm1.README.md");
+  EXPECT_NE(readme.find("openarena-data"), std::string::npos);
+
+  r = dynbench(fmt::format("stats {} --fps 50 --json {}", (dir / "ds" / "dm1.gltf").string(), (dir / "stats.json").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(test::slurp(dir / "stats.json"))["datasets"][0];
+  const auto& p = j["properties"];
+  EXPECT_TRUE(p["animated_camera"].get<bool>());
+  EXPECT_TRUE(p["morph_targets"].get<bool>());
+  EXPECT_GE(p["morph_animated_objects"].get<int>(), 4);  // players' legs and torsos
+  EXPECT_EQ(p["static_objects"].get<int>(), 1);          // the map
+  EXPECT_GT(p["faces"].get<int>(), 10000);
+  EXPECT_GT(p["static_point_lights"].get<int>(), 10);    // the map's light-emitting surfaces
+  EXPECT_GT(p["dynamic_point_lights"].get<int>(), 0);    // muzzle flashes, rockets, explosions
+  EXPECT_GT(p["dynamic_rigid_objects"].get<int>(), 10);  // player parts, weapons, items, projectiles
+  // A bot's view: faster than a slow fly-through (5 degrees a second).
+  EXPECT_GT(j["camera_motion"]["rotation_degrees"]["mean"].get<double>() * 50.0, 15.0);
+  std::printf("oa_dm1 6 s: %d faces, %d dynamic objects (%d morph-animated), %d + %d point lights, camera %.3f deg/frame\n",
+              p["faces"].get<int>(), p["dynamic_rigid_objects"].get<int>(), p["morph_animated_objects"].get<int>(),
+              p["static_point_lights"].get<int>(), p["dynamic_point_lights"].get<int>(),
+              j["camera_motion"]["rotation_degrees"]["mean"].get<double>());
+
+  // Blender's importer makes what stats counts: a mesh object per static or dynamic object, a light
+  // per light, the camera, and the morph targets as shape keys.
+  if (test::missingBlender().empty()) {
+    std::string out;
+    const int blender = runShell(fmt::format("blender --background --factory-startup --python {}/tools/blender/import_gltf.py -- '{}' 2>&1",
+                                             DYNBENCH_SOURCE_DIR, (dir / "ds" / "dm1.gltf").string()),
+                                 out);
+    const auto at = out.find("DYNBENCH_IMPORT ");
+    ASSERT_TRUE(blender == 0 && at != std::string::npos) << out;
+    const auto summary = nlohmann::json::parse(out.substr(at + 16, out.find('\n', at) - at - 16));
+    EXPECT_EQ(summary["meshes"].get<int>(), p["static_objects"].get<int>() + p["dynamic_rigid_objects"].get<int>());
+    EXPECT_EQ(summary["lights"].get<int>(), p["static_point_lights"].get<int>() + p["dynamic_point_lights"].get<int>());
+    EXPECT_EQ(summary["cameras"].get<int>(), 1);
+    EXPECT_EQ(summary["objects"].get<int>(), p["nodes"].get<int>());
+    EXPECT_GT(summary["shape_keys"].get<int>(), 0);
+  }
+
+  // Morph targets, against the capture itself: a vertex-animated capturable's vertices in the
+  // dataset at a recorded frame are its ModelMesh key frames interpolated as the engine does,
+  // (1 - fraction) P[from] + fraction P[to], moved by its recorded pose.
+  auto dataset = scene::loadScene(dir / "ds" / "dm1.gltf");
+  ASSERT_TRUE(dataset) << dataset.error().message;
+  const scene::Evaluator evaluator(*dataset);
+  std::ifstream capture(dir / "cap" / "Capture.txt");
+  std::string line;
+  double time = 0;
+  int checked = 0;
+  std::map<std::string, std::string> modelFiles;  // model path -> ModelMesh file
+  for (const auto& entry : fs::directory_iterator(dir / "cap" / "models")) {
+    std::ifstream in(entry.path());
+    std::string version, origin;
+    std::getline(in, version);
+    std::getline(in, origin);
+    modelFiles[origin.substr(2)] = entry.path().string();
+  }
+  std::vector<std::string> pose;
+  double worst = 0;
+  while (std::getline(capture, line) && checked < 12) {
+    const auto f = splitFields(line);
+    if (f[0] == "f") time = std::stod(f[2]);
+    if (f[0] == "m") pose = f;
+    if (f[0] != "v" || pose.size() < 11 || pose[1] != f[1]) continue;
+    const int frame = static_cast<int>(std::lround(time * 50));
+    if (frame % 37 != 5) continue;  // a spread of frames
+    const std::string& model = f[5];
+    const unsigned from = std::stoul(f[2]), to = std::stoul(f[3]);
+    const double fraction = std::stod(f[4]);
+    // mesh 0's key-frame positions
+    std::ifstream mesh(modelFiles.at(model));
+    std::vector<glm::dvec3> at_from, at_to;
+    std::string record;
+    while (std::getline(mesh, record)) {
+      const auto r = splitFields(record);
+      if (r[0] != "P" || r[1] != "0") continue;
+      const unsigned k = std::stoul(r[2]);
+      const glm::dvec3 v(std::stod(r[3]), std::stod(r[4]), std::stod(r[5]));
+      if (k == from) at_from.push_back(v);
+      if (k == to) at_to.push_back(v);
+    }
+    ASSERT_FALSE(at_from.empty());
+    ASSERT_EQ(at_from.size(), at_to.size());
+    const glm::dquat r(std::stod(pose[5]), std::stod(pose[2]), std::stod(pose[3]), std::stod(pose[4]));
+    const glm::dquat d(std::stod(pose[9]), std::stod(pose[6]), std::stod(pose[7]), std::stod(pose[8]));
+    const glm::dquat tq = 2.0 * d * glm::conjugate(r);
+    const glm::dvec3 translation(tq.x, tq.y, tq.z);
+    const auto node = std::find_if(dataset->nodes.begin(), dataset->nodes.end(),
+                                   [&](const auto& n) { return n.name == "model_" + f[1] + "_" + model; });
+    ASSERT_NE(node, dataset->nodes.end()) << model;
+    std::vector<glm::dvec3> positions, normals;
+    evaluator.worldGeometry(static_cast<int>(node - dataset->nodes.begin()), 0, time, positions, normals);
+    ASSERT_EQ(positions.size(), at_from.size());
+    for (std::size_t v = 0; v < positions.size(); ++v) {
+      const glm::dvec3 expected = r * ((1 - fraction) * at_from[v] + fraction * at_to[v]) + translation;
+      worst = std::max(worst, glm::distance(expected, positions[v]));
+    }
+    ++checked;
+  }
+  EXPECT_GE(checked, 4);
+  std::printf("morph targets vs the capture's key frames: %d poses, worst vertex %.2g units\n", checked, worst);
+  EXPECT_LT(worst, 0.01);  // float rounding of 1-unit-scale positions (32 units a metre)
+
+  // oa_dm1's own misc_model soups wind 480 of their 9,240 corners against their smoothed normals.
+  expectFacesAlongNormals(*dataset, "oa_dm1", 0.03);
+}
+
+TEST(OpenArena, BadOptionsFailClearly) {
+  const auto dir = test::freshDir("openarena_bad");
+  auto r = dynbench(fmt::format("capture openarena -o {} --fps 30", (dir / "a").string()), dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("divisor of 1000"), std::string::npos) << r.err;
+  r = dynbench(fmt::format("capture openarena -o {} --map 'oa dm1'", (dir / "b").string()), dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("expected a map name"), std::string::npos) << r.err;
+  r = dynbench(fmt::format("capture openarena -o {} --follow someone", (dir / "c").string()), dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("--follow 'someone'"), std::string::npos) << r.err;
+  r = dynbench(fmt::format("capture openarena -o {} --bots 17", (dir / "d").string()), dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  r = dynbench(fmt::format("capture openarena -o {} --modules {}", (dir / "e").string(), dir.string()), dir);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("cgamex86_64.so"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "e" / "Capture.txt"));
+  if (missingOpenArena().empty()) {
+    // A map the game does not have: the game quits, and the error says so with the game's words.
+    r = dynbench(fmt::format("capture openarena -o {} --map no_such_map --seconds 1", (dir / "f").string()), dir);
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.err.find("OpenArena stopped after 0 of 50 frames"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("Can't find map maps/no_such_map.bsp"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "f" / "Capture.txt")) << "no capture that looks complete";
+  }
+}
+
+}  // namespace
+}  // namespace dynbench
