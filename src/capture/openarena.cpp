@@ -151,7 +151,8 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
                       {"DYNBENCH_CAPTURE_SEED", std::to_string(o.seed)},
                       {"DYNBENCH_CAPTURE_WARMUP", fmt::format("{}", o.warmup)},
                       {"DYNBENCH_CAPTURE_SECONDS", fmt::format("{}", o.seconds)},
-                      {"DYNBENCH_CAPTURE_FOLLOW", o.follow}};
+                      {"DYNBENCH_CAPTURE_FOLLOW", o.follow},
+                      {"DYNBENCH_CAPTURE_RECORD", o.record ? "1" : "0"}};
   // The bots join after the level restart the adapter makes (dynbench_oa.c says why).
   std::string bots;
   const auto names = openArenaBots(o.bots);  // checked by openArenaArguments
@@ -167,6 +168,7 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
   game.argv = {"timeout", std::to_string(timeout), o.engine.string()};
   game.argv.insert(game.argv.end(), arguments->begin(), arguments->end());
   std::size_t frames = 0;
+  unsigned long windowMs = 0;
   bool complete = false;
   std::string adapterErrors;
   game.onLine = [&](std::string_view line) {
@@ -175,7 +177,8 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
       frames = static_cast<std::size_t>(done);
       if (progress) progress(frames, total);
     }
-    if (line.starts_with("dynbench-capture: window of ")) complete = true;
+    unsigned long n = 0;
+    if (std::sscanf(std::string(line).c_str(), "dynbench-capture: window of %lu frames took %lu ms", &n, &windowMs) == 2) complete = true;
     if (line.starts_with("dynbench-capture: error")) adapterErrors += std::string(line) + "\n";
     // The engine stays at its console after a map it cannot load; stop it then.
     if (line.starts_with("Can't find map")) {
@@ -191,6 +194,11 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
   if (!complete || frames < total)
     return fail(ErrorCode::kExternalTool, "OpenArena stopped after {} of {} frames (status {}){}; its last output:\n{}", frames, total,
                 result->exitStatus, adapterErrors.empty() ? "" : ":\n" + adapterErrors, result->tail);
+  OpenArenaReport report;
+  report.frames = frames;
+  report.windowWallSeconds = static_cast<double>(windowMs) / 1000.0;
+  report.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (!o.record) return report;
   auto summary = checkCapture(o.output);
   if (!summary) return std::unexpected(summary.error());
   // The licences of what the capture holds, which `convert` copies into the dataset's README.
@@ -204,9 +212,6 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
     else licences += fmt::format("({} was not found: check the game data's licences before publishing.)\n", copyright.string());
   }
   if (auto ok = writeFileAtomic(o.output / "LICENSES.txt", licences); !ok) return std::unexpected(ok.error());
-  OpenArenaReport report;
-  report.frames = frames;
-  report.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return report;
 }
 

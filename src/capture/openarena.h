@@ -36,11 +36,15 @@ struct OpenArenaOptions {
   std::filesystem::path modules;  // folder with cgamex86_64.so and qagamex86_64.so; empty: the build's
   std::filesystem::path engine = "/usr/lib/ioquake3/ioquake3";  // Debian's ioquake3
   std::filesystem::path data = "/usr/lib/openarena";             // Debian's openarena (baseoa/)
+  // false: play the same match without writing anything (bench/bench_capture_openarena.sh
+  // compares the window's wall time with and without recording)
+  bool record = true;
 };
 
 struct OpenArenaReport {
   std::size_t frames = 0;
-  double wallSeconds = 0.0;
+  double wallSeconds = 0.0;        // the whole run: start, loading, warm-up, recording, exit
+  double windowWallSeconds = 0.0;  // the recorded frames alone (the adapter's own clock)
 };
 
 using OpenArenaProgress = std::function<void(std::size_t, std::size_t)>;  // (recorded, total)

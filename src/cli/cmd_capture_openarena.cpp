@@ -32,6 +32,8 @@ void addCaptureOpenArenaCommand(CLI::App* capture, CommandRun& run) {
   cmd->add_option("--modules", o->modules, "Folder with the capture's cgamex86_64.so and qagamex86_64.so (empty: the build's)");
   cmd->add_option("--engine", o->engine, "The ioquake3 executable (Debian's)");
   cmd->add_option("--data", o->data, "OpenArena's base path, holding baseoa/ (Debian's openarena)");
+  cmd->add_flag("--no-record", [o](std::int64_t) { o->record = false; },
+                "Play the same match without writing anything; prints the recording window's wall time (bench/bench_capture_openarena.sh)");
   cmd->callback([o, &run] {
     run = [o]() -> Expected<void> {
       std::optional<Progress> progress;
@@ -44,9 +46,16 @@ void addCaptureOpenArenaCommand(CLI::App* capture, CommandRun& run) {
       auto result = capture::captureOpenArena(*o, report);
       progress.reset();
       if (!result) return std::unexpected(result.error());
-      fmt::print("{}: {} frames ({:.1f} s of game time at {} frames/s) in {:.1f} s; next: dynbench convert {} -o DATASET.gltf\n",
+      const double perFrame = 1000.0 * result->windowWallSeconds / static_cast<double>(std::max<std::size_t>(result->frames, 1));
+      if (!o->record) {
+        fmt::print("not recorded: window of {} frames took {:.3f} s of wall time ({:.2f} ms/frame)\n", result->frames,
+                   result->windowWallSeconds, perFrame);
+        return {};
+      }
+      fmt::print("{}: {} frames ({:.1f} s of game time at {} frames/s) in {:.1f} s (the recorded window {:.3f} s, {:.2f} ms/frame); next: "
+                 "dynbench convert {} -o DATASET.gltf\n",
                  o->output.string(), result->frames, static_cast<double>(result->frames) / o->fps, o->fps, result->wallSeconds,
-                 o->output.string());
+                 result->windowWallSeconds, perFrame, o->output.string());
       return {};
     };
   });

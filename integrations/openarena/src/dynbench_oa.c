@@ -88,6 +88,8 @@ static struct {
   int finished;
   int spectate_sent_at, follow_sent_at, next_sent_for_death;
   int restart_sent, restarted, connected_in_time, connected_at, following_since;
+  int record;       /* 0: play the same match without writing anything (the overhead benchmark) */
+  int window_start; /* wall-clock ms when recording started */
   int follow_target;
   uint64_t camera_id;
   int last_client, last_teleport, last_dead, have_last;
@@ -1021,9 +1023,27 @@ void dynbench_render_scene(const refdef_t* view) {
     }
     g_db.started = 1;
     g_db.start_time = cg.time;
+    g_db.window_start = trap_Milliseconds(); /* the machine's clock: this is the one place it is read */
     printf("dynbench-capture: level started at %d ms of server time, recording from %d (following since %d)\n", cgs.levelStartTime, cg.time, g_db.following_since);
   }
   const playerState_t* ps = &cg.snap->ps;
+  /* --follow auto: the next bot once the followed one dies (the server switches the view) */
+  const int dead = ps->stats[STAT_HEALTH] <= 0 || ps->pm_type == PM_DEAD;
+  if (dead && !strcmp(g_db.follow, "auto") && g_db.next_sent_for_death != ps->clientNum + 1) {
+    trap_SendClientCommand("follownext");
+    g_db.next_sent_for_death = ps->clientNum + 1;
+  }
+  if (!dead) g_db.next_sent_for_death = 0;
+  if (!g_db.record) {
+    printf("dynbench-capture: %d/%d frames\n", ++g_db.frame, g_db.total_frames);
+    if (g_db.frame >= g_db.total_frames) {
+      printf("dynbench-capture: window of %d frames took %d ms of wall time (not recorded)\n", g_db.frame, trap_Milliseconds() - g_db.window_start);
+      fflush(stdout);
+      g_db.active = 0;
+      trap_SendConsoleCommand("quit\n");
+    }
+    return;
+  }
   dbc_session* s = g_db.session;
   if (view->width != g_db.last_camera_width || view->height != g_db.last_camera_height || view->fov_y != g_db.camera_fov) {
     g_db.last_camera_width = view->width;
@@ -1045,7 +1065,6 @@ void dynbench_render_scene(const refdef_t* view) {
   if (dbc_camera(s, g_db.camera_id, position, pitch, yaw, roll) != DBC_OK) { db_fail("camera"); return; }
   /* cuts: another player followed, a respawn or a teleporter (the game toggles EF_TELEPORT_BIT
    * when the view's origin jumps), or a jump the game did not mark */
-  const int dead = ps->stats[STAT_HEALTH] <= 0 || ps->pm_type == PM_DEAD;
   const int teleport = ps->eFlags & EF_TELEPORT_BIT;
   if (g_db.have_last) {
     const float dx = position[0] - g_db.last_position[0], dy = position[1] - g_db.last_position[1], dz = position[2] - g_db.last_position[2];
@@ -1060,11 +1079,6 @@ void dynbench_render_scene(const refdef_t* view) {
   g_db.last_teleport = teleport;
   g_db.last_dead = dead;
   memcpy(g_db.last_position, position, sizeof(position));
-  if (dead && !strcmp(g_db.follow, "auto") && g_db.next_sent_for_death != ps->clientNum + 1) {
-    trap_SendClientCommand("follownext");
-    g_db.next_sent_for_death = ps->clientNum + 1;
-  }
-  if (!dead) g_db.next_sent_for_death = 0;
 
   if (g_db.frame == 0) {
     const dbc_dual_quat identity_pose = {0, 0, 0, 1, 0, 0, 0, 0};
@@ -1109,7 +1123,8 @@ void dynbench_render_scene(const refdef_t* view) {
     if (dbc_close(s) != DBC_OK) { g_db.session = NULL; db_fail("close"); return; }
     g_db.session = NULL;
     g_db.active = 0;
-    printf("dynbench-capture: window of %d frames complete (%d frames off the fixed clock)\n", g_db.frame, g_db.clock_resets);
+    printf("dynbench-capture: window of %d frames took %d ms of wall time (recorded; %d frames off the fixed clock)\n", g_db.frame,
+           trap_Milliseconds() - g_db.window_start, g_db.clock_resets);
     fflush(stdout);
     trap_SendConsoleCommand("quit\n");
   }
@@ -1143,6 +1158,11 @@ void dynbench_cg_init(void) {
   /* the fixed clock: every frame advances the game by exactly 1/fps (a cheat cvar: devmap) */
   g_db.frame_ms = (int)(1000.0 / fps + 0.5);
   trap_Cvar_Set("fixedtime", va("%d", g_db.frame_ms));
+  g_db.record = !getenv("DYNBENCH_CAPTURE_RECORD") || atoi(getenv("DYNBENCH_CAPTURE_RECORD")) != 0;
+  if (!g_db.record) {
+    g_db.active = 1;
+    return;
+  }
   load_shader_scripts();
   if (!load_bsp()) {
     fprintf(stderr, "dynbench-capture: error: cannot read maps/%s.bsp\n", g_db.map);
