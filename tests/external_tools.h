@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "capture/cube2.h"
+#include "capture/openarena.h"
 
 namespace dynbench::test {
 
@@ -39,6 +40,14 @@ inline std::string missingGltfValidator() {
 inline std::string missingCube2() {
   if (!capture::findCube2Client({})) return "the Cube 2 client is not built (scripts/setup.sh, then cmake --build)";
   if (!std::filesystem::exists("/usr/share/games/cube2/packages/base/colos.ogz")) return "Debian's cube2-data is not installed";
+  if (!onPath("Xvfb")) return "Xvfb is not installed (Debian package xvfb)";
+  return {};
+}
+
+inline std::string missingOpenArena() {
+  if (!capture::findOpenArenaModules({})) return "OpenArena's game modules are not built (scripts/setup.sh, then cmake --build)";
+  if (!std::filesystem::exists("/usr/lib/ioquake3/ioquake3") || !std::filesystem::exists("/usr/lib/openarena/baseoa"))
+    return "Debian's openarena is not installed (scripts/setup.sh)";
   if (!onPath("Xvfb")) return "Xvfb is not installed (Debian package xvfb)";
   return {};
 }

@@ -27,14 +27,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string missingOpenArena() {
-  if (!capture::findOpenArenaModules({})) return "OpenArena's game modules are not built (scripts/setup.sh, then cmake --build)";
-  if (!fs::exists("/usr/lib/ioquake3/ioquake3") || !fs::exists("/usr/lib/openarena/baseoa"))
-    return "Debian's openarena is not installed (scripts/setup.sh)";
-  if (!test::onPath("Xvfb")) return "Xvfb is not installed (Debian package xvfb)";
-  return {};
-}
-
 // Every file under a folder, by relative path, with its bytes.
 std::map<std::string, std::string> filesUnder(const fs::path& root) {
   std::map<std::string, std::string> files;
@@ -82,7 +74,7 @@ void expectFacesAlongNormals(const scene::Scene& dataset, const std::string& map
 }
 
 TEST(OpenArena, SeededMatchesOnTwoMapsAreByteIdentical) {
-  DYNBENCH_NEEDS(missingOpenArena());
+  DYNBENCH_NEEDS(test::missingOpenArena());
   const auto dir = test::freshDir("openarena_identical");
   for (const auto& [map, seed] : {std::pair<std::string, int>{"oa_dm1", 3}, {"oa_dm3", 5}}) {
     for (const char* run : {"a", "b"}) {
@@ -110,7 +102,7 @@ TEST(OpenArena, SeededMatchesOnTwoMapsAreByteIdentical) {
 }
 
 TEST(OpenArena, MatchConvertsWithMorphTargetsWhereTheGamePutThem) {
-  DYNBENCH_NEEDS(missingOpenArena());
+  DYNBENCH_NEEDS(test::missingOpenArena());
   DYNBENCH_NEEDS(test::missingGltfValidator());
   const auto dir = test::freshDir("openarena_dataset");
   auto r = dynbench(fmt::format("capture openarena -o {} --map oa_dm1 --bots 4 --seconds 6 --seed 3", (dir / "cap").string()), dir);
@@ -248,7 +240,7 @@ TEST(OpenArena, BadOptionsFailClearly) {
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("cgamex86_64.so"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "e" / "Capture.txt"));
-  if (missingOpenArena().empty()) {
+  if (test::missingOpenArena().empty()) {
     // A map the game does not have: the game quits, and the error says so with the game's words.
     r = dynbench(fmt::format("capture openarena -o {} --map no_such_map --seconds 1", (dir / "f").string()), dir);
     EXPECT_NE(r.status, 0);

@@ -289,6 +289,8 @@ static void find_image(const char* name, char out[MAX_QPATH]) {
   char base[MAX_QPATH];
   out[0] = 0;
   Q_strncpyz(base, name, sizeof(base));
+  for (char* c = base; *c; ++c)
+    if (*c == '\\') *c = '/'; /* some MD3s name their shaders with Windows separators; the game's file system takes both */
   char* dot = strrchr(base, '.');
   char* slash = strrchr(base, '/');
   if (dot && (!slash || dot > slash)) *dot = 0;
