@@ -223,6 +223,27 @@ TEST(OpenArena, MatchConvertsWithMorphTargetsWhereTheGamePutThem) {
   expectFacesAlongNormals(*dataset, "oa_dm1", 0.03);
 }
 
+// The demo's datasets part with --engine openarena: the match captured and converted, the
+// fly-through made over it, the capture's options recorded so that a second run reuses all of it.
+TEST(OpenArena, DemoMakesItsDatasetsFromAnOpenArenaMatch) {
+  DYNBENCH_NEEDS(test::missingOpenArena());
+  const auto dir = test::freshDir("openarena_demo");
+  const std::string command = fmt::format("demo --engine openarena -o {} --bots 3 --seconds 2 --seed 2 --part datasets", (dir / "demo").string());
+  auto r = dynbench(command, dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* name : {"oa_dm1_bot.gltf", "oa_dm1_flythrough.gltf"}) {
+    auto dataset = scene::loadScene(dir / "demo" / "datasets" / name);
+    ASSERT_TRUE(dataset) << name << ": " << dataset.error().message;
+    EXPECT_GE(dataset->animations.size(), 1u) << name;
+  }
+  const std::string record = test::slurp(dir / "demo" / "capture" / "dynbench-demo-capture.json");
+  EXPECT_NE(record.find("\"engine\": \"openarena\""), std::string::npos) << record;
+  EXPECT_NE(record.find("\"bots\": 3"), std::string::npos) << record;
+  r = dynbench(command, dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE((r.out + r.err).find("exists, reused"), std::string::npos) << r.out << r.err;
+}
+
 TEST(OpenArena, BadOptionsFailClearly) {
   const auto dir = test::freshDir("openarena_bad");
   auto r = dynbench(fmt::format("capture openarena -o {} --fps 30", (dir / "a").string()), dir);

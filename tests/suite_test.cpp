@@ -41,7 +41,8 @@ TEST(Suite, ManifestErrorsNameTheFileAndPointer) {
       {"/datasets/0/camera", "drone", "/datasets/0/camera: expected \"bot\" or \"flythrough\""},
       {"/datasets/1/name", "fps-1-bot", "/datasets/1/name: expected a name no other dataset has"},
       {"/datasets/0/preset", "frantic", "/datasets/0/preset"},
-      {"/datasets/0/engine", "openarena", "/datasets/0/engine: expected \"cube2\""},
+      {"/datasets/0/engine", "quake", "/datasets/0/engine: expected \"cube2\" or \"openarena\""},
+      {"/datasets/0/engine", "openarena", "/datasets/0/preset: expected no preset"},  // dataset 0 has preset fps
       {"/datasets/2/seconds", -3, "/datasets/2/seconds"},
       {"/datasets/0/seed", nullptr, "/datasets/0/seed: missing"},
       {"/render/width", 3, "/render/width: expected a whole number in [8, 7680]"},

@@ -29,8 +29,9 @@ export PKG_CONFIG_PATH="$sdk/lib/pkgconfig"
 pkg-config --exists dynbench-capture || { echo "openarena: no dynbench-capture.pc under $sdk/lib/pkgconfig: install the SDK first" >&2; exit 1; }
 cflags=$(pkg-config --cflags dynbench-capture)
 # The SDK's own run path (pkg-config's), and the installed layout's: PREFIX/lib/dynbench/openarena
-# holds the modules, PREFIX/lib the SDK.
-libs="$(pkg-config --libs dynbench-capture) -Wl,-rpath,'\$\$ORIGIN/../..'"
+# holds the modules, PREFIX/lib the SDK. OpenGL: the adapter reads the game's own frames back
+# (capture openarena --game-frames).
+libs="$(pkg-config --libs dynbench-capture) -Wl,-rpath,'\$\$ORIGIN/../..' -lGL"
 
 src="$build_dir/oa-0.8.8"
 # A fresh tree whenever the patch changes; the adapter is copied in every time.

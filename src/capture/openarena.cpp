@@ -153,6 +153,15 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
                       {"DYNBENCH_CAPTURE_SECONDS", fmt::format("{}", o.seconds)},
                       {"DYNBENCH_CAPTURE_FOLLOW", o.follow},
                       {"DYNBENCH_CAPTURE_RECORD", o.record ? "1" : "0"}};
+  if (!o.gameFrames.empty()) {
+    std::string list;
+    for (const long k : o.gameFrames) {
+      if (k < 0 || static_cast<std::size_t>(k) >= total)
+        return fail(ErrorCode::kUsage, "--game-frames: frame {} is outside the capture's frames 0 to {}", k, total - 1);
+      list += (list.empty() ? "" : ",") + std::to_string(k);
+    }
+    game.environment.emplace_back("DYNBENCH_CAPTURE_GAME_FRAMES", list);
+  }
   // The bots join after the level restart the adapter makes (dynbench_oa.c says why).
   std::string bots;
   const auto names = openArenaBots(o.bots);  // checked by openArenaArguments

@@ -31,6 +31,9 @@ struct OpenArenaOptions {
   // whole capture (its respawns are cuts); or a client number (bots are 1, 2, ...)
   std::string follow = "auto";
   double warmup = 3.0;           // game seconds between the map loading and recording
+  // Recorded frames (0-based) whose own image the game keeps in game/frame_NNNNN.ppm (8-bit sRGB,
+  // the HUD hidden), to put beside the dataset's render of them.
+  std::vector<long> gameFrames;
   int width = 640, height = 360;
   bool window = false;           // on the user's display instead of Xvfb
   std::filesystem::path modules;  // folder with cgamex86_64.so and qagamex86_64.so; empty: the build's

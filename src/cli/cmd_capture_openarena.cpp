@@ -24,6 +24,9 @@ void addCaptureOpenArenaCommand(CLI::App* capture, CommandRun& run) {
   cmd->add_option("--fps", o->fps, "Fixed clock, frames per game second (a divisor of 1000: the engine counts whole milliseconds)")
       ->check(between(1, 1000));
   cmd->add_option("--seed", o->seed, "Seed of every random choice");
+  cmd->add_option("--game-frames", o->gameFrames,
+                  "Recorded frames (0-based, comma-separated) whose own image the game keeps in DIR/game/frame_NNNNN.ppm (the HUD hidden)")
+      ->delimiter(',');
   cmd->add_option("--follow", o->follow, "auto (a bot, then the next whenever the followed one dies), one (the first bot throughout; its respawns are camera cuts) or a bot's client number (1, 2, ...)");
   cmd->add_option("--warmup", o->warmup, "Game seconds after the map loads before recording")->check(between(capture::kOpenArenaMinWarmup, 3600.0));
   cmd->add_option("--width", o->width, "Window width")->check(between(64, 16384));

@@ -14,50 +14,77 @@ namespace fs = std::filesystem;
 namespace {
 
 // What makes a capture: the match options, compared as text with the record beside a capture.
-// Raised whenever the Cube 2 adapter changes what it records (2: the map's normals decoded as the
+// Raised whenever an adapter changes what it records (Cube 2: 2: the map's normals decoded as the
 // signed bytes they are; 3: lights keep their identity across frames, camera cuts), so that
 // captures an older adapter made are not reused.
-constexpr int kCaptureAdapterVersion = 3;
+constexpr int kCube2AdapterVersion = 3;
+constexpr int kOpenArenaAdapterVersion = 1;
 
 std::string captureRecord(const capture::Cube2Options& c) {
   return fmt::format("{{\"map\": \"{}\", \"mode\": \"{}\", \"bots\": {}, \"skill\": {}, \"follow\": \"{}\", \"seconds\": {}, \"seed\": {}, "
                      "\"adapter\": {}}}\n",
-                     c.map, c.mode, c.bots, c.skill, c.follow, c.seconds, c.seed, kCaptureAdapterVersion);
+                     c.map, c.mode, c.bots, c.skill, c.follow, c.seconds, c.seed, kCube2AdapterVersion);
 }
 
-}  // namespace
+std::string captureRecord(const capture::OpenArenaOptions& c) {
+  return fmt::format("{{\"engine\": \"openarena\", \"map\": \"{}\", \"bots\": {}, \"skill\": {}, \"follow\": \"{}\", \"seconds\": {}, "
+                     "\"fps\": {}, \"seed\": {}, \"adapter\": {}}}\n",
+                     c.map, c.bots, c.skill, c.follow, c.seconds, c.fps, c.seed, kOpenArenaAdapterVersion);
+}
 
-Expected<void> captureAndConvert(const capture::Cube2Options& options, const fs::path& record, const fs::path& dataset, const RunLog& log) {
-  const fs::path& capture = options.output;
+// The capture (`capture` runs the engine) unless `record` says it exists with these options, then
+// the dataset unless it is newer than the capture.
+template <typename Options, typename Capture>
+Expected<void> captureAndConvertWith(const Options& options, const fs::path& record, const fs::path& dataset, const RunLog& log,
+                                     const Capture& capture) {
+  const fs::path& folder = options.output;
   const std::string wanted = captureRecord(options);
   auto recorded = readWholeFile(record);
   std::error_code ec;
-  if (!(fs::exists(capture / "Capture.txt", ec) && recorded && *recorded == wanted)) {
-    if (fs::exists(capture, ec)) {
-      log(fmt::format("capture: {} was made with other options, capturing again", capture.string()));
-      fs::remove_all(capture, ec);
-      if (ec) return fail(ErrorCode::kIo, "{}: cannot remove the old capture: {}", capture.string(), ec.message());
+  if (!(fs::exists(folder / "Capture.txt", ec) && recorded && *recorded == wanted)) {
+    if (fs::exists(folder, ec)) {
+      log(fmt::format("capture: {} was made with other options, capturing again", folder.string()));
+      fs::remove_all(folder, ec);
+      if (ec) return fail(ErrorCode::kIo, "{}: cannot remove the old capture: {}", folder.string(), ec.message());
     }
     fs::create_directories(record.parent_path(), ec);
     log(fmt::format("capture: {} s of a {}-bot match on {} (seed {})", options.seconds, options.bots, options.map, options.seed));
-    auto captured = capture::captureCube2(options);
-    if (!captured) return std::unexpected(captured.error());
-    log(fmt::format("  {} frames in {:.0f} s{}", captured->frames, captured->wallSeconds,
-                    captured->clientStoppedAfterCapture ? " (the client did not exit after closing the capture; stopped)" : ""));
+    if (auto ok = capture(); !ok) return ok;
     if (auto ok = writeFileAtomic(record, wanted); !ok) return std::unexpected(ok.error());
   } else {
-    log(fmt::format("the capture {} exists, reused", (capture / "Capture.txt").string()));
+    log(fmt::format("the capture {} exists, reused", (folder / "Capture.txt").string()));
   }
-  if (!isNewerThan(dataset, capture / "Capture.txt")) {
+  if (!isNewerThan(dataset, folder / "Capture.txt")) {
     log("convert: capture -> " + dataset.string());
     convert::ConvertOptions convertOptions;
-    convertOptions.capture = capture;
+    convertOptions.capture = folder;
     convertOptions.output = dataset;
     if (auto converted = convert::convertCapture(convertOptions); !converted) return std::unexpected(converted.error());
   } else {
     log("convert: " + dataset.string() + " is newer than the capture, reused");
   }
   return {};
+}
+
+}  // namespace
+
+Expected<void> captureAndConvert(const capture::Cube2Options& options, const fs::path& record, const fs::path& dataset, const RunLog& log) {
+  return captureAndConvertWith(options, record, dataset, log, [&]() -> Expected<void> {
+    auto captured = capture::captureCube2(options);
+    if (!captured) return std::unexpected(captured.error());
+    log(fmt::format("  {} frames in {:.0f} s{}", captured->frames, captured->wallSeconds,
+                    captured->clientStoppedAfterCapture ? " (the client did not exit after closing the capture; stopped)" : ""));
+    return {};
+  });
+}
+
+Expected<void> captureAndConvert(const capture::OpenArenaOptions& options, const fs::path& record, const fs::path& dataset, const RunLog& log) {
+  return captureAndConvertWith(options, record, dataset, log, [&]() -> Expected<void> {
+    auto captured = capture::captureOpenArena(options);
+    if (!captured) return std::unexpected(captured.error());
+    log(fmt::format("  {} frames in {:.0f} s", captured->frames, captured->wallSeconds));
+    return {};
+  });
 }
 
 Expected<void> flyThroughUnlessNewer(const fs::path& bot, const fs::path& fly, const fs::path& csv, const flythrough::FlythroughOptions& options,

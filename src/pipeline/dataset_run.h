@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "capture/cube2.h"
+#include "capture/openarena.h"
 #include "core/error.h"
 #include "discard/discard.h"
 #include "evaluate/evaluate.h"
@@ -39,11 +40,14 @@ struct DatasetRunSettings {
 using RunLog = std::function<void(const std::string&)>;
 
 // ---- a match's datasets (demo and suite) ------------------------------------------------------
-// A Cube 2 capture into options.output and the dataset converted from it, each made only when
-// stale: the capture unless `record` (a file) holds its match options and the adapter version, the
-// dataset unless it is newer than the capture. Anything made after a capture follows from it.
+// A Cube 2 or OpenArena capture into options.output and the dataset converted from it, each made
+// only when stale: the capture unless `record` (a file) holds its match options and the adapter
+// version, the dataset unless it is newer than the capture. Anything made after a capture follows
+// from it.
 Expected<void> captureAndConvert(const capture::Cube2Options& options, const std::filesystem::path& record, const std::filesystem::path& dataset,
                                  const RunLog& log);
+Expected<void> captureAndConvert(const capture::OpenArenaOptions& options, const std::filesystem::path& record,
+                                 const std::filesystem::path& dataset, const RunLog& log);
 // The fly-through of `bot` as the dataset `fly` (its pose log `csv`), made unless `fly` is newer
 // than `bot`.
 Expected<void> flyThroughUnlessNewer(const std::filesystem::path& bot, const std::filesystem::path& fly, const std::filesystem::path& csv,

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "capture/cube2.h"
+#include "capture/openarena.h"
 #include "core/files.h"
 #include "core/math.h"
 #include "evaluate/evaluate.h"
@@ -17,20 +18,31 @@ namespace dynbench::demo {
 using namespace dynbench::pipeline;
 namespace fs = std::filesystem;
 
+std::string demoMap(const DemoOptions& o) {
+  if (!o.map.empty()) return o.map;
+  return o.engine == "openarena" ? capture::OpenArenaOptions{}.map : capture::Cube2Options{}.map;
+}
+
 Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
   const fs::path capture = o.output / "capture";
   const fs::path datasets = o.output / "datasets";
-  const fs::path bot = datasets / (o.map + "_bot.gltf"), fly = datasets / (o.map + "_flythrough.gltf");
+  const bool openArena = o.engine == "openarena";
+  if (!openArena && o.engine != "cube2") return fail(ErrorCode::kUsage, "--engine '{}': expected cube2 or openarena", o.engine);
+  const std::string map = demoMap(o);
+  const fs::path bot = datasets / (map + "_bot.gltf"), fly = datasets / (map + "_flythrough.gltf");
   // The capture is reused only when it was made with the same match options (recorded beside it);
   // anything else is captured again, and every later stage follows from the newer capture, so the
   // frames rendered from it stay valid too.
-  capture::Cube2Options c;
-  c.output = capture;
-  c.map = o.map;
-  c.bots = o.bots;
-  c.seconds = o.seconds;
-  c.seed = o.seed;
-  if (auto ok = captureAndConvert(c, capture / "dynbench-demo-capture.json", bot, log); !ok) return std::unexpected(ok.error());
+  const fs::path record = capture / "dynbench-demo-capture.json";
+  if (openArena) {
+    capture::OpenArenaOptions c;
+    c.output = capture, c.map = map, c.bots = o.bots, c.seconds = o.seconds, c.seed = o.seed;
+    if (auto ok = captureAndConvert(c, record, bot, log); !ok) return std::unexpected(ok.error());
+  } else {
+    capture::Cube2Options c;
+    c.output = capture, c.map = map, c.bots = o.bots, c.seconds = o.seconds, c.seed = o.seed;
+    if (auto ok = captureAndConvert(c, record, bot, log); !ok) return std::unexpected(ok.error());
+  }
   if (auto ok = flyThroughUnlessNewer(bot, fly, datasets / "flythrough.csv", {}, log); !ok) return std::unexpected(ok.error());
 
   if (o.part == DemoPart::kDatasets) return fly;
@@ -53,7 +65,7 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
   report::ReportOptions r;
   r.runs = runs;
   r.output = o.output / "report.html";
-  r.title = fmt::format("dynbench demo: {} with {} bots, first-person bot vs fly-through", o.map, o.bots);
+  r.title = fmt::format("dynbench demo: {} with {} bots ({}), first-person bot vs fly-through", map, o.bots, openArena ? "OpenArena" : "Cube 2");
   auto files = runReport(r);
   if (!files) return std::unexpected(files.error());
   log(fmt::format("report: {:.2f} MB, self-contained ({} images, {} videos inline)", files->htmlBytes / 1e6, files->images, files->videos));

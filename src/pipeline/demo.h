@@ -27,7 +27,8 @@ enum class DemoPart {
 // describes the match, not the noise), and the methods' 4-spp input.
 struct DemoOptions : pipeline::DatasetRunSettings {
   std::filesystem::path output = "dynbench-demo";
-  std::string map = "colos";
+  std::string engine = "cube2";  // or "openarena"
+  std::string map;               // empty: the engine's default (colos, oa_dm1)
   int bots = 6;
   double seconds = 10.0;  // game time captured
   DemoPart part = DemoPart::kAll;
@@ -37,6 +38,9 @@ struct DemoOptions : pipeline::DatasetRunSettings {
 // The number of frame renders the demo makes (two datasets, reference and input, renderFrames
 // each at most): what `demo --slurm` divides among its render tasks.
 inline int demoFrameRenders(const DemoOptions& o) { return 2 * 2 * std::max(2, o.renderFrames); }
+
+// The map the demo plays: --map, or the engine's default (colos for Cube 2, oa_dm1 for OpenArena).
+std::string demoMap(const DemoOptions& options);
 
 // One line per stage (for the terminal and logs).
 using DemoLog = std::function<void(const std::string&)>;

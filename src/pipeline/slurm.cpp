@@ -466,7 +466,7 @@ Expected<CaptureArrayOutcome> captureArray(const capture::Cube2Options& captureI
 }
 
 std::vector<std::string> demoArguments(const demo::DemoOptions& o) {
-  return {"-o", fs::absolute(o.output).lexically_normal().string(), "--map", o.map, "--bots", std::to_string(o.bots), "--seconds",
+  return {"-o", fs::absolute(o.output).lexically_normal().string(), "--engine", o.engine, "--map", demo::demoMap(o), "--bots", std::to_string(o.bots), "--seconds",
           fmt::format("{:.17g}", o.seconds), "--seed", std::to_string(o.seed), "--fps", fmt::format("{:.17g}", o.fps), "--res",
           fmt::format("{}x{}", o.width, o.height), "--spp", std::to_string(o.samplesPerPixel), "--tolerance", fmt::format("{:.17g}", o.tolerance),
           "--max-spp", std::to_string(o.maxSamplesPerPixel), "--render-frames", std::to_string(o.renderFrames), "--bounces",
@@ -576,7 +576,7 @@ Expected<DemoChainOutcome> demoChain(const demo::DemoOptions& demoIn, const Opti
   spec.frameRenders = demo::demoFrameRenders(demo);
   spec.datasetsWhat = "capture, convert and the fly-through";
   spec.finalWhat = "the whole demo, reusing the datasets and frames: stats, discard, evaluate, report";
-  spec.datasetsDone = demo.output / "datasets" / (demo.map + "_flythrough.gltf");
+  spec.datasetsDone = demo.output / "datasets" / (demo::demoMap(demo) + "_flythrough.gltf");
   spec.finalFile = demo.output / "report.html";
   return chainOfJobs(spec, options, progress);
 }

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "capture/cube2.h"
+#include "capture/openarena.h"
 #include "core/checksum.h"
 #include "core/files.h"
 #include "core/json_fields.h"
@@ -128,7 +129,9 @@ Expected<Manifest> parseManifest(const nlohmann::json& document, const fs::path&
       if (!engine) return std::unexpected(engine.error());
       d.engine = *engine;
     }
-    if (d.engine != "cube2") return bad(at + "/engine", fmt::format("\"cube2\" (the engine dynbench captures), found \"{}\"", d.engine));
+    if (d.engine != "cube2" && d.engine != "openarena")
+      return bad(at + "/engine", fmt::format("\"cube2\" or \"openarena\" (the engines dynbench captures), found \"{}\"", d.engine));
+    const bool openArena = d.engine == "openarena";
     for (const auto& [key, target] : {std::pair{"/preset", &d.preset}, std::pair{"/map", &d.map}}) {
       if (!f.has(at + key)) continue;
       auto v = f.string(at + key);
@@ -136,14 +139,15 @@ Expected<Manifest> parseManifest(const nlohmann::json& document, const fs::path&
       *target = *v;
     }
     if (!d.preset.empty()) {
+      if (openArena) return bad(at + "/preset", "no preset: OpenArena has none (give map and bots)");
       capture::Cube2Options probe;
       if (auto ok = capture::applyCube2Preset(d.preset, probe); !ok) return bad(at + "/preset", ok.error().message);
     }
     if (f.has(at + "/bots")) {
       auto bots = f.integer(at + "/bots");
       if (!bots) return std::unexpected(bots.error());
-      if (*bots < capture::kBotsRange.first || *bots > capture::kBotsRange.second)
-        return bad(at + "/bots", fmt::format("a whole number in [{}, {}]", capture::kBotsRange.first, capture::kBotsRange.second));
+      const auto range = openArena ? capture::kOpenArenaBotsRange : capture::kBotsRange;
+      if (*bots < range.first || *bots > range.second) return bad(at + "/bots", fmt::format("a whole number in [{}, {}]", range.first, range.second));
       d.bots = static_cast<int>(*bots);
     }
     auto seed = f.count(at + "/seed");
@@ -225,10 +229,23 @@ std::map<std::string, std::map<std::string, double>> errorsOf(const std::vector<
 // datasets that differ only in camera.
 struct CapturePlan {
   std::string key;  // the folder name, from the capture options
-  capture::Cube2Options options;
+  bool openArena = false;
+  capture::Cube2Options options;          // engine cube2
+  capture::OpenArenaOptions openArenaOptions;  // engine openarena
 };
 Expected<CapturePlan> capturePlan(const DatasetSpec& d, const fs::path& root) {
   CapturePlan plan;
+  if (d.engine == "openarena") {
+    plan.openArena = true;
+    capture::OpenArenaOptions& c = plan.openArenaOptions;
+    if (!d.map.empty()) c.map = d.map;
+    if (d.bots > 0) c.bots = d.bots;
+    c.seed = d.seed;
+    c.seconds = d.seconds;
+    plan.key = fmt::format("openarena-custom-{}-{}bots-seed{}-{}s", c.map, c.bots, c.seed, c.seconds);
+    c.output = root / "captures" / plan.key / "capture";
+    return plan;
+  }
   capture::Cube2Options& c = plan.options;
   std::vector<std::string> keep;
   if (!d.map.empty()) c.map = d.map, keep.push_back("map");
@@ -255,7 +272,9 @@ Expected<fs::path> prepareDataset(const DatasetSpec& d, const fs::path& root, do
   if (!plan) return std::unexpected(plan.error());
   const fs::path folder = root / "captures" / plan->key, bot = folder / "bot.gltf";
   auto indented = [&](const std::string& line) { log("  " + line); };
-  if (auto ok = pipeline::captureAndConvert(plan->options, folder / "capture-options.json", bot, indented); !ok) return std::unexpected(ok.error());
+  auto made = plan->openArena ? pipeline::captureAndConvert(plan->openArenaOptions, folder / "capture-options.json", bot, indented)
+                              : pipeline::captureAndConvert(plan->options, folder / "capture-options.json", bot, indented);
+  if (!made) return std::unexpected(made.error());
   if (d.camera == "bot") return bot;
   flythrough::FlythroughOptions o;
   o.frameRate = fps;  // the rate the suite renders and measures at

@@ -25,7 +25,7 @@ inline constexpr int kResultsVersion = 1;   // "dynbench_suite_results" in suite
 
 struct DatasetSpec {
   std::string name;             // unique in the suite: the RUN folder's name
-  std::string engine = "cube2";
+  std::string engine = "cube2";  // or "openarena" (no presets; map oa_dm1 and 4 bots unless given)
   std::string preset;           // a capture preset (calm, fps, hard) or empty
   std::string map;              // empty: the preset's (or colos)
   int bots = 0;                 // 0: the preset's (or 6)

@@ -31,6 +31,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include <GL/gl.h>
+
 #include <dynbench/capture.h>
 
 #define MAX_HANDLES 4096
@@ -89,6 +91,8 @@ static struct {
   int spectate_sent_at, follow_sent_at, next_sent_for_death;
   int restart_sent, restarted, connected_in_time, connected_at, following_since;
   int record;       /* 0: play the same match without writing anything (the overhead benchmark) */
+  char game_frames[1024]; /* ",60,120,": recorded frames whose own image the game keeps in game/ */
+  int pending_game_frame; /* a frame whose image is on screen at the next frame's start, or -1 */
   int window_start; /* wall-clock ms when recording started */
   int follow_target;
   uint64_t camera_id;
@@ -983,9 +987,38 @@ static int ensure_following(void) {
   return 0;
 }
 
+/* The game's own image of recorded frame `frame`: the engine swapped it to the front buffer at the
+ * end of that frame, and this frame has not drawn yet, so the front buffer still holds it (the
+ * HUD is off: cg_draw2D 0). 8-bit sRGB, binary PPM, top row first, written to a temporary name
+ * and renamed. */
+static void keep_game_frame(int frame) {
+  const int w = cgs.glconfig.vidWidth, h = cgs.glconfig.vidHeight;
+  unsigned char* rgb = malloc((size_t)w * h * 3);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadBuffer(GL_FRONT);
+  glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, rgb);
+  glReadBuffer(GL_BACK);
+  char path[1400], temporary[1500];
+  Com_sprintf(path, sizeof(path), "%s/game/frame_%05d.ppm", g_db.dir, frame);
+  Com_sprintf(temporary, sizeof(temporary), "%s.part", path);
+  FILE* out = make_directories(path) ? fopen(temporary, "wb") : NULL;
+  int ok = out != NULL;
+  if (out) {
+    fprintf(out, "P6\n%d %d\n255\n", w, h);
+    for (int y = h - 1; y >= 0 && ok; --y) ok = fwrite(rgb + (size_t)y * w * 3, 1, (size_t)w * 3, out) == (size_t)w * 3;
+    ok = fclose(out) == 0 && ok;
+  }
+  free(rgb);
+  if (!ok || rename(temporary, path) != 0) fprintf(stderr, "dynbench-capture: warning: cannot write %s\n", path);
+}
+
 void dynbench_render_scene(const refdef_t* view) {
   if (!g_db.active || (view->rdflags & RDF_NOWORLDMODEL) || !cg.snap) return;
   ++g_db.pass;
+  if (g_db.pending_game_frame >= 0) {
+    keep_game_frame(g_db.pending_game_frame);
+    g_db.pending_game_frame = -1;
+  }
   /* How many frames the client takes to connect and load depends on the machine's load, and the
    * client shares the C library's random numbers with the game and the bots (native modules in
    * one process), so a match that ran while the client connected would differ from run to run.
@@ -1118,6 +1151,7 @@ void dynbench_render_scene(const refdef_t* view) {
     if (dbc_light(s, id, at, l->rgb, l->intensity, DBC_FALLOFF_QUADRATIC, DBC_LIGHT_POINT, 1, type) != DBC_OK) { db_fail("light"); return; }
   }
   if (dbc_frame_end(s) != DBC_OK) { db_fail("frame end"); return; }
+  if (strstr(g_db.game_frames, va(",%d,", g_db.frame))) g_db.pending_game_frame = g_db.frame;
   ++g_db.frame;
   printf("dynbench-capture: %d/%d frames\n", g_db.frame, g_db.total_frames);
   fflush(stdout);
@@ -1161,6 +1195,8 @@ void dynbench_cg_init(void) {
   g_db.frame_ms = (int)(1000.0 / fps + 0.5);
   trap_Cvar_Set("fixedtime", va("%d", g_db.frame_ms));
   g_db.record = !getenv("DYNBENCH_CAPTURE_RECORD") || atoi(getenv("DYNBENCH_CAPTURE_RECORD")) != 0;
+  g_db.pending_game_frame = -1;
+  Com_sprintf(g_db.game_frames, sizeof(g_db.game_frames), ",%s,", getenv("DYNBENCH_CAPTURE_GAME_FRAMES") ? getenv("DYNBENCH_CAPTURE_GAME_FRAMES") : "");
   if (!g_db.record) {
     g_db.active = 1;
     return;
