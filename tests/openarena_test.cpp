@@ -105,8 +105,19 @@ TEST(OpenArena, MatchConvertsWithMorphTargetsWhereTheGamePutThem) {
   DYNBENCH_NEEDS(test::missingOpenArena());
   DYNBENCH_NEEDS(test::missingGltfValidator());
   const auto dir = test::freshDir("openarena_dataset");
-  auto r = dynbench(fmt::format("capture openarena -o {} --map oa_dm1 --bots 4 --seconds 6 --seed 3", (dir / "cap").string()), dir);
+  auto r = dynbench(fmt::format("capture openarena -o {} --map oa_dm1 --bots 4 --seconds 6 --seed 3 --game-frames 100", (dir / "cap").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
+  // The game's own image of frame 100: the window's size, and a lit room, not a black buffer.
+  {
+    const std::string ppm = test::slurp(dir / "cap" / "game" / "frame_00100.ppm");
+    const std::string header = "P6\n640 360\n255\n";
+    ASSERT_EQ(ppm.substr(0, header.size()), header);
+    ASSERT_EQ(ppm.size(), header.size() + 640u * 360u * 3u);
+    double mean = 0;
+    for (std::size_t i = header.size(); i < ppm.size(); ++i) mean += static_cast<unsigned char>(ppm[i]);
+    mean /= 640.0 * 360.0 * 3.0 * 255.0;
+    EXPECT_GT(mean, 0.05) << "the game's frame is black";
+  }
   r = dynbench(fmt::format("convert {} -o {}", (dir / "cap").string(), (dir / "ds" / "dm1.gltf").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err.find("is neither PNG nor JPEG"), std::string::npos) << r.err;  // TGA textures become PNG
@@ -255,6 +266,9 @@ TEST(OpenArena, BadOptionsFailClearly) {
   r = dynbench(fmt::format("capture openarena -o {} --follow someone", (dir / "c").string()), dir);
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("--follow 'someone'"), std::string::npos) << r.err;
+  r = dynbench(fmt::format("capture openarena -o {} --seconds 1 --game-frames 49", (dir / "g").string()), dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("--game-frames: frame 49"), std::string::npos) << r.err;
   r = dynbench(fmt::format("capture openarena -o {} --bots 17", (dir / "d").string()), dir);
   EXPECT_EQ(r.status, 2) << r.err;
   r = dynbench(fmt::format("capture openarena -o {} --modules {}", (dir / "e").string(), dir.string()), dir);

@@ -113,6 +113,15 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
   if (o.width < 64 || o.height < 64) return fail(ErrorCode::kUsage, "--width and --height must be at least 64");
   if (o.follow != "auto" && o.follow != "one" && (o.follow.empty() || o.follow.find_first_not_of("0123456789") != std::string::npos))
     return fail(ErrorCode::kUsage, "--follow '{}': expected auto, one or a bot's client number (1, 2, ...)", o.follow);
+  const std::size_t total = static_cast<std::size_t>(o.seconds * o.fps + 0.5);
+  std::string gameFrames;
+  for (const long k : o.gameFrames) {
+    // the last frame's image would be read at the frame after it, which is not played
+    if (k < 0 || static_cast<std::size_t>(k) + 1 >= total)
+      return fail(ErrorCode::kUsage, "--game-frames: frame {} is outside the capture's frames 0 to {} (the last one cannot be kept)", k,
+                  static_cast<long>(total) - 2);
+    gameFrames += (gameFrames.empty() ? "" : ",") + std::to_string(k);
+  }
   auto modules = findOpenArenaModules(o.modules);
   if (!modules) return std::unexpected(modules.error());
   if (!isExecutable(o.engine))
@@ -141,7 +150,6 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
   auto arguments = openArenaArguments(o, run / "base", run / "home");
   if (!arguments) return std::unexpected(arguments.error());
 
-  const std::size_t total = static_cast<std::size_t>(o.seconds * o.fps + 0.5);
   // A stalled game is stopped: at least 2 frames/s of wall time plus a minute for loading.
   const int timeout = 60 + static_cast<int>((o.seconds + o.warmup) * o.fps / 2.0);
   ProcessOptions game;
@@ -153,15 +161,7 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
                       {"DYNBENCH_CAPTURE_SECONDS", fmt::format("{}", o.seconds)},
                       {"DYNBENCH_CAPTURE_FOLLOW", o.follow},
                       {"DYNBENCH_CAPTURE_RECORD", o.record ? "1" : "0"}};
-  if (!o.gameFrames.empty()) {
-    std::string list;
-    for (const long k : o.gameFrames) {
-      if (k < 0 || static_cast<std::size_t>(k) >= total)
-        return fail(ErrorCode::kUsage, "--game-frames: frame {} is outside the capture's frames 0 to {}", k, total - 1);
-      list += (list.empty() ? "" : ",") + std::to_string(k);
-    }
-    game.environment.emplace_back("DYNBENCH_CAPTURE_GAME_FRAMES", list);
-  }
+  if (!gameFrames.empty()) game.environment.emplace_back("DYNBENCH_CAPTURE_GAME_FRAMES", gameFrames);
   // The bots join after the level restart the adapter makes (dynbench_oa.c says why).
   std::string bots;
   const auto names = openArenaBots(o.bots);  // checked by openArenaArguments

@@ -987,17 +987,18 @@ static int ensure_following(void) {
   return 0;
 }
 
-/* The game's own image of recorded frame `frame`: the engine swapped it to the front buffer at the
- * end of that frame, and this frame has not drawn yet, so the front buffer still holds it (the
- * HUD is off: cg_draw2D 0). 8-bit sRGB, binary PPM, top row first, written to a temporary name
- * and renamed. */
+/* The game's own image of recorded frame `frame`, read at the start of the next frame, before
+ * anything of it is drawn (the renderer draws at the end of the engine's frame, after this module
+ * has queued the scene): Mesa's software OpenGL (llvmpipe, under Xvfb) swaps by copying, so the
+ * back buffer still holds the frame shown last. (Its front buffer, read the same way, was black
+ * in 2 of 6 frames.) The HUD is off (cg_draw2D 0). 8-bit sRGB, binary PPM, top row first, written
+ * to a temporary name and renamed. */
 static void keep_game_frame(int frame) {
   const int w = cgs.glconfig.vidWidth, h = cgs.glconfig.vidHeight;
   unsigned char* rgb = malloc((size_t)w * h * 3);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadBuffer(GL_FRONT);
-  glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, rgb);
   glReadBuffer(GL_BACK);
+  glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, rgb);
   char path[1400], temporary[1500];
   Com_sprintf(path, sizeof(path), "%s/game/frame_%05d.ppm", g_db.dir, frame);
   Com_sprintf(temporary, sizeof(temporary), "%s.part", path);
