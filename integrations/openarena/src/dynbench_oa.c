@@ -383,6 +383,22 @@ static void mesh_triangle(mesh_builder_t* m, uint32_t a, uint32_t b, uint32_t c)
   ++m->triangles;
 }
 
+/* Gives the SDK a built mesh of the model being recorded; 0 when it refuses. */
+static int record_mesh(int mesh_id, const char* name, const char* texture, const mesh_builder_t* m) {
+  dbc_mesh mesh;
+  memset(&mesh, 0, sizeof(mesh));
+  mesh.mesh_id = mesh_id;
+  mesh.name = name;
+  mesh.texture = texture;
+  mesh.vertex_count = m->vertices;
+  mesh.positions = m->positions;
+  mesh.normals = m->normals;
+  mesh.uvs = m->uvs;
+  mesh.triangle_count = m->triangles;
+  mesh.indices = m->indices;
+  return dbc_model_mesh(g_db.session, &mesh) == DBC_OK;
+}
+
 static void mesh_free(mesh_builder_t* m) {
   free(m->positions); free(m->normals); free(m->uvs); free(m->indices);
   memset(m, 0, sizeof(*m));
@@ -511,18 +527,8 @@ static int record_bsp_model(int index, const char* model_path) {
     for (int k = first; k < model->firstSurface + model->numSurfaces; ++k)
       if (g_bsp.surfaces[k].shaderNum == s->shaderNum && surface_drawn(&g_bsp.surfaces[k])) add_surface(&m, &g_bsp.surfaces[k]);
     if (m.triangles > 0) {
-      dbc_mesh mesh;
-      memset(&mesh, 0, sizeof(mesh));
-      mesh.mesh_id = mesh_id;
-      mesh.name = g_bsp.shaders[s->shaderNum].shader;
-      mesh.texture = shader_texture(g_bsp.shaders[s->shaderNum].shader);
-      mesh.vertex_count = m.vertices;
-      mesh.positions = m.positions;
-      mesh.normals = m.normals;
-      mesh.uvs = m.uvs;
-      mesh.triangle_count = m.triangles;
-      mesh.indices = m.indices;
-      if (dbc_model_mesh(g_db.session, &mesh) != DBC_OK) { mesh_free(&m); free(done); db_fail("world mesh"); return 0; }
+      const char* shader = g_bsp.shaders[s->shaderNum].shader;
+      if (!record_mesh(mesh_id, shader, shader_texture(shader), &m)) { mesh_free(&m); free(done); db_fail("world mesh"); return 0; }
       ++mesh_id;
     }
     mesh_free(&m);
@@ -723,18 +729,7 @@ static int record_md3(const char* file, const char* skin, const char* model_path
       if (index[0] < 0 || index[1] < 0 || index[2] < 0 || index[0] >= nv || index[1] >= nv || index[2] >= nv) continue;
       mesh_triangle(&m, (uint32_t)index[0], (uint32_t)index[1], (uint32_t)index[2]);
     }
-    dbc_mesh mesh;
-    memset(&mesh, 0, sizeof(mesh));
-    mesh.mesh_id = mesh_id;
-    mesh.name = surface->name;
-    mesh.texture = shader[0] ? shader_texture(shader) : NULL;
-    mesh.vertex_count = m.vertices;
-    mesh.positions = m.positions;
-    mesh.normals = m.normals;
-    mesh.uvs = m.uvs;
-    mesh.triangle_count = m.triangles;
-    mesh.indices = m.indices;
-    int ok = dbc_model_mesh(g_db.session, &mesh) == DBC_OK;
+    int ok = record_mesh(mesh_id, surface->name, shader[0] ? shader_texture(shader) : NULL, &m);
     if (ok && key_positions) ok = dbc_model_mesh_frames(g_db.session, mesh_id, (size_t)frames, key_positions, key_normals) == DBC_OK;
     free(key_positions);
     free(key_normals);
