@@ -28,10 +28,11 @@ fi
 export PKG_CONFIG_PATH="$sdk/lib/pkgconfig"
 pkg-config --exists dynbench-capture || { echo "openarena: no dynbench-capture.pc under $sdk/lib/pkgconfig: install the SDK first" >&2; exit 1; }
 cflags=$(pkg-config --cflags dynbench-capture)
-# The SDK's own run path (pkg-config's), and the installed layout's: PREFIX/lib/dynbench/openarena
-# holds the modules, PREFIX/lib the SDK. OpenGL: the adapter reads the game's own frames back
-# (capture openarena --game-frames).
-libs="$(pkg-config --libs dynbench-capture) -Wl,-rpath,'\$\$ORIGIN/../..' -lGL"
+# Run paths: first the installed layout's (PREFIX/lib/dynbench/openarena holds the modules,
+# PREFIX/lib the SDK), so that installed modules load the installed SDK; then the SDK's own
+# (pkg-config's), for the modules in the build folder. OpenGL: the adapter reads the game's own
+# frames back (capture openarena --game-frames).
+libs="-Wl,-rpath,'\$\$ORIGIN/../..' $(pkg-config --libs dynbench-capture) -lGL"
 
 src="$build_dir/oa-0.8.8"
 # A fresh tree whenever the patch changes; the adapter is copied in every time.
@@ -45,8 +46,9 @@ for f in dynbench_oa.c dynbench_oa.h; do
   cmp -s "$here/src/$f" "$src/code/cgame/$f" || cp "$here/src/$f" "$src/code/cgame/$f"
 done
 out="$src/build/release-linux-x86_64/baseq3"
-# The game's Makefile does not know the adapter's header or the SDK: relink when either is newer.
-for dep in "$src/code/cgame/dynbench_oa.h" "$sdk/lib/libdynbench_capture.so"; do
+# The game's Makefile does not know the adapter's header, the SDK or this script's link flags:
+# rebuild the client module when any of them is newer.
+for dep in "$src/code/cgame/dynbench_oa.h" "$sdk/lib/libdynbench_capture.so" "$here/build.sh"; do
   [[ -f "$out/cgamex86_64.so" && "$dep" -nt "$out/cgamex86_64.so" ]] && rm -f "$out/cgamex86_64.so" "$out"/cgame/*.o
 done
 make -C "$src" -j"$(nproc)" release BUILD_GAME_QVM=0 BUILD_MISSIONPACK=0 \

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
 
 #include <fmt/format.h>
@@ -120,7 +121,7 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
     if (k < 0 || static_cast<std::size_t>(k) + 1 >= total)
       return fail(ErrorCode::kUsage, "--game-frames: frame {} is outside the capture's frames 0 to {} (the last one cannot be kept)", k,
                   static_cast<long>(total) - 2);
-    gameFrames += (gameFrames.empty() ? "" : ",") + std::to_string(k);
+    gameFrames += fmt::format("{}{}", gameFrames.empty() ? "" : ",", k);
   }
   auto modules = findOpenArenaModules(o.modules);
   if (!modules) return std::unexpected(modules.error());
@@ -162,6 +163,16 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
                       {"DYNBENCH_CAPTURE_FOLLOW", o.follow},
                       {"DYNBENCH_CAPTURE_RECORD", o.record ? "1" : "0"}};
   if (!gameFrames.empty()) game.environment.emplace_back("DYNBENCH_CAPTURE_GAME_FRAMES", gameFrames);
+  // The engine loads the modules through the run's base folder (links), so their run path's
+  // $ORIGIN/../.. names that folder, not the prefix they are installed in: installed modules
+  // (PREFIX/lib/dynbench/openarena) get their prefix's SDK (PREFIX/lib) this way instead. Modules
+  // in the build folder have none there and keep their run path's (the SDK installed into the build).
+  const fs::path prefixLib = fs::weakly_canonical(fs::absolute(*modules)) / ".." / "..";
+  if (fs::exists(prefixLib / "libdynbench_capture.so", ec)) {
+    const char* existing = std::getenv("LD_LIBRARY_PATH");
+    game.environment.emplace_back("LD_LIBRARY_PATH", existing && *existing ? fmt::format("{}:{}", prefixLib.lexically_normal().string(), existing)
+                                                                           : prefixLib.lexically_normal().string());
+  }
   // The bots join after the level restart the adapter makes (dynbench_oa.c says why).
   std::string bots;
   const auto names = openArenaBots(o.bots);  // checked by openArenaArguments

@@ -40,6 +40,18 @@ LD_DEBUG=libs "$prefix/bin/dynbench" convert "$work/capture_consumer_sdk_example
 grep -q "calling init: $prefix/lib/dynbench/libdynbench_image.so" "$work/ld.log" ||
   { echo "install_test: the installed dynbench did not load $prefix/lib/dynbench/libdynbench_image.so"; grep image "$work/ld.log"; exit 1; }
 "$prefix/bin/dynbench" stats "$work/dataset/crate.gltf" | grep -q "| crate.gltf " || { echo "install_test: stats of the converted dataset failed"; exit 1; }
+# OpenArena's installed game modules: the installed `capture openarena` finds them, and they load
+# the installed SDK (a real engine linked with the SDK as installed).
+if [[ -e "$prefix/lib/dynbench/openarena/cgamex86_64.so" && -x /usr/lib/ioquake3/ioquake3 ]]; then
+  mkdir -p "$work/ld_oa"
+  LD_DEBUG=libs LD_DEBUG_OUTPUT="$work/ld_oa/ld" "$prefix/bin/dynbench" capture openarena -o "$work/oa" --seconds 1 --bots 2 >"$work/oa.log" 2>&1 ||
+    { echo "install_test: the installed capture openarena failed"; tail "$work/oa.log"; exit 1; }
+  cat "$work"/ld_oa/ld.* >"$work/ld_oa.log"
+  grep -q "calling init: .*/baseoa/cgamex86_64.so" "$work/ld_oa.log" &&
+    grep -q "calling init: $prefix/lib/libdynbench_capture.so" "$work/ld_oa.log" ||
+    { echo "install_test: the installed game module did not load the installed SDK"; grep "calling init: .*\(cgame\|dynbench_capture\)" "$work/ld_oa.log"; exit 1; }
+  "$prefix/bin/dynbench" capture-check "$work/oa" | grep -q "frames: *50 " || { echo "install_test: the OpenArena capture is not 50 frames"; exit 1; }
+fi
 # The installed Python package (docs/python.md), imported from here with PYTHONPATH into the
 # prefix: its stats equal the installed CLI's, and it reads images through the installed image module.
 if [[ "${3:-}" == python ]]; then
