@@ -848,6 +848,8 @@ void dynbench_add_ref_entity(const refEntity_t* e) {
   if (e->reType != RT_MODEL || e->hModel <= 0 || e->hModel >= MAX_HANDLES) return;
   if (e->renderfx & (RF_THIRD_PERSON | RF_FIRST_PERSON | RF_DEPTHHACK)) return; /* not in the main view / the HUD gun */
   if (e->customShader) return; /* an effect shell drawn over a model (quad damage, spawn, invisibility) */
+  for (int i = 0; i < 3; ++i) /* scaled to nothing (an item respawning grows from zero): nothing is drawn */
+    if (!(VectorLength(e->axis[i]) >= 1e-4f) || !isfinite(e->origin[i])) return; /* (NaN too: the SDK would refuse it) */
   pending_entity_t* p = &g_db.entities[g_db.entity_count++];
   p->entity = *e;
   p->slot = g_db.owner_slot;
