@@ -260,6 +260,7 @@ TEST(OpenArena, BadOptionsFailClearly) {
   auto r = dynbench(fmt::format("capture openarena -o {} --fps 30", (dir / "a").string()), dir);
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("divisor of 1000"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "a")) << "nothing is made for a match that cannot be played";
   r = dynbench(fmt::format("capture openarena -o {} --map 'oa dm1'", (dir / "b").string()), dir);
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("expected a map name"), std::string::npos) << r.err;

@@ -123,6 +123,8 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
                   static_cast<long>(total) - 2);
     gameFrames += fmt::format("{}{}", gameFrames.empty() ? "" : ",", k);
   }
+  // The match's own settings (map name, fps, skill, bots) before anything is made.
+  if (auto checked = openArenaArguments(o, {}, {}); !checked) return std::unexpected(checked.error());
   auto modules = findOpenArenaModules(o.modules);
   if (!modules) return std::unexpected(modules.error());
   if (!isExecutable(o.engine))
