@@ -16,6 +16,8 @@
 
 #include "capture/openarena.h"
 #include "core/files.h"
+#include "frames/feature_frame.h"
+#include "frames/frame_io.h"
 #include "scene/evaluate.h"
 #include "scene/load.h"
 #include "gltf_builder.h"
@@ -232,6 +234,55 @@ TEST(OpenArena, MatchConvertsWithMorphTargetsWhereTheGamePutThem) {
 
   // oa_dm1's own misc_model soups wind 480 of their 9,240 corners against their smoothed normals.
   expectFacesAlongNormals(*dataset, "oa_dm1", 0.03);
+
+  // Cycles, through Blender's glTF import, draws the frame where dynbench's renderer does, players'
+  // morphed MD3 parts included: the recorded frame with the most vertex-animated parts drawn,
+  // rendered by both, P buffers compared pixel by pixel (Embree's object ids tell the map from the
+  // rest).
+  if (test::missingBlender().empty()) {
+    std::map<long, int> animatedParts;
+    std::ifstream again(dir / "cap" / "Capture.txt");
+    long frame = -1;
+    while (std::getline(again, line)) {
+      if (line.starts_with("f:")) frame = std::stol(splitFields(line)[1]);
+      if (line.starts_with("v:")) ++animatedParts[frame];
+    }
+    const auto busiest = std::max_element(animatedParts.begin(), animatedParts.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+    ASSERT_NE(busiest, animatedParts.end());
+    std::map<std::string, frames::FeatureFrame> rendered;
+    for (const char* engine : {"embree", "cycles"}) {
+      const fs::path out = dir / (std::string("render_") + engine);
+      std::string log;
+      ASSERT_EQ(runShell(fmt::format("{} render '{}' -o '{}' --res 160x90 --spp 1 --bounces 0 --fps 50 --frames {} --engine {} 2>&1", DYNBENCH_EXE,
+                                     (dir / "ds" / "dm1.gltf").string(), out.string(), busiest->first, engine),
+                         log),
+                0)
+          << log;
+      auto read = frames::readFrame({busiest->first, frames::frameImagePath(out, busiest->first), frames::frameSidecarPath(out, busiest->first)});
+      ASSERT_TRUE(read) << read.error().message;
+      rendered.emplace(engine, std::move(*read));
+    }
+    const auto& embree = rendered.at("embree");
+    const auto& cycles = rendered.at("cycles");
+    std::map<float, std::size_t> idPixels;
+    for (float id : embree.id) ++idPixels[id];
+    const float mapId = std::max_element(idPixels.begin(), idPixels.end(), [](const auto& a, const auto& b) { return a.second < b.second; })->first;
+    std::size_t objectPixels = 0, far = 0;
+    double objectWorst = 0;
+    for (std::size_t i = 0; i < embree.pixelCount(); ++i) {
+      if (!(embree.hit[i] > 0) || !(cycles.hit[i] > 0)) continue;
+      const double d = glm::distance(glm::dvec3(embree.position[3 * i], embree.position[3 * i + 1], embree.position[3 * i + 2]),
+                                     glm::dvec3(cycles.position[3 * i], cycles.position[3 * i + 1], cycles.position[3 * i + 2]));
+      far += d > 1.0 ? 1 : 0;
+      if (embree.id[i] != mapId) ++objectPixels, objectWorst = std::max(objectWorst, d);
+    }
+    std::printf("Cycles vs dynbench's renderer, frame %ld (%d animated parts): %zu of %zu pixels more than 1 unit apart; %zu pixels of "
+                "models, at most %.3g units apart\n",
+                busiest->first, busiest->second, far, embree.pixelCount(), objectPixels, objectWorst);
+    EXPECT_LT(static_cast<double>(far), 0.005 * static_cast<double>(embree.pixelCount()));  // silhouette pixels only
+    EXPECT_GT(objectPixels, 10u);
+    EXPECT_LT(objectWorst, 0.1);  // a tenth of a unit, 3 mm: float rounding, not a different pose
+  }
 }
 
 // The demo's datasets part with --engine openarena: the match captured and converted, the
