@@ -72,9 +72,6 @@ typedef struct {
   int used;
 } shader_info_t;
 
-typedef struct {
-  int key_frames; /* 0 for a rigid model */
-} model_info_t;
 
 static struct {
   int active;
@@ -89,7 +86,7 @@ static struct {
   int start_time;
   int finished;
   int spectate_sent_at, follow_sent_at, next_sent_for_death;
-  int restart_sent, restarted, connected_in_time, connected_at, following_since;
+  int restart_sent, restarted, connected_at;
   int record;       /* 0: play the same match without writing anything (the overhead benchmark) */
   char game_frames[1024]; /* ",60,120,": recorded frames whose own image the game keeps in game/ */
   int pending_game_frame; /* a frame whose image is on screen at the next frame's start, or -1 */
@@ -108,8 +105,7 @@ static struct {
   int owner_slot, owner_type;
   int owner_serial[DYNBENCH_LOCAL_SLOT * 2];
   int owner_signature[DYNBENCH_LOCAL_SLOT * 2];
-  int owner_last_frame[DYNBENCH_LOCAL_SLOT * 2];
-  int owner_seen[DYNBENCH_LOCAL_SLOT * 2]; /* render pass the slot was last drawn in */
+  int owner_last_frame[DYNBENCH_LOCAL_SLOT * 2]; /* render pass the slot was last drawn in */
   int owner_models[DYNBENCH_LOCAL_SLOT * 2][8];
   int owner_model_count[DYNBENCH_LOCAL_SLOT * 2][8];
   int owner_lights[DYNBENCH_LOCAL_SLOT * 2];
@@ -798,6 +794,13 @@ void dynbench_register_skin(const char* name, qhandle_t handle) {
   if (handle > 0 && handle < MAX_HANDLES && name) Q_strncpyz(g_db.skin_names[handle], name, MAX_QPATH);
 }
 
+/* Forgets what the slot drew before this pass (its draws are counted per pass: occurrence_of). */
+static void reset_owner_draws(int slot) {
+  memset(g_db.owner_model_count[slot], 0, sizeof(g_db.owner_model_count[slot]));
+  memset(g_db.owner_models[slot], 0, sizeof(g_db.owner_models[slot]));
+  g_db.owner_lights[slot] = 0;
+}
+
 void dynbench_owner_begin(int slot, int entity_type, int signature) {
   if (!g_db.active || slot < 0 || slot >= UNOWNED_SLOT) return;
   g_db.owner_slot = slot;
@@ -807,13 +810,8 @@ void dynbench_owner_begin(int slot, int entity_type, int signature) {
   const int gap = g_db.owner_last_frame[slot] < g_db.pass - 1;
   if (g_db.owner_signature[slot] != signature || (gap && entity_type != ET_PLAYER)) ++g_db.owner_serial[slot];
   g_db.owner_signature[slot] = signature;
+  if (g_db.owner_last_frame[slot] != g_db.pass) reset_owner_draws(slot); /* its first draw this pass */
   g_db.owner_last_frame[slot] = g_db.pass;
-  if (g_db.owner_seen[slot] != g_db.pass) {
-    g_db.owner_seen[slot] = g_db.pass;
-    memset(g_db.owner_model_count[slot], 0, sizeof(g_db.owner_model_count[slot]));
-    memset(g_db.owner_models[slot], 0, sizeof(g_db.owner_models[slot]));
-    g_db.owner_lights[slot] = 0;
-  }
 }
 
 void dynbench_owner_end(void) { g_db.owner_slot = UNOWNED_SLOT; g_db.owner_type = -1; }
@@ -823,11 +821,7 @@ void dynbench_clear_scene(void) {
   g_db.light_count = 0;
   g_db.owner_slot = UNOWNED_SLOT;
   g_db.owner_type = -1;
-  g_db.owner_seen[UNOWNED_SLOT] = -1; /* its draws are counted afresh each frame */
-  g_db.owner_last_frame[UNOWNED_SLOT] = g_db.pass;
-  memset(g_db.owner_model_count[UNOWNED_SLOT], 0, sizeof(g_db.owner_model_count[UNOWNED_SLOT]));
-  memset(g_db.owner_models[UNOWNED_SLOT], 0, sizeof(g_db.owner_models[UNOWNED_SLOT]));
-  g_db.owner_lights[UNOWNED_SLOT] = 0;
+  reset_owner_draws(UNOWNED_SLOT); /* its draws are counted afresh each frame */
 }
 
 /* The k-th draw of this model by the current owner in this pass. */
@@ -1035,16 +1029,14 @@ void dynbench_render_scene(const refdef_t* view) {
     if (cg.snap->ps.persistant[PERS_TEAM] != TEAM_SPECTATOR) {
       ensure_following();
     } else if (!g_db.restart_sent && cg.snap->serverTime >= RESTART_AT) {
-      if (!g_db.connected_in_time)
+      if (g_db.connected_at >= RESTART_AT)
         fprintf(stderr, "dynbench-capture: warning: the client connected after %d ms of server time; the match may differ from run to run\n", RESTART_AT);
       trap_SendConsoleCommand("map_restart 0\n");
       g_db.restart_sent = 1;
     }
-    if (cg.snap->serverTime < RESTART_AT) g_db.connected_in_time = 1;
     return;
   }
   const int following = ensure_following();
-  if (following && !g_db.following_since) g_db.following_since = cg.time;
   if (!g_db.started) {
     if (!following || cg.time < cgs.levelStartTime + (int)(g_db.warmup * 1000)) {
       if (cg.time > cgs.levelStartTime + (int)(g_db.warmup * 1000) + 20000) {
@@ -1057,7 +1049,7 @@ void dynbench_render_scene(const refdef_t* view) {
     g_db.started = 1;
     g_db.start_time = cg.time;
     g_db.window_start = trap_Milliseconds(); /* the machine's clock: this is the one place it is read */
-    printf("dynbench-capture: level started at %d ms of server time, recording from %d (following since %d)\n", cgs.levelStartTime, cg.time, g_db.following_since);
+    printf("dynbench-capture: level started at %d ms of server time, recording from %d\n", cgs.levelStartTime, cg.time);
   }
   const playerState_t* ps = &cg.snap->ps;
   /* --follow auto: the next bot once the followed one dies (the server switches the view) */
