@@ -75,7 +75,10 @@ Expected<fs::path> findOpenArenaModules(const fs::path& requested) {
               "(target openarena_modules), or pass --modules DIR");
 }
 
-Expected<std::vector<std::string>> openArenaArguments(const OpenArenaOptions& o, const fs::path& basePath, const fs::path& homePath) {
+namespace {
+
+// The match's own settings (map name, skill, fps, bots), checked before anything is made.
+Expected<void> checkMatch(const OpenArenaOptions& o) {
   if (o.map.empty() || o.map.find_first_of(" ;\"\\/\n") != std::string::npos)
     return fail(ErrorCode::kUsage, "--map '{}': expected a map name such as oa_dm1", o.map);
   if (o.skill < kOpenArenaSkillRange.first || o.skill > kOpenArenaSkillRange.second)
@@ -83,6 +86,13 @@ Expected<std::vector<std::string>> openArenaArguments(const OpenArenaOptions& o,
   if (!(o.fps > 0 && o.fps <= 1000 && 1000 % o.fps == 0))
     return fail(ErrorCode::kUsage, "--fps {}: the engine's fixed clock is whole milliseconds a frame; expected a divisor of 1000 (50, 40, 25, ...)", o.fps);
   if (auto bots = openArenaBots(o.bots); !bots) return std::unexpected(bots.error());
+  return {};
+}
+
+}  // namespace
+
+Expected<std::vector<std::string>> openArenaArguments(const OpenArenaOptions& o, const fs::path& basePath, const fs::path& homePath) {
+  if (auto ok = checkMatch(o); !ok) return std::unexpected(ok.error());
   std::vector<std::string> a = {
       // Debian's openarena wrapper's settings (/usr/games/openarena), with private base and home folders
       "+set", "com_basegame", "baseoa", "+set", "fs_basepath", basePath.string(), "+set", "fs_homepath", homePath.string(),
@@ -123,8 +133,7 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
                   static_cast<long>(total) - 2);
     gameFrames += fmt::format("{}{}", gameFrames.empty() ? "" : ",", k);
   }
-  // The match's own settings (map name, fps, skill, bots) before anything is made.
-  if (auto checked = openArenaArguments(o, {}, {}); !checked) return std::unexpected(checked.error());
+  if (auto ok = checkMatch(o); !ok) return std::unexpected(ok.error());
   auto modules = findOpenArenaModules(o.modules);
   if (!modules) return std::unexpected(modules.error());
   if (!isExecutable(o.engine))
