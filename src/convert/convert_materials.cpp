@@ -1,5 +1,7 @@
 #include "convert/converter.h"
 
+#include <optional>
+
 namespace dynbench::convert::detail {
 
 int Converter::image(const std::string& texture) {
@@ -8,32 +10,33 @@ int Converter::image(const std::string& texture) {
   int index = -1;
   std::string ext = fs::path(texture).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (ext != ".png" && ext != ".jpg" && ext != ".jpeg") {
-    // glTF's images are PNG or JPEG; another format OpenImageIO reads (id Tech 3's TGA) is
-    // rewritten as PNG beside the others, its 8-bit values unchanged (read as float, written 8-bit).
-    if (const fs::path source = textureSource(texture); !source.empty()) {
-      auto pixels = readImage(source);
-      if (!pixels) {
-        report_.warnings.push_back(fmt::format("texture '{}': {}; left out", texture, pixels.error().message));
-      } else {
-        const fs::path relative = fs::path(texture).lexically_normal().replace_extension(".png");
-        const fs::path target = outDir_ / (stem_ + "_textures") / relative;
-        std::error_code ec;
-        fs::create_directories(target.parent_path(), ec);
-        if (auto ok = writeImage(target, *pixels); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
-        report_.written.push_back(target);
-        index = addTexture(relative.generic_string(), "image/png");
+  // glTF's images are PNG or JPEG, copied as they are; another format OpenImageIO reads (id Tech
+  // 3's TGA) is rewritten as PNG beside them, its 8-bit values unchanged (read as float, written 8-bit).
+  const bool copied = ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+  if (const fs::path source = textureSource(texture); !source.empty()) {
+    fs::path relative = fs::path(texture).lexically_normal();
+    std::optional<FloatImage> pixels;
+    if (!copied) {
+      auto read = readImage(source);
+      if (!read) {
+        report_.warnings.push_back(fmt::format("texture '{}': {}; left out", texture, read.error().message));
+        imageByTexture_[texture] = -1;
+        return -1;
       }
+      pixels = std::move(*read);
+      relative.replace_extension(".png");
     }
-  } else if (const fs::path source = textureSource(texture); !source.empty()) {
-    const fs::path relative = fs::path(texture).lexically_normal();
     const fs::path target = outDir_ / (stem_ + "_textures") / relative;
     std::error_code ec;
     fs::create_directories(target.parent_path(), ec);
-    fs::copy_file(source, target, fs::copy_options::overwrite_existing, ec);
-    if (ec) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: cannot copy texture: {}", target.string(), ec.message())}};
+    if (pixels) {
+      if (auto ok = writeImage(target, *pixels); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
+    } else {
+      fs::copy_file(source, target, fs::copy_options::overwrite_existing, ec);
+      if (ec) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: cannot copy texture: {}", target.string(), ec.message())}};
+    }
     report_.written.push_back(target);
-    index = addTexture(relative.generic_string(), ext == ".png" ? "image/png" : "image/jpeg");
+    index = addTexture(relative.generic_string(), ext == ".jpg" || ext == ".jpeg" ? "image/jpeg" : "image/png");
   }
   imageByTexture_[texture] = index;
   return index;
@@ -42,8 +45,6 @@ int Converter::image(const std::string& texture) {
 // A texture's file under the data root, or empty (with a warning) when it cannot be used.
 fs::path Converter::textureSource(const std::string& texture) {
   const fs::path relative = fs::path(texture).lexically_normal();
-  std::string ext = relative.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   fs::path root = options_.dataRoot ? *options_.dataRoot : fs::path(reader_->settings().dataRoot);
   if (root.is_relative()) root = options_.capture / root;
   std::error_code ec;
