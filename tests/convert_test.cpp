@@ -32,13 +32,6 @@ const unsigned char kPng[] = {137, 80, 78, 71, 13, 10, 26, 10, 0, 0, 0, 13, 73, 
                               144, 119, 83, 222, 0, 0, 0, 12, 73, 68, 65, 84, 120, 156, 99, 248, 223, 192, 0, 0, 4, 1, 1, 128,
                               197, 42, 24, 93, 0, 0, 0, 0, 73, 69, 78, 68, 174, 66, 96, 130};
 
-// Runs the Khronos validator (node + npm gltf-validator, installed by scripts/setup.sh).
-std::string validate(const fs::path& file, int& status) {
-  const std::string cmd = fmt::format("node {}/tools/gltf-validator/validate.mjs '{}' 2>&1", DYNBENCH_SOURCE_DIR, file.string());
-  std::string out;
-  status = runShell(cmd, out);
-  return out;
-}
 
 struct Converted {
   fs::path capture, dataset;
@@ -82,7 +75,7 @@ glm::dmat4 matrix(const dbc_dual_quat& q) {
 TEST(Convert, RoundTripMatchesTheCapture) {
   const Converted c = convertFixture("convert_roundtrip");
   int status = -1;
-  const std::string validation = validate(c.dataset, status);
+  const std::string validation = test::validateGltf(c.dataset, status);
   EXPECT_EQ(status, 0) << validation;
   EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
 
@@ -234,30 +227,16 @@ TEST(Convert, MaskMapBecomesMetallicRoughness) {
   EXPECT_NEAR(mr->pixels[4], 1.0f, 1.0f / 255);
   EXPECT_NEAR(mr->pixels[5], 1.0f, 1.0f / 255);
   int status = -1;
-  const std::string validation = validate(options.output, status);
+  const std::string validation = test::validateGltf(options.output, status);
   EXPECT_EQ(status, 0) << validation;
 }
 
 // Blender's own glTF importer reads the dataset (the thesis rendered its datasets with Blender).
-// What Blender's glTF importer makes of a dataset (tools/blender/import_gltf.py's summary), or
-// null after a test failure naming its output.
-nlohmann::json blenderImport(const fs::path& dataset) {
-  const std::string cmd = fmt::format("blender --background --factory-startup --python {}/tools/blender/import_gltf.py -- '{}' 2>&1",
-                                      DYNBENCH_SOURCE_DIR, dataset.string());
-  std::string out;
-  const int status = runShell(cmd, out);
-  const auto at = out.find("DYNBENCH_IMPORT ");
-  if (status != 0 || at == std::string::npos) {
-    ADD_FAILURE() << "blender exited " << status << ":\n" << out;
-    return nullptr;
-  }
-  return nlohmann::json::parse(out.substr(at + 16, out.find('\n', at) - at - 16));
-}
 
 TEST(Convert, BlenderImportsTheDataset) {
   DYNBENCH_NEEDS(test::missingBlender());
   const Converted c = convertFixture("convert_blender");
-  const nlohmann::json summary = blenderImport(c.dataset);
+  const nlohmann::json summary = test::blenderImport(c.dataset);
   ASSERT_FALSE(summary.is_null());
   EXPECT_EQ(summary["result"], "FINISHED");
   EXPECT_EQ(summary["armatures"], 1);  // the arm
@@ -272,7 +251,7 @@ TEST(Convert, GlbHoldsTheSameDataset) {
   options.glb = true;
   const Converted c = convertFixture("convert_glb", options);
   int status = -1;
-  const std::string validation = validate(c.dataset, status);
+  const std::string validation = test::validateGltf(c.dataset, status);
   EXPECT_EQ(status, 0) << validation;
   auto loaded = scene::loadScene(c.dataset);
   ASSERT_TRUE(loaded) << loaded.error().message;
@@ -382,7 +361,7 @@ TEST(Convert, NegativeLightColoursBecomeZero) {
   EXPECT_EQ(light["color"], nlohmann::json({0.0, 0.5, 1.0}));
   EXPECT_DOUBLE_EQ(light["intensity"].get<double>(), 100.0);
   int status = 0;
-  const std::string validation = validate(dir / "out" / "neg.gltf", status);
+  const std::string validation = test::validateGltf(dir / "out" / "neg.gltf", status);
   EXPECT_EQ(status, 0) << validation;
   EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
 }
@@ -428,7 +407,7 @@ TEST(Convert, TheMapsSunPlacesTheSkysSunAndCalibratesTheLights) {
       EXPECT_NEAR(intensity, dome / 0.4 * 400.0 / 6.0, 1e-3 * intensity);
     }
     int status = 0;
-    const std::string validation = validate(options.output, status);
+    const std::string validation = test::validateGltf(options.output, status);
     EXPECT_EQ(status, 0) << validation;
     EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
   }
@@ -482,7 +461,7 @@ TEST(Convert, AStaticLightTheEngineDoesNotAttenuateGetsItsIrradianceAtTheMapsCen
   EXPECT_EQ(lights[1]["type"], "point");
   EXPECT_DOUBLE_EQ(lights[1]["intensity"].get<double>(), 50.0);
   int status = 0;
-  const std::string validation = validate(options.output, status);
+  const std::string validation = test::validateGltf(options.output, status);
   EXPECT_EQ(status, 0) << validation;
   EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
 }
@@ -550,7 +529,7 @@ TEST(MergeCamera, CsvPoseLogReplacesTheCameraKeepingRoll) {
   EXPECT_EQ(report->keys, 20u);
   EXPECT_NEAR(report->startTime, 0.02, 1e-6);
   int status = -1;
-  const std::string validation = validate(options.output, status);
+  const std::string validation = test::validateGltf(options.output, status);
   EXPECT_EQ(status, 0) << validation;
   auto merged = scene::loadScene(options.output);
   ASSERT_TRUE(merged) << merged.error().message;
@@ -639,7 +618,7 @@ TEST(MergeCamera, DatasetNamesWithSpaces) {
   EXPECT_EQ(doc["buffers"][0]["uri"], "my%20dataset%20vr.bin");
   EXPECT_TRUE(fs::exists(c.dataset.parent_path() / "my dataset vr.bin"));
   int status = -1;
-  const std::string validation = validate(options.output, status);
+  const std::string validation = test::validateGltf(options.output, status);
   EXPECT_EQ(status, 0) << validation;
   auto merged = scene::loadScene(options.output);
   ASSERT_TRUE(merged) << merged.error().message;
@@ -784,7 +763,7 @@ TEST(Convert, VertexAnimationBecomesMorphTargetsWithAnimatedWeights) {
   ASSERT_TRUE(report) << report.error().message;
   EXPECT_EQ(report->morphTargets, 3u);
   int status = -1;
-  const std::string validation = validate(options.output, status);
+  const std::string validation = test::validateGltf(options.output, status);
   EXPECT_EQ(status, 0) << validation;
   auto loaded = scene::loadScene(options.output);
   ASSERT_TRUE(loaded) << loaded.error().message;
@@ -819,7 +798,7 @@ TEST(Convert, BlenderImportsTheMorphTargetsAsShapeKeys) {
   options.output = freshDir("vertex_animation_blender_out") / "flag.gltf";
   auto report = convertCapture(options);
   ASSERT_TRUE(report) << report.error().message;
-  const nlohmann::json summary = blenderImport(options.output);
+  const nlohmann::json summary = test::blenderImport(options.output);
   ASSERT_FALSE(summary.is_null());
   EXPECT_EQ(summary["result"], "FINISHED");
   EXPECT_EQ(summary["meshes"], 1);      // the flag (its two primitives in one mesh)

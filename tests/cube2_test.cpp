@@ -45,10 +45,8 @@ TEST(Cube2, SeededMatchIsDeterministicAndConverts) {
 
   auto r = dynbench(fmt::format("convert {} -o {}", (dir / "a").string(), (dir / "ds" / "colos.gltf").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
-  std::string validation;
-  const int status = runShell(fmt::format("node {}/tools/gltf-validator/validate.mjs {} 2>&1", DYNBENCH_SOURCE_DIR,
-                                          (dir / "ds" / "colos.gltf").string()),
-                              validation);
+  int status = -1;
+  const std::string validation = test::validateGltf(dir / "ds" / "colos.gltf", status);
   EXPECT_EQ(status, 0) << validation;
   EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
 
@@ -178,8 +176,8 @@ TEST(Cube2, SecondMapConvertsAndValidates) {
   ASSERT_EQ(r.status, 0) << r.err;
   r = dynbench(fmt::format("convert {} -o {}", (dir / "cap").string(), (dir / "ds" / "cyber1.gltf").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
-  std::string validation;
-  runShell(fmt::format("node {}/tools/gltf-validator/validate.mjs {} 2>&1", DYNBENCH_SOURCE_DIR, (dir / "ds" / "cyber1.gltf").string()), validation);
+  int status = -1;
+  const std::string validation = test::validateGltf(dir / "ds" / "cyber1.gltf", status);
   EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
   r = dynbench(fmt::format("stats {} --fps 60 --json {}", (dir / "ds" / "cyber1.gltf").string(), (dir / "stats.json").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;

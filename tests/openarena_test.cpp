@@ -123,10 +123,8 @@ TEST(OpenArena, MatchConvertsWithMorphTargetsWhereTheGamePutThem) {
   r = dynbench(fmt::format("convert {} -o {}", (dir / "cap").string(), (dir / "ds" / "dm1.gltf").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err.find("is neither PNG nor JPEG"), std::string::npos) << r.err;  // TGA textures become PNG
-  std::string validation;
-  const int status = runShell(fmt::format("node {}/tools/gltf-validator/validate.mjs {} 2>&1", DYNBENCH_SOURCE_DIR,
-                                          (dir / "ds" / "dm1.gltf").string()),
-                              validation);
+  int status = -1;
+  const std::string validation = test::validateGltf(dir / "ds" / "dm1.gltf", status);
   EXPECT_EQ(status, 0) << validation;
   EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
   const std::string readme = test::slurp(dir / "ds" / "dm1.README.md");
@@ -154,13 +152,8 @@ TEST(OpenArena, MatchConvertsWithMorphTargetsWhereTheGamePutThem) {
   // Blender's importer makes what stats counts: a mesh object per static or dynamic object, a light
   // per light, the camera, and the morph targets as shape keys.
   if (test::missingBlender().empty()) {
-    std::string out;
-    const int blender = runShell(fmt::format("blender --background --factory-startup --python {}/tools/blender/import_gltf.py -- '{}' 2>&1",
-                                             DYNBENCH_SOURCE_DIR, (dir / "ds" / "dm1.gltf").string()),
-                                 out);
-    const auto at = out.find("DYNBENCH_IMPORT ");
-    ASSERT_TRUE(blender == 0 && at != std::string::npos) << out;
-    const auto summary = nlohmann::json::parse(out.substr(at + 16, out.find('\n', at) - at - 16));
+    const auto summary = test::blenderImport(dir / "ds" / "dm1.gltf");
+    ASSERT_FALSE(summary.is_null());
     EXPECT_EQ(summary["meshes"].get<int>(), p["static_objects"].get<int>() + p["dynamic_rigid_objects"].get<int>());
     EXPECT_EQ(summary["lights"].get<int>(), p["static_point_lights"].get<int>() + p["dynamic_point_lights"].get<int>());
     EXPECT_EQ(summary["cameras"].get<int>(), 1);

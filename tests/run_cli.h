@@ -10,6 +10,7 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 namespace dynbench {
 
@@ -37,6 +38,31 @@ inline int runShell(const std::string& command, std::string& out) {
   const int status = ::pclose(pipe);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
+
+namespace test {
+// The Khronos glTF validator's report on a file (node + npm gltf-validator, installed by
+// scripts/setup.sh); `status` gets its exit status.
+inline std::string validateGltf(const std::filesystem::path& file, int& status) {
+  std::string out;
+  status = runShell("node " + std::string(DYNBENCH_SOURCE_DIR) + "/tools/gltf-validator/validate.mjs '" + file.string() + "' 2>&1", out);
+  return out;
+}
+
+// What Blender's glTF importer makes of a dataset (tools/blender/import_gltf.py's summary), or
+// null after a test failure naming its output.
+inline nlohmann::json blenderImport(const std::filesystem::path& dataset) {
+  std::string out;
+  const int status = runShell("blender --background --factory-startup --python " + std::string(DYNBENCH_SOURCE_DIR) +
+                                  "/tools/blender/import_gltf.py -- '" + dataset.string() + "' 2>&1",
+                              out);
+  const auto at = out.find("DYNBENCH_IMPORT ");
+  if (status != 0 || at == std::string::npos) {
+    ADD_FAILURE() << "blender exited " << status << ":\n" << out;
+    return nullptr;
+  }
+  return nlohmann::json::parse(out.substr(at + 16, out.find('\n', at) - at - 16));
+}
+}  // namespace test
 
 struct Run {
   int status = -1;
