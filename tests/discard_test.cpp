@@ -506,9 +506,9 @@ TEST(DiscardCli, CameraCutsAreMarkedAndLeftOutOfTheMeanUnlessIncluded) {
   const auto dir = test::freshDir("discard_cuts");
   writeFrames(dir / "plain", 4, 48, 27);
   writeFrames(dir / "cut", 4, 48, 27, true, 2);  // pairs (0,1), (1,2) cut, (2,3)
-  const auto plain = dynbench(fmt::format("discard {} --json {}", (dir / "plain").string(), (dir / "p.json").string()), dir);
+  const auto plain = dynbench(fmt::format("discard {} --radiance-test expected --json {}", (dir / "plain").string(), (dir / "p.json").string()), dir);
   ASSERT_EQ(plain.status, 0) << plain.err;
-  const auto cut = dynbench(fmt::format("discard {} --json {} --csv {}", (dir / "cut").string(), (dir / "c.json").string(),
+  const auto cut = dynbench(fmt::format("discard {} --radiance-test expected --json {} --csv {}", (dir / "cut").string(), (dir / "c.json").string(),
                                         (dir / "c.csv").string()), dir);
   ASSERT_EQ(cut.status, 0) << cut.err;
   EXPECT_NE(cut.out.find("3 frame pairs of which 1 camera cuts are left out"), std::string::npos) << cut.out;
@@ -525,7 +525,7 @@ TEST(DiscardCli, CameraCutsAreMarkedAndLeftOutOfTheMeanUnlessIncluded) {
   EXPECT_GT(c["frames"][1]["frustum"].get<double>(), 5 * p["mean"]["frustum"].get<double>());
   const auto csv = test::slurp(dir / "c.csv");
   EXPECT_NE(csv.find(",cut\n"), std::string::npos);
-  const auto all = dynbench(fmt::format("discard {} --include-cuts --json {}", (dir / "cut").string(), (dir / "a.json").string()), dir);
+  const auto all = dynbench(fmt::format("discard {} --radiance-test expected --include-cuts --json {}", (dir / "cut").string(), (dir / "a.json").string()), dir);
   ASSERT_EQ(all.status, 0) << all.err;
   const auto a = nlohmann::json::parse(test::slurp(dir / "a.json"));
   EXPECT_EQ(a["cuts_in_mean"], true);
@@ -534,7 +534,7 @@ TEST(DiscardCli, CameraCutsAreMarkedAndLeftOutOfTheMeanUnlessIncluded) {
   EXPECT_NEAR(a["mean"]["frustum"].get<double>(), sum / 3, 1e-9);
   // Only cuts: nothing to average without --include-cuts.
   writeFrames(dir / "only", 2, 16, 9, true, 1);
-  const auto only = dynbench(fmt::format("discard {}", (dir / "only").string()), dir);
+  const auto only = dynbench(fmt::format("discard {} --radiance-test expected", (dir / "only").string()), dir);
   EXPECT_EQ(only.status, 5) << only.err;  // invalid data
   EXPECT_NE(only.err.find("every frame pair is a camera cut"), std::string::npos) << only.err;
 }
@@ -623,7 +623,7 @@ TEST(DiscardCli, ASubPixelPanOverAFineTextureDiscardsNothingWhenRadianceIsFilter
 TEST(DiscardCli, TableJsonCsvAndMasks) {
   const auto dir = test::freshDir("discard_cli");
   writeFrames(dir / "frames", 4, 48, 27);
-  const auto r = dynbench(fmt::format("discard {} --json {} --csv {} --masks {} --plots {}", (dir / "frames").string(),
+  const auto r = dynbench(fmt::format("discard {} --radiance-test expected --json {} --csv {} --masks {} --plots {}", (dir / "frames").string(),
                                       (dir / "d.json").string(), (dir / "d.csv").string(), (dir / "masks").string(), (dir / "plots").string()),
                           dir);
   ASSERT_EQ(r.status, 0) << r.err;
@@ -686,7 +686,7 @@ TEST(DiscardCli, BadFramesFoldersFailClearly) {
   const auto dir = test::freshDir("discard_bad");
   writeFrames(dir / "f", 3, 16, 9);
   fs::remove(dir / "f" / "frame_00001.json");
-  auto r = dynbench(fmt::format("discard {} --json {}", (dir / "f").string(), (dir / "out.json").string()), dir);
+  auto r = dynbench(fmt::format("discard {} --radiance-test expected --json {}", (dir / "f").string(), (dir / "out.json").string()), dir);
   EXPECT_EQ(r.status, 5) << r.err;
   EXPECT_NE(r.err.find("frame_00001.exr: has no frame_00001.json"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out.json"));
@@ -694,55 +694,62 @@ TEST(DiscardCli, BadFramesFoldersFailClearly) {
   writeFrames(dir / "g", 2, 16, 9);
   writeFrames(dir / "g2", 2, 20, 9);  // a frame of another size
   fs::copy_file(dir / "g2" / "frame_00001.exr", dir / "g" / "frame_00001.exr", fs::copy_options::overwrite_existing);
-  r = dynbench(fmt::format("discard {}", (dir / "g").string()), dir);
+  r = dynbench(fmt::format("discard {} --radiance-test expected", (dir / "g").string()), dir);
   EXPECT_EQ(r.status, 5) << r.err;
   EXPECT_NE(r.err.find("frame_00001.exr: is 20x9 but its sidecar says 16x9"), std::string::npos) << r.err;
 
   writeFrames(dir / "h", 2, 16, 9);
   FloatImage bare{16, 9, 3, std::vector<float>(16 * 9 * 3, 0.0f), {"P.X", "P.Y", "P.Z"}};
   ASSERT_TRUE(writeImage(dir / "h" / "frame_00001.exr", bare));
-  r = dynbench(fmt::format("discard {}", (dir / "h").string()), dir);
+  r = dynbench(fmt::format("discard {} --radiance-test expected", (dir / "h").string()), dir);
   EXPECT_EQ(r.status, 5) << r.err;
   EXPECT_NE(r.err.find("lacks the channel(s) N.X, N.Y, N.Z"), std::string::npos) << r.err;
 
   writeFrames(dir / "novar", 2, 16, 9, false);
   // Frames without variances (Cycles'): the expected test runs, says what it assumed.
-  r = dynbench(fmt::format("discard {}", (dir / "novar").string()), dir);
+  r = dynbench(fmt::format("discard {} --radiance-test expected", (dir / "novar").string()), dir);
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NE((r.out + r.err).find("no direct.var / indirect.var channels"), std::string::npos) << r.out << r.err;
   EXPECT_NE(r.out.find("0.000 ± 0.000"), std::string::npos) << r.out;
-  r = dynbench(fmt::format("discard {} --noise-aware", (dir / "novar").string()), dir);
+  r = dynbench(fmt::format("discard {} --radiance-test expected --noise-aware", (dir / "novar").string()), dir);
   EXPECT_EQ(r.status, 5) << r.err;
   EXPECT_NE(r.err.find("direct.var"), std::string::npos) << r.err;
 
   writeFrames(dir / "k", 2, 16, 9);
   ASSERT_TRUE(writeFileAtomic(dir / "k" / "frame_00000.json",
                               R"({"format": "dynbench-frame", "version": 1, "width": 16, "height": 9, "camera": {"view": [1, 2]}})"));
-  r = dynbench(fmt::format("discard {}", (dir / "k").string()), dir);
+  r = dynbench(fmt::format("discard {} --radiance-test expected", (dir / "k").string()), dir);
   EXPECT_EQ(r.status, 5) << r.err;
   EXPECT_NE(r.err.find("frame_00000.json: /camera/view: expected an array of 16 numbers"), std::string::npos) << r.err;
 
   // The sidecar's format and version are checked: a file that is not a frame sidecar, and one
   // from a newer dynbench.
   ASSERT_TRUE(writeFileAtomic(dir / "k" / "frame_00000.json", R"({"width": 16, "height": 9})"));
-  r = dynbench(fmt::format("discard {}", (dir / "k").string()), dir);
+  r = dynbench(fmt::format("discard {} --radiance-test expected", (dir / "k").string()), dir);
   EXPECT_EQ(r.status, 5) << r.err;
   EXPECT_NE(r.err.find("frame_00000.json: /format: expected \"dynbench-frame\""), std::string::npos) << r.err;
   ASSERT_TRUE(writeFileAtomic(dir / "k" / "frame_00000.json", R"({"format": "dynbench-frame", "version": 2, "width": 16, "height": 9})"));
-  r = dynbench(fmt::format("discard {}", (dir / "k").string()), dir);
+  r = dynbench(fmt::format("discard {} --radiance-test expected", (dir / "k").string()), dir);
   EXPECT_EQ(r.status, 6) << r.err;
   EXPECT_NE(r.err.find("frame_00000.json: /version: 2 is not a sidecar version this dynbench reads (it reads 1)"), std::string::npos)
       << r.err;
 
-  r = dynbench(fmt::format("discard {}", (dir / "nowhere").string()), dir);
+  r = dynbench(fmt::format("discard {} --radiance-test expected", (dir / "nowhere").string()), dir);
   EXPECT_EQ(r.status, 3) << r.err;
+  // The default radiance test reads the frames' radiance-change pairs: frames without them are
+  // refused, naming the first such frame and the options that help.
+  writeFrames(dir / "nopairs", 3, 16, 9);
+  r = dynbench(fmt::format("discard {}", (dir / "nopairs").string()), dir);
+  EXPECT_EQ(r.status, 5) << r.err;
+  EXPECT_NE(r.err.find("frame_00001.exr: no radiance-change pairs"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--radiance-test expected"), std::string::npos) << r.err;
 }
 
 // Golden output of `discard` on the analytic frames above (Table 6.7 as Markdown).
 TEST(Golden, DiscardMarkdown) {
   const auto dir = test::freshDir("golden_discard");
   writeFrames(dir / "frames", 4, 48, 27);
-  const auto r = dynbench(fmt::format("discard {}", (dir / "frames").string()), dir);
+  const auto r = dynbench(fmt::format("discard {} --radiance-test expected", (dir / "frames").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
   test::expectGolden(r.out, "discard.md");
 }

@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include "cli/commands.h"
+#include "frames/radiance_change.h"
 #include "core/progress.h"
 #include "render/backend.h"
 #include "pipeline/slurm.h"
@@ -23,6 +24,7 @@ struct RenderCli {
   bool noEnvironment = false;
   std::string pixelFilter = render::pixelFilterName(render::PixelFilterSpec{}.type);
   std::optional<double> pixelFilterWidth;
+  std::optional<bool> pairs;  // --pairs / --no-pairs; unset: with --converge on the embree engine
   bool slurm = false;
   pipeline::slurm::Options slurmOptions;
 };
@@ -74,6 +76,7 @@ Expected<void> runRender(const RenderCli& cli) {
     if (!(r >= 0 && g >= 0 && b >= 0)) return fail(ErrorCode::kUsage, "--env-constant '{}': radiance must be non-negative", *cli.envConstant);
     job.settings.constantEnvironment = glm::dvec3(r, g, b);
   }
+  job.settings.pairs = cli.pairs.value_or(job.settings.converge && job.engine == "embree");
   if (!cli.frames.empty()) {
     auto range = render::parseFrameRange(cli.frames);
     if (!range) return std::unexpected(range.error());
@@ -109,6 +112,9 @@ Expected<void> runRender(const RenderCli& cli) {
   if (summary->pixels > 0)
     fmt::print(", {:.1f} spp on average", static_cast<double>(summary->cameraSamples) / static_cast<double>(summary->pixels));
   if (job.settings.converge) fmt::print(", {} pixel(s) reached --max-spp before the tolerance", summary->cappedPixels);
+  if (job.settings.pairs && summary->pixels > 0)
+    fmt::print(", {:.1f} radiance-change pairs per pixel on average, {} pixel(s) undecided at --max-pairs",
+               summary->pairs / static_cast<double>(summary->pixels), summary->undecidedPixels);
   fmt::print("\n");
   return {};
 }
@@ -168,6 +174,15 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--tolerance", o->job.settings.tolerance, "With --converge: the standard error target as a fraction of discard's threshold")
       ->check(CLI::Range(1e-4, 10.0));
   cmd->add_option("--max-spp", o->job.settings.maxSamplesPerPixel, "With --converge: samples per pixel at most")->check(positive());
+  cmd->add_flag_callback("--pairs", [o] { o->pairs = true; },
+                         "Radiance-change pairs for Table 6.7's radiance columns (discard's default test): each pixel's samples re-shaded "
+                         "in the previous frame with the same random numbers (docs/feature-buffers.md). Default: on with --converge "
+                         "(embree engine)");
+  cmd->add_flag_callback("--no-pairs", [o] { o->pairs = false; }, "No radiance-change pairs, also with --converge");
+  cmd->add_option("--max-pairs", o->job.settings.maxPairs,
+                  "With pairs: pairs per pixel at most (from 4, doubled while the change test is undecided)")
+      ->check(CLI::Range(frames::kFirstPairs, 1 << 20))
+      ->capture_default_str();
   cmd->add_flag("--float32", o->job.float32,
                 "Store every channel as 32-bit float (default: half where docs/feature-buffers.md allows it, about half the disk)");
   cmd->add_option("--lights-per-point", o->job.settings.lightsPerPoint,

@@ -2,6 +2,7 @@
 
 #include "core/json_fields.h"
 #include "core/math.h"
+#include "frames/radiance_change.h"
 #include "frames/preview.h"
 
 #include <algorithm>
@@ -138,8 +139,13 @@ Thresholds withPositionDefault(Thresholds thresholds, std::optional<double> posi
   return thresholds;
 }
 
+double uncertainLimit(Thresholds::RadianceTest test) {
+  return test == Thresholds::RadianceTest::kPairs ? kUndecidedWarning : kNoisyWarning;
+}
+
 const char* radianceTestName(Thresholds::RadianceTest test) {
   switch (test) {
+    case Thresholds::RadianceTest::kPairs: return "pairs";
     case Thresholds::RadianceTest::kExpected: return "expected";
     case Thresholds::RadianceTest::kNoiseAware: return "noise-aware";
     case Thresholds::RadianceTest::kPlain: return "plain";
@@ -233,7 +239,41 @@ struct FrameSums {
   std::array<double, 5> count{};
   double directVariance = 0.0, indirectVariance = 0.0;
   double directNoisy = 0.0, indirectNoisy = 0.0;  // pixels whose noise exceeds half the threshold
+  // kPairs, direct (0) and indirect (1): the column's bounds in pixels (changed; changed or
+  // undecided), each widened by the decided pixels' chance of a wrong decision.
+  std::array<double, 2> low{}, high{};
 };
+
+// One pixel's radiance-change pairs for a buffer (the frame's change.* channels).
+frames::ChangeEstimate changeEstimate(const std::vector<float>& change, const std::vector<float>& pairs, std::size_t i) {
+  return {change[3 * i], change[3 * i + 1], change[3 * i + 2], static_cast<int>(pairs[i])};  // mean, se, gathered, n
+}
+
+// A pixel under the pairs test (frames/radiance_change.h) at luminance threshold tau: adds its
+// share of the column's estimate, its bounds and whether it is undecided; returns the probability
+// that it changed (1 or 0 when decided). The chance that a decision is wrong is at most the looks'
+// number times the normal tail beyond its margin (Bonferroni over the sequential test's looks);
+// a decision on pairs with no spread (s = 0) is exact up to the unseen-change bound.
+double pairsChange(const frames::ChangeEstimate& e, double tau, double& low, double& high, double& undecided) {
+  if (e.pairs == 0) return 0.0;  // no pair: the surface is new in frame i (the position column's)
+  const frames::ChangeDecision decision = frames::decideChange(e, tau);
+  const double margin = std::abs(std::abs(e.mean) - tau);
+  const double wrong =
+      e.standardError > 0 ? std::min(1.0, frames::changeLooks(e.pairs) * standardNormalCdf(-margin / e.standardError)) : 0.0;
+  switch (decision) {
+    case frames::ChangeDecision::kChanged:
+      low += 1.0 - wrong;
+      high += 1.0;
+      return 1.0;
+    case frames::ChangeDecision::kUnchanged:
+      high += wrong;
+      return 0.0;
+    case frames::ChangeDecision::kUndecided: break;
+  }
+  high += 1.0;
+  undecided += 1.0;
+  return exceedanceProbability(std::abs(e.mean), e.standardError, tau);
+}
 
 }  // namespace
 
@@ -244,7 +284,11 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
   const auto n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
   result.mask.assign(n, 0);
   const bool variance = current.hasVariance() && previous.hasVariance();
-  const Test test = t.radianceTest;
+  // The pairs test on a frame without pairs is the expected test (discardFolder refuses such
+  // folders; a caller comparing two frames directly gets the image-against-image answer).
+  const bool pairs = t.radianceTest == Test::kPairs && current.hasChanges();
+  const Test test = t.radianceTest == Test::kPairs && !pairs ? Test::kExpected : t.radianceTest;
+  constexpr double kGrey = 1.7320508075688772;  // sqrt(3): a grey change's RGB distance per unit luminance
   // Eq. (3.3) on the thesis's pixel-index coordinates (pixel i at x = i): outside [0, w - 1].
   // A pixel that reprojects onto an edge pixel's centre stays inside despite rounding: buffers store
   // float positions, about 1e-7 relative, i.e. up to a few 1e-6 px; the slack is 1e-3 px.
@@ -302,7 +346,6 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
                                     const std::vector<float>& varNow, const std::vector<float>& varBefore, double& noisy) {
             const glm::dvec3 a = at3(now, i), b = cubic ? sample3(before, cubicTaps) : sample3(before, history.history);
             const double d = glm::length(a - b);
-            constexpr double kGrey = 1.7320508075688772;  // sqrt(3): a grey change's RGB distance per unit luminance
             // At an edge, the threshold grows by the history's distance from the range's nearest
             // point to the pixel (on the thresholds' scale), so that what is compared is the
             // pixel's distance outside the range.
@@ -337,9 +380,13 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
             return exceedanceProbability(kGrey * std::abs(luminance(a) - luminance(b)), kGrey * std::sqrt(var), threshold);
           };
           const double pd =
-              radianceChange(current.direct, previous.direct, t.direct, current.directVariance, previous.directVariance, row.directNoisy);
-          const double pi = radianceChange(current.indirect, previous.indirect, t.indirect, current.indirectVariance, previous.indirectVariance,
-                                           row.indirectNoisy);
+              pairs ? pairsChange(changeEstimate(current.directChange, current.changePairs, i), t.direct / kGrey, row.low[0], row.high[0],
+                                  row.directNoisy)
+                    : radianceChange(current.direct, previous.direct, t.direct, current.directVariance, previous.directVariance, row.directNoisy);
+          const double pi = pairs ? pairsChange(changeEstimate(current.indirectChange, current.changePairs, i), t.indirect / kGrey, row.low[1],
+                                                row.high[1], row.indirectNoisy)
+                                  : radianceChange(current.indirect, previous.indirect, t.indirect, current.indirectVariance,
+                                                   previous.indirectVariance, row.indirectNoisy);
           row.count[3] += pd;
           row.count[4] += pi;
           row.directVariance += pd * (1.0 - pd);
@@ -360,6 +407,10 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
     total.indirectVariance += row.indirectVariance;
     total.directNoisy += row.directNoisy;
     total.indirectNoisy += row.indirectNoisy;
+    for (std::size_t b = 0; b < 2; ++b) {
+      total.low[b] += row.low[b];
+      total.high[b] += row.high[b];
+    }
   }
   const double scale = 100.0 / static_cast<double>(n);  // Eq. (3.4), as a percentage
   auto& p = result.percentages;
@@ -373,6 +424,13 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
     };
     p.directInterval = interval(p.direct, total.directVariance);
     p.indirectInterval = interval(p.indirect, total.indirectVariance);
+    p.directNoisy = total.directNoisy * scale;
+    p.indirectNoisy = total.indirectNoisy * scale;
+  } else if (pairs) {
+    // Bounds, not a sampling interval: the decided pixels as decided (each widened by its chance
+    // of a wrong decision), the undecided ones either way.
+    p.directInterval = Interval{std::max(0.0, total.low[0] * scale), std::min(100.0, total.high[0] * scale)};
+    p.indirectInterval = Interval{std::max(0.0, total.low[1] * scale), std::min(100.0, total.high[1] * scale)};
     p.directNoisy = total.directNoisy * scale;
     p.indirectNoisy = total.indirectNoisy * scale;
   }
@@ -406,6 +464,13 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
       return fail(ErrorCode::kInvalidData, "{}: is {}x{}, but the frames before it are {}x{}", (*entries)[k].image.string(), frame->width,
                   frame->height, run.width, run.height);
     }
+    // The pairs test reads frame i's pairs (against i - 1): every frame but the first needs them.
+    if (thresholds.radianceTest == Thresholds::RadianceTest::kPairs && k > 0 && !frame->hasChanges())
+      return fail(ErrorCode::kInvalidData,
+                  "{}: no radiance-change pairs (channels change.direct.*, change.indirect.*, change.pairs), which the default radiance "
+                  "test reads; render with dynbench render --converge or --pairs (embree engine), or pass --radiance-test expected for "
+                  "the image-against-image test",
+                  (*entries)[k].image.string());
     if (thresholds.radianceTest == Thresholds::RadianceTest::kNoiseAware && !frame->hasVariance())
       return fail(ErrorCode::kInvalidData, "{}: --noise-aware needs the direct.var and indirect.var channels", (*entries)[k].image.string());
     if (thresholds.radianceTest == Thresholds::RadianceTest::kExpected && !frame->hasVariance() && !warnedNoVariance) {
@@ -451,7 +516,28 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
   }
   const double n = static_cast<double>(averaged.size());  // Eq. (3.5)
   for (double* v : {&run.mean.frustum, &run.mean.position, &run.mean.normal, &run.mean.direct, &run.mean.indirect}) *v /= n;
-  if (thresholds.radianceTest == Thresholds::RadianceTest::kExpected) {
+  if (thresholds.radianceTest == Thresholds::RadianceTest::kPairs) {
+    // Bounds average as the columns do.
+    auto meanBounds = [&](std::optional<Interval> FramePercentages::*member) {
+      Interval mean;
+      for (const FramePercentages* f : averaged) {
+        mean.low += (f->*member)->low / n;
+        mean.high += (f->*member)->high / n;
+      }
+      return mean;
+    };
+    run.mean.directInterval = meanBounds(&FramePercentages::directInterval);
+    run.mean.indirectInterval = meanBounds(&FramePercentages::indirectInterval);
+    for (const FramePercentages* f : averaged) {
+      run.mean.directNoisy += f->directNoisy / n;
+      run.mean.indirectNoisy += f->indirectNoisy / n;
+    }
+    for (const auto& [name, undecided] : {std::pair{"direct", run.mean.directNoisy}, {"indirect", run.mean.indirectNoisy}})
+      if (undecided > kUndecidedWarning)
+        run.warnings.push_back(fmt::format("the {} radiance column is uncertain: {:.2f} % of the pixels stayed undecided at the render's "
+                                           "pair cap (render with a higher --max-pairs)",
+                                           name, undecided));
+  } else if (thresholds.radianceTest == Thresholds::RadianceTest::kExpected) {
     // The mean of independent frame estimates: half-widths add in quadrature, over n.
     auto meanInterval = [&](double mean, std::optional<Interval> FramePercentages::*member) {
       double sumSq = 0.0;
@@ -578,6 +664,22 @@ Expected<DiscardRun> readDiscardJson(const std::filesystem::path& path) {
     auto v = f.integer(key);
     if (!v) return std::unexpected(v.error());
     *target = static_cast<int>(*v);
+  }
+  // The radiance test: optional (files of earlier versions have none, and were the expected test's).
+  run.thresholds.radianceTest = Thresholds::RadianceTest::kExpected;
+  if (f.has("/thresholds/radiance_test")) {
+    auto name = f.string("/thresholds/radiance_test");
+    if (!name) return std::unexpected(name.error());
+    bool known = false;
+    for (const auto test : {Thresholds::RadianceTest::kPairs, Thresholds::RadianceTest::kExpected, Thresholds::RadianceTest::kNoiseAware,
+                            Thresholds::RadianceTest::kPlain})
+      if (*name == radianceTestName(test)) {
+        run.thresholds.radianceTest = test;
+        known = true;
+      }
+    if (!known)
+      return fail(ErrorCode::kInvalidData, "{}: /thresholds/radiance_test: expected pairs, expected, noise-aware or plain (got '{}')",
+                  path.string(), *name);
   }
   auto mean = readPercentages(f, "/mean");
   if (!mean) return std::unexpected(mean.error());

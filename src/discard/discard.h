@@ -51,17 +51,23 @@ struct Thresholds {
   double direct = 0.1, indirect = 0.1;
   bool absoluteRadiance = false;
   // How a radiance difference becomes a discard (docs/metrics.md, "Radiance discard"):
-  //  kExpected (default): each pixel counts with the probability that its true change exceeds the
+  //  kPairs (default): the frame's radiance-change pairs (render --pairs: each sample of frame i
+  //    re-shaded in frame i-1 with the same random numbers, so no noise where nothing changed)
+  //    decide each pixel by the sequential test of frames/radiance_change.h: changed, unchanged,
+  //    or undecided (counted with the probability of a change, and bounding the column's interval
+  //    both ways). Exact reprojection: the history is the same surface point, so the taps and the
+  //    edge rule play no part in these columns.
+  //  kExpected: each pixel counts with the probability that its true change exceeds the
   //    threshold, given its Monte Carlo noise (the variance channels) under the normal
   //    approximation; the column is the expected percentage, with a 95 % interval.
   //  kNoiseAware: the difference must also exceed noiseSigmas standard deviations of the noise.
   //  kPlain: the thesis's test on the rendered values (noise counts as change).
-  enum class RadianceTest { kExpected, kNoiseAware, kPlain };
-  RadianceTest radianceTest = RadianceTest::kExpected;
+  enum class RadianceTest { kPairs, kExpected, kNoiseAware, kPlain };
+  RadianceTest radianceTest = RadianceTest::kPairs;
   double noiseSigmas = 3.0;
 };
 
-const char* radianceTestName(Thresholds::RadianceTest test);  // "expected", "noise-aware", "plain"
+const char* radianceTestName(Thresholds::RadianceTest test);  // "pairs", "expected", "noise-aware", "plain"
 const char* geometryTestName(Thresholds::GeometryTest test);  // "taps", "bilinear"
 // The thesis's default world-position threshold of the bilinear test: 0.05 scene units.
 inline constexpr double kBilinearPositionThreshold = 0.05;
@@ -89,17 +95,22 @@ struct FramePercentages {
   long frame = 0;       // the current frame i (compared with i - 1)
   double time = 0.0;
   double frustum = 0, position = 0, normal = 0, direct = 0, indirect = 0;  // percent of w x h
-  // The radiance columns' 95 % intervals (the kExpected test; absent otherwise).
+  // The radiance columns' 95 % intervals (the kPairs and kExpected tests; absent otherwise).
   std::optional<Interval> directInterval, indirectInterval;
-  // The expected test: percent of w x h whose noise (on the threshold's scale) exceeds half the
-  // threshold, where noise alone counts as change with probability 5 % or more. A column whose
-  // share is large measures the render's noise more than the dataset (a warning says so).
+  // Percent of w x h whose outcome the noise leaves open. kPairs: the pixels the sequential test
+  // left undecided at the render's pair cap. kExpected: those whose noise (on the threshold's
+  // scale) exceeds half the threshold, where noise alone counts as change with probability 5 % or
+  // more. A column whose share is large measures the render's noise more than the dataset (a
+  // warning says so, and the report marks it †).
   double directNoisy = 0, indirectNoisy = 0;
   bool cut = false;  // frame i's sidecar marks a camera cut: a jump, not motion
 };
 
-// The share of uncertain pixels (FramePercentages::directNoisy) above which discard warns.
+// The share of uncertain pixels (FramePercentages::directNoisy) above which discard warns and the
+// report marks the column: kExpected's noisy pixels, and kPairs' undecided ones.
 inline constexpr double kNoisyWarning = 5.0;
+inline constexpr double kUndecidedWarning = 0.5;
+double uncertainLimit(Thresholds::RadianceTest test);  // kUndecidedWarning for kPairs, else kNoisyWarning
 
 struct DiscardResult {
   FramePercentages percentages;
@@ -178,7 +189,8 @@ glm::dvec3 pixelDirection(const FrameCamera& camera, double x, double y);
 // mean luminance) into absolute ones for this pair.
 Thresholds absoluteThresholds(const Thresholds& thresholds, const FeatureFrame& current, double sceneSize);
 
-// Compares frame `current` (i) with `previous` (i - 1); thresholds are absolute here.
+// Compares frame `current` (i) with `previous` (i - 1); thresholds are absolute here. The pairs
+// test reads `current`'s radiance-change pairs; a frame without them gets the expected test.
 DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& previous, const Thresholds& absolute);
 
 // The diagonal of the world-position bounding box of a frame's hit pixels (0 when none).

@@ -23,7 +23,8 @@ void FeatureFrame::resize(int w, int h) {
   camera.width = w;
   camera.height = h;
   const std::size_t n = pixelCount();
-  for (const auto& spec : contractBuffers()) (this->*spec.member).assign(n * spec.channels.size(), 0.0f);
+  for (const auto& spec : contractBuffers())
+    if (!spec.onRequest) (this->*spec.member).assign(n * spec.channels.size(), 0.0f);
 }
 
 const std::vector<BufferSpec>& contractBuffers() {
@@ -45,6 +46,13 @@ const std::vector<BufferSpec>& contractBuffers() {
       {"indirect.var", {"indirect.var"}, &FeatureFrame::indirectVariance, false, kFloat16},
       {"hit", {"hit"}, &FeatureFrame::hit, true, kFloat16WhenExact},
       {"spp", {"spp"}, &FeatureFrame::spp, false, kFloat16WhenExact},
+      // Differences of two nearly equal luminances keep 32 bits: half's 2^-11 of the halves' size
+      // would be noise of its own on a change a hundred times smaller.
+      {"change.direct", {"change.direct.mean", "change.direct.se", "change.direct.gathered"}, &FeatureFrame::directChange, false, kFloat32,
+       65504.0f, true},
+      {"change.indirect", {"change.indirect.mean", "change.indirect.se", "change.indirect.gathered"}, &FeatureFrame::indirectChange, false,
+       kFloat32, 65504.0f, true},
+      {"change.pairs", {"change.pairs"}, &FeatureFrame::changePairs, false, kFloat16WhenExact, 65504.0f, true},
   };
   return buffers;
 }

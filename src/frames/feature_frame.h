@@ -41,6 +41,12 @@ struct SamplingSummary {
   double meanSamples = 0.0;
   long cappedPixels = 0;               // pixels that reached --max-spp before their target
   int lightsPerPoint = 0;              // point and spot lights evaluated per shading point at most (0: all)
+  // Radiance-change pairs (render --pairs; 0 when the frame has none): the cap on a pixel's pairs,
+  // the mean and largest count, and the pixels still undecided at the cap for direct or indirect
+  // (at the thresholds the render estimated; discard decides again at its own).
+  int pairCap = 0, maxPairs = 0;
+  double meanPairs = 0.0;
+  long undecidedPixels = 0;
 };
 
 // One frame's buffers: row 0 at the top, channels of a buffer interleaved per pixel. A buffer the
@@ -55,6 +61,13 @@ struct FeatureFrame {
   std::vector<float> motion;                                      // 2 per pixel
   std::vector<float> directVariance, indirectVariance;            // 1 per pixel
   std::vector<float> spp;                                         // 1 per pixel: samples taken
+  // Radiance change from the previous frame by correlated re-shading (frames/radiance_change.h,
+  // docs/feature-buffers.md), where the renderer made pairs: per pixel, for the luminance of each
+  // of direct and indirect, the pairs' mean difference Y_t - Y_{t-1}, its standard error and the
+  // mean |Y_t| + |Y_{t-1}| the halves' paths gathered (3 per pixel, in that order); and how many
+  // pairs (1 per pixel).
+  std::vector<float> directChange, indirectChange;
+  std::vector<float> changePairs;
   std::optional<SamplingSummary> sampling;                        // the sidecar's `sampling`
   // The sidecar's `cut`: the camera jumped between the previous frame and this one (a respawn or
   // a switch of the followed player), so temporal methods start their history again here.
@@ -62,7 +75,9 @@ struct FeatureFrame {
 
   std::size_t pixelCount() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(height); }
   bool hasVariance() const { return !directVariance.empty() && !indirectVariance.empty(); }
-  // Sizes every buffer of the contract for width x height, zero-filled.
+  bool hasChanges() const { return !directChange.empty() && !indirectChange.empty() && !changePairs.empty(); }
+  // Sizes every buffer of the contract for width x height, zero-filled (those made on request, the
+  // radiance-change pairs, stay empty: a frame without them must not look as if it had them).
   void resize(int width, int height);
 };
 
@@ -85,10 +100,11 @@ struct BufferSpec {
   bool required;                    // every frames folder has it
   Storage storage;
   float halfLimit = 65504.0f;       // kFloat16: the largest magnitude stored as half (65504: half's largest)
+  bool onRequest = false;           // made only when asked for (FeatureFrame::resize leaves it empty)
 };
 
 // The contract's buffers in the order dynbench writes them (P N direct indirect albedo Z id
-// motion direct.var indirect.var hit spp).
+// motion direct.var indirect.var hit spp change.direct change.indirect change.pairs).
 const std::vector<BufferSpec>& contractBuffers();
 // Every channel name of the contract, in that order.
 std::vector<std::string> contractChannelNames();

@@ -81,7 +81,7 @@ json sidecarJson(long frame, double time, const FrameCamera& camera, const json&
 }
 
 json samplingJson(const SamplingSummary& s) {
-  return {{"adaptive", s.adaptive},
+  json j = {{"adaptive", s.adaptive},
           {"tolerance", s.tolerance},
           {"direct_target", s.directTarget},
           {"indirect_target", s.indirectTarget},
@@ -90,6 +90,13 @@ json samplingJson(const SamplingSummary& s) {
           {"mean_spp", s.meanSamples},
           {"capped_pixels", s.cappedPixels},
           {"lights_per_point", s.lightsPerPoint}};
+  if (s.pairCap > 0) {
+    j["pair_cap"] = s.pairCap;
+    j["max_pairs"] = s.maxPairs;
+    j["mean_pairs"] = s.meanPairs;
+    j["undecided_pixels"] = s.undecidedPixels;
+  }
+  return j;
 }
 
 namespace {
@@ -103,12 +110,13 @@ Expected<SamplingSummary> readSampling(const json& j, const fs::path& path) {
     s.adaptive = o["adaptive"].get<bool>();
   }
   for (auto [key, target] : {std::pair{"tolerance", &s.tolerance}, {"direct_target", &s.directTarget}, {"indirect_target", &s.indirectTarget},
-                             {"mean_spp", &s.meanSamples}}) {
+                             {"mean_spp", &s.meanSamples}, {"mean_pairs", &s.meanPairs}}) {
     auto v = numberAt(j, path, std::string("/sampling/") + key, 0.0);
     if (!v) return std::unexpected(v.error());
     *target = *v;
   }
-  for (auto [key, target] : {std::pair{"min_spp", &s.minSamples}, {"max_spp", &s.maxSamples}, {"lights_per_point", &s.lightsPerPoint}}) {
+  for (auto [key, target] : {std::pair{"min_spp", &s.minSamples}, {"max_spp", &s.maxSamples}, {"lights_per_point", &s.lightsPerPoint},
+                             {"pair_cap", &s.pairCap}, {"max_pairs", &s.maxPairs}}) {
     auto v = numberAt(j, path, std::string("/sampling/") + key, 0.0);
     if (!v) return std::unexpected(v.error());
     *target = static_cast<int>(*v);
@@ -116,6 +124,9 @@ Expected<SamplingSummary> readSampling(const json& j, const fs::path& path) {
   auto capped = numberAt(j, path, "/sampling/capped_pixels", 0.0);
   if (!capped) return std::unexpected(capped.error());
   s.cappedPixels = static_cast<long>(*capped);
+  auto undecided = numberAt(j, path, "/sampling/undecided_pixels", 0.0);
+  if (!undecided) return std::unexpected(undecided.error());
+  s.undecidedPixels = static_cast<long>(*undecided);
   return s;
 }
 

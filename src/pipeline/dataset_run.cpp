@@ -111,6 +111,7 @@ DatasetRenders datasetRenders(const fs::path& dataset, const fs::path& run, cons
   render.job.settings.bounces = o.bounces;
   render.job.settings.seed = o.seed;
   render.job.settings.converge = true;
+  render.job.settings.pairs = true;  // Table 6.7's radiance columns (discard's default test)
   render.job.settings.tolerance = o.tolerance;
   render.job.settings.maxSamplesPerPixel = o.maxSamplesPerPixel;
   render.job.threads = o.threads;
@@ -129,6 +130,7 @@ DatasetRenders datasetRenders(const fs::path& dataset, const fs::path& run, cons
   RenderStage input = render;
   input.job.output = run / "input";
   input.job.settings.converge = false;
+  input.job.settings.pairs = false;
   input.job.settings.samplesPerPixel = o.inputSamplesPerPixel;
   input.job.settings.seed = o.seed + 1;
   input.job.settings.jitter = true;

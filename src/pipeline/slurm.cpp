@@ -300,6 +300,9 @@ std::vector<std::string> renderArguments(const render::RenderJob& job) {
   if (s.converge)
     a.insert(a.end(), {"--converge", "--tolerance", fmt::format("{:.17g}", s.tolerance), "--max-spp", std::to_string(s.maxSamplesPerPixel)});
   a.insert(a.end(), {"--lights-per-point", std::to_string(s.lightsPerPoint)});
+  // Pairs spelled out either way: the CLI's default follows --converge and the engine.
+  if (s.pairs) a.insert(a.end(), {"--pairs", "--max-pairs", std::to_string(s.maxPairs)});
+  else a.push_back("--no-pairs");
   if (job.float32) a.push_back("--float32");
   return a;
 }

@@ -131,7 +131,7 @@ Expected<DiscardOutcome> runDiscard(const DiscardStage& stage, const discard::Di
   DiscardOutcome out;
   const std::string name = stage.frames.filename().empty() ? stage.frames.parent_path().filename().string() : stage.frames.filename().string();
   out.markdown = report::markdownTable(
-      report::discardTable({{name, run->mean}}, fmt::format("{} frame pairs{}, {}x{}", run->frames.size(),
+      report::discardTable({{name, run->mean, run->thresholds.radianceTest}}, fmt::format("{} frame pairs{}, {}x{}", run->frames.size(),
                                                             run->cutPairs == 0 ? ""
                                                             : run->cutsInMean ? fmt::format(", {} of them camera cuts", run->cutPairs)
                                                                               : fmt::format(" of which {} camera cuts are left out", run->cutPairs),

@@ -116,7 +116,8 @@ py::object discardFrames(const fs::path& frames, const std::string& geometryTest
   discard::Thresholds t;
   t.geometryTest = choice<Geometry>(geometryTest, "geometry_test", {{"taps", Geometry::kTaps}, {"bilinear", Geometry::kBilinear}});
   t.radianceTest = choice<Radiance>(radianceTest, "radiance_test",
-                                    {{"expected", Radiance::kExpected}, {"noise-aware", Radiance::kNoiseAware}, {"plain", Radiance::kPlain}});
+                                    {{"pairs", Radiance::kPairs}, {"expected", Radiance::kExpected}, {"noise-aware", Radiance::kNoiseAware},
+                                     {"plain", Radiance::kPlain}});
   for (const auto& [value, name] : {std::pair{thresholdPosition.value_or(0.0), "threshold_position"}, {thresholdNormal, "threshold_normal"},
                                     {thresholdDirect, "threshold_direct"}, {thresholdIndirect, "threshold_indirect"}})
     if (!(value >= 0)) raiseError({ErrorCode::kUsage, fmt::format("{}: {} (expected a number >= 0)", name, value)});
@@ -225,7 +226,7 @@ PYBIND11_MODULE(_core, m) {
   const discard::Thresholds defaults;
   m.def("discard", &discardFrames, py::arg("frames_dir"), py::kw_only(), py::arg("geometry_test") = "taps", py::arg("threshold_position") = py::none(),
         py::arg("relative_position") = false, py::arg("threshold_normal") = defaults.normal, py::arg("threshold_direct") = defaults.direct,
-        py::arg("threshold_indirect") = defaults.indirect, py::arg("absolute_radiance") = false, py::arg("radiance_test") = "expected",
+        py::arg("threshold_indirect") = defaults.indirect, py::arg("absolute_radiance") = false, py::arg("radiance_test") = "pairs",
         py::arg("include_cuts") = false, "Reprojection discard of a frames folder (Table 6.7), as `dynbench discard --json` writes it");
   m.def("compare", &compareImages, py::arg("reference"), py::arg("test"), py::kw_only(), py::arg("ppd") = evaluate::flip::defaultPixelsPerDegree(),
         py::arg("hdr") = true, "Image metrics of test against reference (paths, or arrays (H, W, 3)), as `dynbench compare --json` writes them");

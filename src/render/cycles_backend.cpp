@@ -236,6 +236,12 @@ Expected<void> CyclesBackend::render(const std::vector<FrameRequest>& requests, 
 Expected<std::unique_ptr<RenderBackend>> createCyclesBackend(const BackendContext& context) {
   if (context.job.settings.jitter)
     return fail(ErrorCode::kUnsupported, "--jitter is implemented by the embree engine only (Cycles renders pixel centres)");
+  // Correlated re-shading needs each sample's first hit rebuilt in another frame and both shaded
+  // with the same random numbers: Cycles cannot be asked for that from a script.
+  if (context.job.settings.pairs)
+    return fail(ErrorCode::kUnsupported,
+                "--pairs (radiance-change pairs for Table 6.7's radiance columns) is implemented by the embree engine only; render with "
+                "--no-pairs and run discard with --radiance-test expected (the image-against-image test)");
   auto blender = findBlender(context.job.blender);
   if (!blender) return std::unexpected(blender.error());
   auto script = renderScript();

@@ -39,6 +39,8 @@ class EmbreeBackend final : public RenderBackend {
       auto renderFrame = [&] {
         buffers = tracer_->render(static_cast<std::uint64_t>(request.frame), request.cameras.camera, request.cameras.previous, &rowsDone,
                                   &stats);
+        if (tracer_->settings().pairs)
+          tracer_->renderChanges(static_cast<std::uint64_t>(request.frame), request.cameras.camera, request.cameras.previous, buffers, &stats);
       };
       if (rows) {
         // The frame renders on a worker thread while this one reports its rows, every 100 ms

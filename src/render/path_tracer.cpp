@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/math.h"
+#include "frames/radiance_change.h"
 #include "render/bsdf_batch.h"
 #include "render/equirect_batch.h"
 #include "render/prefetch.h"
@@ -62,18 +63,30 @@ Expected<std::unique_ptr<PathTracer>> PathTracer::create(const scene::Scene& sce
     if (!env) return std::unexpected(env.error());
     tracer->environment_ = std::move(*env);
   }
-  AlphaTest alpha;
   const PathTracer* self = tracer.get();
-  alpha.needed = [self](int node, int primitive) {
-    const scene::Material* m = self->materialOf(node, primitive);
-    return m && m->alphaMode == scene::AlphaMode::kMask;
+  auto alphaTest = [self] {
+    AlphaTest alpha;
+    alpha.needed = [self](int node, int primitive) {
+      const scene::Material* m = self->materialOf(node, primitive);
+      return m && m->alphaMode == scene::AlphaMode::kMask;
+    };
+    alpha.opaque = [self](int node, int primitive, unsigned triangle, glm::dvec2 b) {
+      return self->alphaOpaque(node, primitive, triangle, b);
+    };
+    return alpha;
   };
-  alpha.opaque = [self](int node, int primitive, unsigned triangle, glm::dvec2 b) {
-    return self->alphaOpaque(node, primitive, triangle, b);
-  };
-  auto rt = RayTracingScene::create(scene, std::move(alpha));
+  auto rt = RayTracingScene::create(scene, alphaTest());
   if (!rt) return std::unexpected(rt.error());
   tracer->rayTracing_ = std::move(*rt);
+  if (settings.pairs) {
+    if (settings.maxPairs < frames::kFirstPairs)
+      return fail(ErrorCode::kUsage, "--max-pairs {}: expected at least {} (the first round's pairs)", settings.maxPairs, frames::kFirstPairs);
+    // The same geometries in the same order as rayTracing_, so that a hit of one names the same
+    // surface point in the other (RayTracingScene::surfaceAt).
+    auto previous = RayTracingScene::create(scene, alphaTest());
+    if (!previous) return std::unexpected(previous.error());
+    tracer->previousRayTracing_ = std::move(*previous);
+  }
   return tracer;
 }
 
@@ -149,7 +162,7 @@ glm::dvec3 PathTracer::emission(const scene::Material& m, glm::dvec2 uv, double 
 
 PathTracer::Shading PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, double coneWidth) const {
   Shading s;
-  shade(hit, wo, uv, coneWidth, s);
+  shade(hit, wo, uv, coneWidth, *rayTracing_, s);
   return s;
 }
 
@@ -165,15 +178,22 @@ double PathTracer::textureLodAt(const SurfaceHit& hit, const std::array<glm::dve
   return textureLod(coneWidth, glm::dot(hit.geometricNormal, direction), uvArea, worldArea);
 }
 
-void PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, double coneWidth, Shading& s) const {
-  const scene::Material* m = materialOf(*hit.source);
-  SurfaceMaterial& mat = s.material;
+void PathTracer::shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, double coneWidth, const RayTracingScene& scene,
+                       Shading& s) const {
   // The triangle's corners and the level of detail only where a texture is read.
+  const scene::Material* m = materialOf(*hit.source);
   const bool textured = m && (m->baseColorTexture.image >= 0 || m->metallicRoughnessTexture.image >= 0 || m->normalTexture.image >= 0 ||
                               m->emissiveTexture.image >= 0);
   std::array<glm::dvec3, 3> corners{};
-  if (textured) corners = rayTracing_->trianglePositions(hit);
+  if (textured) corners = scene.trianglePositions(hit);
   const double lod = textured ? textureLodAt(hit, corners, -wo, coneWidth) : -kInfinity;
+  shadeAt(hit, wo, uv, corners, lod, s);
+}
+
+void PathTracer::shadeAt(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, const std::array<glm::dvec3, 3>& corners, double lod,
+                         Shading& s) const {
+  const scene::Material* m = materialOf(*hit.source);
+  SurfaceMaterial& mat = s.material;
   if (!m) {
     // glTF's default material when a primitive has none: white, metallic 1, roughness 1 (§3.9.6).
     mat = SurfaceMaterial{};
@@ -255,8 +275,15 @@ Expected<void> PathTracer::setTime(double time, double previousTime) {
     });
     if (lo.x <= hi.x) sceneRadius_ = std::max(1e-3, 0.5 * glm::length(hi - lo));
   }
-  return lights_.build(scene_, *rayTracing_, environment_ ? &*environment_ : nullptr, *sceneRadius_,
-                       [this](int node, int primitive, unsigned triangle, glm::dvec2 b) { return emission(node, primitive, triangle, b); });
+  const auto emissionAt = [this](int node, int primitive, unsigned triangle, glm::dvec2 b) { return emission(node, primitive, triangle, b); };
+  if (previousRayTracing_) {
+    if (!previousTime_ || *previousTime_ != previousTime)
+      if (auto ok = previousRayTracing_->update(previousTime); !ok) return ok;
+    previousTime_ = previousTime;
+    if (auto ok = previousLights_.build(scene_, *previousRayTracing_, environment_ ? &*environment_ : nullptr, *sceneRadius_, emissionAt); !ok)
+      return ok;
+  }
+  return lights_.build(scene_, *rayTracing_, environment_ ? &*environment_ : nullptr, *sceneRadius_, emissionAt);
 }
 
 struct PathTracer::PathSample {
@@ -267,6 +294,10 @@ struct PathTracer::PathSample {
 struct PathTracer::PathState {
   const FirstVertex* first = nullptr;  // its pixel's camera ray and first hit
   Random rng;
+  // A radiance-change pair's half (renderChanges): `rng` is drawn anew at every vertex from this
+  // key (Random::vertex), so that both halves draw the same numbers at every vertex.
+  bool keyed = false;
+  std::uint64_t keySeed = 0, keyFrame = 0, keyPixel = 0, keySample = 0;
   Ray ray;
   std::size_t streamIndex = 0;  // where the hit of `ray` is in the batch's stream (depth > 0)
   glm::dvec3 throughput{1.0};
@@ -304,6 +335,10 @@ struct PathTracer::FirstVertex {
 
 // Per-thread working memory of the path loop, so the per-ray path does not allocate.
 struct PathTracer::PathScratch {
+  // The scene state the paths are traced in: the frame's (rayTracing_, lights_), or for the
+  // previous half of a radiance-change pair the previous frame's (renderChanges).
+  const RayTracingScene* scene = nullptr;
+  const LightSet* lights = nullptr;
   // What advance computes at a path vertex, written in place (returned by value, GCC zeroed and
   // copied them, with loads that waited on the stores just made).
   Shading shading;
@@ -328,9 +363,9 @@ struct PathTracer::PathScratch {
   std::uint64_t rays = 0, shadingPoints = 0, punctualEvaluated = 0;
 };
 
-void PathTracer::tracePaths(std::span<PathState> paths, PathScratch& scratch) const {
+void PathTracer::tracePaths(std::span<PathState> paths, PathScratch& scratch, bool firstHitsKnown) const {
   // A path's camera ray is set by whoever queued it (its pixel's, or its own through the filter).
-  const bool ownCameraRays = !filter_.atCentre();
+  const bool ownCameraRays = !filter_.atCentre() && !firstHitsKnown;
   for (PathState& p : paths) {
     p.throughput = glm::dvec3(1.0);
     p.pathLength = 0.0;
@@ -344,6 +379,8 @@ void PathTracer::tracePaths(std::span<PathState> paths, PathScratch& scratch) co
   scratch.equirect.reserve(paths.size());
   for (int depth = 0;; ++depth) {
     const bool shadesHere = depth <= settings_.bounces;  // a hit at this depth gathers light and bounces
+    for (PathState& p : paths)
+      if (p.active && p.keyed) p.rng = Random::vertex(p.keySeed, p.keyFrame, p.keyPixel, p.keySample, static_cast<std::uint64_t>(depth) + 1);
     // Stage 1: trace; start loading the hit's texture coordinates and the environment pixel of an
     // escape; start the light choice (which loads the table entry stage 2 reads).
     bool any = false;
@@ -354,7 +391,7 @@ void PathTracer::tracePaths(std::span<PathState> paths, PathScratch& scratch) co
         if (p.active) scratch.streamRays.push_back(p.ray);
       // Grown, never shrunk: growing again after a shrink would value-initialise the hit records.
       if (scratch.streamHits.size() < scratch.streamRays.size()) scratch.streamHits.resize(scratch.streamRays.size());
-      rayTracing_->intersect(scratch.streamRays, std::span(scratch.streamHits).first(scratch.streamRays.size()));
+      scratch.scene->intersect(scratch.streamRays, std::span(scratch.streamHits).first(scratch.streamRays.size()));
       std::size_t k = 0;
       for (PathState& p : paths)
         if (p.active) p.streamIndex = k++;
@@ -376,7 +413,7 @@ void PathTracer::tracePaths(std::span<PathState> paths, PathScratch& scratch) co
       if (lightSample && shadesHere) {
         const double uChoice = p.rng.uniform();
         const glm::dvec2 uLight = p.rng.uniform2();
-        lights_.startChoice(uChoice, uLight, p.lightChoice);
+        scratch.lights->startChoice(uChoice, uLight, p.lightChoice);
       }
     }
     if (!any) break;
@@ -387,7 +424,7 @@ void PathTracer::tracePaths(std::span<PathState> paths, PathScratch& scratch) co
       for (PathState& p : paths)
         if (escaped(p)) {
           p.uv = scratch.equirect.point(lane++, &p.escapeSinTheta);
-          lights_.prefetchEnvironment(p.uv);
+          scratch.lights->prefetchEnvironment(p.uv);
         }
     }
     // Stage 2: what stage 1's loads point to: the texels at the hit; the light choice, which
@@ -403,11 +440,11 @@ void PathTracer::tracePaths(std::span<PathState> paths, PathScratch& scratch) co
         prefetchTextures(hit, p.uv);
       }
       if (lightSample && shadesHere) {
-        lights_.finishChoice(p.lightChoice);
+        scratch.lights->finishChoice(p.lightChoice);
         scratch.choices.push_back(&p.lightChoice);
       }
     }
-    lights_.mapDirections(scratch.choices, scratch.equirect);
+    scratch.lights->mapDirections(scratch.choices, scratch.equirect);
     // Stage 3: shade and gather the punctual lights, path by path, each path's BSDF going into a
     // lane of the batch; evaluate the light samples and sample the bounces of all the lanes at
     // once (BsdfBatch); then each path's light sample (its shadow ray) and its bounce.
@@ -433,7 +470,7 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const F
   if (!hit.hit) {
     if (environment_) {
       double pdfLight = 0.0;
-      const glm::dvec3 le = lights_.environmentRadianceAt(p.uv, p.escapeSinTheta, &pdfLight);
+      const glm::dvec3 le = scratch.lights->environmentRadianceAt(p.uv, p.escapeSinTheta, &pdfLight);
       const double w = p.previousDelta || !settings_.nextEventEstimation ? 1.0 : powerHeuristic(p.previousBsdfPdf, pdfLight);
       bucket += p.throughput * le * w;
     }
@@ -442,13 +479,13 @@ bool PathTracer::advance(PathState& p, int depth, const SurfaceHit& hit, const F
   const glm::dvec3 wo = -ray.direction;
   p.pathLength += hit.distance;
   // The hit's shading, written in place (scratch.shading: returned, GCC zeroed and copied it).
-  if (!first) shade(hit, wo, p.uv, scratch.pixelSpread * p.pathLength, scratch.shading);
+  if (!first) shade(hit, wo, p.uv, scratch.pixelSpread * p.pathLength, *scratch.scene, scratch.shading);
   const Shading& s = first ? first->shading : scratch.shading;
   if (s.material.emission != glm::dvec3(0.0)) {
     double w = 1.0;
     if (!p.previousDelta && settings_.nextEventEstimation) {
       const double cosLight = std::abs(glm::dot(hit.geometricNormal, ray.direction));
-      w = powerHeuristic(p.previousBsdfPdf, lights_.pdfEmissive(s.emissiveWeight, hit.distance, cosLight));
+      w = powerHeuristic(p.previousBsdfPdf, scratch.lights->pdfEmissive(s.emissiveWeight, hit.distance, cosLight));
     }
     bucket += p.throughput * s.material.emission * w;
   }
@@ -471,16 +508,19 @@ bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const S
     // The punctual lights the light tree selects for this point, each divided by the probability
     // of its selection (LightSet::selectPunctual), here, with the scalar BSDF. The tree's random
     // number is drawn only where there is a tree, so scenes without point lights keep their stream.
-    if (lights_.punctualCount() > 0) {
-      const double uLight = lights_.hasPunctualTree() ? p.rng.uniform() : 0.0;
-      lights_.selectPunctual(hit.position, s.geometricNormal, uLight, settings_.lightsPerPoint, scratch.selected);
+    // A pair's halves draw it whether or not their frame has a tree (each vertex's numbers keep
+    // their places when one frame's lights differ from the other's).
+    const double uTree = p.keyed ? p.rng.uniform() : 0.0;
+    if (scratch.lights->punctualCount() > 0) {
+      const double uLight = p.keyed ? uTree : scratch.lights->hasPunctualTree() ? p.rng.uniform() : 0.0;
+      scratch.lights->selectPunctual(hit.position, s.geometricNormal, uLight, settings_.lightsPerPoint, scratch.selected);
       scratch.punctualEvaluated += scratch.selected.size();
       if (!scratch.selected.empty()) {
         const Bsdf bsdf(s.material, Frame(s.shadingNormal), s.geometricNormal);
         const Bsdf::View view = bsdf.view(wo);
         LightSample& punctual = scratch.lightSample;
         for (const LightTree::Selected& selected : scratch.selected)
-          if (lights_.samplePunctual(selected.light, hit.position, punctual)) {
+          if (scratch.lights->samplePunctual(selected.light, hit.position, punctual)) {
             punctual.pdf = selected.probability;
             addLight(p, depth, punctual, bsdf.evaluate(view, punctual.direction), scratch);
           }
@@ -489,7 +529,7 @@ bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const S
     // The environment or an emissive triangle: one Monte Carlo sample (its random numbers drawn
     // in the trace stage whether or not there is anything to choose, so the stream stays aligned),
     // evaluated in the path's lane. No light to choose: a kNone choice, no sample.
-    p.lightEvaluated = lights_.sample(hit.position, p.lightChoice, p.lightSample) && p.lightSample.pdf > 0;
+    p.lightEvaluated = scratch.lights->sample(hit.position, p.lightChoice, p.lightSample) && p.lightSample.pdf > 0;
   }
   if (p.lightEvaluated) bsdfs.setEvaluation(p.lane, p.lightSample.direction);
   else bsdfs.clearEvaluation(p.lane);
@@ -507,7 +547,7 @@ void PathTracer::addLight(PathState& p, int depth, const LightSample& ls, const 
   const double cosine = std::abs(glm::dot(p.shadingNormal, ls.direction));
   const double tMax = std::isinf(ls.distance) ? 1e30 : ls.distance * (1.0 - 1e-4) - 3e-5;
   ++scratch.rays;
-  if (rayTracing_->occluded(p.origin, ls.direction, tMax)) return;
+  if (scratch.scene->occluded(p.origin, ls.direction, tMax)) return;
   const double w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, e.pdf);
   glm::dvec3& bucket = depth == 0 ? p.out.direct : p.out.indirect;  // light reaching this hit
   bucket += p.throughput * f * ls.radiance * (cosine * w / ls.pdf);
@@ -582,8 +622,10 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
   std::vector<SurfaceHit> firstHits(pixels);
   // A pixel's ray cone spreads by this angle (radians) per unit of length (textureLod).
   const double pixelSpread = std::atan(2.0 * std::tan(0.5 * camera.yfov()) / height);
-  tbb::enumerable_thread_specific<PathScratch> scratches([pixelSpread] {
+  tbb::enumerable_thread_specific<PathScratch> scratches([this, pixelSpread] {
     PathScratch scratch;
+    scratch.scene = rayTracing_.get();
+    scratch.lights = &lights_;
     scratch.pixelSpread = pixelSpread;
     return scratch;
   });
@@ -623,7 +665,7 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
     v.hit = filtered ? nullptr : &hit;
     if (!filtered) {
       if (known) v.shading = *known;
-      else shade(hit, -ray.direction, texCoord(hit), pixelSpread * hit.distance, v.shading);
+      else shade(hit, -ray.direction, texCoord(hit), pixelSpread * hit.distance, *rayTracing_, v.shading);
       v.origin = offsetOrigin(hit.position, v.shading.geometricNormal);
     }
     v.next = sum.samples;
@@ -778,6 +820,245 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
     statistics->punctualInFrame += lights_.punctualCount();
   }
   return out;
+}
+
+}  // namespace dynbench::render
+
+namespace dynbench::render {
+namespace {
+
+// A radiance-change pair's random numbers: a stream of their own, apart from the image's samples.
+constexpr std::uint64_t kPairStream = 0x7061697273ull;  // "pairs"
+
+// Running sums of one pixel's radiance-change pairs: D = Y_t - Y_{t-1} of direct (0) and indirect
+// (1) luminance, the smallest and largest D (all equal: no spread at all, whatever the rounding of
+// the sums), and |Y_t| + |Y_{t-1}| of the light the halves' paths gathered (not the environment
+// seen through the pixel, nor the first hit's own emission, the same in both by construction).
+struct ChangeSums {
+  std::array<double, 2> sum{}, sumSq{}, gathered{};
+  std::array<double, 2> lowest{HUGE_VAL, HUGE_VAL}, highest{-HUGE_VAL, -HUGE_VAL};
+  int pairs = 0, attempted = 0;
+  bool done = false;
+
+  void add(const std::array<double, 2>& now, const std::array<double, 2>& before, const std::array<double, 2>& light) {
+    for (std::size_t b = 0; b < 2; ++b) {
+      const double d = now[b] - before[b];
+      sum[b] += d;
+      sumSq[b] += d * d;
+      lowest[b] = std::min(lowest[b], d);
+      highest[b] = std::max(highest[b], d);
+      gathered[b] += light[b];
+    }
+    ++pairs;
+  }
+  // `image`: the frame's own estimate of the pixel's luminance in that buffer (its converged image),
+  // a floor under `gathered`: pairs that happened to gather no light (bounces that all missed the
+  // one lit wall) say nothing about what the paths that would have could differ by.
+  frames::ChangeEstimate estimate(std::size_t b, double image) const {
+    frames::ChangeEstimate e;
+    e.pairs = pairs;
+    if (pairs == 0) return e;
+    const double n = pairs;
+    e.gathered = std::max(gathered[b] / n, 2.0 * std::abs(image));
+    e.mean = sum[b] / n;
+    // Pairs whose D are all equal have exactly no spread (all 0: nothing changed on any path).
+    if (pairs >= 2 && lowest[b] < highest[b]) e.standardError = std::sqrt(std::max(0.0, (sumSq[b] - n * e.mean * e.mean) / (n - 1.0)) / n);
+    if (lowest[b] == highest[b]) e.mean = lowest[b];
+    return e;
+  }
+};
+
+}  // namespace
+
+void PathTracer::renderChanges(std::uint64_t frameIndex, const RenderCamera& camera, const RenderCamera& previousCamera, FrameBuffers& frame,
+                               RenderStatistics* statistics) const {
+  const std::size_t pixels = frame.pixelCount();
+  frame.directChange.assign(3 * pixels, 0.0f);
+  frame.indirectChange.assign(3 * pixels, 0.0f);
+  frame.changePairs.assign(pixels, 0.0f);
+  if (!previousRayTracing_ || pixels == 0) return;
+  const int width = camera.width(), height = camera.height();
+  // The thresholds on luminance: discard's (a fraction of the frame's mean luminance of each
+  // buffer, an RGB distance) over sqrt(3), the grey change's scale (frames/radiance_change.h).
+  auto imageLuminance = [](const std::vector<float>& rgb, std::size_t i) {
+    return luminance(glm::dvec3(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]));
+  };
+  auto meanLuminance = [&](const std::vector<float>& rgb) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < pixels; ++i) sum += luminance(glm::dvec3(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]));
+    return sum / static_cast<double>(pixels);
+  };
+  constexpr double kGrey = 1.7320508075688772;
+  const std::array<double, 2> tau{settings_.directThresholdFraction * meanLuminance(frame.direct) / kGrey,
+                                  settings_.indirectThresholdFraction * meanLuminance(frame.indirect) / kGrey};
+  const int cap = std::max(frames::kFirstPairs, settings_.maxPairs);
+  const double pixelSpread = std::atan(2.0 * std::tan(0.5 * camera.yfov()) / height);
+  const glm::dvec2 jitter = settings_.jitter ? frames::jitterOffset(static_cast<long>(frameIndex)) : glm::dvec2(0.0);
+  const std::uint64_t seed = settings_.seed ^ kPairStream;
+  const glm::dvec3 cameraNow = camera.position(), cameraBefore = previousCamera.position();
+  std::vector<ChangeSums> sums(pixels);
+
+  // Per thread: the path scratch, and a batch's samples with both halves' first vertices and paths.
+  struct Batch {
+    PathScratch scratch;
+    std::vector<std::pair<std::size_t, int>> samples;  // (pixel, sample index)
+    std::vector<Ray> rays;
+    std::vector<SurfaceHit> hits, previousHits;
+    std::vector<FirstVertex> now, before;
+    std::vector<PathState> pathsNow, pathsBefore;
+    std::vector<std::size_t> traced;  // samples whose halves are traced (the others escaped or have no pair)
+  };
+  tbb::enumerable_thread_specific<Batch> batches([&] {
+    Batch b;
+    b.scratch.pixelSpread = pixelSpread;
+    return b;
+  });
+  const std::size_t batchSize = std::max<std::size_t>(1, static_cast<std::size_t>(settings_.pathBatch) / 2);
+
+  // One batch of samples: trace their camera rays in this frame, rebuild each hit in the previous
+  // frame, trace both halves, add each pair to its pixel's sums.
+  auto trace = [&](Batch& b, std::span<const std::pair<std::size_t, int>> samples) {
+    const std::size_t n = samples.size();
+    b.rays.resize(n);
+    b.hits.resize(n);
+    b.previousHits.resize(n);
+    b.now.resize(n);
+    b.before.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const auto [pixel, sample] = samples[k];
+      const int px = static_cast<int>(pixel % static_cast<std::size_t>(width)), py = static_cast<int>(pixel / static_cast<std::size_t>(width));
+      Random rng = Random::vertex(seed, frameIndex, pixel, static_cast<std::uint64_t>(sample), 0);
+      const glm::dvec2 offset = filter_.atCentre() ? glm::dvec2(0.0) : filter_.offset(rng.uniform2());
+      b.rays[k] = camera.ray(px + 0.5 + jitter.x + offset.x, py + 0.5 + jitter.y + offset.y);
+    }
+    rayTracing_->intersect(b.rays, b.hits);
+    b.scratch.rays += n;
+    b.pathsNow.clear();
+    b.pathsBefore.clear();
+    b.traced.clear();
+    for (std::size_t k = 0; k < n; ++k) {
+      const auto [pixel, sample] = samples[k];
+      const SurfaceHit& hit = b.hits[k];
+      if (!hit.hit) {
+        // The environment, at infinity and unanimated: the same radiance in both frames.
+        const double y = environment_ ? luminance(environment_->radiance(b.rays[k].direction)) : 0.0;
+        sums[pixel].add({y, 0.0}, {y, 0.0}, {0.0, 0.0});
+        continue;
+      }
+      b.previousHits[k] = previousRayTracing_->surfaceAt(hit);
+      if (!b.previousHits[k].hit) continue;  // the surface is not in the previous frame: no pair
+      // Both halves' first vertices alike: the view direction from each frame's camera to its
+      // point, the texture level of detail of this frame's sample (a filtering choice of the
+      // pixel, not a change of its lighting).
+      const glm::dvec2 uv = texCoord(hit);
+      const glm::dvec3 woNow = glm::normalize(cameraNow - hit.position);
+      const auto cornersNow = rayTracing_->trianglePositions(hit);
+      const double lod = textureLodAt(hit, cornersNow, -woNow, pixelSpread * hit.distance);
+      auto setUp = [&](FirstVertex& v, const SurfaceHit& h, const glm::dvec3& cameraPosition, const std::array<glm::dvec3, 3>& corners,
+                       std::vector<PathState>& paths) {
+        glm::dvec3 wo = glm::normalize(cameraPosition - h.position);
+        // A point the previous camera sees from behind (a silhouette turning away) is shaded from
+        // the side this frame sees, the view mirrored in its plane: which side a camera sees is the
+        // position column's business, not a change of lighting.
+        if (&h != &hit && (glm::dot(h.geometricNormal, wo) > 0) != (glm::dot(hit.geometricNormal, woNow) > 0))
+          wo -= 2.0 * glm::dot(wo, h.geometricNormal) * h.geometricNormal;
+        v.pixel = pixel;
+        v.ray = Ray{cameraPosition, -wo};
+        v.hit = &h;
+        shadeAt(h, wo, uv, corners, lod, v.shading);
+        v.origin = offsetOrigin(h.position, v.shading.geometricNormal);
+        PathState& p = paths.emplace_back();
+        p.first = &v;
+        p.ray = v.ray;
+        p.keyed = true;
+        p.keySeed = seed;
+        p.keyFrame = frameIndex;
+        p.keyPixel = pixel;
+        p.keySample = static_cast<std::uint64_t>(sample);
+      };
+      setUp(b.now[k], hit, cameraNow, cornersNow, b.pathsNow);
+      setUp(b.before[k], b.previousHits[k], cameraBefore, previousRayTracing_->trianglePositions(b.previousHits[k]), b.pathsBefore);
+      b.traced.push_back(k);
+    }
+    if (b.traced.empty()) return;
+    b.scratch.scene = rayTracing_.get();
+    b.scratch.lights = &lights_;
+    tracePaths(b.pathsNow, b.scratch, true);
+    b.scratch.scene = previousRayTracing_.get();
+    b.scratch.lights = &previousLights_;
+    tracePaths(b.pathsBefore, b.scratch, true);
+    for (std::size_t j = 0; j < b.traced.size(); ++j) {
+      const std::size_t k = b.traced[j];
+      const PathSample& now = b.pathsNow[j].out;
+      const PathSample& before = b.pathsBefore[j].out;
+      const double yNow = luminance(now.direct), yBefore = luminance(before.direct);
+      // The first hit's emission reaches the camera unweighted (depth 0): the same in both halves.
+      const double gatheredDirect = std::abs(yNow - luminance(b.now[k].shading.material.emission)) +
+                                    std::abs(yBefore - luminance(b.before[k].shading.material.emission));
+      const double gatheredIndirect = std::abs(luminance(now.indirect)) + std::abs(luminance(before.indirect));
+      sums[samples[k].first].add({yNow, luminance(now.indirect)}, {yBefore, luminance(before.indirect)}, {gatheredDirect, gatheredIndirect});
+    }
+  };
+
+  // Pixels in runs of 8, each in rounds: kFirstPairs pairs, then doubling while either buffer is
+  // undecided, up to the cap. A pixel's pairs depend on its own sums alone, so the result does not
+  // depend on the thread schedule.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pixels, 8), [&](const tbb::blocked_range<std::size_t>& run) {
+    Batch& b = batches.local();
+    for (;;) {
+      b.samples.clear();
+      for (std::size_t pixel = run.begin(); pixel < run.end(); ++pixel) {
+        ChangeSums& sum = sums[pixel];
+        if (sum.done) continue;
+        const int upTo = sum.attempted == 0 ? frames::kFirstPairs : std::min(cap, 2 * sum.attempted);
+        for (int k = sum.attempted; k < upTo; ++k) b.samples.emplace_back(pixel, k);
+        sum.attempted = upTo;
+      }
+      if (b.samples.empty()) break;
+      for (std::size_t start = 0; start < b.samples.size(); start += batchSize)
+        trace(b, std::span(b.samples).subspan(start, std::min(batchSize, b.samples.size() - start)));
+      for (std::size_t pixel = run.begin(); pixel < run.end(); ++pixel) {
+        ChangeSums& sum = sums[pixel];
+        if (sum.done) continue;
+        const bool decided = frames::decideChange(sum.estimate(0, imageLuminance(frame.direct, pixel)), tau[0]) != frames::ChangeDecision::kUndecided &&
+                             frames::decideChange(sum.estimate(1, imageLuminance(frame.indirect, pixel)), tau[1]) != frames::ChangeDecision::kUndecided;
+        // No pair after the first round: every sample's surface is new in this frame.
+        sum.done = decided || sum.attempted >= cap || sum.pairs == 0;
+      }
+    }
+  });
+
+  long undecided = 0;
+  double totalPairs = 0.0;
+  int mostPairs = 0;
+  for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
+    const ChangeSums& sum = sums[pixel];
+    std::array<frames::ChangeEstimate, 2> estimates{};
+    for (std::size_t b = 0; b < 2; ++b) {
+      const frames::ChangeEstimate e = estimates[b] = sum.estimate(b, imageLuminance(b == 0 ? frame.direct : frame.indirect, pixel));
+      std::vector<float>& out = b == 0 ? frame.directChange : frame.indirectChange;
+      out[3 * pixel] = static_cast<float>(e.mean);
+      out[3 * pixel + 1] = static_cast<float>(e.standardError);
+      out[3 * pixel + 2] = static_cast<float>(e.gathered);
+    }
+    frame.changePairs[pixel] = static_cast<float>(sum.pairs);
+    totalPairs += sum.pairs;
+    mostPairs = std::max(mostPairs, sum.pairs);
+    if (sum.pairs > 0 && (frames::decideChange(estimates[0], tau[0]) == frames::ChangeDecision::kUndecided ||
+                          frames::decideChange(estimates[1], tau[1]) == frames::ChangeDecision::kUndecided))
+      ++undecided;
+  }
+  if (!frame.sampling) frame.sampling = frames::SamplingSummary{};
+  frame.sampling->pairCap = cap;
+  frame.sampling->maxPairs = mostPairs;
+  frame.sampling->meanPairs = totalPairs / static_cast<double>(pixels);
+  frame.sampling->undecidedPixels = undecided;
+  if (statistics)
+    for (const Batch& b : batches) {
+      statistics->rays += b.scratch.rays;
+      statistics->shadingPoints += b.scratch.shadingPoints;
+      statistics->punctualEvaluated += b.scratch.punctualEvaluated;
+    }
 }
 
 }  // namespace dynbench::render

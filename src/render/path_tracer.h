@@ -73,6 +73,12 @@ struct RenderSettings {
   // Paths traced together (PathTracer::tracePaths); 1 traces one path at a time. The image does
   // not depend on it (tested): only the speed does.
   int pathBatch = 64;
+  // Radiance-change pairs (render --pairs; on with --converge): for each frame, the change of each
+  // pixel's direct and indirect radiance since the frame before, by correlated re-shading
+  // (PathTracer::renderChanges): kFirstPairs pairs a pixel, doubled in rounds until the test of
+  // frames/radiance_change.h decides both buffers, or maxPairs.
+  bool pairs = false;
+  int maxPairs = 1024;
 };
 
 // One frame's buffers: the feature-buffer contract's frame (frames/feature_frame.h).
@@ -97,6 +103,19 @@ class PathTracer {
   // `rowsDone` (optional) counts finished rows for progress reporting.
   FrameBuffers render(std::uint64_t frameIndex, const RenderCamera& camera, const RenderCamera& previousCamera,
                       std::atomic<int>* rowsDone = nullptr, RenderStatistics* statistics = nullptr) const;
+  // The radiance change of the frame at the current time since the one at setTime's previousTime
+  // (settings().pairs), into `frame`'s directChange, indirectChange and changePairs
+  // (docs/feature-buffers.md). Each pair is one pixel-filter sample of this frame: its first hit
+  // (instance, primitive, triangle, barycentrics) is rebuilt in the previous frame's scene state
+  // (RayTracingScene::surfaceAt) and both halves are path traced, each in its own frame's scene,
+  // lights and camera, with the same random numbers keyed per path vertex (Random::vertex), the
+  // texture level of detail of this frame's sample in both; D = Y_t - Y_{t-1} is then exactly 0
+  // wherever nothing on the path changed, and unbiased where something did (the gradient samples of
+  // A-SVGF, Schied et al. 2018, at every pixel). A sample whose surface is hidden in the previous
+  // frame is no pair (that pixel's history is the position column's). The thresholds come from
+  // `frame`'s own direct and indirect, as discard computes them.
+  void renderChanges(std::uint64_t frameIndex, const RenderCamera& camera, const RenderCamera& previousCamera, FrameBuffers& frame,
+                     RenderStatistics* statistics = nullptr) const;
 
   const RayTracingScene& rayTracing() const { return *rayTracing_; }
   const RenderSettings& settings() const { return settings_; }
@@ -107,7 +126,11 @@ class PathTracer {
   // The material at a hit seen from direction wo, at the hit's texture coordinates uv, its
   // textures filtered for a ray cone of width coneWidth there (textureLod; 0: level 0, unfiltered).
   Shading shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, double coneWidth) const;
-  void shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, double coneWidth, Shading& shading) const;  // every field written
+  // The same, written in place (every field), with the triangle's corners from `scene`.
+  void shade(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, double coneWidth, const RayTracingScene& scene, Shading& shading) const;
+  // The same for a texture level of detail already known (corners: the triangle's world corners).
+  void shadeAt(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2 uv, const std::array<glm::dvec3, 3>& corners, double lod,
+               Shading& shading) const;
   // The texture-independent level of detail of a ray cone of width coneWidth arriving along
   // `direction` at the hit's triangle, whose world corners are `corners` (textureLod).
   double textureLodAt(const SurfaceHit& hit, const std::array<glm::dvec3, 3>& corners, const glm::dvec3& direction,
@@ -137,7 +160,9 @@ class PathTracer {
   // pixels, light tables) is prefetched while the other paths trace: one path at a time spent
   // most of its time waiting on those loads. Each path computes exactly what it would alone: the
   // same random numbers in the same order, the same arithmetic.
-  void tracePaths(std::span<PathState> paths, PathScratch& scratch) const;
+  // firstHitsKnown: every path's first hit is its FirstVertex's, also with a pixel filter (the
+  // halves of radiance-change pairs, whose first hits renderChanges has found).
+  void tracePaths(std::span<PathState> paths, PathScratch& scratch, bool firstHitsKnown = false) const;
   // One vertex of one path (its hit traced, its prefetches issued), first half: adds the hit's
   // emission and its punctual lights to the path's radiance, takes its light sample and puts its
   // BSDF, the light sample's direction and the bounce's random numbers into lane `lanes` of the
@@ -163,6 +188,10 @@ class PathTracer {
   std::optional<EnvironmentLight> environment_;
   std::unique_ptr<RayTracingScene> rayTracing_;
   LightSet lights_;
+  // The previous frame's scene state for radiance-change pairs (settings_.pairs).
+  std::unique_ptr<RayTracingScene> previousRayTracing_;
+  LightSet previousLights_;
+  std::optional<double> previousTime_;
   std::optional<double> sceneRadius_;  // from the first frame's geometry (1 when there is none)
   std::optional<double> time_;
 };

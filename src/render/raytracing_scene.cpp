@@ -269,6 +269,8 @@ void setEmbreeRay(RTCRayHit& rh, const Ray& ray, double tMin, double tMax) {
 
 }  // namespace
 
+static void setSurfacePoint(SurfaceHit& hit, const Entry& e, bool dynamicGeometry, unsigned geometry, unsigned triangle, glm::dvec2 b);
+
 // The hit record of what Embree found: the scene model's ids and double-precision surface data,
 // written in place (see setEmbreeRay).
 static void setSurfaceHit(SurfaceHit& hit, const RayTracingScene::Impl& impl, const RTCRayHit& rh) {
@@ -277,19 +279,23 @@ static void setSurfaceHit(SurfaceHit& hit, const RayTracingScene::Impl& impl, co
     return;
   }
   const auto& entries = rh.hit.instID[0] == 0 ? impl.staticEntries : impl.dynamicEntries;
-  const Entry& e = entries[rh.hit.geomID];
-  hit.hit = true;
   hit.distance = rh.ray.tfar;
+  setSurfacePoint(hit, entries[rh.hit.geomID], rh.hit.instID[0] != 0, rh.hit.geomID, rh.hit.primID, {rh.hit.u, rh.hit.v});
+}
+
+// The surface data of barycentric point b of triangle `triangle` of an entry, at its positions.
+static void setSurfacePoint(SurfaceHit& hit, const Entry& e, bool dynamicGeometry, unsigned geometry, unsigned triangle, glm::dvec2 b) {
+  hit.hit = true;
   hit.node = e.node;
   hit.primitive = e.primitive;
   hit.source = e.source;
-  hit.triangle = rh.hit.primID;
-  hit.barycentric = {rh.hit.u, rh.hit.v};
-  hit.dynamicGeometry = rh.hit.instID[0] != 0;
-  hit.geometry = rh.hit.geomID;
-  const std::uint32_t i0 = e.indices[3 * rh.hit.primID], i1 = e.indices[3 * rh.hit.primID + 1], i2 = e.indices[3 * rh.hit.primID + 2];
+  hit.triangle = triangle;
+  hit.barycentric = b;
+  hit.dynamicGeometry = dynamicGeometry;
+  hit.geometry = geometry;
+  const std::uint32_t i0 = e.indices[3 * triangle], i1 = e.indices[3 * triangle + 1], i2 = e.indices[3 * triangle + 2];
   hit.vertices = {i0, i1, i2};
-  const double u = rh.hit.u, v = rh.hit.v, w = 1.0 - u - v;
+  const double u = b.x, v = b.y, w = 1.0 - u - v;
   hit.position = w * e.positions[i0] + u * e.positions[i1] + v * e.positions[i2];
   hit.geometricNormal = glm::normalize(glm::cross(e.positions[i1] - e.positions[i0], e.positions[i2] - e.positions[i0]));
   hit.shadingNormal = hit.geometricNormal;
@@ -297,6 +303,19 @@ static void setSurfaceHit(SurfaceHit& hit, const RayTracingScene::Impl& impl, co
     const glm::dvec3 n = w * e.normals[i0] + u * e.normals[i1] + v * e.normals[i2];
     if (glm::length(n) > 0) hit.shadingNormal = glm::normalize(n);
   }
+}
+
+SurfaceHit RayTracingScene::surfaceAt(const SurfaceHit& other) const {
+  SurfaceHit hit;
+  if (!other.hit) return hit;
+  const auto& entries = other.dynamicGeometry ? impl_->dynamicEntries : impl_->staticEntries;
+  if (other.geometry >= entries.size()) return hit;
+  const Entry& e = entries[other.geometry];
+  // Hidden at this update (a geometry that appears later, or held at scale 0): no such point.
+  if (e.node != other.node || e.primitive != other.primitive || !e.enabled || 3 * (other.triangle + 1) > e.indices.size()) return hit;
+  setSurfacePoint(hit, e, other.dynamicGeometry, other.geometry, other.triangle, other.barycentric);
+  hit.distance = other.distance;
+  return hit;
 }
 
 SurfaceHit RayTracingScene::intersect(const Ray& ray, double tMin, double tMax) const {

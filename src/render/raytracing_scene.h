@@ -70,6 +70,13 @@ class RayTracingScene {
   // The world positions of the hit's triangle at the last update (tangent frames for normal maps).
   std::array<glm::dvec3, 3> trianglePositions(const SurfaceHit& hit) const;  // every node at the last update's time
   SurfaceHit intersect(const Ray& ray, double tMin = 0.0, double tMax = 1e30) const;
+  // The surface point `other` names (the same barycentric point of the same triangle of the same
+  // node and primitive), as this scene has it at its last update: position and normals moved with
+  // its node, skin and morph targets; `distance` copied. No hit where that geometry is hidden now.
+  // `other` may come from another RayTracingScene of the same scene::Scene (their geometries are
+  // created in the same order): how a radiance-change pair rebuilds frame t's first hit in frame
+  // t - 1 (PathTracer::renderChanges).
+  SurfaceHit surfaceAt(const SurfaceHit& other) const;
   // Many rays at once, through Embree's stream API: hits[k] is intersect(rays[k]).
   void intersect(std::span<const Ray> rays, std::span<SurfaceHit> hits) const;
   bool occluded(const glm::dvec3& origin, const glm::dvec3& direction, double tMax) const;

@@ -10,6 +10,7 @@
 
 #include "core/files.h"
 #include "core/image_io.h"
+#include "frames/radiance_change.h"
 #include "render/backend.h"
 #include "scene/queries.h"
 #include "frames/frame_io.h"
@@ -105,6 +106,9 @@ nlohmann::json renderRecord(const RenderJob& job) {
     r["pixel_filter"] = {{"type", pixelFilterName(s.pixelFilter.type)}, {"width", s.pixelFilter.width}};
   if (s.converge) r["converge"] = {{"tolerance", s.tolerance}, {"max_spp", s.maxSamplesPerPixel},
                                    {"direct_threshold", s.directThresholdFraction}, {"indirect_threshold", s.indirectThresholdFraction}};
+  // Radiance-change pairs (frames without them are not complete for a job that wants them).
+  if (s.pairs) r["pairs"] = {{"max_pairs", s.maxPairs}, {"first_pairs", frames::kFirstPairs}, {"z", frames::kChangeZ},
+                             {"direct_threshold", s.directThresholdFraction}, {"indirect_threshold", s.indirectThresholdFraction}};
   // Point and spot lights through the light tree (frames of the earlier cut-off are not reused).
   r["lights"] = {{"sampler", "tree"}, {"per_point", s.lightsPerPoint}};
   if (s.jitter) r["jitter"] = "halton23x8";
@@ -179,6 +183,8 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
     summary.rendered.push_back(frame.frame);
     if (frame.sampling) {
       summary.cappedPixels += frame.sampling->cappedPixels;
+      summary.pairs += frame.sampling->meanPairs * static_cast<double>(frame.pixelCount());
+      summary.undecidedPixels += frame.sampling->undecidedPixels;
       summary.pixels += frame.pixelCount();
     }
     const std::size_t done = summary.rendered.size();

@@ -47,6 +47,8 @@ struct RenderSummary {
   std::uint64_t cameraSamples = 0, rays = 0;
   std::uint64_t pixels = 0;      // of the frames rendered (with a sampling summary)
   long cappedPixels = 0;         // --converge: pixels that reached --max-spp before their target
+  double pairs = 0.0;            // --pairs: radiance-change pairs taken, over the frames' pixels
+  long undecidedPixels = 0;      // --pairs: pixels undecided at --max-pairs
   RenderStatistics light;        // the backend's counters (shading points, lights evaluated)
   std::vector<std::string> warnings;
 };

@@ -28,6 +28,14 @@ class Random {
     state_ += mix(pixel * 0x100000001B3ull + sample);
     next();
   }
+  // The stream of one path vertex (0: the camera ray, k: the k-th hit) of sample `sample` of
+  // `pixel`: each vertex's random numbers depend on its key alone, not on how many numbers the
+  // vertices before it drew. Two paths with the same key (the halves of a radiance-change pair,
+  // PathTracer::renderChanges) then draw the same numbers at every vertex, even where one half took
+  // a branch the other did not (a light-tree pick, Russian roulette) at an earlier vertex.
+  static Random vertex(std::uint64_t seed, std::uint64_t frame, std::uint64_t pixel, std::uint64_t sample, std::uint64_t vertex) {
+    return Random(mix(seed ^ mix(vertex + 0xD1B54A32D192ED03ull)), frame, pixel, sample);
+  }
   std::uint32_t next() {
     const std::uint64_t old = state_;
     state_ = old * 6364136223846793005ull + increment_;

@@ -86,7 +86,7 @@ std::vector<Table> tables(const std::vector<Run>& runs) {
   for (const auto& r : runs) {
     statsRows.push_back(r.stats);
     statsRows.back().name = r.name;
-    discardRows.push_back({r.name, r.discard.mean});
+    discardRows.push_back({r.name, r.discard.mean, r.discard.thresholds.radianceTest});
   }
   auto all = statsTables(statsRows);
   all.push_back(discardTable(discardRows));

@@ -102,21 +102,23 @@ Table discardTable(const std::vector<DiscardRow>& rows, const std::string& detai
   Table t{"Table 6.7. Discarded pixels, % of the image, mean over the frame pairs" + (detail.empty() ? "" : " (" + detail + ")") + ".",
           {"dataset", "frustum %", "world position %", "shading normal %", "direct radiance %", "indirect radiance %"},
           {}};
-  // † marks a radiance column that the render's noise leaves uncertain (discard::kNoisyWarning).
-  bool marked = false;
-  auto radiance = [&](double value, const std::optional<discard::Interval>& interval, double noisy) {
+  // † marks a radiance column that the render's noise leaves uncertain (discard::uncertainLimit).
+  bool markedNoisy = false, markedUndecided = false;
+  auto radiance = [&](double value, const std::optional<discard::Interval>& interval, double noisy, discard::Thresholds::RadianceTest test) {
     std::string cell = withInterval(value, interval);
-    if (noisy > discard::kNoisyWarning) {
-      marked = true;
+    if (noisy > discard::uncertainLimit(test)) {
+      (test == discard::Thresholds::RadianceTest::kPairs ? markedUndecided : markedNoisy) = true;
       cell += " †";
     }
     return cell;
   };
   for (const auto& r : rows)
     t.rows.push_back({r.name, fixed3(r.mean.frustum), fixed3(r.mean.position), fixed3(r.mean.normal),
-                      radiance(r.mean.direct, r.mean.directInterval, r.mean.directNoisy),
-                      radiance(r.mean.indirect, r.mean.indirectInterval, r.mean.indirectNoisy)});
-  if (marked)
+                      radiance(r.mean.direct, r.mean.directInterval, r.mean.directNoisy, r.radianceTest),
+                      radiance(r.mean.indirect, r.mean.indirectInterval, r.mean.indirectNoisy, r.radianceTest)});
+  if (markedUndecided)
+    t.title += " †: more than 0.5 % of the pixels stayed undecided at the render's pair cap; the interval bounds them both ways.";
+  if (markedNoisy)
     t.title += " †: the noise of more than 5 % of the pixels exceeds half the threshold, and there noise alone counts as change:"
                " the column measures the render's noise as much as the dataset.";
   return t;

@@ -23,6 +23,7 @@ std::vector<Table> statsTables(const std::vector<StatsRow>& rows);
 struct DiscardRow {
   std::string name;
   discard::FramePercentages mean;  // Eq. (3.5), percent of the image
+  discard::Thresholds::RadianceTest radianceTest = discard::Thresholds::RadianceTest::kPairs;  // what made the radiance columns
 };
 // Table 6.7, one row per dataset; `detail` is appended to the title (frame pairs, size).
 Table discardTable(const std::vector<DiscardRow>& rows, const std::string& detail = {});
