@@ -112,6 +112,7 @@ DatasetRenders datasetRenders(const fs::path& dataset, const fs::path& run, cons
   render.job.settings.seed = o.seed;
   render.job.settings.converge = true;
   render.job.settings.pairs = true;  // Table 6.7's radiance columns (discard's default test)
+  render.job.settings.maxPairs = o.maxPairs;
   render.job.settings.tolerance = o.tolerance;
   render.job.settings.maxSamplesPerPixel = o.maxSamplesPerPixel;
   render.job.threads = o.threads;
