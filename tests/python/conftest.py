@@ -40,5 +40,5 @@ def frames(tmp_path_factory):
     root = tmp_path_factory.mktemp("frames")
     common = [ORBIT, "--res", "40x24", "--frames", "0:5", "--bounces", "2"]
     run_cli("render", *common, "-o", root / "input", "--spp", "4", "--jitter", "--pixel-filter", "centre")
-    run_cli("render", *common, "-o", root / "reference", "--spp", "256")
+    run_cli("render", *common, "-o", root / "reference", "--spp", "256", "--pairs", "--max-pairs", "16")  # discard's default test reads pairs
     return {"input": root / "input", "reference": root / "reference"}
