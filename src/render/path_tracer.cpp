@@ -298,6 +298,11 @@ struct PathTracer::PathState {
   // key (Random::vertex), so that both halves draw the same numbers at every vertex.
   bool keyed = false;
   std::uint64_t keySeed = 0, keyFrame = 0, keyPixel = 0, keySample = 0;
+  // A pair's previous half: its first bounce is sampled as the current half's is, from the current
+  // camera's view direction `samplingView` (the same lobe, the same direction, the same density),
+  // and weighted by its own BSDF value towards its own camera (renderChanges says why).
+  bool sharedFirstBounce = false;
+  glm::dvec3 samplingView{0.0};
   Ray ray;
   std::size_t streamIndex = 0;  // where the hit of `ray` is in the batch's stream (depth > 0)
   glm::dvec3 throughput{1.0};
@@ -502,7 +507,9 @@ bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const S
   p.lane = lanes++;
   BsdfBatch& bsdfs = scratch.bsdfs;
   const glm::dvec3 wo = -p.ray.direction;
-  bsdfs.set(p.lane, s.material, s.shadingNormal, s.geometricNormal, wo);
+  // A pair's previous half samples its first bounce (and weighs it, in MIS) as the current half
+  // does; its BSDF's values towards its own camera are applied in addLight and bounce.
+  bsdfs.set(p.lane, s.material, s.shadingNormal, s.geometricNormal, depth == 0 && p.sharedFirstBounce ? p.samplingView : wo);
   if (settings_.nextEventEstimation) {
     ++scratch.shadingPoints;
     // The punctual lights the light tree selects for this point, each divided by the probability
@@ -513,7 +520,10 @@ bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const S
     const double uTree = p.keyed ? p.rng.uniform() : 0.0;
     if (scratch.lights->punctualCount() > 0) {
       const double uLight = p.keyed ? uTree : scratch.lights->hasPunctualTree() ? p.rng.uniform() : 0.0;
-      scratch.lights->selectPunctual(hit.position, s.geometricNormal, uLight, settings_.lightsPerPoint, scratch.selected);
+      // A pair's halves evaluate every light that reaches the point (lightsPerPoint 0): each frame's
+      // light tree is built from its own lights, and once they differ (a muzzle flash, a moving
+      // player's light) the same number picks different lights in the two halves everywhere.
+      scratch.lights->selectPunctual(hit.position, s.geometricNormal, uLight, p.keyed ? 0 : settings_.lightsPerPoint, scratch.selected);
       scratch.punctualEvaluated += scratch.selected.size();
       if (!scratch.selected.empty()) {
         const Bsdf bsdf(s.material, Frame(s.shadingNormal), s.geometricNormal);
@@ -554,9 +564,21 @@ void PathTracer::addLight(PathState& p, int depth, const LightSample& ls, const 
 }
 
 bool PathTracer::bounce(PathState& p, int depth, PathScratch& scratch) const {
-  if (p.lightEvaluated) addLight(p, depth, p.lightSample, scratch.bsdfs.evaluation(p.lane), scratch);
+  const bool shared = depth == 0 && p.sharedFirstBounce;
+  // The value of the pair's previous half's own BSDF, seen from its own camera, towards wi.
+  auto ownValue = [&](const glm::dvec3& wi) {
+    const Shading& s = p.first->shading;
+    const Bsdf bsdf(s.material, Frame(s.shadingNormal), s.geometricNormal);
+    return bsdf.evaluate(bsdf.view(-p.ray.direction), wi).value;
+  };
+  if (p.lightEvaluated) {
+    Bsdf::Evaluation e = scratch.bsdfs.evaluation(p.lane);
+    if (shared) e.value = ownValue(p.lightSample.direction);
+    addLight(p, depth, p.lightSample, e, scratch);
+  }
   BsdfSample& bs = scratch.bsdfSample;
   if (!scratch.bsdfs.sample(p.lane, bs)) return false;
+  if (shared) bs.value = ownValue(bs.direction);
   p.throughput *= bs.value * (std::abs(glm::dot(p.shadingNormal, bs.direction)) / bs.pdf);
   if (depth >= 3) {  // Russian roulette keeps long paths cheap without bias
     const double survive = std::min(0.95, std::max({p.throughput.x, p.throughput.y, p.throughput.z}));
@@ -975,6 +997,13 @@ void PathTracer::renderChanges(std::uint64_t frameIndex, const RenderCamera& cam
         p.keyFrame = frameIndex;
         p.keyPixel = pixel;
         p.keySample = static_cast<std::uint64_t>(sample);
+        // Both halves' first bounces are sampled from this frame's view, carried into the previous
+        // surface's shading frame where it turned: the same lobe and direction wherever the surface
+        // did not move, so the rest of the path is the same (see renderChanges in path_tracer.h);
+        // both weigh it with the scalar BSDF (the batch's SIMD evaluation rounds differently).
+        p.sharedFirstBounce = true;
+        const glm::dvec3& nowNormal = b.now[k].shading.shadingNormal;
+        p.samplingView = v.shading.shadingNormal == nowNormal ? woNow : Frame(v.shading.shadingNormal).toWorld(Frame(nowNormal).toLocal(woNow));
       };
       setUp(b.now[k], hit, cameraNow, cornersNow, b.pathsNow);
       setUp(b.before[k], b.previousHits[k], cameraBefore, previousRayTracing_->trianglePositions(b.previousHits[k]), b.pathsBefore);

@@ -111,7 +111,14 @@ class PathTracer {
   // lights and camera, with the same random numbers keyed per path vertex (Random::vertex), the
   // texture level of detail of this frame's sample in both; D = Y_t - Y_{t-1} is then exactly 0
   // wherever nothing on the path changed, and unbiased where something did (the gradient samples of
-  // A-SVGF, Schied et al. 2018, at every pixel). A sample whose surface is hidden in the previous
+  // A-SVGF, Schied et al. 2018, at every pixel). Two choices keep the halves together where the
+  // view or the lights change: the previous half samples its first bounce as this frame's half does
+  // (from this frame's view direction, its lobe, direction and density) and weighs it with its own
+  // BSDF towards its own camera, f_{t-1}(wo_{t-1}, wi) cos / pdf_t(wi), unbiased since pdf_t covers
+  // the hemisphere (a glossy lobe sampled from each half's own view gave different bounces, and the
+  // indirect column stayed undecided on a third of Cube 2's pixels); and both halves evaluate
+  // every light in reach rather than their frames' light trees, which pick different lights once
+  // the frames' lights differ. A sample whose surface is hidden in the previous
   // frame is no pair (that pixel's history is the position column's). The thresholds come from
   // `frame`'s own direct and indirect, as discard computes them.
   void renderChanges(std::uint64_t frameIndex, const RenderCamera& camera, const RenderCamera& previousCamera, FrameBuffers& frame,
