@@ -516,6 +516,11 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
   }
   const double n = static_cast<double>(averaged.size());  // Eq. (3.5)
   for (double* v : {&run.mean.frustum, &run.mean.position, &run.mean.normal, &run.mean.direct, &run.mean.indirect}) *v /= n;
+  // The uncertain pixels' shares (the pairs test's undecided, the expected test's noisy; 0 for the others).
+  for (const FramePercentages* f : averaged) {
+    run.mean.directNoisy += f->directNoisy / n;
+    run.mean.indirectNoisy += f->indirectNoisy / n;
+  }
   if (thresholds.radianceTest == Thresholds::RadianceTest::kPairs) {
     // Bounds average as the columns do.
     auto meanBounds = [&](std::optional<Interval> FramePercentages::*member) {
@@ -528,10 +533,6 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
     };
     run.mean.directInterval = meanBounds(&FramePercentages::directInterval);
     run.mean.indirectInterval = meanBounds(&FramePercentages::indirectInterval);
-    for (const FramePercentages* f : averaged) {
-      run.mean.directNoisy += f->directNoisy / n;
-      run.mean.indirectNoisy += f->indirectNoisy / n;
-    }
     for (const auto& [name, undecided] : {std::pair{"direct", run.mean.directNoisy}, {"indirect", run.mean.indirectNoisy}})
       if (undecided > kUndecidedWarning)
         run.warnings.push_back(fmt::format("the {} radiance column is uncertain: {:.2f} % of the pixels stayed undecided at the render's "
@@ -547,10 +548,6 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
     };
     run.mean.directInterval = meanInterval(run.mean.direct, &FramePercentages::directInterval);
     run.mean.indirectInterval = meanInterval(run.mean.indirect, &FramePercentages::indirectInterval);
-    for (const FramePercentages* f : averaged) {
-      run.mean.directNoisy += f->directNoisy / n;
-      run.mean.indirectNoisy += f->indirectNoisy / n;
-    }
     // The interval covers the count's chance, not the bias noise gives the expected test: say
     // when a column is mostly noise.
     for (const auto& [name, noisy] : {std::pair{"direct", run.mean.directNoisy}, {"indirect", run.mean.indirectNoisy}})
