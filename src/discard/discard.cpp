@@ -254,7 +254,7 @@ frames::ChangeEstimate changeEstimate(const std::vector<float>& change, const st
 // that it changed (1 or 0 when decided). The chance that a decision is wrong is at most the looks'
 // number times the normal tail beyond its margin (Bonferroni over the sequential test's looks);
 // a decision on pairs with no spread (s = 0) is exact up to the unseen-change bound.
-double pairsChange(const frames::ChangeEstimate& e, double tau, double& low, double& high, double& undecided) {
+double pairsChange(const frames::ChangeEstimate& e, double tau, double& low, double& high, double& undecided, bool& isUndecided) {
   if (e.pairs == 0) return 0.0;  // no pair: the surface is new in frame i (the position column's)
   const frames::ChangeDecision decision = frames::decideChange(e, tau);
   const double margin = std::abs(std::abs(e.mean) - tau);
@@ -272,6 +272,7 @@ double pairsChange(const frames::ChangeEstimate& e, double tau, double& low, dou
   }
   high += 1.0;
   undecided += 1.0;
+  isUndecided = true;
   return exceedanceProbability(std::abs(e.mean), e.standardError, tau);
 }
 
@@ -379,20 +380,23 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
             if (kGrey * std::sqrt(var) > 0.5 * threshold) noisy += 1.0;
             return exceedanceProbability(kGrey * std::abs(luminance(a) - luminance(b)), kGrey * std::sqrt(var), threshold);
           };
+          bool undecidedDirect = false, undecidedIndirect = false;
           const double pd =
               pairs ? pairsChange(changeEstimate(current.directChange, current.changePairs, i), t.direct / kGrey, row.low[0], row.high[0],
-                                  row.directNoisy)
+                                  row.directNoisy, undecidedDirect)
                     : radianceChange(current.direct, previous.direct, t.direct, current.directVariance, previous.directVariance, row.directNoisy);
           const double pi = pairs ? pairsChange(changeEstimate(current.indirectChange, current.changePairs, i), t.indirect / kGrey, row.low[1],
-                                                row.high[1], row.indirectNoisy)
+                                                row.high[1], row.indirectNoisy, undecidedIndirect)
                                   : radianceChange(current.indirect, previous.indirect, t.indirect, current.indirectVariance,
                                                    previous.indirectVariance, row.indirectNoisy);
           row.count[3] += pd;
           row.count[4] += pi;
           row.directVariance += pd * (1.0 - pd);
           row.indirectVariance += pi * (1.0 - pi);
-          if (pd > 0.5) bits |= kDirect;  // the mask shows the more likely outcome
-          if (pi > 0.5) bits |= kIndirect;
+          // The mask shows the more likely outcome; an undecided pair test, as undecided.
+          if (pd > 0.5 && !undecidedDirect) bits |= kDirect;
+          if (pi > 0.5 && !undecidedIndirect) bits |= kIndirect;
+          if (undecidedDirect || undecidedIndirect) bits |= kUndecided;
         }
       }
       result.mask[i] = bits;
@@ -561,13 +565,13 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
 }
 
 std::vector<float> maskImage(const FeatureFrame& frame, const std::vector<unsigned char>& mask) {
-  static const glm::dvec3 colours[5] = {{1, 0.1, 0.1}, {1, 0.9, 0.1}, {0.2, 0.4, 1}, {1, 0.2, 1}, {0.1, 1, 1}};
+  static const glm::dvec3 colours[6] = {{1, 0.1, 0.1}, {1, 0.9, 0.1}, {0.2, 0.4, 1}, {1, 0.2, 1}, {0.1, 1, 1}, {0.85, 0.85, 0.85}};
   const std::size_t n = mask.size();
   const frames::PreviewToneMap toneMap(frame);
   std::vector<float> rgb(3 * n);
   for (std::size_t i = 0; i < n; ++i) {
     glm::dvec3 c = toneMap(frame, i) * 0.45;  // dimmed, so the reasons' colours stand out
-    for (int b = 0; b < 5; ++b)
+    for (int b = 0; b < 6; ++b)
       if (mask[i] & (1u << b)) {
         c = 0.3 * c + 0.7 * colours[b];
         break;

@@ -89,6 +89,9 @@ enum DiscardBit : unsigned char {
   kNormal = 4,
   kDirect = 8,
   kIndirect = 16,
+  // The pairs test left the pixel's direct or indirect change undecided at the render's pair cap
+  // (neither kDirect nor kIndirect is set for it then): drawn apart in the masks, not as change.
+  kUndecided = 32,
 };
 
 struct FramePercentages {
@@ -233,7 +236,8 @@ Expected<DiscardRun> readDiscardJson(const std::filesystem::path& path);
 
 // The mask image of Figure 6.2: the frame's direct + indirect radiance, tone-mapped and dimmed,
 // with discarded pixels coloured by their first reason (frustum red, world position yellow,
-// shading normal blue, direct magenta, indirect cyan). 8-bit RGB values in [0, 1].
+// shading normal blue, direct magenta, indirect cyan), and pixels whose radiance change the pairs
+// test left undecided white. 8-bit RGB values in [0, 1].
 std::vector<float> maskImage(const FeatureFrame& frame, const std::vector<unsigned char>& mask);
 
 }  // namespace dynbench::discard

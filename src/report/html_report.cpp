@@ -122,7 +122,7 @@ std::vector<double> rotationSeries(const std::string& csv) {
 }
 
 // The colours of discard::maskImage, in its order of reasons.
-constexpr const char* kMaskLegend = "red frustum, yellow position, blue normal, magenta direct, cyan indirect";
+constexpr const char* kMaskLegend = "red frustum, yellow position, blue normal, magenta direct, cyan indirect, white undecided (radiance)";
 
 // Up to n indices of [0, count), evenly spaced from the first to the last, none twice.
 std::vector<std::size_t> evenlySpaced(std::size_t count, int n) {
