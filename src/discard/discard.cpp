@@ -19,12 +19,6 @@ namespace {
 
 glm::dvec3 at3(const std::vector<float>& b, std::size_t i) { return {b[3 * i], b[3 * i + 1], b[3 * i + 2]}; }
 
-double meanLuminance(const std::vector<float>& rgb) {
-  const std::size_t n = rgb.size() / 3;
-  double sum = 0;
-  for (std::size_t i = 0; i < n; ++i) sum += luminance(at3(rgb, i));
-  return n ? sum / static_cast<double>(n) : 0.0;
-}
 
 }  // namespace
 
@@ -124,8 +118,8 @@ Thresholds absoluteThresholds(const Thresholds& t, const FeatureFrame& current, 
   Thresholds a = t;
   if (t.relativePosition && t.geometryTest == Thresholds::GeometryTest::kBilinear) a.position = t.position * size;
   if (!t.absoluteRadiance) {
-    a.direct = t.direct * meanLuminance(current.direct);
-    a.indirect = t.indirect * meanLuminance(current.indirect);
+    a.direct = t.direct * frames::meanLuminance(current.direct);
+    a.indirect = t.indirect * frames::meanLuminance(current.indirect);
   }
   a.relativePosition = false;
   a.absoluteRadiance = true;
@@ -289,7 +283,7 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
   // folders; a caller comparing two frames directly gets the image-against-image answer).
   const bool pairs = t.radianceTest == Test::kPairs && current.hasChanges();
   const Test test = t.radianceTest == Test::kPairs && !pairs ? Test::kExpected : t.radianceTest;
-  constexpr double kGrey = 1.7320508075688772;  // sqrt(3): a grey change's RGB distance per unit luminance
+  constexpr double kGrey = frames::kGreyDistance;
   // Eq. (3.3) on the thesis's pixel-index coordinates (pixel i at x = i): outside [0, w - 1].
   // A pixel that reprojects onto an edge pixel's centre stays inside despite rounding: buffers store
   // float positions, about 1e-7 relative, i.e. up to a few 1e-6 px; the slack is 1e-3 px.

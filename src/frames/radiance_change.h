@@ -11,8 +11,26 @@
 // is exactly 0; where something did, D is an unbiased sample of the change.
 #include <algorithm>
 #include <cmath>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/math.h"  // luminance
 
 namespace dynbench::frames {
+
+// sqrt(3): the RGB distance of a grey change per unit of luminance, the scale discard's radiance
+// thresholds are on (docs/metrics.md).
+inline constexpr double kGreyDistance = 1.7320508075688772;
+
+// The mean luminance of an RGB buffer (3 floats a pixel): what a relative radiance threshold is a
+// fraction of (discard's defaults).
+inline double meanLuminance(const std::vector<float>& rgb) {
+  const std::size_t n = rgb.size() / 3;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < n; ++i) sum += luminance(glm::dvec3(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]));
+  return n ? sum / static_cast<double>(n) : 0.0;
+}
 
 // One pixel's pairs for one buffer (direct or indirect), in luminance units.
 struct ChangeEstimate {

@@ -515,8 +515,8 @@ bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const S
     // The punctual lights the light tree selects for this point, each divided by the probability
     // of its selection (LightSet::selectPunctual), here, with the scalar BSDF. The tree's random
     // number is drawn only where there is a tree, so scenes without point lights keep their stream.
-    // A pair's halves draw it whether or not their frame has a tree (each vertex's numbers keep
-    // their places when one frame's lights differ from the other's).
+    // A pair's halves draw it whatever their frames' lights, though they select without a tree
+    // (below), so that a vertex's numbers keep the places they had when first measured.
     const double uTree = p.keyed ? p.rng.uniform() : 0.0;
     if (scratch.lights->punctualCount() > 0) {
       const double uLight = p.keyed ? uTree : scratch.lights->hasPunctualTree() ? p.rng.uniform() : 0.0;
@@ -905,14 +905,8 @@ void PathTracer::renderChanges(std::uint64_t frameIndex, const RenderCamera& cam
   auto imageLuminance = [](const std::vector<float>& rgb, std::size_t i) {
     return luminance(glm::dvec3(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]));
   };
-  auto meanLuminance = [&](const std::vector<float>& rgb) {
-    double sum = 0.0;
-    for (std::size_t i = 0; i < pixels; ++i) sum += luminance(glm::dvec3(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]));
-    return sum / static_cast<double>(pixels);
-  };
-  constexpr double kGrey = 1.7320508075688772;
-  const std::array<double, 2> tau{settings_.directThresholdFraction * meanLuminance(frame.direct) / kGrey,
-                                  settings_.indirectThresholdFraction * meanLuminance(frame.indirect) / kGrey};
+  const std::array<double, 2> tau{settings_.directThresholdFraction * frames::meanLuminance(frame.direct) / frames::kGreyDistance,
+                                  settings_.indirectThresholdFraction * frames::meanLuminance(frame.indirect) / frames::kGreyDistance};
   const int cap = std::max(frames::kFirstPairs, settings_.maxPairs);
   const double pixelSpread = std::atan(2.0 * std::tan(0.5 * camera.yfov()) / height);
   const glm::dvec2 jitter = settings_.jitter ? frames::jitterOffset(static_cast<long>(frameIndex)) : glm::dvec2(0.0);
