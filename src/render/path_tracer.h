@@ -78,7 +78,7 @@ struct RenderSettings {
   // (PathTracer::renderChanges): kFirstPairs pairs a pixel, doubled in rounds until the test of
   // frames/radiance_change.h decides both buffers, or maxPairs.
   bool pairs = false;
-  int maxPairs = 1024;
+  int maxPairs = 4096;
 };
 
 // One frame's buffers: the feature-buffer contract's frame (frames/feature_frame.h).

@@ -467,6 +467,13 @@ void dynbench_capture_init() {
   // game takes from it depends on that frame's overlay rendering; without it the game places
   // muzzle flashes and grenades from the player's body, as it does for every other player.
   execute("hudgun 0");
+  // No sound. A sound the game plays draws from the game's random numbers (an alternative sample,
+  // engine/sound.cpp's chooseslot), and only when the machine has a working audio device (with
+  // none, playsound returns first); channels are freed when the device has played them, in real
+  // time. So the bots' dice, and with them the match, depended on the machine's audio: the same
+  // seed gave 9 cuts without a device and 8 with SDL's dummy driver (issue 45). With the volume 0
+  // playsound returns before choosing, whatever the machine has.
+  execute("soundvol 0");
   // Debian's cube2-data ships one player model, snoutx10k (1); bots otherwise pick models at random
   // from five and are not drawn when theirs is missing.
   execute("playermodel 1");
