@@ -49,6 +49,9 @@ TEST(Suite, ManifestErrorsNameTheFileAndPointer) {
       {"/render/max_spp", 0, "/render/max_spp"},
       {"/methods/1", 7, "/methods/1: expected a string"},
       {"/name", "../up", "/name"},
+      {"/datasets/0/sha256", "05aa", "/datasets/0/sha256: expected an object"},
+      {"/datasets/0/sha256/capture", "05AA494F", "/datasets/0/sha256/capture: expected a SHA-256 as 64 lower-case hex digits"},
+      {"/datasets/0/sha256/bin", "00", "/datasets/0/sha256/bin: expected no other key"},
   };
   for (const Case& c : cases) {
     nlohmann::json doc = good;
@@ -132,6 +135,34 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
     EXPECT_EQ(window, 6);
     EXPECT_TRUE(doc["files"].contains(fmt::format("{}/input/frame_{:05d}.exr", d["run"].get<std::string>(), d["window"]["first"].get<long>())));
   }
+  // The smoke manifest's pins (issue 45) held, and suite.json records each dataset's digests.
+  const auto manifest = nlohmann::json::parse(test::slurp(kSmoke));
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(doc["datasets"][i]["sha256"], manifest["datasets"][i]["sha256"]) << i;
+    EXPECT_EQ(doc["datasets"][i]["sha256"]["dataset"],
+              *suite::datasetDigest(out / doc["datasets"][i]["dataset"].get<std::string>()));
+  }
+  // A pin that does not hold: status 5 naming the dataset, the pointer and the stage, before
+  // anything is rendered (the captures are copied, so nothing is captured again).
+  for (const auto& [pointer, stage] : {std::pair{"/datasets/3/sha256/capture", "the capture stage"},
+                                       std::pair{"/datasets/3/sha256/dataset", "the convert or fly-through stage"}}) {
+    nlohmann::json bad = manifest;
+    std::string& pin = bad[nlohmann::json::json_pointer(pointer)].get_ref<std::string&>();
+    pin[0] = pin[0] == '0' ? '1' : '0';
+    ASSERT_TRUE(writeFileAtomic(dir / "pinned.json", bad.dump(2)));
+    const fs::path other = dir / "other";
+    fs::remove_all(other);
+    fs::create_directories(other);
+    fs::copy(out / "captures", other / "captures", fs::copy_options::recursive);
+    const auto mismatch = dynbench(fmt::format("suite {} -o {}", (dir / "pinned.json").string(), other.string()), dir);
+    EXPECT_EQ(mismatch.status, 5) << mismatch.err;
+    EXPECT_NE(mismatch.err.find(fmt::format("pinned.json: {}: dataset 'fps-2-flythrough': {}", pointer, stage)), std::string::npos)
+        << mismatch.err;
+    EXPECT_NE(mismatch.err.find(pin), std::string::npos) << mismatch.err;
+    EXPECT_FALSE(fs::exists(other / "runs")) << "rendered before the pins were checked";
+    EXPECT_FALSE(fs::exists(other / "suite.json"));
+  }
+
   // The fly-throughs share their bot's capture: two captures for four datasets.
   EXPECT_EQ(std::distance(fs::directory_iterator(out / "captures"), fs::directory_iterator()), 2);
   // The validity table: a cell per measure, method and error, rho from the recorded numbers.

@@ -1,5 +1,6 @@
 #include "core/checksum.h"
 
+#include <algorithm>
 #include <array>
 #include <fstream>
 #include <memory>
@@ -9,25 +10,60 @@
 
 namespace dynbench {
 
+namespace {
+
+// One SHA-256 in progress (OpenSSL's EVP interface).
+class Sha256 {
+ public:
+  Sha256() : context_(EVP_MD_CTX_new(), EVP_MD_CTX_free) { ok_ = context_ && EVP_DigestInit_ex(context_.get(), EVP_sha256(), nullptr) == 1; }
+  void update(const void* bytes, std::size_t size) { ok_ = ok_ && EVP_DigestUpdate(context_.get(), bytes, size) == 1; }
+  // The digest as hex, or empty when OpenSSL failed on the way.
+  std::string hex() {
+    std::array<unsigned char, EVP_MAX_MD_SIZE> digest;
+    unsigned int length = 0;
+    if (!ok_ || EVP_DigestFinal_ex(context_.get(), digest.data(), &length) != 1) return {};
+    std::string out;
+    for (unsigned int i = 0; i < length; ++i) out += fmt::format("{:02x}", digest[i]);
+    return out;
+  }
+
+ private:
+  std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> context_;
+  bool ok_ = false;
+};
+
+}  // namespace
+
 Expected<std::string> sha256File(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return fail(ErrorCode::kIo, "{}: cannot read", path.string());
-  const std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> context(EVP_MD_CTX_new(), EVP_MD_CTX_free);
-  if (!context || EVP_DigestInit_ex(context.get(), EVP_sha256(), nullptr) != 1)
-    return fail(ErrorCode::kInternal, "{}: OpenSSL could not start a SHA-256", path.string());
+  Sha256 sha;
   std::array<char, 1 << 16> buffer;
   while (in) {
     in.read(buffer.data(), buffer.size());
-    if (in.gcount() > 0 && EVP_DigestUpdate(context.get(), buffer.data(), static_cast<std::size_t>(in.gcount())) != 1)
-      return fail(ErrorCode::kInternal, "{}: OpenSSL's SHA-256 failed", path.string());
+    if (in.gcount() > 0) sha.update(buffer.data(), static_cast<std::size_t>(in.gcount()));
   }
   if (in.bad()) return fail(ErrorCode::kIo, "{}: read error", path.string());
-  std::array<unsigned char, EVP_MAX_MD_SIZE> digest;
-  unsigned int length = 0;
-  if (EVP_DigestFinal_ex(context.get(), digest.data(), &length) != 1) return fail(ErrorCode::kInternal, "{}: OpenSSL's SHA-256 failed", path.string());
-  std::string hex;
-  for (unsigned int i = 0; i < length; ++i) hex += fmt::format("{:02x}", digest[i]);
+  std::string hex = sha.hex();
+  if (hex.empty()) return fail(ErrorCode::kInternal, "{}: OpenSSL's SHA-256 failed", path.string());
   return hex;
+}
+
+std::string sha256Text(std::string_view bytes) {
+  Sha256 sha;
+  sha.update(bytes.data(), bytes.size());
+  return sha.hex();
+}
+
+Expected<std::string> sha256Listing(const std::filesystem::path& root, std::vector<std::string> relativePaths) {
+  std::sort(relativePaths.begin(), relativePaths.end());  // std::string compares bytes, as LC_ALL=C sort
+  std::string listing;
+  for (const std::string& path : relativePaths) {
+    auto sum = sha256File(root / path);
+    if (!sum) return std::unexpected(sum.error());
+    listing += *sum + "  " + path + "\n";
+  }
+  return sha256Text(listing);
 }
 
 }  // namespace dynbench

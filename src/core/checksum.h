@@ -3,6 +3,8 @@
 // libcrypto (Debian libssl-dev) computes it; this is the one place dynbench talks to it.
 #include <filesystem>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "core/error.h"
 
@@ -10,5 +12,14 @@ namespace dynbench {
 
 // The file's SHA-256 as 64 lower-case hex digits; an error names the file.
 Expected<std::string> sha256File(const std::filesystem::path& path);
+
+// The SHA-256 of bytes, as 64 lower-case hex digits.
+std::string sha256Text(std::string_view bytes);
+
+// The SHA-256 of a set of files under `root` as `sha256sum` lists them: the digest of the text of
+// one line "<file's SHA-256>  <path relative to root, '/'-separated>\n" per file, in the byte
+// order of the paths. So `(cd ROOT && LC_ALL=C sort FILE-LIST | xargs -d '\n' sha256sum) | sha256sum`
+// gives the same digest. An error names the first file that cannot be read.
+Expected<std::string> sha256Listing(const std::filesystem::path& root, std::vector<std::string> relativePaths);
 
 }  // namespace dynbench

@@ -16,6 +16,7 @@
 #include "pipeline/flythrough.h"
 #include "report/plots.h"
 #include "report/stats_output.h"
+#include "scene/load.h"
 
 namespace dynbench::suite {
 
@@ -60,6 +61,7 @@ Expected<Manifest> parseManifest(const nlohmann::json& document, const fs::path&
   Manifest m;
   m.document = document;
   const JsonFields f(m.document, path);
+  m.path = path;
   auto bad = [&](const std::string& pointer, const std::string& expected) {
     return fail(ErrorCode::kInvalidData, "{}: {}: expected {}", path.string(), pointer, expected);
   };
@@ -161,9 +163,67 @@ Expected<Manifest> parseManifest(const nlohmann::json& document, const fs::path&
     if (!camera) return std::unexpected(camera.error());
     if (*camera != "bot" && *camera != "flythrough") return bad(at + "/camera", fmt::format("\"bot\" or \"flythrough\", found \"{}\"", *camera));
     d.camera = *camera;
+    if (f.has(at + "/sha256")) {
+      auto pins = f.value(at + "/sha256");
+      if (!(*pins)->is_object()) return bad(at + "/sha256", "an object with \"capture\" and/or \"dataset\" SHA-256s");
+      for (const auto& [key, value] : (*pins)->items())
+        if (key != "capture" && key != "dataset") return bad(at + "/sha256/" + key, "no other key than \"capture\" and \"dataset\"");
+      for (const auto& [key, target] : {std::pair{"capture", &d.captureSha256}, std::pair{"dataset", &d.datasetSha256}}) {
+        const std::string pointer = at + "/sha256/" + key;
+        if (!f.has(pointer)) continue;
+        auto v = f.string(pointer);
+        if (!v) return std::unexpected(v.error());
+        if (v->size() != 64 || v->find_first_not_of("0123456789abcdef") != std::string::npos)
+          return bad(pointer, fmt::format("a SHA-256 as 64 lower-case hex digits, found \"{}\"", *v));
+        *target = *v;
+      }
+    }
     m.datasets.push_back(d);
   }
   return m;
+}
+
+Expected<std::string> captureDigest(const fs::path& folder) {
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(folder, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+    if (it->path().filename().string().starts_with(".")) {
+      if (it->is_directory()) it.disable_recursion_pending();
+      continue;
+    }
+    if (it->is_regular_file()) files.push_back(fs::relative(it->path(), folder).generic_string());
+  }
+  if (ec) return fail(ErrorCode::kIo, "{}: cannot list the capture: {}", folder.string(), ec.message());
+  if (files.empty()) return fail(ErrorCode::kIo, "{}: no capture there", folder.string());
+  return sha256Listing(folder, std::move(files));
+}
+
+Expected<std::string> datasetDigest(const fs::path& gltf) {
+  auto document = readJsonFile(gltf);
+  if (!document) return std::unexpected(document.error());
+  std::set<std::string> files{gltf.filename().string()};
+  // Every "uri" in the document: buffers, images and extensions' files alike; data: URIs are inside.
+  std::vector<const nlohmann::json*> stack{&*document};
+  while (!stack.empty()) {
+    const nlohmann::json* node = stack.back();
+    stack.pop_back();
+    if (node->is_array())
+      for (const auto& item : *node) stack.push_back(&item);
+    if (!node->is_object()) continue;
+    for (const auto& [key, value] : node->items()) {
+      if (key == "uri" && value.is_string()) {
+        const std::string uri = value.get<std::string>();
+        if (uri.starts_with("data:") || uri.find("://") != std::string::npos) continue;
+        const fs::path relative = fs::path(scene::percentDecodeUri(uri)).lexically_normal();
+        if (relative.is_absolute() || relative.string().starts_with(".."))
+          return fail(ErrorCode::kInvalidData, "{}: uri '{}' leaves the dataset's folder", gltf.string(), uri);
+        files.insert(relative.generic_string());
+      } else {
+        stack.push_back(&value);
+      }
+    }
+  }
+  return sha256Listing(gltf.parent_path(), std::vector<std::string>(files.begin(), files.end()));
 }
 
 std::string rankingError(const std::string& method) { return method == "none" ? "flip" : "flip_over_none"; }
@@ -283,6 +343,54 @@ Expected<fs::path> prepareDataset(const DatasetSpec& d, const fs::path& root, do
   return fly;
 }
 
+// The capture's and the dataset's digests of one prepared dataset, checked against the manifest's
+// pins (dataset `index`); a mismatch names the dataset and the stage that made something else.
+struct Digests {
+  std::string capture, dataset;
+};
+Expected<Digests> checkPins(const Manifest& manifest, std::size_t index, const fs::path& dataset, const fs::path& root) {
+  const DatasetSpec& d = manifest.datasets[index];
+  auto plan = capturePlan(d, root);
+  if (!plan) return std::unexpected(plan.error());
+  const fs::path captureFolder = plan->openArena ? plan->openArenaOptions.output : plan->options.output;
+  auto capture = captureDigest(captureFolder);
+  if (!capture) return std::unexpected(capture.error());
+  auto made = datasetDigest(dataset);
+  if (!made) return std::unexpected(made.error());
+  const std::string manifestName = manifest.path.string();
+  if (!d.captureSha256.empty() && *capture != d.captureSha256)
+    return fail(ErrorCode::kInvalidData,
+                "{}: /datasets/{}/sha256/capture: dataset '{}': the capture stage made {} with SHA-256 {}, not the pinned {} (another "
+                "game, game data or capture adapter than the manifest's, or a capture that does not reproduce; docs/suite.md)",
+                manifestName, index, d.name, captureFolder.string(), *capture, d.captureSha256);
+  if (!d.datasetSha256.empty() && *made != d.datasetSha256)
+    return fail(ErrorCode::kInvalidData,
+                "{}: /datasets/{}/sha256/dataset: dataset '{}': the {} stage made {} with SHA-256 {}, not the pinned {} (the capture "
+                "{}; docs/suite.md)",
+                manifestName, index, d.name, d.camera == "bot" ? "convert" : "convert or fly-through", dataset.string(), *made,
+                d.datasetSha256, d.captureSha256.empty() ? "is not pinned" : "matches its pin: convert or flythrough made another dataset");
+  return Digests{*capture, *made};
+}
+
+// Every dataset of the suite captured, converted and flown through as needed, and its pins
+// checked: all of them before anything is rendered.
+Expected<std::vector<std::pair<fs::path, Digests>>> prepareDatasets(const Manifest& manifest, const fs::path& root, double fps,
+                                                                   const pipeline::RunLog& log) {
+  std::vector<std::pair<fs::path, Digests>> prepared;
+  for (std::size_t i = 0; i < manifest.datasets.size(); ++i) {
+    log(fmt::format("[{}/{}] {}: dataset", i + 1, manifest.datasets.size(), manifest.datasets[i].name));
+    auto dataset = prepareDataset(manifest.datasets[i], root, fps, log);
+    if (!dataset) return std::unexpected(dataset.error());
+    auto digests = checkPins(manifest, i, *dataset, root);
+    if (!digests) return std::unexpected(digests.error());
+    const DatasetSpec& d = manifest.datasets[i];
+    log(fmt::format("  sha256: capture {}{}, dataset {}{}", digests->capture, d.captureSha256.empty() ? "" : " (as pinned)", digests->dataset,
+                    d.datasetSha256.empty() ? "" : " (as pinned)"));
+    prepared.emplace_back(*dataset, *digests);
+  }
+  return prepared;
+}
+
 // The files a dataset's numbers come from, relative to DIR: the dataset's .gltf and .bin, and the
 // run's reference and input frames with their sidecars.
 std::vector<fs::path> recordedFiles(const fs::path& root, const fs::path& dataset, const fs::path& run) {
@@ -400,10 +508,7 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
   settings.threads = options.threads;
   SuiteOutcome outcome;
   if (options.part == SuitePart::kDatasets) {
-    for (std::size_t i = 0; i < manifest->datasets.size(); ++i) {
-      log(fmt::format("[{}/{}] {}", i + 1, manifest->datasets.size(), manifest->datasets[i].name));
-      if (auto dataset = prepareDataset(manifest->datasets[i], root, settings.fps, log); !dataset) return std::unexpected(dataset.error());
-    }
+    if (auto prepared = prepareDatasets(*manifest, root, settings.fps, log); !prepared) return std::unexpected(prepared.error());
     return outcome;
   }
   if (options.part == SuitePart::kRenderTask) {
@@ -424,6 +529,8 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
                         {"ranking_error", "flip_over_none (flip for none)"},
                         {"datasets", nlohmann::json::array()},
                         {"files", nlohmann::json::object()}};
+  auto prepared = prepareDatasets(*manifest, root, settings.fps, log);
+  if (!prepared) return std::unexpected(prepared.error());
   const auto start = std::chrono::steady_clock::now();
   for (std::size_t i = 0; i < manifest->datasets.size(); ++i) {
     const DatasetSpec& spec = manifest->datasets[i];
@@ -433,22 +540,22 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
                                     : fmt::format(" ({} done in {:.1f} min, about {:.0f} min left)", i, elapsed / 60.0,
                                                   elapsed / static_cast<double>(i) * static_cast<double>(manifest->datasets.size() - i) / 60.0);
     log(fmt::format("[{}/{}] {}{}", i + 1, manifest->datasets.size(), spec.name, pace));
-    auto dataset = prepareDataset(spec, root, settings.fps, log);
-    if (!dataset) return std::unexpected(dataset.error());
+    const auto& [dataset, digests] = (*prepared)[i];
     const fs::path run = root / "runs" / spec.name;
     DatasetRunSettings s = settings;
     s.seed = spec.seed;
-    auto measured = pipeline::measureDataset(*dataset, run, s, log);
+    auto measured = pipeline::measureDataset(dataset, run, s, log);
     if (!measured) return std::unexpected(measured.error());
     DatasetResult result{spec.name, measuresOf(measured->motion, measured->firstFrame, measured->lastFrame, measured->discard), errorsOf(measured->methods)};
     outcome.datasets.push_back(result);
     doc["datasets"].push_back({{"name", spec.name},
-                               {"dataset", fs::relative(*dataset, root).string()},
+                               {"dataset", fs::relative(dataset, root).string()},
                                {"run", fs::relative(run, root).string()},
+                               {"sha256", {{"capture", digests.capture}, {"dataset", digests.dataset}}},
                                {"window", {{"first", measured->firstFrame}, {"last", measured->lastFrame}}},
                                {"measures", result.measures},
                                {"errors", result.errors}});
-    for (const fs::path& file : recordedFiles(root, *dataset, run)) {
+    for (const fs::path& file : recordedFiles(root, dataset, run)) {
       auto sum = sha256File(root / file);
       if (!sum) return std::unexpected(sum.error());
       doc["files"][file.string()] = *sum;

@@ -32,6 +32,9 @@ struct DatasetSpec {
   unsigned seed = 1;
   double seconds = 10.0;        // game time captured
   std::string camera = "bot";   // "bot" (the first-person bot) or "flythrough"
+  // Pins (/datasets/N/sha256/capture and /dataset): the SHA-256 the capture folder and the dataset
+  // must have (captureDigest, datasetDigest); empty: not checked.
+  std::string captureSha256, datasetSha256;
 };
 
 struct Manifest {
@@ -40,11 +43,21 @@ struct Manifest {
   pipeline::DatasetRunSettings run;  // the render window, samples and methods of every dataset
   std::vector<DatasetSpec> datasets;
   nlohmann::json document;           // as read (recorded in suite.json)
+  std::filesystem::path path;        // where it was read from (errors name it)
 };
 // Errors name the file and the JSON pointer of the value and what was expected.
 Expected<Manifest> readManifest(const std::filesystem::path& path);
 // The same of a manifest already parsed (`path` names it in errors).
 Expected<Manifest> parseManifest(const nlohmann::json& document, const std::filesystem::path& path);
+
+// A capture folder's digest, what /datasets/N/sha256/capture pins: every file in it (Capture.txt,
+// LICENSES.txt, models/*.txt; names starting with '.' aside) as sha256Listing (core/checksum.h)
+// lists them.
+Expected<std::string> captureDigest(const std::filesystem::path& folder);
+// A dataset's digest, what /datasets/N/sha256/dataset pins: its .gltf and every file the .gltf names
+// by a relative "uri" (the .bin, the textures, the environment map), listed relative to the
+// .gltf's folder. The README beside it is not part of it.
+Expected<std::string> datasetDigest(const std::filesystem::path& gltf);
 
 // One dataset's numbers. Difficulty measures (docs/suite.md): Table 6.7's five columns over the
 // render window (percent) and the camera's motion over the same frames (Tables 6.4-6.6: position
