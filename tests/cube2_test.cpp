@@ -14,10 +14,9 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
-#include <utility>
-#include <vector>
 
 #include "capture/cube2.h"
 #include "core/files.h"
@@ -25,6 +24,7 @@
 #include "scene/load.h"
 #include "gltf_builder.h"
 #include "external_tools.h"
+#include "other_machine.h"
 #include "run_cli.h"
 
 namespace dynbench {
@@ -39,16 +39,11 @@ TEST(Cube2, SeededMatchIsDeterministicAndConverts) {
   ::setenv("DYNBENCH_CAPTURE_VERIFY_FRAME", "120", 1);
   // Run b as another machine would: SDL's dummy audio driver is a working audio device (with one,
   // the game's sounds drew from its random numbers before the adapter turned the volume to 0).
-  const std::vector<std::pair<const char*, const char*>> otherMachine = {
-      {"SDL_AUDIODRIVER", "dummy"},
-      {"GALLIUM_OVERRIDE_CPU_CAPS", "avx"},
-      {"LP_NUM_THREADS", "1"},
-      {"GLIBC_TUNABLES", "glibc.cpu.hwcaps=-AVX2,-FMA,-AVX512F,-AVX512VL,-AVX512BW,-AVX512DQ"}};
   for (const char* run : {"a", "b"}) {
-    if (std::string(run) == "b")
-      for (const auto& [name, value] : otherMachine) ::setenv(name, value, 1);
+    std::optional<test::OtherMachine> other;
+    if (std::string(run) == "b") other.emplace();
     const auto r = dynbench(fmt::format("capture cube2 -o {} --map colos --bots 4 --seconds 5 --seed 3", (dir / run).string()), dir);
-    for (const auto& [name, value] : otherMachine) ::unsetenv(name);
+    other.reset();
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("300 frames"), std::string::npos) << r.out;
   }
