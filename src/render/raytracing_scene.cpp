@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 
 #include <embree3/rtcore.h>
@@ -122,13 +123,26 @@ struct RayTracingScene::Impl {
   }
 };
 
+namespace {
+
+// Embree picks its kernels for the CPU at run time (SSE4.2 to AVX-512), so its hits could in
+// principle differ between machines. DYNBENCH_EMBREE_CONFIG passes an Embree device configuration
+// (rtcNewDevice(3), e.g. "max_isa=avx2") so that one machine can run as another would: the
+// reproducibility checks of issue 45 use it (docs/suite.md, "Pins"). Unset: Embree's defaults.
+RTCDevice newDevice() {
+  const char* config = std::getenv("DYNBENCH_EMBREE_CONFIG");
+  return rtcNewDevice(config && *config ? config : nullptr);
+}
+
+}  // namespace
+
 RayTracingScene::RayTracingScene(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 RayTracingScene::~RayTracingScene() = default;
 
 Expected<std::unique_ptr<RayTracingScene>> RayTracingScene::create(const scene::Scene& scene, AlphaTest alphaTest) {
   auto impl = std::make_unique<Impl>(scene);
   impl->alphaTest = std::move(alphaTest);
-  impl->device = rtcNewDevice(nullptr);
+  impl->device = newDevice();
   if (!impl->device) return fail(ErrorCode::kExternalTool, "Embree: cannot create a device (error {})", static_cast<int>(rtcGetDeviceError(nullptr)));
   rtcSetDeviceErrorFunction(impl->device, onEmbreeError, &impl->error);
   impl->staticScene = rtcNewScene(impl->device);
@@ -425,7 +439,7 @@ Expected<void> SphereIndex::build(const std::vector<glm::dvec4>& spheres) {
       return fail(ErrorCode::kInternal, "sphere index: sphere {} has radius {}; expected a finite positive radius", i, spheres[i].w);
   spheres_ = spheres;
   if (!impl_->device) {
-    impl_->device = rtcNewDevice(nullptr);
+    impl_->device = newDevice();
     if (!impl_->device) return fail(ErrorCode::kExternalTool, "Embree: cannot create a device (error {})", static_cast<int>(rtcGetDeviceError(nullptr)));
     rtcSetDeviceErrorFunction(impl_->device, onEmbreeError, &impl_->error);
   }
