@@ -15,6 +15,7 @@
 #include <glm/glm.hpp>
 
 #include "frames/frame_io.h"
+#include "frames/radiance_change.h"
 
 namespace dynbench::discard {
 
@@ -48,7 +49,7 @@ struct Thresholds {
   // Radiance vector distance ||L_i - L_{i-1}|| (RGB). By default a fraction of the current frame's
   // mean luminance of that buffer (the exposure-like tuning the thesis did by hand);
   // absoluteRadiance takes it in radiance units, as the thesis's functions literally do.
-  double direct = 0.1, indirect = 0.1;
+  double direct = frames::kDefaultRadianceThreshold, indirect = frames::kDefaultRadianceThreshold;
   bool absoluteRadiance = false;
   // How a radiance difference becomes a discard (docs/metrics.md, "Radiance discard"):
   //  kPairs (default): the frame's radiance-change pairs (render --pairs: each sample of frame i

@@ -23,6 +23,11 @@ namespace dynbench::frames {
 // thresholds are on (docs/metrics.md).
 inline constexpr double kGreyDistance = 1.7320508075688772;
 
+// Discard's default radiance thresholds, direct and indirect alike: a change of a tenth of the
+// frame's mean luminance of that buffer (docs/metrics.md). The render's adaptive sampling and its
+// pairs aim at the same threshold (RenderSettings), so both read it from here.
+inline constexpr double kDefaultRadianceThreshold = 0.1;
+
 // The mean luminance of an RGB buffer (3 floats a pixel): what a relative radiance threshold is a
 // fraction of (discard's defaults).
 inline double meanLuminance(const std::vector<float>& rgb) {

@@ -777,9 +777,8 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
     summary.tolerance = settings_.tolerance;
     // Discard's expected test measures a luminance change on the thresholds' RGB scale, x sqrt(3)
     // (a grey change): the luminance standard error's target is the threshold's share over sqrt(3).
-    constexpr double kGrey = 1.7320508075688772;
-    summary.directTarget = settings_.tolerance * settings_.directThresholdFraction * meanDirect / kGrey;
-    summary.indirectTarget = settings_.tolerance * settings_.indirectThresholdFraction * meanIndirect / kGrey;
+    summary.directTarget = settings_.tolerance * settings_.directThresholdFraction * meanDirect / frames::kGreyDistance;
+    summary.indirectTarget = settings_.tolerance * settings_.indirectThresholdFraction * meanIndirect / frames::kGreyDistance;
     const double directTargetSq = summary.directTarget * summary.directTarget;
     const double indirectTargetSq = summary.indirectTarget * summary.indirectTarget;
     const int cap = std::max(firstRound, settings_.maxSamplesPerPixel);

@@ -28,6 +28,7 @@
 
 #include "core/error.h"
 #include "frames/feature_frame.h"
+#include "frames/radiance_change.h"
 #include "render/bsdf.h"
 #include "render/camera.h"
 #include "render/lights.h"
@@ -69,7 +70,7 @@ struct RenderSettings {
   // own camera ray, offset from the (jittered) pixel centre by the filter. The geometry buffers stay
   // the centre's. kCentre: every path starts at the centre's hit (radiance at a point, aliased).
   PixelFilterSpec pixelFilter;
-  double directThresholdFraction = 0.1, indirectThresholdFraction = 0.1;
+  double directThresholdFraction = frames::kDefaultRadianceThreshold, indirectThresholdFraction = frames::kDefaultRadianceThreshold;
   // Paths traced together (PathTracer::tracePaths); 1 traces one path at a time. The image does
   // not depend on it (tested): only the speed does.
   int pathBatch = 64;
