@@ -71,6 +71,14 @@ inline std::array<double, 4> catmullRomWeights(double t) {
 // channels, light choice and the discard's noise test use.
 inline double luminance(const glm::dvec3& rgb) { return 0.2126 * rgb.r + 0.7152 * rgb.g + 0.0722 * rgb.b; }
 
+// The sRGB transfer function decoded (IEC 61966-2-1): an sRGB-encoded channel in [0, 1] to linear.
+// In the channel's own precision (float for textures, double for ꟻLIP and fidelity), so each caller
+// computes exactly what it did with its own copy.
+template <typename T>
+inline T srgbToLinear(T c) {
+  return c <= T(0.04045) ? c / T(12.92) : std::pow((c + T(0.055)) / T(1.055), T(2.4));
+}
+
 // sin and cos of an angle, computed in single precision and widened. For Monte Carlo sampling
 // only: a sampled direction is off by at most ~3e-7 rad (the float rounding of the angle), far
 // below a pixel of any image here, and the sample's density is computed from the direction

@@ -16,6 +16,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
+#include "core/math.h"
 #include "evaluate/vector_loops.h"
 
 namespace dynbench::evaluate::flip {
@@ -286,10 +287,7 @@ FeatureKernels featureKernels(double ppd) {
 
 double defaultPixelsPerDegree() { return 0.7 * (3840.0 / 0.7) * (pi / 180.0); }
 
-glm::dvec3 srgbToLinear(glm::dvec3 s) {
-  auto f = [](double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); };
-  return {f(s.x), f(s.y), f(s.z)};
-}
+glm::dvec3 srgbToLinear(glm::dvec3 s) { return {dynbench::srgbToLinear(s.x), dynbench::srgbToLinear(s.y), dynbench::srgbToLinear(s.z)}; }
 glm::dvec3 linearToSrgb(glm::dvec3 l) {
   auto f = [](double c) { return c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055; };
   return {f(l.x), f(l.y), f(l.z)};

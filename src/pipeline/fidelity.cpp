@@ -21,8 +21,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-double srgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
-
 // Separable Gaussian blur of a one-channel image (sigma in pixels, kernel to 3 sigma, edges clamped).
 std::vector<double> blur(const std::vector<double>& image, int w, int h, double sigma) {
   const int radius = std::max(1, static_cast<int>(std::ceil(3 * sigma)));
@@ -93,7 +91,8 @@ FidelityFrame compareWithGame(const FidelityImages& m) {
   f.unlitShare = geometry ? static_cast<double>(unlit) / static_cast<double>(geometry) : 0.0;
   std::vector<double> game(n), render(n);
   for (std::size_t i = 0; i < n; ++i) {
-    game[i] = luminance(glm::dvec3(srgbToLinear(m.gameColour[3 * i]), srgbToLinear(m.gameColour[3 * i + 1]), srgbToLinear(m.gameColour[3 * i + 2])));
+    game[i] = luminance(glm::dvec3(srgbToLinear<double>(m.gameColour[3 * i]), srgbToLinear<double>(m.gameColour[3 * i + 1]),
+                                   srgbToLinear<double>(m.gameColour[3 * i + 2])));
     render[i] = luminance(glm::dvec3(m.renderRadiance[3 * i], m.renderRadiance[3 * i + 1], m.renderRadiance[3 * i + 2]));
   }
   const double sigma = std::max(1.0, m.height / 90.0);

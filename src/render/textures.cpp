@@ -8,14 +8,11 @@
 #include <tbb/parallel_for.h>
 
 #include "core/image_io.h"
+#include "core/math.h"
 #include "render/prefetch.h"
 
 namespace dynbench::render {
 namespace {
-
-float srgbToLinear(float c) {  // IEC 61966-2-1
-  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
 
 // Texel i of `image` as RGBA: grey expands to RGB, a missing alpha is 1.
 glm::vec4 rgba(const FloatImage& image, std::size_t i) {
