@@ -63,7 +63,9 @@ Expected<std::string> sha256Listing(const std::filesystem::path& root, std::vect
     if (!sum) return std::unexpected(sum.error());
     listing += *sum + "  " + path + "\n";
   }
-  return sha256Text(listing);
+  std::string digest = sha256Text(listing);
+  if (digest.empty()) return fail(ErrorCode::kInternal, "{}: OpenSSL's SHA-256 of the files' listing failed", root.string());
+  return digest;
 }
 
 }  // namespace dynbench

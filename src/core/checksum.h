@@ -13,7 +13,7 @@ namespace dynbench {
 // The file's SHA-256 as 64 lower-case hex digits; an error names the file.
 Expected<std::string> sha256File(const std::filesystem::path& path);
 
-// The SHA-256 of bytes, as 64 lower-case hex digits.
+// The SHA-256 of bytes, as 64 lower-case hex digits (empty only if OpenSSL itself fails).
 std::string sha256Text(std::string_view bytes);
 
 // The SHA-256 of a set of files under `root` as `sha256sum` lists them: the digest of the text of

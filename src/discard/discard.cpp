@@ -19,7 +19,6 @@ namespace {
 
 glm::dvec3 at3(const std::vector<float>& b, std::size_t i) { return {b[3 * i], b[3 * i + 1], b[3 * i + 2]}; }
 
-
 }  // namespace
 
 namespace {

@@ -345,31 +345,38 @@ Expected<fs::path> prepareDataset(const DatasetSpec& d, const fs::path& root, do
 
 // The capture's and the dataset's digests of one prepared dataset, checked against the manifest's
 // pins (dataset `index`); a mismatch names the dataset and the stage that made something else.
+// `captureDigests` keeps each capture folder's digest: a bot dataset and its fly-through share one.
 struct Digests {
   std::string capture, dataset;
 };
-Expected<Digests> checkPins(const Manifest& manifest, std::size_t index, const fs::path& dataset, const fs::path& root) {
+Expected<Digests> checkPins(const Manifest& manifest, std::size_t index, const fs::path& dataset, const fs::path& root,
+                            std::map<fs::path, std::string>& captureDigests) {
   const DatasetSpec& d = manifest.datasets[index];
   auto plan = capturePlan(d, root);
   if (!plan) return std::unexpected(plan.error());
   const fs::path captureFolder = plan->openArena ? plan->openArenaOptions.output : plan->options.output;
-  auto capture = captureDigest(captureFolder);
-  if (!capture) return std::unexpected(capture.error());
+  auto known = captureDigests.find(captureFolder);
+  if (known == captureDigests.end()) {
+    auto digest = captureDigest(captureFolder);
+    if (!digest) return std::unexpected(digest.error());
+    known = captureDigests.emplace(captureFolder, *digest).first;
+  }
+  const std::string& capture = known->second;
   auto made = datasetDigest(dataset);
   if (!made) return std::unexpected(made.error());
   const std::string manifestName = manifest.path.string();
-  if (!d.captureSha256.empty() && *capture != d.captureSha256)
+  if (!d.captureSha256.empty() && capture != d.captureSha256)
     return fail(ErrorCode::kInvalidData,
                 "{}: /datasets/{}/sha256/capture: dataset '{}': the capture stage made {} with SHA-256 {}, not the pinned {} (another "
                 "game, game data or capture adapter than the manifest's, or a capture that does not reproduce; docs/suite.md)",
-                manifestName, index, d.name, captureFolder.string(), *capture, d.captureSha256);
+                manifestName, index, d.name, captureFolder.string(), capture, d.captureSha256);
   if (!d.datasetSha256.empty() && *made != d.datasetSha256)
     return fail(ErrorCode::kInvalidData,
                 "{}: /datasets/{}/sha256/dataset: dataset '{}': the {} stage made {} with SHA-256 {}, not the pinned {} (the capture "
                 "{}; docs/suite.md)",
                 manifestName, index, d.name, d.camera == "bot" ? "convert" : "convert or fly-through", dataset.string(), *made,
                 d.datasetSha256, d.captureSha256.empty() ? "is not pinned" : "matches its pin: convert or flythrough made another dataset");
-  return Digests{*capture, *made};
+  return Digests{capture, *made};
 }
 
 // Every dataset of the suite captured, converted and flown through as needed, and its pins
@@ -377,11 +384,12 @@ Expected<Digests> checkPins(const Manifest& manifest, std::size_t index, const f
 Expected<std::vector<std::pair<fs::path, Digests>>> prepareDatasets(const Manifest& manifest, const fs::path& root, double fps,
                                                                    const pipeline::RunLog& log) {
   std::vector<std::pair<fs::path, Digests>> prepared;
+  std::map<fs::path, std::string> captureDigests;
   for (std::size_t i = 0; i < manifest.datasets.size(); ++i) {
     log(fmt::format("[{}/{}] {}: dataset", i + 1, manifest.datasets.size(), manifest.datasets[i].name));
     auto dataset = prepareDataset(manifest.datasets[i], root, fps, log);
     if (!dataset) return std::unexpected(dataset.error());
-    auto digests = checkPins(manifest, i, *dataset, root);
+    auto digests = checkPins(manifest, i, *dataset, root, captureDigests);
     if (!digests) return std::unexpected(digests.error());
     const DatasetSpec& d = manifest.datasets[i];
     log(fmt::format("  sha256: capture {}{}, dataset {}{}", digests->capture, d.captureSha256.empty() ? "" : " (as pinned)", digests->dataset,
