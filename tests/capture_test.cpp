@@ -341,6 +341,86 @@ TEST(BadCapture, LightRangeFalloffAndMapLighting) {
   expectCaptureError(handCapture("bad_lighting_fields", kHeader + "L:0:1:0:1:1:1\n"), ErrorCode::kParse, {"Capture.txt:3:", "needs 12 fields"});
 }
 
+// A mesh's material beyond its maps (ModelMesh version 3): what the SDK takes comes back from the
+// reader; values out of range are refused by the SDK (nothing written) and by the reader (file:line).
+TEST(Capture, MaterialRecordsAndVertexColoursRoundTrip) {
+  const fs::path dir = freshDir("capture_materials");
+  dbc_session* s = nullptr;
+  ASSERT_EQ(dbc_open(dir.c_str(), "test", &s), DBC_OK) << dbc_last_error();
+  const float positions[] = {0, 0, 0, 1, 0, 0, 1, 0, 1}, uvs[] = {0, 0, 1, 0, 1, 1};
+  const float colors[] = {1, 1, 1, 1, 0.5f, 0.25f, 0, 0.5f, 0, 0, 0, 0};
+  const float base[] = {0.2f, 0.4f, 0.6f, 1}, mr[] = {0, 0.05f}, emission[] = {1.5f, 0.75f, 0};
+  const uint32_t tri[] = {0, 1, 2};
+  ASSERT_EQ(dbc_model_begin(s, "map"), DBC_OK);
+  dbc_mesh lava{};
+  lava.name = "lava";
+  lava.texture = lava.emission_texture = "lava.png";
+  lava.vertex_count = 3;
+  lava.positions = positions;
+  lava.uvs = uvs;
+  lava.triangle_count = 1;
+  lava.indices = tri;
+  lava.base_color = base;
+  lava.metallic_roughness = mr;
+  lava.emission = emission;
+  lava.colors = colors;
+  // Refused before anything is kept: a colour above 1, a negative emission, roughness above 1.
+  const float tooBright[] = {1.5f, 1, 1, 1}, negative[] = {-1, 0, 0}, rough[] = {0, 2};
+  for (int bad = 0; bad < 3; ++bad) {
+    dbc_mesh b = lava;
+    if (bad == 0) b.base_color = tooBright;
+    if (bad == 1) b.emission = negative;
+    if (bad == 2) b.metallic_roughness = rough;
+    EXPECT_EQ(dbc_model_mesh(s, &b), DBC_ERROR_ARGUMENT) << bad;
+  }
+  dbc_mesh badVertex = lava;
+  const float badColors[] = {1, 1, 1, 1, 1, 1, 1, -0.5f, 1, 1, 1, 1};
+  badVertex.colors = badColors;
+  EXPECT_EQ(dbc_model_mesh(s, &badVertex), DBC_ERROR_ARGUMENT);
+  EXPECT_NE(std::string(dbc_last_error()).find("vertex 1"), std::string::npos) << dbc_last_error();
+  ASSERT_EQ(dbc_model_mesh(s, &lava), DBC_OK) << dbc_last_error();
+  ASSERT_EQ(dbc_model_end(s), DBC_OK);
+  const uint64_t camera = dbc_new_id(s);
+  for (int f = 0; f < 2; ++f) {
+    ASSERT_EQ(dbc_frame_begin(s, static_cast<uint64_t>(f), f / 60.0), DBC_OK);
+    ASSERT_EQ(dbc_camera(s, camera, positions, 0, 0, 0), DBC_OK);
+    ASSERT_EQ(dbc_frame_end(s), DBC_OK);
+  }
+  ASSERT_EQ(dbc_close(s), DBC_OK);
+  auto reader = CaptureReader::open(dir);
+  ASSERT_TRUE(reader) << reader.error().message;
+  ASSERT_EQ((*reader)->models().size(), 1u);
+  const CapturedMesh& m = (*reader)->models()[0].meshes.at(0);
+  EXPECT_EQ(m.texture, "lava.png");
+  EXPECT_EQ(m.emissionTexture, "lava.png");
+  EXPECT_EQ(m.baseColor, glm::vec4(0.2f, 0.4f, 0.6f, 1));
+  ASSERT_TRUE(m.metallicRoughness);
+  EXPECT_EQ(*m.metallicRoughness, glm::vec2(0, 0.05f));
+  EXPECT_EQ(m.emission, glm::vec3(1.5f, 0.75f, 0));
+  ASSERT_EQ(m.colors.size(), 3u);
+  EXPECT_EQ(m.colors[1], glm::vec4(0.5f, 0.25f, 0, 0.5f));
+
+  // The reader names the line of a value out of range, and of a missing vertex colour.
+  fs::path file;
+  for (const auto& e : fs::directory_iterator(dir / "models")) file = e.path();
+  std::ifstream in(file);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  in.close();
+  auto rewrite = [&](const std::string& from, const std::string& to) {
+    std::string changed = text;
+    const auto at = changed.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    changed.replace(at, from.size(), to);
+    std::ofstream(file, std::ios::trunc) << changed;
+  };
+  rewrite("e:0:1.5:", "e:0:-1.5:");
+  expectCaptureError(dir, ErrorCode::kInvalidData, {file.filename().string() + ":", "emission must not be negative"});
+  rewrite("c:0:0.5:0.25:0:0.5\n", "");
+  expectCaptureError(dir, ErrorCode::kInvalidData, {file.filename().string(), "'c' records"});
+  rewrite("f:0:0.2", "f:0:1.2");
+  expectCaptureError(dir, ErrorCode::kInvalidData, {file.filename().string() + ":", "[0, 1]"});
+}
+
 TEST(BadCapture, BrokenModelMeshFile) {
   const auto dir = writeCapture("bad_modelmesh");
   fs::path file;

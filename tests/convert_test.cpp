@@ -231,6 +231,100 @@ TEST(Convert, MaskMapBecomesMetallicRoughness) {
   EXPECT_EQ(status, 0) << validation;
 }
 
+// A mesh's material beyond its maps (Cube 2's lava and water): base colour factor, metallic and
+// roughness, emission in cd/m2 (E_u e / pi, docs/dataset.md) and vertex colours as COLOR_0 with
+// alpha blending; the Khronos validator accepts it and dynbench's loader reads it back.
+TEST(Convert, MaterialFactorsEmissionAndVertexColours) {
+  const fs::path dir = freshDir("convert_materials");
+  fs::create_directories(dir / "data");
+  std::ofstream(dir / "data/lava.png", std::ios::binary).write(reinterpret_cast<const char*>(kPng), sizeof kPng);
+  dbc_session* s = nullptr;
+  ASSERT_EQ(dbc_open((dir / "capture").c_str(), "test", &s), DBC_OK);
+  ASSERT_EQ(dbc_set_data_root(s, (dir / "data").c_str()), DBC_OK);
+  const float positions[] = {0, 0, 0, 1, 0, 0, 1, 0, 1, 0, 0, 1}, uvs[] = {0, 0, 1, 0, 1, 1, 0, 1};
+  const float normals[] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
+  const float colors[] = {1, 1, 1, 1, 0.5f, 0.5f, 0.5f, 0.25f, 1, 1, 1, 1, 1, 1, 1, 1};
+  const float water[] = {0.1f, 0.2f, 0.3f, 1}, smooth[] = {0, 0.05f}, emission[] = {1.5f, 0.75f, 0};
+  const uint32_t quad[] = {0, 1, 2, 0, 2, 3};
+  dbc_mesh lava{};
+  lava.name = "lava";
+  lava.texture = lava.emission_texture = "lava.png";
+  lava.vertex_count = 4;
+  lava.positions = positions;
+  lava.normals = normals;
+  lava.uvs = uvs;
+  lava.triangle_count = 2;
+  lava.indices = quad;
+  lava.emission = emission;
+  dbc_mesh pool = lava;
+  pool.mesh_id = 1;
+  pool.name = "water";
+  pool.texture = pool.emission_texture = nullptr;
+  pool.emission = nullptr;
+  pool.base_color = water;
+  pool.metallic_roughness = smooth;
+  dbc_mesh layer = pool;
+  layer.mesh_id = 2;
+  layer.name = "layer";
+  layer.base_color = nullptr;
+  layer.metallic_roughness = nullptr;
+  layer.colors = colors;
+  ASSERT_EQ(dbc_model_begin(s, "map"), DBC_OK);
+  for (const dbc_mesh* m : {&lava, &pool, &layer}) ASSERT_EQ(dbc_model_mesh(s, m), DBC_OK) << dbc_last_error();
+  ASSERT_EQ(dbc_model_end(s), DBC_OK);
+  const uint64_t camera = dbc_new_id(s), map = dbc_new_id(s);
+  const float eye[] = {0.5f, 2, 0.5f};
+  const dbc_dual_quat identity{0, 0, 0, 1, 0, 0, 0, 0};
+  for (int f = 0; f < 2; ++f) {
+    ASSERT_EQ(dbc_frame_begin(s, static_cast<uint64_t>(f), f / 60.0), DBC_OK);
+    ASSERT_EQ(dbc_camera(s, camera, eye, -90, 0, 0), DBC_OK);
+    if (f == 0) ASSERT_EQ(dbc_static_model(s, map, "map", identity), DBC_OK) << dbc_last_error();
+    ASSERT_EQ(dbc_frame_end(s), DBC_OK);
+  }
+  ASSERT_EQ(dbc_close(s), DBC_OK);
+  ConvertOptions options;
+  options.capture = dir / "capture";
+  options.output = dir / "out" / "materials.gltf";
+  options.lightRules.luxPerUnit = 20000.0;
+  auto report = convertCapture(options);
+  ASSERT_TRUE(report) << report.error().message;
+  const auto j = readJson(options.output);
+  ASSERT_EQ(j["materials"].size(), 3u);
+  const auto& lavaMaterial = j["materials"][0];
+  EXPECT_EQ(lavaMaterial["emissiveFactor"], nlohmann::json({1.0, 0.5, 0.0}));
+  // Radiance E_u e / pi: strength E_u max(e) / pi.
+  EXPECT_NEAR(lavaMaterial["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"].get<double>(), 20000.0 * 1.5 / kPi, 1e-6);
+  EXPECT_TRUE(lavaMaterial.contains("emissiveTexture"));
+  EXPECT_FALSE(lavaMaterial.contains("alphaMode"));
+  const auto& waterMaterial = j["materials"][1]["pbrMetallicRoughness"];
+  EXPECT_NEAR(waterMaterial["baseColorFactor"][2].get<double>(), 0.3, 1e-6);
+  EXPECT_NEAR(waterMaterial["roughnessFactor"].get<double>(), 0.05, 1e-6);
+  EXPECT_EQ(waterMaterial["metallicFactor"].get<double>(), 0.0);
+  EXPECT_EQ(j["materials"][2]["alphaMode"], "BLEND");  // a vertex alpha below 1
+  const auto& used = j["extensionsUsed"];
+  EXPECT_NE(std::find(used.begin(), used.end(), "KHR_materials_emissive_strength"), used.end());
+  int status = -1;
+  const std::string validation = test::validateGltf(options.output, status);
+  EXPECT_EQ(status, 0) << validation;
+  EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
+
+  auto loaded = scene::loadScene(options.output);
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  const scene::Material& lavaLoaded = loaded->materials[0];
+  EXPECT_NEAR(lavaLoaded.emissiveFactor.r, 20000.0 * 1.5 / kPi, 1e-2);  // factor x strength
+  EXPECT_NEAR(lavaLoaded.emissiveFactor.g, 20000.0 * 0.75 / kPi, 1e-2);
+  bool sawColours = false;
+  for (const auto& mesh : loaded->meshes)
+    for (const auto& prim : mesh.primitives)
+      if (!prim.colors.empty()) {
+        sawColours = true;
+        ASSERT_EQ(prim.colors.size(), 4u);
+        EXPECT_EQ(prim.colors[1], glm::vec4(0.5f, 0.5f, 0.5f, 0.25f));
+        EXPECT_EQ(loaded->materials[static_cast<std::size_t>(prim.material)].alphaMode, scene::AlphaMode::kBlend);
+      }
+  EXPECT_TRUE(sawColours);
+}
+
 // Blender's own glTF importer reads the dataset (the thesis rendered its datasets with Blender).
 
 TEST(Convert, BlenderImportsTheDataset) {

@@ -115,6 +115,39 @@ TEST(Render, PointLightOverDiffusePlaneGivesTheAnalyticRadianceWithoutNoise) {
   }
 }
 
+TEST(Render, VertexColoursMultiplyTheBaseColour) {
+  // glTF's COLOR_0 multiplies the base colour: with (0.5, 0.25, 1) on every vertex the plane's
+  // direct radiance is the analytic one of the previous test times that colour, channel by channel.
+  PlaneScene p = pointLightOverPlane();
+  const glm::vec4 colour(0.5f, 0.25f, 1.0f, 1.0f);
+  for (auto& mesh : p.scene.meshes)
+    for (auto& prim : mesh.primitives) prim.colors.assign(prim.positions.size(), colour);
+  RenderSettings settings;
+  settings.pixelFilter = {PixelFilterType::kCentre, 0.0};
+  settings.samplesPerPixel = 1;
+  settings.useEnvironment = false;
+  auto tracer = tracerFor(p.scene, settings);
+  ASSERT_TRUE(tracer);
+  ASSERT_TRUE(tracer->setTime(0.0, 0.0));
+  const int w = 40, h = 30;
+  const RenderCamera cam = lookCamera({0, 4, 0}, {0, -1, 0}, 60.0, w, h);
+  const FrameBuffers f = tracer->render(0, cam, cam);
+  int checked = 0;
+  for (int py = 0; py < h; ++py)
+    for (int px = 0; px < w; ++px) {
+      const std::size_t i = static_cast<std::size_t>(py * w + px);
+      if (f.hit[i] == 0.0f) continue;
+      const Ray r = cam.ray(px + 0.5, py + 0.5);
+      const glm::dvec3 x = r.origin + r.direction * (-r.origin.y / r.direction.y);
+      const double d = glm::length(p.light - x);
+      const double analytic = p.albedo / kPi * p.intensity * p.light.y / (d * d * d);
+      for (int c = 0; c < 3; ++c) ASSERT_NEAR(f.direct[3 * i + c], analytic * colour[c], 2e-6 * analytic) << px << "," << py << " channel " << c;
+      EXPECT_NEAR(f.albedo[3 * i + 1], p.albedo * 0.25, 1e-6);
+      ++checked;
+    }
+  EXPECT_GT(checked, 700);
+}
+
 TEST(Render, ThousandLightsOfWhichTenReachGiveTheImageOfTheTen) {
   // Ten point lights with a range over the plane, and 990 whose range ends before the plane: the
   // light tree must find the ten (and only those) and the image must be the ten's alone.

@@ -66,6 +66,14 @@ typedef struct dbc_mesh {
   const float* weights;     /* 4 per vertex */
   size_t triangle_count;
   const uint32_t* indices;  /* 3 per triangle */
+  /* The surface's material beyond its maps (ModelMesh version 3); NULL for the defaults. */
+  const float* base_color;        /* 4: linear RGBA multiplying the texture map (default 1, 1, 1, 1) */
+  const float* metallic_roughness; /* 2: metallic, roughness in [0, 1] (default: from the mask map, or 0 and 0.8) */
+  const float* emission;          /* 3: light the surface gives off, in the light colours' units (1: as bright
+                                     as a white surface under the engine's full light); default none */
+  const char* emission_texture;   /* emission map multiplying `emission`, relative to the data root */
+  const float* colors;            /* 4 per vertex: linear RGBA multiplying base_color; an alpha below 1 (here
+                                     or in base_color) becomes glTF's alphaMode BLEND */
 } dbc_mesh;
 
 /* Session. dbc_open creates the directory (and models/) and writes the version line. */

@@ -12,10 +12,12 @@ namespace dynbench::capture {
 // predate the adapters' signed normals, so they are refused, not converted. Version 3 (this one)
 // added vertex animation: a mesh's key frames (ModelMesh version 2: `K`, `P`, `N`) and a
 // capturable's key-frame pose each frame (`v`); version 2 captures and version 1 ModelMesh files
-// read as before.
+// read as before. ModelMesh version 3 added a mesh's material beyond its maps (`f`, `r`, `e`, `E`)
+// and vertex colours (`c`); versions 1 and 2 read as before.
 inline constexpr std::string_view kCaptureVersionLine = "dynbench-capture:3";
 inline constexpr std::string_view kCaptureVersion2Line = "dynbench-capture:2";
-inline constexpr std::string_view kModelMeshVersionLine = "dynbench-modelmesh:2";
+inline constexpr std::string_view kModelMeshVersionLine = "dynbench-modelmesh:3";
+inline constexpr std::string_view kModelMeshVersion2Line = "dynbench-modelmesh:2";
 inline constexpr std::string_view kModelMeshVersion1Line = "dynbench-modelmesh:1";
 inline constexpr std::string_view kCaptureFile = "Capture.txt";
 inline constexpr std::string_view kModelsFolder = "models";

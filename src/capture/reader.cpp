@@ -122,9 +122,9 @@ CapturedModel parseModelMesh(const fs::path& path) {
   model.file = path;
   std::string text;
   bool complete = true;
-  if (!source.next(text, complete) || (text != kModelMeshVersionLine && text != kModelMeshVersion1Line))
-    throw Failure{Error{ErrorCode::kParse, fmt::format("{}:1: expected the version line '{}' (or '{}')", file, kModelMeshVersionLine,
-                                                       kModelMeshVersion1Line)}};
+  if (!source.next(text, complete) || (text != kModelMeshVersionLine && text != kModelMeshVersion2Line && text != kModelMeshVersion1Line))
+    throw Failure{Error{ErrorCode::kParse, fmt::format("{}:1: expected the version line '{}' (or '{}', '{}')", file, kModelMeshVersionLine,
+                                                       kModelMeshVersion2Line, kModelMeshVersion1Line)}};
   std::vector<std::size_t> declaredVertices, declaredTriangles;
   std::vector<std::vector<int>> influenceCounts;  // per mesh, per vertex: joints listed by `j`
   std::set<int> bound, inverseBound;
@@ -183,9 +183,26 @@ CapturedModel parseModelMesh(const fs::path& path) {
       l.expectFields(4, "mesh_id:a:b:c");
       auto& mesh = meshAt(1);
       for (std::size_t k = 2; k <= 4; ++k) mesh.indices.push_back(l.integer<std::uint32_t>(k, "vertex index"));
-    } else if (token == "a" || token == "g") {
+    } else if (token == "a" || token == "g" || token == "E") {
       l.expectFields(2, "mesh_id:texture");
-      (token == "a" ? meshAt(1).texture : meshAt(1).maskTexture) = l.text(2);
+      (token == "a" ? meshAt(1).texture : token == "g" ? meshAt(1).maskTexture : meshAt(1).emissionTexture) = l.text(2);
+    } else if (token == "f" || token == "c") {
+      l.expectFields(5, "mesh_id:r:g:b:a");
+      const glm::vec4 rgba(l.real(2, "r"), l.real(3, "g"), l.real(4, "b"), l.real(5, "a"));
+      if (glm::any(glm::lessThan(rgba, glm::vec4(0.0f))) || glm::any(glm::greaterThan(rgba, glm::vec4(1.0f))))
+        l.fail("colour components must lie in [0, 1]");
+      if (token == "f") meshAt(1).baseColor = rgba;
+      else meshAt(1).colors.push_back(rgba);
+    } else if (token == "r") {
+      l.expectFields(3, "mesh_id:metallic:roughness");
+      const glm::vec2 mr(l.real(2, "metallic"), l.real(3, "roughness"));
+      if (mr.x < 0 || mr.x > 1 || mr.y < 0 || mr.y > 1) l.fail("metallic and roughness must lie in [0, 1]");
+      meshAt(1).metallicRoughness = mr;
+    } else if (token == "e") {
+      l.expectFields(4, "mesh_id:r:g:b");
+      const glm::vec3 e(l.real(2, "r"), l.real(3, "g"), l.real(4, "b"));
+      if (glm::any(glm::lessThan(e, glm::vec3(0.0f)))) l.fail("emission must not be negative");
+      meshAt(1).emission = e;
     } else if (token == "K") {
       l.expectFields(2, "mesh_id:frame_count");
       auto& mesh = meshAt(1);
@@ -225,7 +242,8 @@ CapturedModel parseModelMesh(const fs::path& path) {
         inverseBound.insert(id);
       }
     } else {
-      l.fail(fmt::format("unknown record '{}'; a ModelMesh file has o, M, p, n, t, j, w, i, a, g, b, x, K, P, N", token), ErrorCode::kParse);
+      l.fail(fmt::format("unknown record '{}'; a ModelMesh file has o, M, p, n, t, c, j, w, i, a, g, f, r, e, E, b, x, K, P, N", token),
+             ErrorCode::kParse);
     }
   }
   const auto where = fmt::format("{}:{}", file, source.number());
@@ -242,6 +260,7 @@ CapturedModel parseModelMesh(const fs::path& path) {
     check(mesh.positions.size(), "'p'", false);
     check(mesh.normals.size(), "'n'", true);
     check(mesh.uvs.size(), "'t'", true);
+    check(mesh.colors.size(), "'c'", true);
     check(mesh.joints.size(), "'j'", true);
     check(mesh.weights.size(), "'w'", true);
     if (mesh.indices.size() != 3 * declaredTriangles[static_cast<std::size_t>(mesh.id)])

@@ -21,8 +21,14 @@ namespace dynbench::capture {
 struct CapturedMesh {
   int id = 0;
   std::string name, texture, maskTexture;  // textures relative to the data root; empty when none
+  // The material beyond its maps (ModelMesh version 3: `f`, `r`, `e`, `E`).
+  glm::vec4 baseColor{1.0f};                       // linear RGBA, multiplies the texture map
+  std::optional<glm::vec2> metallicRoughness;      // unset: from the mask map, or the converter's default
+  glm::vec3 emission{0.0f};                        // in the light colours' units (1: the engine's full light on white)
+  std::string emissionTexture;                     // multiplies emission; empty when none
   std::vector<glm::vec3> positions, normals;
   std::vector<glm::vec2> uvs;
+  std::vector<glm::vec4> colors;  // `c`: linear RGBA per vertex, multiplying baseColor; empty when none
   std::vector<glm::u16vec4> joints;  // up to 4 influences; unused ones have weight 0
   std::vector<glm::vec4> weights;
   std::vector<std::uint32_t> indices;  // 3 per triangle

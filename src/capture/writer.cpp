@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <set>
 #include <string>
@@ -209,6 +210,24 @@ int dbc_model_mesh(dbc_session* s, const dbc_mesh* m) {
   std::string text = fmt::format("M:{}:{}:{}:{}\n", m->mesh_id, m->vertex_count, m->triangle_count, escapeField(m->name ? m->name : ""));
   if (m->texture) text += fmt::format("a:{}:{}\n", m->mesh_id, escapeField(m->texture));
   if (m->mask_texture) text += fmt::format("g:{}:{}\n", m->mesh_id, escapeField(m->mask_texture));
+  // The material beyond the maps: each value finite and in its range, checked before anything is kept.
+  auto factors = [&](char token, const float* data, std::size_t width, float high) {
+    if (!data) return true;
+    std::string line = fmt::format("{}:{}", token, m->mesh_id);
+    for (std::size_t c = 0; c < width; ++c) {
+      if (!std::isfinite(data[c]) || data[c] < 0 || data[c] > high) return false;
+      appendFloat(line, data[c]);
+    }
+    text += line + "\n";
+    return true;
+  };
+  if (!factors('f', m->base_color, 4, 1.0f))
+    return error(DBC_ERROR_ARGUMENT, fmt::format("mesh {}: base_color needs 4 finite values in [0, 1]", m->mesh_id));
+  if (!factors('r', m->metallic_roughness, 2, 1.0f))
+    return error(DBC_ERROR_ARGUMENT, fmt::format("mesh {}: metallic_roughness needs 2 finite values in [0, 1]", m->mesh_id));
+  if (!factors('e', m->emission, 3, std::numeric_limits<float>::max()))
+    return error(DBC_ERROR_ARGUMENT, fmt::format("mesh {}: emission needs 3 finite values >= 0", m->mesh_id));
+  if (m->emission_texture) text += fmt::format("E:{}:{}\n", m->mesh_id, escapeField(m->emission_texture));
   auto row = [&](char token, const float* data, std::size_t width, std::size_t v) {
     std::string line = fmt::format("{}:{}", token, m->mesh_id);
     for (std::size_t c = 0; c < width; ++c) {
@@ -222,6 +241,13 @@ int dbc_model_mesh(dbc_session* s, const dbc_mesh* m) {
   for (std::size_t v = 0; v < m->vertex_count; ++v) {
     if (!row('p', m->positions, 3, v) || (m->normals && !row('n', m->normals, 3, v)) || (m->uvs && !row('t', m->uvs, 2, v)))
       return error(DBC_ERROR_ARGUMENT, fmt::format("mesh {}: vertex {} has a value that is not finite", m->mesh_id, v));
+    if (m->colors) {
+      const float* c = m->colors + 4 * v;
+      for (int k = 0; k < 4; ++k)
+        if (!std::isfinite(c[k]) || c[k] < 0 || c[k] > 1)
+          return error(DBC_ERROR_ARGUMENT, fmt::format("mesh {}: vertex {} has a colour outside [0, 1]", m->mesh_id, v));
+      row('c', m->colors, 4, v);
+    }
     if (m->joints) {
       std::string j = fmt::format("j:{}", m->mesh_id), w = fmt::format("w:{}", m->mesh_id);
       int influences = 0;

@@ -71,6 +71,7 @@ void Converter::writeOutputs() {
   if (!lights_.empty()) used.push_back("KHR_lights_punctual");
   if (usesVisibility_) used.push_back("KHR_node_visibility");
   if (usesVisibility_ || usesAnimationPointer_) used.push_back("KHR_animation_pointer");
+  if (usesEmissiveStrength_) used.push_back("KHR_materials_emissive_strength");
   if (!used.empty()) document["extensionsUsed"] = used;
   for (const char* key : {"images", "textures", "materials", "meshes", "skins"})
     if (document.contains(key) && document[key].empty()) document.erase(key);

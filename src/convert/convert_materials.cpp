@@ -101,20 +101,49 @@ int Converter::metallicRoughnessFromMask(const std::string& mask) {
   return index;
 }
 
-// Material per (texture, mask) pair (docs/dataset.md): base colour from the texture map;
-// metallic and roughness from the mask map, or dielectric with roughness 0.8 without one.
+namespace {
+// Whether a mesh lies over what is behind it with partial coverage (alpha below 1 in its base
+// colour or its vertex colours: Cube 2's blend layers).
+bool blended(const CapturedMesh& mesh) {
+  if (mesh.baseColor.a < 1.0f) return true;
+  return std::any_of(mesh.colors.begin(), mesh.colors.end(), [](const glm::vec4& c) { return c.a < 1.0f; });
+}
+}  // namespace
+
+// Material per distinct set of maps and factors (docs/dataset.md): base colour from the texture
+// map times the captured factor; metallic and roughness from the captured values, else from the
+// mask map, else dielectric with roughness 0.8; emission in cd/m2.
 int Converter::material(const CapturedMesh& mesh) {
-  const auto key = std::make_pair(mesh.texture, mesh.maskTexture);
+  const bool blend = blended(mesh);
+  const auto& c = mesh.baseColor;
+  const std::string key = fmt::format("{}\n{}\n{}\n{} {} {} {}\n{}\n{} {} {}\n{}", mesh.texture, mesh.maskTexture, mesh.emissionTexture, c.r, c.g,
+                                      c.b, c.a, mesh.metallicRoughness ? fmt::format("{} {}", mesh.metallicRoughness->x, mesh.metallicRoughness->y) : "",
+                                      mesh.emission.r, mesh.emission.g, mesh.emission.b, blend);
   if (auto it = materialByMaps_.find(key); it != materialByMaps_.end()) return it->second;
   json m = {{"name", mesh.texture.empty() ? "untextured" : fs::path(mesh.texture).stem().string()},
             {"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.8}}}};
   if (int t = image(mesh.texture); t >= 0) m["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", t}};
-  if (int t = metallicRoughnessFromMask(mesh.maskTexture); t >= 0) {
+  if (c != glm::vec4(1.0f)) m["pbrMetallicRoughness"]["baseColorFactor"] = {c.r, c.g, c.b, c.a};
+  if (mesh.metallicRoughness) {
+    m["pbrMetallicRoughness"]["metallicFactor"] = mesh.metallicRoughness->x;
+    m["pbrMetallicRoughness"]["roughnessFactor"] = mesh.metallicRoughness->y;
+  } else if (int t = metallicRoughnessFromMask(mesh.maskTexture); t >= 0) {
     m["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", t}};
     m["pbrMetallicRoughness"]["metallicFactor"] = 1.0;
     m["pbrMetallicRoughness"]["roughnessFactor"] = 1.0;
     m["extras"] = {{"dynbench_mask_map", mesh.maskTexture}};
   }
+  // Emission e in the lights' units shows as bright as a white Lambertian surface under the
+  // engine's full light, E_u lux: radiance E_u e / pi cd/m2. glTF keeps emissiveFactor within
+  // [0, 1]; KHR_materials_emissive_strength carries the rest.
+  if (const float peak = std::max({mesh.emission.r, mesh.emission.g, mesh.emission.b}); peak > 0) {
+    const glm::vec3 factor = mesh.emission / peak;
+    m["emissiveFactor"] = {factor.r, factor.g, factor.b};
+    m["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", luxPerUnit_ * peak / kPi}};
+    usesEmissiveStrength_ = true;
+    if (int t = image(mesh.emissionTexture); t >= 0) m["emissiveTexture"] = {{"index", t}};
+  }
+  if (blend) m["alphaMode"] = "BLEND";
   doc_["materials"].push_back(m);
   const int index = static_cast<int>(doc_["materials"].size()) - 1;
   materialByMaps_[key] = index;
@@ -182,6 +211,11 @@ void Converter::buildMeshes() {
           normals.insert(normals.end(), {n.x, n.y, n.z});
         }
         attributes["NORMAL"] = dataAccessor(normals, kFloat, "VEC3", kArrayBuffer);
+      }
+      if (!mesh.colors.empty()) {
+        std::vector<float> colors;
+        for (const auto& c : mesh.colors) colors.insert(colors.end(), {c.r, c.g, c.b, c.a});
+        attributes["COLOR_0"] = dataAccessor(colors, kFloat, "VEC4", kArrayBuffer);
       }
       if (!mesh.uvs.empty()) {
         std::vector<float> uvs;

@@ -164,7 +164,7 @@ class Converter {
   // and metallic (B) = B. Returns -1 when the mask cannot be read.
   int metallicRoughnessFromMask(const std::string& mask);
 
-  // Material per (texture, mask) pair (docs/dataset.md): base colour from the texture map;
+  // Material per distinct maps and factors (docs/dataset.md): base colour from the texture map;
   // metallic and roughness from the mask map, or dielectric with roughness 0.8 without one.
   int material(const CapturedMesh& mesh);
 
@@ -231,10 +231,10 @@ class Converter {
   std::vector<int> meshOfModel_;
   std::map<int, int> ibmOfModel_;
   std::map<std::string, int> imageByTexture_, maskTextures_;
-  std::map<std::pair<std::string, std::string>, int> materialByMaps_;
+  std::map<std::string, int> materialByMaps_;  // by maps and factors (material())
   std::map<std::uint64_t, int> visInputs_;
   int timesView_ = -1;
-  bool cameraChanged_ = false, usesVisibility_ = false, usesAnimationPointer_ = false;
+  bool cameraChanged_ = false, usesVisibility_ = false, usesAnimationPointer_ = false, usesEmissiveStrength_ = false;
   ConvertReport report_;
   std::optional<SkyImage> sky_;  // the generated sky
   SkyParameters skyParameters_;

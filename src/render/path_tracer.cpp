@@ -202,6 +202,12 @@ void PathTracer::shadeAt(const SurfaceHit& hit, const glm::dvec3& wo, glm::dvec2
   } else {
     glm::dvec4 base(m->baseColorFactor);
     if (m->baseColorTexture.image >= 0) base *= textures_.sample(m->baseColorTexture, true, uv, lod);
+    if (const scene::Primitive& prim = *hit.source; !prim.colors.empty()) {
+      // glTF: COLOR_0 multiplies the base colour, interpolated over the triangle.
+      const glm::dvec2 b = hit.barycentric;
+      base *= (1.0 - b.x - b.y) * glm::dvec4(prim.colors[hit.vertices[0]]) + b.x * glm::dvec4(prim.colors[hit.vertices[1]]) +
+              b.y * glm::dvec4(prim.colors[hit.vertices[2]]);
+    }
     mat.baseColor = glm::dvec3(base);
     if (m->workflow == scene::MaterialWorkflow::kMetallicRoughness) {
       mat.metallic = m->metallicFactor;

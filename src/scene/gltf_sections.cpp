@@ -173,6 +173,16 @@ Primitive GltfReader::readPrimitive(const json& pr, const std::string& p) {
     sameCount(a, "TEXCOORD_0");
     prim.uvs = readVectors<glm::vec2>(a, child(ap, "TEXCOORD_0"));
   }
+  if (int a = attribute("COLOR_0"); a >= 0) {
+    // glTF: RGB or RGBA, float or normalised unsigned; RGB has alpha 1.
+    requireType(a, child(ap, "COLOR_0"), {"VEC3", "VEC4"});
+    sameCount(a, "COLOR_0");
+    if (accessorAt(a).components == 4) {
+      prim.colors = readVectors<glm::vec4>(a, child(ap, "COLOR_0"));
+    } else {
+      for (const auto& rgb : readVectors<glm::vec3>(a, child(ap, "COLOR_0"))) prim.colors.push_back(glm::vec4(rgb, 1.0f));
+    }
+  }
   if (int a = attribute("JOINTS_0"); a >= 0) {
     requireType(a, child(ap, "JOINTS_0"), {"VEC4"});
     sameCount(a, "JOINTS_0");

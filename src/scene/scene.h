@@ -39,6 +39,7 @@ struct Primitive {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;   // empty when the file has none
   std::vector<glm::vec2> uvs;       // TEXCOORD_0; empty when absent
+  std::vector<glm::vec4> colors;    // COLOR_0 (linear RGBA, multiplies the base colour); empty when absent
   std::vector<glm::u16vec4> joints;  // JOINTS_0 (indices into the node's skin joints)
   std::vector<glm::vec4> weights;    // WEIGHTS_0
   std::vector<std::uint32_t> indices;  // triangle list (strips and fans are expanded on load)

@@ -94,15 +94,173 @@ void toCapture(const vec &cube, float out[3]) {
   out[2] = -cube.y;
 }
 
+// A mesh of the map model being gathered: capture-space positions and normals, texture coordinates.
+struct SurfaceMesh {
+  vector<float> positions, normals, uvs;
+  vector<uint> indices;
+};
+
 // The map's geometry, as the engine's own writeobj (engine/worldio.cpp) walks it: every vertex
 // array, its index ranges per texture slot. One capture mesh per texture slot, with positions and
 // normals in capture space, texture coordinates as the engine has them (v down, as glTF) and the
 // slot's first texture relative to the data root.
-struct MapMesh {
+struct MapMesh : SurfaceMesh {
   int slot = -1;
-  vector<float> positions, normals, uvs;
-  vector<uint> indices;
 };
+
+// The SDK's record of a map surface mesh (texture "" for none); the arrays stay the mesh's.
+dbc_mesh surfaceRecord(int meshId, const char *name, const char *texture, const SurfaceMesh &mesh) {
+  dbc_mesh m = {};
+  m.mesh_id = meshId;
+  m.name = name;
+  m.texture = texture[0] ? texture : nullptr;
+  m.vertex_count = size_t(mesh.positions.length() / 3);
+  m.positions = mesh.positions.getbuf();
+  m.normals = mesh.normals.getbuf();
+  m.uvs = mesh.uvs.getbuf();
+  m.triangle_count = size_t(mesh.indices.length() / 3);
+  m.indices = mesh.indices.getbuf();
+  return m;
+}
+
+// A texture slot's file relative to the data root. Texture commands prefix load options such as
+// <dds> or <mad:...>: the file name follows them.
+void texturePath(const char *name, string &out) {
+  const char *file = name;
+  while (*file == '<') {
+    const char *end = strchr(file, '>');
+    if (!end) break;
+    file = end + 1;
+  }
+  formatstring(out, "packages/%s", file);
+}
+
+// Water and lava are material volumes, not world geometry: the engine draws their visible faces
+// (engine/material.cpp, water.cpp) and the capture records them as surfaces of the map, one mesh
+// per material and side (top or falls), with the material the engine gives them:
+// - top faces lie WATER_OFFSET below the volume's top, as renderflatwater draws them (the engine's
+//   waves, WATER_AMPLITUDE about that, are not recorded); the falls' top and bottom edges move as
+//   renderwaterfall moves them at the waves' mean;
+// - lava is drawn unlit, texture x 2t with t pulsing between 0.5 and 1 (its shader, material.cpp):
+//   emission 1.5, the pulse's mean, times its texture, in full-light units; texture coordinates are
+//   the shader's world-space projection (TEX_SCALE / (texture size x slot scale)) without its scroll;
+// - water is the engine's reflecting, refracting surface tinted by its colour (watercolour): a
+//   smooth opaque dielectric of that colour (the floor seen through it, fogged, is not recorded).
+// Bottom faces, which the engine does not draw, and faces only the editor shows are left out.
+struct MaterialMesh : SurfaceMesh {
+  int material = 0;  // MAT_WATER or MAT_LAVA with its index (water2...)
+  bool top = true;
+};
+
+void addMaterialFace(vector<MaterialMesh *> &meshes, const materialsurface &m) {
+  const bool top = m.orient == O_TOP;
+  MaterialMesh *mesh = nullptr;
+  loopv(meshes) if (meshes[i]->material == m.material && meshes[i]->top == top) mesh = meshes[i];
+  if (!mesh) {
+    mesh = new MaterialMesh;
+    mesh->material = m.material;
+    mesh->top = top;
+    meshes.add(mesh);
+  }
+  vec corners[4];
+  if (top) {
+    const float z = m.o.z - WATER_OFFSET;
+    corners[0] = vec(m.o.x, m.o.y, z);
+    corners[1] = vec(m.o.x + m.rsize, m.o.y, z);
+    corners[2] = vec(m.o.x + m.rsize, m.o.y + m.csize, z);
+    corners[3] = vec(m.o.x, m.o.y + m.csize, z);
+  } else {
+    // renderwaterfall's corners (GENFACEVERTSXY), its waves at their mean.
+    const float x = m.o.x, y = m.o.y, offset = 0.1f;
+    float zmin = m.o.z, zmax = zmin;
+    if (m.ends & 1) zmin += -WATER_OFFSET - WATER_AMPLITUDE;
+    if (m.ends & 2) zmax += -WATER_OFFSET;
+    const int csize = m.csize, rsize = m.rsize;
+    int n = 0;
+    switch (m.orient) {
+#define GENFACEORIENT(orient, v0, v1, v2, v3) \
+  case orient: v0 v1 v2 v3 break;
+#define GENFACEVERT(orient, vert, mx, my, mz, sx, sy, sz) corners[n++] = vec(mx sx, my sy, mz sz);
+      GENFACEVERTSXY(x, x, y, y, zmin, zmax, /**/, +csize, /**/, +rsize, +offset, -offset)
+#undef GENFACEORIENT
+#undef GENFACEVERT
+      default: return;
+    }
+  }
+  // Texture coordinates: the lava shader's projection, tc = mix(xz, yy, |n.xz|) (top: xy).
+  MSlot &slot = lookupmaterialslot(m.material, true);
+  const int sub = top ? 0 : 1;
+  Texture *t = slot.sts.inrange(sub) ? slot.sts[sub].t : nullptr;
+  const float scale = slot.scale > 0 ? slot.scale : 1.0f;
+  const float su = t && t->xs > 0 ? TEX_SCALE / (t->xs * scale) : 1.0f / 64, sv = t && t->ys > 0 ? TEX_SCALE / (t->ys * scale) : 1.0f / 64;
+  const int dim = dimension(m.orient);
+  const uint base = uint(mesh->positions.length() / 3);
+  vec outward(0, 0, 0);
+  outward[dim] = dimcoord(m.orient) ? 1 : -1;
+  float normal[3];
+  toCapture(outward, normal);
+  loopi(4) {
+    float p[3];
+    toCapture(corners[i], p);
+    loopk(3) mesh->positions.add(p[k]);
+    loopk(3) mesh->normals.add(normal[k]);
+    const vec &c = corners[i];
+    const float u = top ? c.x : dim == 0 ? c.y : c.x, v = top ? c.y : c.z;
+    mesh->uvs.add(u * su);
+    mesh->uvs.add(top ? v * sv : -v * sv);
+  }
+  // Two triangles, wound counter-clockwise seen from the outward side (glTF's front).
+  float a[3], b[3], c[3];
+  toCapture(corners[0], a);
+  toCapture(corners[1], b);
+  toCapture(corners[2], c);
+  const vec e1(b[0] - a[0], b[1] - a[1], b[2] - a[2]), e2(c[0] - a[0], c[1] - a[1], c[2] - a[2]);
+  vec cross;
+  cross.cross(e1, e2);
+  const bool ccw = cross.dot(vec(normal[0], normal[1], normal[2])) > 0;
+  const uint order[6] = {0, 1, 2, 0, 2, 3};
+  loopi(6) mesh->indices.add(base + (ccw ? order[i] : order[5 - i]));
+}
+
+void collectMaterialFaces(vector<MaterialMesh *> &meshes) {
+  loopv(valist) {
+    const vtxarray &va = *valist[i];
+    loopj(va.matsurfs) {
+      const materialsurface &m = va.matbuf[j];
+      const int volume = m.material & MATF_VOLUME;
+      if ((volume != MAT_WATER && volume != MAT_LAVA) || m.visible != MATSURF_VISIBLE || m.orient == O_BOTTOM) continue;
+      addMaterialFace(meshes, m);
+    }
+  }
+}
+
+// A material surface's mesh: its texture (lava) or colour (water) and emission.
+bool writeMaterialMesh(int meshId, const MaterialMesh &mesh) {
+  const bool lava = (mesh.material & MATF_VOLUME) == MAT_LAVA;
+  MSlot &slot = lookupmaterialslot(mesh.material, true);
+  const int sub = mesh.top ? 0 : 1;
+  string texture = "";
+  if (lava && slot.sts.inrange(sub)) texturePath(slot.sts[sub].name, texture);
+  defformatstring(name, "%s%s", lava ? "lava" : "water", mesh.top ? "" : "fall");
+  dbc_mesh m = surfaceRecord(meshId, name, texture, mesh);
+  const float lavaEmission[3] = {1.5f, 1.5f, 1.5f};
+  const float smooth[2] = {0.0f, 0.05f};
+  float colour[4] = {1, 1, 1, 1};
+  if (lava) {
+    m.emission = lavaEmission;
+    m.emission_texture = m.texture;
+  } else {
+    // The engine's colours are 8-bit sRGB values: linear for the capture.
+    const bvec &c = getwatercolor(mesh.material);
+    loopk(3) {
+      const float v = c[k] / 255.0f;
+      colour[k] = v <= 0.04045f ? v / 12.92f : powf((v + 0.055f) / 1.055f, 2.4f);
+    }
+    m.base_color = colour;
+    m.metallic_roughness = smooth;
+  }
+  return dbc_model_mesh(state.session, &m) == DBC_OK;
+}
 
 void exportMap(const char *map) {
   vector<MapMesh *> meshes;
@@ -190,30 +348,16 @@ void exportMap(const char *map) {
     for (int t = 0; t + 2 < mesh.indices.length(); t += 3) swap(mesh.indices[t + 1], mesh.indices[t + 2]);
     VSlot &vslot = lookupvslot(mesh.slot, false);
     string texture = "";
-    if (vslot.slot && !vslot.slot->sts.empty()) {
-      // Texture commands prefix load options such as <dds> or <mad:...>: the file name follows them.
-      const char *file = vslot.slot->sts[0].name;
-      while (*file == '<') {
-        const char *end = strchr(file, '>');
-        if (!end) break;
-        file = end + 1;
-      }
-      formatstring(texture, "packages/%s", file);
-    }
+    if (vslot.slot && !vslot.slot->sts.empty()) texturePath(vslot.slot->sts[0].name, texture);
     defformatstring(name, "slot%d", mesh.slot);
-    dbc_mesh m = {};
-    m.mesh_id = meshId++;
-    m.name = name;
-    m.texture = texture[0] ? texture : nullptr;
-    m.vertex_count = size_t(mesh.positions.length() / 3);
-    m.positions = mesh.positions.getbuf();
-    m.normals = mesh.normals.getbuf();
-    m.uvs = mesh.uvs.getbuf();
-    m.triangle_count = size_t(mesh.indices.length() / 3);
-    m.indices = mesh.indices.getbuf();
+    const dbc_mesh m = surfaceRecord(meshId++, name, texture, mesh);
     if (dbc_model_mesh(state.session, &m) != DBC_OK) failCapture("map mesh");
   }
   meshes.deletecontents();
+  vector<MaterialMesh *> materials;
+  collectMaterialFaces(materials);
+  loopv(materials) if (!writeMaterialMesh(meshId++, *materials[i])) failCapture("water or lava mesh");
+  materials.deletecontents();
   if (dbc_model_end(state.session) != DBC_OK) failCapture("map model end");
 }
 
