@@ -344,6 +344,11 @@ TEST(SlurmScript, TimesAndQuotingAsSlurmAndTheShellRead) {
   EXPECT_FALSE(parseSlurmTime("1h"));
   EXPECT_FALSE(parseSlurmTime(""));
   EXPECT_FALSE(parseSlurmTime("1:2:3:4"));
+  // Numbers beyond a long were an uncaught std::out_of_range (status 1, issue 47): now refused.
+  EXPECT_FALSE(parseSlurmTime("99999999999999999999"));
+  EXPECT_FALSE(parseSlurmTime("99999999999999999999-00"));
+  EXPECT_FALSE(parseSlurmTime("1:99999999999999999999"));
+  EXPECT_EQ(parseSlurmTime("999999999"), 999999999L * 60);
   EXPECT_EQ(pipeline::slurm::shellQuote("/data/run-1/frames"), "/data/run-1/frames");
   EXPECT_EQ(pipeline::slurm::shellQuote("my frames"), "'my frames'");
   EXPECT_EQ(pipeline::slurm::shellQuote("it's"), "'it'\\''s'");

@@ -92,10 +92,13 @@ std::string shellQuote(const std::string& word) {
 }
 
 std::optional<long> parseSlurmTime(const std::string& text) {
-  // Slurm's forms (sbatch(1), --time): MM, MM:SS, HH:MM:SS, D-HH, D-HH:MM, D-HH:MM:SS.
+  // Slurm's forms (sbatch(1), --time): MM, MM:SS, HH:MM:SS, D-HH, D-HH:MM, D-HH:MM:SS. Each number
+  // has at most 9 digits, so that the seconds fit a long (and std::stol cannot throw out_of_range).
+  constexpr std::size_t kMaxDigits = 9;
   long days = 0;
   std::string rest = text;
   if (const auto dash = text.find('-'); dash != std::string::npos) {
+    if (dash > kMaxDigits) return std::nullopt;
     try {
       std::size_t used = 0;
       days = std::stol(text.substr(0, dash), &used);
@@ -108,7 +111,7 @@ std::optional<long> parseSlurmTime(const std::string& text) {
   std::vector<long> parts;
   std::istringstream in(rest);
   for (std::string part; std::getline(in, part, ':');) {
-    if (!allDigits(part)) return std::nullopt;
+    if (!allDigits(part) || part.size() > kMaxDigits) return std::nullopt;
     parts.push_back(std::stol(part));
   }
   if (parts.empty() || parts.size() > 3) return std::nullopt;
