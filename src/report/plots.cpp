@@ -24,7 +24,9 @@ std::string quoted(const std::string& s) {
 }
 
 Expected<void> runGnuplot(const fs::path& script) {
-  auto run = runProcess({.argv = {"gnuplot", script.string()}});
+  ProcessOptions options;
+  options.argv = {"gnuplot", script.string()};
+  auto run = runProcess(options);
   if (!run)
     return fail(ErrorCode::kExternalTool, "{}; install Debian's gnuplot-nox (scripts/setup.sh does)", run.error().message);
   if (!run->succeeded())
@@ -122,7 +124,8 @@ Expected<std::vector<fs::path>> writeMethodsPlot(const std::vector<std::pair<std
   for (const auto& [label, values] : series) {
     std::string name = label;
     std::replace(name.begin(), name.end(), ',', ' ');
-    csv += "," + name;
+    csv += ',';
+    csv += name;
     length = std::max(length, values.size());
   }
   csv += "\n";
@@ -183,8 +186,9 @@ Expected<std::vector<fs::path>> writeComparisonPlots(const std::vector<Compariso
     std::string csv = "frame", cdf;
     std::vector<std::vector<double>> sorted;
     for (const auto* s : rotating) {
-      csv += "," + columnName(s->name);
-      cdf += (cdf.empty() ? "" : ",") + columnName(s->name) + "," + columnName(s->name) + " share";
+      csv += ',';
+      csv += columnName(s->name);
+      cdf += fmt::format("{}{},{} share", cdf.empty() ? "" : ",", columnName(s->name), columnName(s->name));
       length = std::max(length, s->rotation.size());
       std::vector<double> values;
       for (double v : s->rotation)
@@ -196,7 +200,10 @@ Expected<std::vector<fs::path>> writeComparisonPlots(const std::vector<Compariso
     cdf += "\n";
     for (std::size_t k = 0; k < length; ++k) {
       csv += std::to_string(k);
-      for (const auto* s : rotating) csv += "," + (k < s->rotation.size() ? cell(s->rotation[k]) : std::string());
+      for (const auto* s : rotating) {
+        csv += ',';
+        if (k < s->rotation.size()) csv += cell(s->rotation[k]);
+      }
       csv += "\n";
     }
     std::size_t longest = 0;
@@ -232,7 +239,7 @@ Expected<std::vector<fs::path>> writeComparisonPlots(const std::vector<Compariso
     std::size_t length = 0;
     std::string csv = "frame in window";
     for (int f = 0; f < 5; ++f)
-      for (const auto* s : discarding) csv += "," + columnName(s->name) + " " + kDiscardFeatures[f];
+      for (const auto* s : discarding) csv += fmt::format(",{} {}", columnName(s->name), kDiscardFeatures[f]);
     for (const auto* s : discarding) length = std::max(length, s->discard.size());
     csv += "\n";
     for (std::size_t k = 0; k < length; ++k) {
@@ -245,7 +252,8 @@ Expected<std::vector<fs::path>> writeComparisonPlots(const std::vector<Compariso
           }
           const auto& p = s->discard[k];
           const double v[5] = {p.frustum, p.position, p.normal, p.direct, p.indirect};
-          csv += "," + cell(v[f]);
+          csv += ',';
+          csv += cell(v[f]);
         }
       csv += "\n";
     }
@@ -267,7 +275,7 @@ Expected<std::vector<fs::path>> writeComparisonPlots(const std::vector<Compariso
     if (s.mean) means.push_back(&s);
   if (!means.empty()) {
     std::string csv = "feature";
-    for (const auto* s : means) csv += "," + columnName(s->name) + (s->published ? " (published)" : "") + ",low,high";
+    for (const auto* s : means) csv += fmt::format(",{}{},low,high", columnName(s->name), s->published ? " (published)" : "");
     csv += "\n";
     for (int f = 0; f < 5; ++f) {
       csv += std::to_string(f);
