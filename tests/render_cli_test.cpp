@@ -2,6 +2,8 @@
 // resuming, the dataset's environment, and bad input.
 #include <cmath>
 
+#include <fstream>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -73,6 +75,28 @@ TEST(RenderCli, WritesTheContractAndResumes) {
   r = dynbench(fmt::format("render {} -o {} --res 32x18 --spp 2 --frames 0:4:2", kOrbit.string(), out.string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("0 frame(s) rendered, 3 already complete"), std::string::npos) << r.out;
+
+  // The sidecar names the dataset by file name and content, not by where it is (issue 47: the
+  // absolute path, and a file time read against the wrong epoch, negative, made the same frames
+  // rendered in two folders differ): a copy of the dataset elsewhere resumes from these frames.
+  {
+    const auto j = readJson(out / "frame_00000.json");
+    EXPECT_EQ(j["render"]["dataset"], kOrbit.filename().string());
+    EXPECT_EQ(j["render"]["dataset_sha256"].get<std::string>().size(), 64u);
+    EXPECT_FALSE(j["render"].contains("dataset_modified_ns"));
+    const fs::path copy = dir / "copy";
+    fs::create_directories(copy);
+    fs::copy(kOrbit.parent_path(), copy, fs::copy_options::recursive);
+    r = dynbench(fmt::format("render {} -o {} --res 32x18 --spp 2 --frames 0:4:2", (copy / kOrbit.filename()).string(), out.string()), dir);
+    EXPECT_NE(r.out.find("0 frame(s) rendered, 3 already complete"), std::string::npos) << r.out;
+    // The copy edited (orbit keeps its buffers in the .gltf as data: URIs): its frames are not
+    // complete for it any more.
+    std::ofstream(copy / kOrbit.filename(), std::ios::app) << "\n";
+    r = dynbench(fmt::format("render {} -o {} --res 32x18 --spp 2 --frames 0:4:2", (copy / kOrbit.filename()).string(), (dir / "edited").string()), dir);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto edited = readJson(dir / "edited" / "frame_00000.json");
+    EXPECT_NE(edited["render"]["dataset_sha256"], j["render"]["dataset_sha256"]);
+  }
 
   // A frame whose sidecar is missing (interrupted before it was written) is rendered again, and
   // so is every frame when the settings change.
@@ -154,8 +178,13 @@ TEST(RenderCli, AChangedDatasetIsRenderedAgain) {
   ASSERT_EQ(r.status, 0) << r.err;
   r = dynbench(args, dir);
   EXPECT_NE(r.out.find("0 frame(s) rendered, 1 already complete"), std::string::npos) << r.out;
-  // The same path, a newer file (re-converted, edited): its old frames are not complete for it.
+  // The same content with a newer time (copied again, touched): still complete, the record names
+  // the dataset by content.
   fs::last_write_time(dir / "orbit.gltf", fs::last_write_time(dir / "orbit.gltf") + std::chrono::seconds(5));
+  r = dynbench(args, dir);
+  EXPECT_NE(r.out.find("0 frame(s) rendered, 1 already complete"), std::string::npos) << r.out;
+  // The same path, other content (re-converted, edited): its old frames are not complete for it.
+  std::ofstream(dir / "orbit.gltf", std::ios::app) << " ";
   r = dynbench(args, dir);
   EXPECT_NE(r.out.find("1 frame(s) rendered, 0 already complete"), std::string::npos) << r.out;
 }

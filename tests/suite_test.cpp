@@ -14,6 +14,7 @@
 #include "gltf_builder.h"
 #include "other_machine.h"
 #include "run_cli.h"
+#include "scene/dataset_digest.h"
 
 namespace dynbench {
 namespace {
@@ -141,7 +142,7 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
   for (std::size_t i = 0; i < 4; ++i) {
     EXPECT_EQ(doc["datasets"][i]["sha256"], manifest["datasets"][i]["sha256"]) << i;
     EXPECT_EQ(doc["datasets"][i]["sha256"]["dataset"],
-              *suite::datasetDigest(out / doc["datasets"][i]["dataset"].get<std::string>()));
+              *scene::datasetDigest(out / doc["datasets"][i]["dataset"].get<std::string>()));
   }
   // A pin that does not hold: status 5 naming the dataset, the pointer and the stage, before
   // anything is rendered (the captures are copied, so nothing is captured again).

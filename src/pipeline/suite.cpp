@@ -17,6 +17,7 @@
 #include "report/plots.h"
 #include "report/stats_output.h"
 #include "scene/load.h"
+#include "scene/dataset_digest.h"
 
 namespace dynbench::suite {
 
@@ -198,34 +199,6 @@ Expected<std::string> captureDigest(const fs::path& folder) {
   return sha256Listing(folder, std::move(files));
 }
 
-Expected<std::string> datasetDigest(const fs::path& gltf) {
-  auto document = readJsonFile(gltf);
-  if (!document) return std::unexpected(document.error());
-  std::set<std::string> files{gltf.filename().string()};
-  // Every "uri" in the document: buffers, images and extensions' files alike; data: URIs are inside.
-  std::vector<const nlohmann::json*> stack{&*document};
-  while (!stack.empty()) {
-    const nlohmann::json* node = stack.back();
-    stack.pop_back();
-    if (node->is_array())
-      for (const auto& item : *node) stack.push_back(&item);
-    if (!node->is_object()) continue;
-    for (const auto& [key, value] : node->items()) {
-      if (key == "uri" && value.is_string()) {
-        const std::string uri = value.get<std::string>();
-        if (uri.starts_with("data:") || uri.find("://") != std::string::npos) continue;
-        const fs::path relative = fs::path(scene::percentDecodeUri(uri)).lexically_normal();
-        if (relative.is_absolute() || relative.string().starts_with(".."))
-          return fail(ErrorCode::kInvalidData, "{}: uri '{}' leaves the dataset's folder", gltf.string(), uri);
-        files.insert(relative.generic_string());
-      } else {
-        stack.push_back(&value);
-      }
-    }
-  }
-  return sha256Listing(gltf.parent_path(), std::vector<std::string>(files.begin(), files.end()));
-}
-
 std::string rankingError(const std::string& method) { return method == "none" ? "flip" : "flip_over_none"; }
 
 std::vector<ValidityCell> validity(const std::vector<DatasetResult>& datasets) {
@@ -362,7 +335,7 @@ Expected<Digests> checkPins(const Manifest& manifest, std::size_t index, const f
     known = captureDigests.emplace(captureFolder, *digest).first;
   }
   const std::string& capture = known->second;
-  auto made = datasetDigest(dataset);
+  auto made = scene::datasetDigest(dataset);
   if (!made) return std::unexpected(made.error());
   const std::string manifestName = manifest.path.string();
   if (!d.captureSha256.empty() && capture != d.captureSha256)

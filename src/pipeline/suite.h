@@ -33,7 +33,7 @@ struct DatasetSpec {
   double seconds = 10.0;        // game time captured
   std::string camera = "bot";   // "bot" (the first-person bot) or "flythrough"
   // Pins (/datasets/N/sha256/capture and /dataset): the SHA-256 the capture folder and the dataset
-  // must have (captureDigest, datasetDigest); empty: not checked.
+  // must have (captureDigest, scene::datasetDigest); empty: not checked.
   std::string captureSha256, datasetSha256;
 };
 
@@ -54,10 +54,6 @@ Expected<Manifest> parseManifest(const nlohmann::json& document, const std::file
 // LICENSES.txt, models/*.txt; names starting with '.' aside) as sha256Listing (core/checksum.h)
 // lists them.
 Expected<std::string> captureDigest(const std::filesystem::path& folder);
-// A dataset's digest, what /datasets/N/sha256/dataset pins: its .gltf and every file the .gltf names
-// by a relative "uri" (the .bin, the textures, the environment map), listed relative to the
-// .gltf's folder. The README beside it is not part of it.
-Expected<std::string> datasetDigest(const std::filesystem::path& gltf);
 
 // One dataset's numbers. Difficulty measures (docs/suite.md): Table 6.7's five columns over the
 // render window (percent) and the camera's motion over the same frames (Tables 6.4-6.6: position

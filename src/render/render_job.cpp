@@ -15,6 +15,7 @@
 #include "scene/queries.h"
 #include "frames/frame_io.h"
 #include "scene/evaluate.h"
+#include "scene/dataset_digest.h"
 
 namespace dynbench::render {
 namespace {
@@ -91,7 +92,7 @@ Expected<FrameCameras> frameCameras(const scene::Evaluator& evaluator, int camer
 nlohmann::json renderRecord(const RenderJob& job) {
   const auto& s = job.settings;
   nlohmann::json r = {{"engine", job.engine},
-                      {"dataset", job.dataset.string()},
+                      {"dataset", job.dataset.filename().string()},
                       {"fps", job.fps},
                       {"samples_per_pixel", s.samplesPerPixel},
                       {"bounces", s.bounces},
@@ -114,13 +115,10 @@ nlohmann::json renderRecord(const RenderJob& job) {
   if (s.jitter) r["jitter"] = "halton23x8";
   // --float32 is recorded, so such a job does not take half-stored frames as complete.
   if (job.float32) r["storage"] = "float32";
-  // The dataset file's size and modification time: frames of an older version of a dataset at the
-  // same path are not complete for the new one.
-  std::error_code ec;
-  const auto bytes = fs::file_size(job.dataset, ec);
-  if (!ec) r["dataset_bytes"] = bytes;
-  const auto modified = fs::last_write_time(job.dataset, ec);
-  if (!ec) r["dataset_modified_ns"] = static_cast<long long>(std::chrono::duration_cast<std::chrono::nanoseconds>(modified.time_since_epoch()).count());
+  // The dataset by content (scene/dataset_digest.h): frames of another version of a dataset at the
+  // same path are not complete for it, and the same dataset in another folder gives the same record
+  // (its path, and the file times that depended on the clock's epoch, are not recorded).
+  if (auto digest = scene::datasetDigest(job.dataset)) r["dataset_sha256"] = *digest;
   if (job.camera) r["camera"] = *job.camera;
   if (job.animation) r["animation"] = *job.animation;
   if (s.constantEnvironment) r["environment_radiance"] = {s.constantEnvironment->r, s.constantEnvironment->g, s.constantEnvironment->b};
