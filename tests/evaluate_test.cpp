@@ -72,6 +72,27 @@ double mseAgainstTruth(const RgbImage& image) {
   return sum / (3.0 * kW * kH);
 }
 
+// The registry is the one list of built-in methods: every entry makes the method of its name,
+// the defaults are its names in order, and an unknown name's error lists them all.
+TEST(Methods, TheRegistryMakesEachMethodAndListsThemAll) {
+  const auto& methods = builtInMethods();
+  ASSERT_EQ(methods.size(), 4u);
+  std::vector<std::string> names;
+  for (const auto& m : methods) {
+    auto made = createMethod(std::string(m.name), MethodContext{});
+    ASSERT_TRUE(made) << m.name;
+    EXPECT_EQ((*made)->name(), m.name);
+    EXPECT_FALSE(m.description.empty());
+    names.emplace_back(m.name);
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"none", "accumulate", "taa", "svgf"}));
+  EXPECT_EQ(EvaluateOptions{}.methods, names);
+  const auto unknown = createMethod("bogus", MethodContext{});
+  ASSERT_FALSE(unknown);
+  EXPECT_EQ(unknown.error().code, ErrorCode::kUsage);
+  EXPECT_NE(unknown.error().message.find("none, accumulate, taa, svgf, external:DIR"), std::string::npos) << unknown.error().message;
+}
+
 TEST(Methods, AccumulateErrorFallsAsOneOverSqrtNOnAStaticScene) {
   // With alpha = max(1/n, 0.1) and every history kept, the output after n <= 10 frames is the mean
   // of n independent frames: variance sigma^2 / n. After that each frame gives

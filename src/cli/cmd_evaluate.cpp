@@ -2,6 +2,8 @@
 // reference (docs/metrics.md, "Temporal methods").
 #include <optional>
 
+#include <fmt/ranges.h>
+
 #include "cli/commands.h"
 #include "core/progress.h"
 #include "evaluate/evaluate.h"
@@ -12,12 +14,15 @@ namespace dynbench::cli {
 void addEvaluateCommand(CLI::App& app, CommandRun& run) {
   auto o = std::make_shared<evaluate::EvaluateOptions>();
   auto paths = std::make_shared<std::array<std::string, 5>>();  // frames, reference, json, csv, out
-  auto methods = std::make_shared<std::string>("none,accumulate,taa,svgf");
+  auto methods = std::make_shared<std::string>(fmt::format("{}", fmt::join(evaluate::builtInMethodNames(), ",")));
   auto* cmd = app.add_subcommand("evaluate", "Run temporal methods over low-sample frames and score them against converged frames");
-  cmd->footer(fmt::format("Methods: {}. FRAMES: e.g. `dynbench render --spp 4 --jitter`; REF_FRAMES: the same frames with\n"
+  std::string methodLines;
+  for (const auto& m : evaluate::builtInMethods()) methodLines += fmt::format("  {:<11} {}\n", m.name, m.description);
+  cmd->footer(fmt::format("Methods:\n{}  external:DIR another program's output frames (docs/metrics.md)\n"
+                          "FRAMES: e.g. `dynbench render --spp 4 --jitter`; REF_FRAMES: the same frames with\n"
                           "`--converge`. Metrics and the external-method contract: docs/metrics.md.\n"
                           "Example: dynbench evaluate noisy/ --reference converged/ --methods none,accumulate,svgf --json eval.json",
-                          evaluate::builtInMethodNames()));
+                          methodLines));
   cmd->add_option("FRAMES", (*paths)[0], "Folder of input frames (noisy radiance, G-buffers, motion)")->required();
   cmd->add_option("--reference", (*paths)[1], "Folder of converged frames with the same numbers")->required();
   cmd->add_option("--methods", *methods, "Comma-separated methods");

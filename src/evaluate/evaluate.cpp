@@ -139,7 +139,7 @@ Expected<EvaluateRun> runEvaluate(const EvaluateOptions& options, const Evaluate
       return fail(ErrorCode::kInvalidData, "{}: no reference for frame {} of {} (expected {})", options.reference.string(), e.frame,
                   options.frames.string(), frames::frameImagePath(options.reference, e.frame).string());
   if (options.methods.empty() && options.callerMethods.empty())
-    return fail(ErrorCode::kUsage, "no methods to evaluate (expected some of {})", builtInMethodNames());
+    return fail(ErrorCode::kUsage, "no methods to evaluate (expected some of {})", methodSpecHelp());
 
   EvaluateRun run;
   run.frames = options.frames, run.reference = options.reference;

@@ -20,7 +20,7 @@ namespace dynbench::evaluate {
 struct EvaluateOptions {
   std::filesystem::path frames;     // the input: noisy radiance, G-buffers, motion
   std::filesystem::path reference;  // converged frames of the same frame numbers and size
-  std::vector<std::string> methods{"none", "accumulate", "taa", "svgf"};
+  std::vector<std::string> methods = builtInMethodNames();
   // Methods the caller made (the Python module's), scored after `methods` exactly as they are: reset
   // at the first frame and at every cut, then given every frame in order.
   std::vector<std::shared_ptr<TemporalMethod>> callerMethods;

@@ -64,15 +64,39 @@ frames::FeatureFrame historyFrame(const frames::FeatureFrame& frame) {
   return h;
 }
 
-const char* builtInMethodNames() { return "none, accumulate, taa, svgf, external:DIR"; }
+const std::vector<MethodInfo>& builtInMethods() {
+  static const std::vector<MethodInfo> methods{
+      {"none", "the input as it is, reusing nothing: the floor the others must beat",
+       [](const MethodContext&) { return makeNoneMethod(); }},
+      {"accumulate", "reprojected history blended in, rejected by the discard stage's tests",
+       [](const MethodContext& context) { return makeAccumulateMethod(context); }},
+      {"taa", "temporal anti-aliasing (Karis 2014, Salvi 2016): Catmull-Rom history, variance clipping",
+       [](const MethodContext&) { return makeTaaMethod(); }},
+      {"svgf", "spatiotemporal variance-guided filtering (Schied et al. 2017)", [](const MethodContext&) { return makeSvgfMethod(); }},
+  };
+  return methods;
+}
+
+std::vector<std::string> builtInMethodNames() {
+  std::vector<std::string> names;
+  for (const auto& m : builtInMethods()) names.emplace_back(m.name);
+  return names;
+}
+
+std::string methodSpecHelp() {
+  std::string text;
+  for (const auto& m : builtInMethods()) {
+    text += m.name;
+    text += ", ";
+  }
+  return text + "external:DIR";
+}
 
 Expected<std::unique_ptr<TemporalMethod>> createMethod(const std::string& spec, const MethodContext& context) {
-  if (spec == "none") return makeNoneMethod();
-  if (spec == "accumulate") return makeAccumulateMethod(context);
-  if (spec == "taa") return makeTaaMethod();
-  if (spec == "svgf") return makeSvgfMethod();
+  for (const auto& m : builtInMethods())
+    if (spec == m.name) return m.make(context);
   if (spec.starts_with("external:")) return makeExternalMethod(spec.substr(9));
-  return fail(ErrorCode::kUsage, "unknown method '{}' (expected one of {})", spec, builtInMethodNames());
+  return fail(ErrorCode::kUsage, "unknown method '{}' (expected one of {})", spec, methodSpecHelp());
 }
 
 }  // namespace dynbench::evaluate

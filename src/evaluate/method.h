@@ -7,6 +7,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -41,10 +43,23 @@ struct MethodContext {
   double sceneSize = 0.0;
 };
 
-// "none", "accumulate", "taa", "svgf" or "external:DIR". Errors name the unknown method.
+// A built-in method: its name as the CLI, manifests and Python spell it, a line for help texts,
+// and its factory. Adding a method is one file (its class and factory) and one entry in
+// builtInMethods() (CONTRIBUTING.md, "Adding a temporal method").
+struct MethodInfo {
+  std::string_view name;
+  std::string_view description;
+  std::function<std::unique_ptr<TemporalMethod>(const MethodContext&)> make;
+};
+// Every built-in method, in the order tables list them (none first: the floor the others must beat).
+const std::vector<MethodInfo>& builtInMethods();
+// Their names: the default of `evaluate --methods`, the demo, suites and Python.
+std::vector<std::string> builtInMethodNames();
+// "none, accumulate, taa, svgf, external:DIR": the methods a spec may name, for help texts.
+std::string methodSpecHelp();
+
+// A built-in method's name or "external:DIR". Errors name the unknown method.
 Expected<std::unique_ptr<TemporalMethod>> createMethod(const std::string& spec, const MethodContext& context);
-// The built-in method names, for help texts.
-const char* builtInMethodNames();
 
 // Shared by the methods: the frame's full radiance (direct + indirect) as an RgbImage.
 RgbImage frameRadiance(const frames::FeatureFrame& frame);

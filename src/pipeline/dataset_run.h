@@ -35,7 +35,7 @@ struct DatasetRunSettings {
   // The temporal methods' input: the window again at this many samples per pixel, scored against
   // the converged frames.
   int inputSamplesPerPixel = 4;
-  std::vector<std::string> methods{"none", "accumulate", "taa", "svgf"};
+  std::vector<std::string> methods = evaluate::builtInMethodNames();
   unsigned seed = 1;  // the reference's; the input's is seed + 1
   int threads = 0;    // render threads (0: all cores)
 };

@@ -231,7 +231,7 @@ PYBIND11_MODULE(_core, m) {
   m.def("compare", &compareImages, py::arg("reference"), py::arg("test"), py::kw_only(), py::arg("ppd") = evaluate::flip::defaultPixelsPerDegree(),
         py::arg("hdr") = true, "Image metrics of test against reference (paths, or arrays (H, W, 3)), as `dynbench compare --json` writes them");
   m.def("evaluate", &evaluateMethods, py::arg("input_dir"), py::arg("reference_dir"), py::kw_only(),
-        py::arg("methods") = py::list(py::cast(std::vector<std::string>{"none", "accumulate", "taa", "svgf"})),
+        py::arg("methods") = py::list(py::cast(evaluate::builtInMethodNames())),
         py::arg("ppd") = evaluate::flip::defaultPixelsPerDegree(), py::arg("out_dir") = py::none(),
         "Temporal methods (built-in names or objects with reset() and process(frame)) scored as `dynbench evaluate --json` writes them");
 }
