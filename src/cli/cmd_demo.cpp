@@ -22,7 +22,7 @@ Expected<void> demoOnSlurm(const demo::DemoOptions& o, pipeline::slurm::Options 
   std::optional<Progress> progress;
   const bool terminal = Progress("slurm demo", 3, "jobs").enabled();
   std::string last;
-  auto outcome = pipeline::slurm::demoChain(o, slurm, [&](const pipeline::slurm::DemoChainStatus& s) {
+  auto outcome = demo::demoChain(o, slurm, [&](const pipeline::slurm::ChainStatus& s) {
     const std::string line = fmt::format("datasets {}, render tasks {} pending, {} running, {} done, report {}", s.datasets, s.render.pending,
                                          s.render.running, s.render.done, s.report);
     if (terminal) {

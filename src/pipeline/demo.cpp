@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "capture/cube2.h"
 #include "capture/openarena.h"
@@ -70,6 +71,30 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
   if (!files) return std::unexpected(files.error());
   log(fmt::format("report: {:.2f} MB, self-contained ({} images, {} videos inline)", files->htmlBytes / 1e6, files->images, files->videos));
   return files->html;
+}
+
+std::vector<std::string> demoArguments(const DemoOptions& o) {
+  return {"-o", fs::absolute(o.output).lexically_normal().string(), "--engine", o.engine, "--map", demoMap(o), "--bots", std::to_string(o.bots), "--seconds",
+          fmt::format("{:.17g}", o.seconds), "--seed", std::to_string(o.seed), "--fps", fmt::format("{:.17g}", o.fps), "--res",
+          fmt::format("{}x{}", o.width, o.height), "--spp", std::to_string(o.samplesPerPixel), "--tolerance", fmt::format("{:.17g}", o.tolerance),
+          "--max-spp", std::to_string(o.maxSamplesPerPixel), "--render-frames", std::to_string(o.renderFrames), "--bounces",
+          std::to_string(o.bounces), "--input-spp", std::to_string(o.inputSamplesPerPixel), "--methods", fmt::format("{}", fmt::join(o.methods, ","))};
+}
+
+Expected<pipeline::slurm::ChainOutcome> demoChain(const DemoOptions& demoIn, const pipeline::slurm::Options& options,
+                                                  const std::function<void(const pipeline::slurm::ChainStatus&)>& progress) {
+  DemoOptions demo = demoIn;
+  demo.output = fs::absolute(demo.output).lexically_normal();
+  pipeline::slurm::ChainSpec spec;
+  spec.name = "demo";
+  spec.output = demo.output;
+  spec.arguments = demoArguments(demo);
+  spec.frameRenders = demoFrameRenders(demo);
+  spec.datasetsWhat = "capture, convert and the fly-through";
+  spec.finalWhat = "the whole demo, reusing the datasets and frames: stats, discard, evaluate, report";
+  spec.datasetsDone = demo.output / "datasets" / (demoMap(demo) + "_flythrough.gltf");
+  spec.finalFile = demo.output / "report.html";
+  return pipeline::slurm::chainOfJobs(spec, options, progress);
 }
 
 }  // namespace dynbench::demo

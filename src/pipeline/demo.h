@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "pipeline/dataset_run.h"
+#include "pipeline/slurm.h"
 
 namespace dynbench::demo {
 
@@ -47,5 +48,17 @@ using DemoLog = std::function<void(const std::string&)>;
 
 // Returns the report's path (kAll), the fly-through dataset (kDatasets) or the output folder.
 Expected<std::filesystem::path> runDemo(const DemoOptions& options, const DemoLog& log);
+
+// ---- the demo as a chain of Slurm jobs (pipeline/slurm.h's chainOfJobs) ---------------------------
+// The demo's command-line options but its part (the inverse of `dynbench demo`'s parsing).
+std::vector<std::string> demoArguments(const DemoOptions& options);
+
+// `demo --slurm`: three jobs in OUT/slurm, each the demo itself: datasets.sbatch (capture, convert,
+// fly-through), render.sbatch (an array: the frame renders, options.framesPerTask a task) after it,
+// and report.sbatch (the whole demo, reusing everything, so only stats, discard, evaluate and the
+// report are left) after the renders, chained with --dependency=afterok and
+// --kill-on-invalid-dep=yes. Waits for the report unless submitOnly.
+Expected<pipeline::slurm::ChainOutcome> demoChain(const DemoOptions& demo, const pipeline::slurm::Options& options,
+                                                  const std::function<void(const pipeline::slurm::ChainStatus&)>& progress = {});
 
 }  // namespace dynbench::demo

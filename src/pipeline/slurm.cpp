@@ -63,7 +63,10 @@ bool waiting(const std::string& state) { return state == "PENDING" || state == "
 // The job's command line: this dynbench by absolute path, the verb, each argument quoted.
 std::string jobCommand(const Options& options, const std::string& verb, const std::vector<std::string>& arguments) {
   std::string command = shellQuote(jobExecutable(options).string()) + " " + verb;
-  for (const auto& a : arguments) command += " " + shellQuote(a);
+  for (const auto& a : arguments) {
+    command += ' ';
+    command += shellQuote(a);
+  }
   return command;
 }
 
@@ -343,7 +346,10 @@ Expected<RenderArrayOutcome> renderArray(const RenderStage& stageIn, const Optio
       "set -u\n",
       shellQuote(out.script.string()));
   script += "chunks=(";
-  for (const auto& c : out.chunks) script += (&c == &out.chunks.front() ? "" : " ") + frameRangeArgument(c, stage.job.frames.step);
+  for (const auto& c : out.chunks) {
+    if (&c != &out.chunks.front()) script += ' ';
+    script += frameRangeArgument(c, stage.job.frames.step);
+  }
   script += ")\n";
   script += "frames=${chunks[$SLURM_ARRAY_TASK_ID]}\n";
   script += fmt::format("output={}\n", shellQuote(stage.job.output.string()));
@@ -471,14 +477,6 @@ Expected<CaptureArrayOutcome> captureArray(const capture::Cube2Options& captureI
   return out;
 }
 
-std::vector<std::string> demoArguments(const demo::DemoOptions& o) {
-  return {"-o", fs::absolute(o.output).lexically_normal().string(), "--engine", o.engine, "--map", demo::demoMap(o), "--bots", std::to_string(o.bots), "--seconds",
-          fmt::format("{:.17g}", o.seconds), "--seed", std::to_string(o.seed), "--fps", fmt::format("{:.17g}", o.fps), "--res",
-          fmt::format("{}x{}", o.width, o.height), "--spp", std::to_string(o.samplesPerPixel), "--tolerance", fmt::format("{:.17g}", o.tolerance),
-          "--max-spp", std::to_string(o.maxSamplesPerPixel), "--render-frames", std::to_string(o.renderFrames), "--bounces",
-          std::to_string(o.bounces), "--input-spp", std::to_string(o.inputSamplesPerPixel), "--methods", fmt::format("{}", fmt::join(o.methods, ","))};
-}
-
 Expected<ChainOutcome> chainOfJobs(const ChainSpec& spec, const Options& options, const std::function<void(const ChainStatus&)>& progress) {
   if (auto ok = checkCluster(options); !ok) return std::unexpected(ok.error());
   const fs::path jobDir = spec.output / "slurm";
@@ -569,22 +567,6 @@ Expected<ChainOutcome> chainOfJobs(const ChainSpec& spec, const Options& options
   }
   if (out.failure.empty()) out.failure = fmt::format("the last job ({}) ended without writing {}", out.reportJob, spec.finalFile.string());
   return out;
-}
-
-Expected<DemoChainOutcome> demoChain(const demo::DemoOptions& demoIn, const Options& options,
-                                     const std::function<void(const DemoChainStatus&)>& progress) {
-  demo::DemoOptions demo = demoIn;
-  demo.output = fs::absolute(demo.output).lexically_normal();
-  ChainSpec spec;
-  spec.name = "demo";
-  spec.output = demo.output;
-  spec.arguments = demoArguments(demo);
-  spec.frameRenders = demo::demoFrameRenders(demo);
-  spec.datasetsWhat = "capture, convert and the fly-through";
-  spec.finalWhat = "the whole demo, reusing the datasets and frames: stats, discard, evaluate, report";
-  spec.datasetsDone = demo.output / "datasets" / (demo::demoMap(demo) + "_flythrough.gltf");
-  spec.finalFile = demo.output / "report.html";
-  return chainOfJobs(spec, options, progress);
 }
 
 }  // namespace dynbench::pipeline::slurm

@@ -15,7 +15,6 @@
 #include <vector>
 
 #include "capture/cube2.h"
-#include "pipeline/demo.h"
 #include "core/error.h"
 #include "pipeline/stages.h"
 
@@ -132,10 +131,7 @@ using CaptureArrayProgress = std::function<void(const ArrayStatus&)>;
 Expected<CaptureArrayOutcome> captureArray(const capture::Cube2Options& capture, unsigned firstSeed, unsigned lastSeed, const Options& options,
                                            const CaptureArrayProgress& progress = {});
 
-// ---- the demo as a chain of jobs ---------------------------------------------------------------
-// The demo's command-line options but its part (the inverse of `dynbench demo`'s parsing).
-std::vector<std::string> demoArguments(const demo::DemoOptions& options);
-
+// ---- a command as a chain of jobs ---------------------------------------------------------------
 // A chain of three jobs (demo --slurm, suite --slurm): the datasets, an array of render tasks, and
 // the whole command again, which reuses both and writes the final file.
 struct ChainStatus {
@@ -150,8 +146,6 @@ struct ChainOutcome {
   std::string failure;           // which job failed and where its log is; empty when complete
   bool waited = false;
 };
-using DemoChainStatus = ChainStatus;
-using DemoChainOutcome = ChainOutcome;
 struct ChainSpec {
   std::string name;                     // the command: "demo" or "suite"
   std::filesystem::path output;         // OUT, absolute: OUT/slurm holds the scripts and logs
@@ -165,13 +159,5 @@ struct ChainSpec {
 // `--part render --render-task K --frames-per-task F`, and nothing, chained with
 // --dependency=afterok and --kill-on-invalid-dep=yes; waits for the last unless submitOnly.
 Expected<ChainOutcome> chainOfJobs(const ChainSpec& spec, const Options& options, const std::function<void(const ChainStatus&)>& progress = {});
-
-// `demo --slurm`: three jobs in OUT/slurm, each the demo itself: datasets.sbatch (capture, convert,
-// fly-through), render.sbatch (an array: the frame renders, options.framesPerTask a task) after it,
-// and report.sbatch (the whole demo, reusing everything, so only stats, discard, evaluate and the
-// report are left) after the renders, chained with --dependency=afterok and
-// --kill-on-invalid-dep=yes. Waits for the report unless submitOnly.
-Expected<DemoChainOutcome> demoChain(const demo::DemoOptions& demo, const Options& options,
-                                     const std::function<void(const DemoChainStatus&)>& progress = {});
 
 }  // namespace dynbench::pipeline::slurm
