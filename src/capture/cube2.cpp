@@ -122,7 +122,8 @@ Expected<Cube2Report> captureCube2(const Cube2Options& o, const Cube2Progress& p
     for (const long k : o.gameFrames) {
       if (k < 0 || static_cast<std::size_t>(k) >= total)
         return fail(ErrorCode::kUsage, "--game-frames: frame {} is outside the capture's frames 0 to {}", k, total - 1);
-      list += (list.empty() ? "" : ",") + std::to_string(k);
+      if (!list.empty()) list += ',';
+      list += std::to_string(k);
     }
     game.environment.emplace_back("DYNBENCH_CAPTURE_GAME_FRAMES", list);
   }

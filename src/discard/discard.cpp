@@ -362,6 +362,7 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
               case Test::kNoiseAware:
                 return d > threshold && std::abs(luminance(a) - luminance(b)) > t.noiseSigmas * std::sqrt(var) ? 1.0 : 0.0;
               case Test::kExpected: break;
+              case Test::kPairs: break;  // a frame with pairs decides its radiance from them; here as kExpected
             }
             // The expected test compares luminance, the quantity whose variance the renderer
             // records: its difference is an unbiased estimate, where the RGB distance of two noisy

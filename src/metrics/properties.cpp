@@ -47,7 +47,7 @@ DatasetProperties measureProperties(const Scene& scene, double fps) {
 
   p.materialCount = scene.materials.size();
   for (const auto& m : scene.materials) ++p.workflowCounts[toString(m.workflow)];
-  p.materialWorkflow = "-";
+  p.materialWorkflow = std::string(1, '-');  // not = "-": GCC 12's -Wrestrict false positive (bug 105651)
   std::size_t best = 0;
   for (const auto& [name, count] : p.workflowCounts)
     if (count > best) {

@@ -220,8 +220,10 @@ Expected<void> CyclesBackend::render(const std::vector<FrameRequest>& requests, 
     if (rows && finished < requests.size()) rows(finished, 0);
     return true;
   };
-  auto run = runProcess({.argv = {blender_.string(), "--background", "--factory-startup", "--python", script_.string(), "--", jobFile.string()},
-                         .onLine = onLine});
+  ProcessOptions blender;
+  blender.argv = {blender_.string(), "--background", "--factory-startup", "--python", script_.string(), "--", jobFile.string()};
+  blender.onLine = onLine;
+  auto run = runProcess(blender);
   if (!run) return std::unexpected(run.error());
   if (handOver) return std::unexpected(*handOver);
   if (!run->succeeded() || finished != requests.size())
