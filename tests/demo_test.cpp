@@ -68,6 +68,26 @@ std::pair<fs::path, double> writeUTurn(const fs::path& dir) {
   return {b.write(dir, "u_turn"), stretchEnd};
 }
 
+// The ORCA ranges come from the thesis's data file, the one copy of its numbers: known answers from
+// its Tables 6.4-6.6 (the smallest and largest of Bistro Interior, Bistro Exterior and Emerald
+// Square), and the fly-through's bounds are those ranges' ends.
+TEST(Demo, OrcaRangesAreTheThesisRowsExtremes) {
+  using flythrough::orcaRange;
+  EXPECT_DOUBLE_EQ(orcaRange("6.4", 0).low, 0.013);
+  EXPECT_DOUBLE_EQ(orcaRange("6.4", 2).high, 0.248);
+  EXPECT_DOUBLE_EQ(orcaRange("6.5", 0).low, 0.134);  // Bistro Exterior, below the Wine camera's 0.136
+  EXPECT_DOUBLE_EQ(orcaRange("6.5", 0).high, 0.258);
+  EXPECT_DOUBLE_EQ(orcaRange("6.6", 2).low, 0.265);
+  EXPECT_DOUBLE_EQ(orcaRange("6.6", 3).high, 0.095);
+  EXPECT_DOUBLE_EQ(orcaRange("6.6", 5).high, 0.0);
+  EXPECT_TRUE(std::isnan(orcaRange("6.6", 9).low));  // no such column
+  EXPECT_TRUE(std::isnan(orcaRange("9.9", 0).low));  // no such table
+  const flythrough::FlythroughOptions o;
+  EXPECT_DOUBLE_EQ(o.maxYawMean, 0.511);
+  EXPECT_DOUBLE_EQ(o.maxPitchVariance, 0.004);
+  EXPECT_DOUBLE_EQ(o.minPitchMean, 0.014);
+}
+
 TEST(Demo, FlythroughFollowsTheBotsLongestStretchAroundAWallAndTurnsGently) {
   // A wall in the plane x = 0 for z in [-100, 5]. The camera walks a U around its end: from
   // (-10, 0, -60) up to z = 10, across to x = 10, back down to z = -60 (160 units, keys every 10

@@ -17,6 +17,15 @@
 
 namespace dynbench::flythrough {
 
+// A column of the thesis's Tables 6.4-6.6 over its three ORCA rows (Bistro Interior, Bistro
+// Exterior, Emerald Square; Table 6.5's Bistro Interior row is its "Wine" camera): the smallest and
+// largest value, as printed, read from data/thesis-alanko2021.json (compiled in: report/reference.h),
+// the one copy of those numbers. NaN if that file were unreadable (the build checks it).
+struct OrcaRange {
+  double low = 0, high = 0;
+};
+OrcaRange orcaRange(const std::string& table, std::size_t column);
+
 // One measure of Tables 6.4-6.6 against the range of the thesis's three ORCA rows (Bistro
 // Interior, Bistro Exterior, Emerald Square): [low, high] in the thesis's units and conventions
 // (metres per frame; rotation as the thesis's half angle, Eq. 2.4 taken literally).
@@ -40,7 +49,8 @@ struct FlythroughOptions {
   // Bounds on the per-frame yaw and pitch changes at frameRate (degrees, Table 6.6): the largest of
   // the thesis's three ORCA rows (yaw: Emerald Square's 0.511 and 0.095; pitch: Bistro Interior's
   // 0.053 and 0.004). The yaw's and the pitch's smoothing each widen until their two hold.
-  double maxYawMean = 0.511, maxYawVariance = 0.095, maxPitchMean = 0.053, maxPitchVariance = 0.004;
+  double maxYawMean = orcaRange("6.6", 2).high, maxYawVariance = orcaRange("6.6", 3).high;
+  double maxPitchMean = orcaRange("6.6", 0).high, maxPitchVariance = orcaRange("6.6", 1).high;
   // And on the largest change in a frame (yaw's and pitch's each): Table 6.5's largest ORCA maximum,
   // Emerald Square's 0.554° as the thesis's half angle, is 1.108° of rotation; 1° leaves the rest
   // to the other axis.
@@ -48,7 +58,7 @@ struct FlythroughOptions {
   // The pitch's floor: where the smoothed pitch changes less than ORCA's least row (Bistro
   // Exterior's 0.014° a frame), a slow nod (period nodPeriod) is added until its mean change per
   // frame is pitchTarget, the middle of ORCA's range. 0 turns the nod off.
-  double pitchTarget = 0.03, minPitchMean = 0.014, nodPeriod = 8.0;
+  double pitchTarget = 0.03, minPitchMean = orcaRange("6.6", 0).low, nodPeriod = 8.0;
   // How many of the longest cut-free stretches are flown and compared.
   int candidates = 8;
 };
