@@ -71,7 +71,7 @@ std::pair<fs::path, double> writeUTurn(const fs::path& dir) {
 // The ORCA ranges come from the thesis's data file, the one copy of its numbers: known answers from
 // its Tables 6.4-6.6 (the smallest and largest of Bistro Interior, Bistro Exterior and Emerald
 // Square), and the fly-through's bounds are those ranges' ends.
-TEST(Demo, OrcaRangesAreTheThesisRowsExtremes) {
+TEST(Flythrough, OrcaRangesAreTheThesisRowsExtremes) {
   using flythrough::orcaRange;
   EXPECT_DOUBLE_EQ(orcaRange("6.4", 0).low, 0.013);
   EXPECT_DOUBLE_EQ(orcaRange("6.4", 2).high, 0.248);
