@@ -10,6 +10,8 @@ packages=(
   # libraries
   nlohmann-json3-dev libassimp-dev libglm-dev libopenimageio-dev
   libembree-dev libtbb-dev libhwy-dev
+  # the game archives (.pk3) that `map-lights` reads (src/maplight/pak.cpp)
+  libzip-dev
   libcli11-dev libfmt-dev libspdlog-dev
   # SHA-256 of a suite's datasets and frames (core/checksum.cpp)
   libssl-dev

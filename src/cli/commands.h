@@ -57,6 +57,9 @@ void addSlurmOptions(CLI::App* cmd, bool& slurm, pipeline::slurm::Options& optio
 // Registers `suite` and `suite verify`.
 void addSuiteCommand(CLI::App& app, CommandRun& run);
 
+// Registers `map-lights`.
+void addMapLightsCommand(CLI::App& app, CommandRun& run);
+
 // Registers `demo`.
 void addDemoCommand(CLI::App& app, CommandRun& run);
 

@@ -68,6 +68,7 @@ int runCommandLine(int argc, char** argv) {
   cli::addCompareCommand(app, run);
   cli::addFidelityCommand(app, run);
   cli::addEvaluateCommand(app, run);
+  cli::addMapLightsCommand(app, run);
   cli::addDemoCommand(app, run);
   cli::addSuiteCommand(app, run);
 

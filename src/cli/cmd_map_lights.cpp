@@ -1,0 +1,73 @@
+// `dynbench map-lights MAP`: an id Tech 3 map's static lights, the ones its BSP names and the
+// stripped ones fitted to its lightmaps (src/maplight/fit.h), with how well they reproduce them.
+#include <memory>
+
+#include "cli/commands.h"
+#include "core/progress.h"
+#include "maplight/fit.h"
+
+namespace dynbench::cli {
+namespace {
+
+struct MapLightsCli {
+  std::string map, data = "/usr/lib/openarena/baseoa", adapterLights;
+  bool hideEntityLights = false;
+  maplight::MapLightFitOptions options;
+};
+
+Expected<void> runMapLights(const MapLightsCli& cli) {
+  auto files = maplight::GameFiles::open(cli.data);
+  if (!files) return std::unexpected(files.error());
+  maplight::MapLightFitOptions options = cli.options;
+  options.hideEntityLights = cli.hideEntityLights;
+  std::unique_ptr<Progress> bar;
+  std::string step;
+  auto lighting = maplight::fitMapLighting(*files, cli.map, options, [&](const std::string& s, std::size_t done, std::size_t total) {
+    if (s != step) {
+      bar = std::make_unique<Progress>("map-lights " + s, total, "");
+      step = s;
+    }
+    bar->update(done);
+  });
+  bar.reset();
+  if (!lighting) return std::unexpected(lighting.error());
+  const auto& r = lighting->report;
+  fmt::print("{}: {} lightmap texels ({} at 255 left out), gamma {}\n", cli.map, r.texels, r.clippedTexels, r.gamma);
+  fmt::print("  known emitters: {} light entities, {} suns, {} surface-light pieces; {} shaders with q3map_skylight (not modelled)\n",
+             r.entityLights, r.suns, r.surfaceEmitters, r.skyLightShaders);
+  fmt::print("  fit: {} texels, {} candidates ({}-unit lattice), {} lights fitted, constant {:.2f} {:.2f} {:.2f} (dropped)\n", r.fitSamples,
+             r.candidates, r.latticeSpacing, r.fittedLights, r.constant.r, r.constant.g, r.constant.b);
+  fmt::print("  held-out texels ({}): correlation {:.3f} (known emitters alone {:.3f}); variance explained {:.3f} (known alone {:.3f})\n",
+             r.heldOutSamples, r.heldOutCorrelation, r.knownCorrelation, r.totalExplained, r.knownExplained);
+  if (cli.hideEntityLights)
+    fmt::print("  hidden entity lights: {:.0f} of light value, {:.1f} % of it with a fitted light within {} units\n", r.hiddenLightValue,
+               100.0 * r.recoveredShare, maplight::kRecoveryRadius);
+  for (const auto& [name, weight] : r.groupWeights) fmt::print("  {}: weight {:.3f}\n", name, weight);
+  if (!cli.adapterLights.empty()) {
+    auto bytes = files->read("maps/" + cli.map + ".bsp");
+    if (!bytes) return std::unexpected(bytes.error());
+    auto bsp = maplight::parseBsp(*bytes, cli.map);
+    if (!bsp) return std::unexpected(bsp.error());
+    if (auto written = maplight::writeAdapterLights(cli.adapterLights, *lighting, *bsp); !written) return written;
+  }
+  return {};
+}
+
+}  // namespace
+
+void addMapLightsCommand(CLI::App& app, CommandRun& run) {
+  auto cli = std::make_shared<MapLightsCli>();
+  auto* cmd = app.add_subcommand("map-lights", "An id Tech 3 map's static lights: those its BSP names and the stripped ones fitted to its lightmaps");
+  cmd->footer("Example: dynbench map-lights oa_dm1\n         dynbench map-lights kaos --hide-entity-lights   (how well the fit recovers the map's real lights)");
+  cmd->add_option("MAP", cli->map, "The map's name (maps/MAP.bsp in the game's archives)")->required();
+  cmd->add_option("--data", cli->data, "The game's base folder with its .pk3 archives")->capture_default_str();
+  cmd->add_flag("--hide-entity-lights", cli->hideEntityLights, "Fit without the map's light entities (to measure recovery)");
+  cmd->add_option("--max-lights", cli->options.maxLights, "Fitted lights at most")->capture_default_str()->check(CLI::Range(0, 4096));
+  cmd->add_option("--minimum-gain", cli->options.minimumGain, "Stop when a light explains less than this share of the signal")->capture_default_str();
+  cmd->add_option("--fit-samples", cli->options.fitSamples, "Lightmap texels fitted")->capture_default_str();
+  cmd->add_option("--max-candidates", cli->options.maxCandidates, "Candidate light positions at most")->capture_default_str();
+  cmd->add_option("--adapter-lights", cli->adapterLights, "Write the lights file the OpenArena capture adapter reads");
+  cmd->callback([cli, &run] { run = [cli] { return runMapLights(*cli); }; });
+}
+
+}  // namespace dynbench::cli

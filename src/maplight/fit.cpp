@@ -1,0 +1,796 @@
+#include "maplight/fit.h"
+
+#include <algorithm>
+#include <atomic>
+#include <map>
+#include <set>
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <numeric>
+#include <regex>
+#include <sstream>
+
+#include <tbb/parallel_for.h>
+
+#include "core/files.h"
+#include "maplight/nnls.h"
+#include "render/raytracing_scene.h"
+
+namespace dynbench::maplight {
+
+namespace {
+
+constexpr double kNudge = 1.0;  // units a sample is lifted off its surface before tracing (q3map2 nudges too)
+
+double luminance(const glm::dvec3& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
+
+struct Sample {
+  glm::dvec3 position{0.0}, normal{0.0};
+  glm::dvec3 value{0.0};  // linear lightmap units
+};
+
+// The map's geometry as Embree sees it: node 0 the solid surfaces, node 1 the sky's.
+struct Occluders {
+  std::unique_ptr<render::RayTracingScene> tracer;
+  bool visible(const glm::dvec3& from, const glm::dvec3& to) const {
+    const glm::dvec3 d = to - from;
+    const double length = glm::length(d);
+    return length <= 1e-6 || !tracer->occluded(from, d / length, length - 1e-3);
+  }
+  // Whether a ray from `from` towards `direction` reaches the sky (or leaves the map).
+  bool seesSky(const glm::dvec3& from, const glm::dvec3& direction) const {
+    const render::SurfaceHit hit = tracer->intersect(render::Ray{from, direction});
+    return !hit.hit || hit.node == 1;
+  }
+};
+
+bool drawn(const Bsp& bsp, const ShaderScripts& scripts, const BspSurface& s, bool& sky) {
+  if (s.type == BspSurfaceType::kBad || s.type == BspSurfaceType::kFlare) return false;
+  const BspShader& shader = bsp.shaders[static_cast<std::size_t>(s.shader)];
+  const ShaderLighting* script = scripts.find(shader.name);
+  sky = (shader.surfaceFlags & kSurfaceSky) != 0 || (script && script->sky);
+  if ((shader.surfaceFlags & kSurfaceNoDraw) != 0 || (script && script->noDraw)) return false;
+  return !(script && script->translucent) || sky;
+}
+
+Expected<Occluders> buildOccluders(const Bsp& bsp, const ShaderScripts& scripts) {
+  scene::Scene scene;
+  scene.meshes.resize(2);
+  for (int k = 0; k < 2; ++k) {
+    scene.meshes[static_cast<std::size_t>(k)].primitives.resize(1);
+    scene::Node node;
+    node.mesh = k;
+    scene.nodes.push_back(node);
+    scene.roots.push_back(k);
+  }
+  const BspModel& world = bsp.models[0];
+  for (int i = world.firstSurface; i < world.firstSurface + world.surfaceCount; ++i) {
+    bool sky = false;
+    if (!drawn(bsp, scripts, bsp.surfaces[static_cast<std::size_t>(i)], sky)) continue;
+    scene::Primitive& p = scene.meshes[sky ? 1 : 0].primitives[0];
+    for (const SurfaceTriangle& t : surfaceTriangles(bsp, i)) {
+      for (int k = 0; k < 3; ++k) {
+        p.indices.push_back(static_cast<std::uint32_t>(p.positions.size()));
+        p.positions.push_back(glm::vec3(t.position[static_cast<std::size_t>(k)]));
+        p.normals.push_back(glm::vec3(t.normal[static_cast<std::size_t>(k)]));
+      }
+    }
+  }
+  auto tracer = render::RayTracingScene::create(scene);
+  if (!tracer) return std::unexpected(tracer.error());
+  if (auto updated = (*tracer)->update(0.0); !updated) return std::unexpected(updated.error());
+  return Occluders{std::move(*tracer)};
+}
+
+double gammaOf(const Bsp& bsp) {
+  if (bsp.entities.empty()) return 1.0;
+  const std::string cmdline = entityValue(bsp.entities[0], "_q3map2_cmdline");
+  static const std::regex gamma(R"((?:^|\s)-gamma\s+([0-9.]+))");
+  std::smatch m;
+  if (std::regex_search(cmdline, m, gamma)) {
+    const double g = std::atof(m[1].str().c_str());
+    if (g > 0) return g;
+  }
+  return 1.0;
+}
+
+// Lightmap texels of the world's drawn, lightmapped surfaces, each once (the first triangle over a
+// texel's centre owns it), on a regular subset: texels whose page coordinates are multiples of
+// `stride` plus `offset`.
+std::vector<Sample> lightmapSamples(const Bsp& bsp, const ShaderScripts& scripts, double gamma, int stride, int offset, std::size_t* texels,
+                                    std::size_t* clipped) {
+  std::vector<Sample> samples;
+  std::vector<std::vector<char>> owned(bsp.lightmaps.size(), std::vector<char>(kLightmapSize * kLightmapSize, 0));
+  const BspModel& world = bsp.models[0];
+  for (int i = world.firstSurface; i < world.firstSurface + world.surfaceCount; ++i) {
+    const BspSurface& s = bsp.surfaces[static_cast<std::size_t>(i)];
+    bool sky = false;
+    if (s.lightmap < 0 || !drawn(bsp, scripts, s, sky) || sky) continue;
+    if (bsp.shaders[static_cast<std::size_t>(s.shader)].surfaceFlags & kSurfaceNoLightmap) continue;
+    const auto& page = bsp.lightmaps[static_cast<std::size_t>(s.lightmap)];
+    auto& own = owned[static_cast<std::size_t>(s.lightmap)];
+    for (const SurfaceTriangle& t : surfaceTriangles(bsp, i)) {
+      std::array<glm::dvec2, 3> uv;
+      for (int k = 0; k < 3; ++k) uv[static_cast<std::size_t>(k)] = t.lightmap[static_cast<std::size_t>(k)] * static_cast<double>(kLightmapSize);
+      const double area = (uv[1].x - uv[0].x) * (uv[2].y - uv[0].y) - (uv[2].x - uv[0].x) * (uv[1].y - uv[0].y);
+      if (std::abs(area) < 1e-9) continue;
+      const int x0 = std::max(0, static_cast<int>(std::floor(std::min({uv[0].x, uv[1].x, uv[2].x}))));
+      const int x1 = std::min(kLightmapSize - 1, static_cast<int>(std::ceil(std::max({uv[0].x, uv[1].x, uv[2].x}))));
+      const int y0 = std::max(0, static_cast<int>(std::floor(std::min({uv[0].y, uv[1].y, uv[2].y}))));
+      const int y1 = std::min(kLightmapSize - 1, static_cast<int>(std::ceil(std::max({uv[0].y, uv[1].y, uv[2].y}))));
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) {
+          const glm::dvec2 c(x + 0.5, y + 0.5);
+          const double w1 = ((c.x - uv[0].x) * (uv[2].y - uv[0].y) - (uv[2].x - uv[0].x) * (c.y - uv[0].y)) / area;
+          const double w2 = ((uv[1].x - uv[0].x) * (c.y - uv[0].y) - (c.x - uv[0].x) * (uv[1].y - uv[0].y)) / area;
+          const double w0 = 1.0 - w1 - w2;
+          if (w0 < 0 || w1 < 0 || w2 < 0) continue;
+          char& mark = own[static_cast<std::size_t>(y * kLightmapSize + x)];
+          if (mark) continue;
+          mark = 1;
+          const std::uint8_t* rgb = &page[static_cast<std::size_t>((y * kLightmapSize + x) * 3)];
+          if (texels) ++*texels;
+          // ColorToBytes normalises a colour whose brightest channel passes 255 to 255: its level is lost
+          if (std::max({rgb[0], rgb[1], rgb[2]}) >= 255) {
+            if (clipped) ++*clipped;
+            continue;
+          }
+          if (((x - offset) % stride + stride) % stride != 0 || ((y - offset) % stride + stride) % stride != 0) continue;
+          Sample sample;
+          glm::dvec3 n = w0 * t.normal[0] + w1 * t.normal[1] + w2 * t.normal[2];
+          if (glm::length(n) <= 0) continue;
+          n = glm::normalize(n);
+          sample.normal = n;
+          sample.position = w0 * t.position[0] + w1 * t.position[1] + w2 * t.position[2] + kNudge * n;
+          for (int k = 0; k < 3; ++k) sample.value[k] = 255.0 * std::pow(rgb[k] / 255.0, gamma);  // undo -gamma (ColorToBytes)
+          samples.push_back(sample);
+        }
+    }
+  }
+  return samples;
+}
+
+double triangleArea(const std::array<glm::dvec3, 3>& t) { return 0.5 * glm::length(glm::cross(t[1] - t[0], t[2] - t[0])); }
+
+// Splits a triangle at its longest edge until every edge is at most `size` (q3map2 subdivides a
+// surface light's windings likewise, RadSubdivideDiffuseLight).
+void subdivide(const std::array<glm::dvec3, 3>& t, double size, std::vector<std::array<glm::dvec3, 3>>& out, int depth = 0) {
+  int longest = 0;
+  double length = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double l = glm::length(t[static_cast<std::size_t>((k + 1) % 3)] - t[static_cast<std::size_t>(k)]);
+    if (l > length) {
+      length = l;
+      longest = k;
+    }
+  }
+  if (length <= size || depth > 16) {
+    out.push_back(t);
+    return;
+  }
+  const auto a = static_cast<std::size_t>(longest), b = static_cast<std::size_t>((longest + 1) % 3), c = static_cast<std::size_t>((longest + 2) % 3);
+  const glm::dvec3 mid = 0.5 * (t[a] + t[b]);
+  subdivide({t[a], mid, t[c]}, size, out, depth + 1);
+  subdivide({mid, t[b], t[c]}, size, out, depth + 1);
+}
+
+std::vector<SurfaceEmitter> surfaceEmitters(const Bsp& bsp, const ShaderScripts& scripts, const GameFiles& files) {
+  std::vector<SurfaceEmitter> emitters;
+  std::map<int, glm::dvec3> colors;
+  std::map<int, double> areas;
+  const BspModel& world = bsp.models[0];
+  const auto emitting = [&](int i) -> const ShaderLighting* {
+    const BspSurface& s = bsp.surfaces[static_cast<std::size_t>(i)];
+    const ShaderLighting* script = scripts.find(bsp.shaders[static_cast<std::size_t>(s.shader)].name);
+    return script && script->surfaceLight > 0 ? script : nullptr;
+  };
+  for (int i = world.firstSurface; i < world.firstSurface + world.surfaceCount; ++i)
+    if (emitting(i))
+      for (const SurfaceTriangle& t : surfaceTriangles(bsp, i)) areas[bsp.surfaces[static_cast<std::size_t>(i)].shader] += triangleArea(t.position);
+  for (int i = world.firstSurface; i < world.firstSurface + world.surfaceCount; ++i) {
+    const BspSurface& s = bsp.surfaces[static_cast<std::size_t>(i)];
+    const ShaderLighting* script = emitting(i);
+    if (!script) continue;
+    if (!colors.contains(s.shader)) colors[s.shader] = surfaceLightColor(*script, files);
+    // Pieces of at most 128 units, coarser where a shader covers so much (a sky box that emits)
+    // that it would make more than about 2000 of them.
+    const double pieceSize = std::max(128.0, std::sqrt(2.0 * areas[s.shader] / 2000.0));
+    for (const SurfaceTriangle& t : surfaceTriangles(bsp, i)) {
+      std::vector<std::array<glm::dvec3, 3>> pieces;
+      subdivide(t.position, pieceSize, pieces);
+      const glm::dvec3 facing = t.normal[0] + t.normal[1] + t.normal[2];  // the side the BSP's normals give it
+      for (const auto& piece : pieces) {
+        const glm::dvec3 cross = glm::cross(piece[1] - piece[0], piece[2] - piece[0]);
+        if (glm::length(cross) <= 1e-9) continue;
+        SurfaceEmitter e;
+        e.triangle = piece;
+        e.normal = glm::normalize(cross) * (glm::dot(cross, facing) < 0 ? -1.0 : 1.0);
+        e.color = colors[s.shader];
+        e.value = script->surfaceLight;
+        e.backsplashFraction = script->backsplashFraction;
+        e.backsplashDistance = script->backsplashDistance;
+        e.shader = s.shader;
+        emitters.push_back(e);
+      }
+    }
+  }
+  return emitters;
+}
+
+double pearson(const std::vector<double>& a, const std::vector<double>& b) {
+  const std::size_t n = a.size();
+  if (n < 2) return 0.0;
+  const double ma = std::accumulate(a.begin(), a.end(), 0.0) / n, mb = std::accumulate(b.begin(), b.end(), 0.0) / n;
+  double sab = 0, saa = 0, sbb = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    sab += (a[i] - ma) * (b[i] - mb);
+    saa += (a[i] - ma) * (a[i] - ma);
+    sbb += (b[i] - mb) * (b[i] - mb);
+  }
+  return saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0.0;
+}
+
+struct Column {
+  std::vector<std::uint32_t> rows;
+  std::vector<float> values;
+  double norm2 = 0.0;
+};
+
+// A group of known emitters whose strength the fit confirms with one weight: one light entity, one
+// sun, or every piece of one shader's surface light. Its colour is shared.
+struct EmitterGroup {
+  std::string name;
+  glm::dvec3 color{1.0};
+  std::vector<std::size_t> lights;    // indices into MapLighting::lights
+  std::vector<std::size_t> surfaces;  // indices into MapLighting::surfaceLights
+};
+
+// Every group's light at every sample (q3map2's model, lightmap units per unit colour, visibility
+// included) as sparse columns.
+std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::vector<EmitterGroup>& groups, const std::vector<MapLight>& lights,
+                                 const std::vector<SurfaceEmitter>& surfaces, const Occluders& occluders) {
+  const std::size_t g = groups.size();
+  std::vector<float> dense(samples.size() * g, 0.0f);
+  tbb::parallel_for(std::size_t(0), samples.size(), [&](std::size_t i) {
+    const Sample& s = samples[i];
+    for (std::size_t k = 0; k < g; ++k) {
+      double sum = 0.0;
+      for (std::size_t li : groups[k].lights) {
+        const MapLight& l = lights[li];
+        const double add = lightContribution(l, s.position, s.normal);
+        if (add <= 0) continue;
+        const bool visible = l.kind == MapLightKind::kSun ? occluders.seesSky(s.position, l.towardsSun) : occluders.visible(s.position, l.position);
+        if (visible) sum += add;
+      }
+      for (std::size_t ei : groups[k].surfaces) {
+        const SurfaceEmitter& e = surfaces[ei];
+        const glm::dvec3 centre = (e.triangle[0] + e.triangle[1] + e.triangle[2]) / 3.0 + e.normal;
+        // a bound first: the form factor is at most area / (pi distance^2) from the piece's circumsphere
+        const double radius = std::max({glm::length(e.triangle[0] - centre), glm::length(e.triangle[1] - centre), glm::length(e.triangle[2] - centre)});
+        const double distance = glm::length(s.position - centre) - radius;
+        const double area = triangleArea(e.triangle);
+        const bool negligible = distance > 0 && area / (std::numbers::pi * distance * distance) * e.value * kFormFactorValueScale * kAreaScale < 0.01;
+        if (!negligible) {
+          const double add = surfaceContribution(e, s.position, s.normal);
+          if (add > 0 && occluders.visible(s.position, centre)) sum += add;
+        }
+        if (e.backsplashFraction > 0) {
+          // the point light q3map2 adds in front of every piece: photons V area areaScale fraction, no pointScale
+          MapLight splash;
+          splash.position = centre + e.normal * (e.backsplashDistance - 1.0);
+          splash.value = e.value * area * kAreaScale * e.backsplashFraction / kPointScale;
+          const double b = lightContribution(splash, s.position, s.normal);
+          if (b > 0.01 && occluders.visible(s.position, splash.position)) sum += b;
+        }
+      }
+      dense[i * g + k] = static_cast<float>(sum);
+    }
+  });
+  std::vector<Column> columns(g);
+  for (std::size_t i = 0; i < samples.size(); ++i)
+    for (std::size_t k = 0; k < g; ++k)
+      if (const float v = dense[i * g + k]; v > 0) {
+        columns[k].rows.push_back(static_cast<std::uint32_t>(i));
+        columns[k].values.push_back(v);
+        columns[k].norm2 += static_cast<double>(v) * v;
+      }
+  return columns;
+}
+
+// A candidate point light of V = 1 at `position`: its light at every sample, visibility included.
+Column candidateColumn(const glm::dvec3& position, const std::vector<Sample>& samples, const Occluders& occluders) {
+  Column c;
+  MapLight light;
+  light.position = position;
+  light.value = 1.0;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const double add = lightContribution(light, samples[i].position, samples[i].normal);
+    // below 1/4 of a byte for the brightest entity lights q3map2 maps use (V ~ 1000): nothing
+    if (add * 1000.0 < 0.25) continue;
+    if (!occluders.visible(samples[i].position, position)) continue;
+    c.rows.push_back(static_cast<std::uint32_t>(i));
+    c.values.push_back(static_cast<float>(add));
+    c.norm2 += add * add;
+  }
+  return c;
+}
+
+// Lattice points at least 16 units from every surface, inside the map's sealed hull: rays in 14
+// directions all end on the front of a surface or on the sky.
+std::vector<glm::dvec3> openSpaceLattice(const Bsp& bsp, const Occluders& occluders, int maxCandidates, std::size_t& spacing) {
+  const glm::dvec3 lo = glm::dvec3(bsp.models[0].mins) + kMinimumDistance, hi = glm::dvec3(bsp.models[0].maxs) - kMinimumDistance;
+  const glm::dvec3 size = glm::max(hi - lo, glm::dvec3(1.0));
+  std::vector<glm::dvec3> directions;
+  for (int a = 0; a < 3; ++a)
+    for (int s : {-1, 1}) {
+      glm::dvec3 d(0.0);
+      d[a] = s;
+      directions.push_back(d);
+    }
+  for (int x : {-1, 1})
+    for (int y : {-1, 1})
+      for (int z : {-1, 1}) directions.push_back(glm::normalize(glm::dvec3(x, y, z)));
+  const auto open = [&](const glm::dvec3& p) {
+    for (const glm::dvec3& d : directions) {
+      const render::SurfaceHit hit = occluders.tracer->intersect(render::Ray{p, d});
+      if (!hit.hit) return false;
+      if (hit.node == 1) continue;  // the sky
+      // the surface's own side: its vertex normals (the BSP's), not a winding convention
+      if (hit.distance < kMinimumDistance || glm::dot(hit.shadingNormal, d) > 0) return false;
+    }
+    return true;
+  };
+  // Coarsen the lattice until the open points are few enough (deterministic: spacing in 8-unit steps).
+  for (double step = 32.0;; step += 8.0) {
+    const glm::ivec3 n = glm::ivec3(glm::floor(size / step)) + 1;
+    const std::size_t total = static_cast<std::size_t>(n.x) * n.y * n.z;
+    if (total > static_cast<std::size_t>(maxCandidates) * 20) continue;
+    std::vector<char> isOpen(total, 0);
+    tbb::parallel_for(std::size_t(0), total, [&](std::size_t k) {
+      const int x = static_cast<int>(k % n.x), y = static_cast<int>((k / n.x) % n.y), z = static_cast<int>(k / (static_cast<std::size_t>(n.x) * n.y));
+      isOpen[k] = open(lo + glm::dvec3(x, y, z) * step) ? 1 : 0;
+    });
+    const auto count = static_cast<std::size_t>(std::count(isOpen.begin(), isOpen.end(), 1));
+    if (count > static_cast<std::size_t>(maxCandidates)) continue;
+    std::vector<glm::dvec3> points;
+    for (std::size_t k = 0; k < total; ++k)
+      if (isOpen[k]) {
+        const int x = static_cast<int>(k % n.x), y = static_cast<int>((k / n.x) % n.y), z = static_cast<int>(k / (static_cast<std::size_t>(n.x) * n.y));
+        points.push_back(lo + glm::dvec3(x, y, z) * step);
+      }
+    spacing = static_cast<std::size_t>(step);
+    return points;
+  }
+}
+
+double dot(const Column& c, const std::vector<double>& dense) {
+  double s = 0;
+  for (std::size_t k = 0; k < c.rows.size(); ++k) s += c.values[k] * dense[c.rows[k]];
+  return s;
+}
+
+}  // namespace
+
+double formFactor(const std::array<glm::dvec3, 3>& triangle, const glm::dvec3& point, const glm::dvec3& normal) {
+  // Lambert: the projected solid angle is 1/2 sum_i gamma_i (n . u_i), with gamma_i the angle the
+  // edge i subtends and u_i the unit normal of the plane through it and the point.
+  std::array<glm::dvec3, 3> dirs;
+  for (int i = 0; i < 3; ++i) {
+    const glm::dvec3 d = triangle[static_cast<std::size_t>(i)] - point;
+    const double l = glm::length(d);
+    if (l <= 1e-12) return 0.0;
+    dirs[static_cast<std::size_t>(i)] = d / l;
+  }
+  double total = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const glm::dvec3& a = dirs[static_cast<std::size_t>(i)];
+    const glm::dvec3& b = dirs[static_cast<std::size_t>((i + 1) % 3)];
+    const double angle = std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
+    const glm::dvec3 cross = glm::cross(a, b);
+    const double length = glm::length(cross);
+    if (length < 1e-12) continue;
+    total += glm::dot(normal, cross / length) * angle;
+  }
+  // The sum's sign follows the winding: positive for a triangle wound clockwise seen from the
+  // point. Either winding gives the same form factor here.
+  const double side = glm::dot(glm::cross(triangle[1] - triangle[0], triangle[2] - triangle[0]), point - triangle[0]);
+  return (side > 0 ? -total : total) / (2.0 * std::numbers::pi);
+}
+
+double lightContribution(const MapLight& light, const glm::dvec3& point, const glm::dvec3& normal) {
+  if (light.kind == MapLightKind::kSun) {
+    const double angle = light.angleAttenuation ? glm::dot(normal, light.towardsSun) : 1.0;
+    return std::max(0.0, light.value * angle);
+  }
+  const glm::dvec3 toLight = light.position - point;
+  if (glm::dot(toLight, normal) < 0.0) return 0.0;  // behind the surface
+  const double d = glm::length(toLight);
+  if (d <= 0) return 0.0;
+  const double dist = std::max(d, kMinimumDistance);
+  const double angle = light.angleAttenuation ? glm::dot(normal, toLight / d) : 1.0;
+  const double photons = light.value * kPointScale;
+  double add = light.linear ? std::max(0.0, angle * photons * kLinearScale - dist * light.fade) : photons / (dist * dist) * angle;
+  if (light.kind == MapLightKind::kSpot) {
+    const double along = glm::dot(point - light.position, light.spotAxis);
+    if (along < 0.0) return 0.0;
+    const double radiusAtDist = light.spotRadiusByDist * along;
+    const double sampleRadius = glm::length(point - (light.position + along * light.spotAxis));
+    if (sampleRadius >= radiusAtDist) return 0.0;
+    if (sampleRadius > radiusAtDist - 32.0) add *= (radiusAtDist - sampleRadius) / 32.0;  // the cone's 32-unit edge
+  }
+  return std::max(0.0, add);
+}
+
+double surfaceContribution(const SurfaceEmitter& e, const glm::dvec3& point, const glm::dvec3& normal) {
+  const double d = glm::dot(point - e.triangle[0], e.normal);
+  if (d < -1.0) return 0.0;  // behind the emitter
+  if (d < 3.0 && glm::dot(normal, e.normal) > 0.9) return 0.0;  // coplanar with it
+  // q3map2 pushes a point close to the emitter's plane 8 units in front of it (no black edges)
+  const glm::dvec3 pushed = d > -8.0 && d < 8.0 ? point + (8.0 - d) * e.normal : point;
+  const double factor = formFactor(e.triangle, pushed, normal);
+  return factor > 0 ? factor * e.value * kFormFactorValueScale * kAreaScale : 0.0;
+}
+
+std::vector<MapLight> entityLights(const Bsp& bsp) {
+  std::vector<MapLight> lights;
+  for (std::size_t i = 0; i < bsp.entities.size(); ++i) {
+    const BspEntity& e = bsp.entities[i];
+    std::string classname = entityValue(e, "classname");
+    std::transform(classname.begin(), classname.end(), classname.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (!classname.starts_with("light") || classname.starts_with("lightjunior")) continue;
+    if (entityValue(e, "noradiosity") == "1") continue;
+    MapLight l;
+    l.source = fmt::format("entity {}", i);
+    const int spawnflags = std::atoi(entityValue(e, "spawnflags").c_str());
+    l.linear = (spawnflags & 1) != 0;
+    l.angleAttenuation = (spawnflags & 3) == 0;
+    if (l.linear) {
+      l.fade = std::atof(entityValue(e, "fade").c_str());
+      if (l.fade == 0) l.fade = 1.0;
+    }
+    l.position = entityVector(e, "origin");
+    double intensity = std::atof(entityValue(e, "_light").c_str());
+    if (intensity == 0) intensity = std::atof(entityValue(e, "light").c_str());
+    if (intensity == 0) intensity = 300.0;
+    if (const double scale = std::atof(entityValue(e, "scale").c_str()); scale != 0) intensity *= scale;
+    l.value = intensity;
+    if (const std::string color = entityValue(e, "_color"); !color.empty()) {
+      std::istringstream in(color);
+      glm::dvec3 c(0.0);
+      in >> c.r >> c.g >> c.b;
+      const double peak = std::max({c.r, c.g, c.b});
+      l.color = peak > 0 ? c / peak : glm::dvec3(1.0);
+    }
+    if (const std::string target = entityValue(e, "target"); !target.empty()) {
+      const auto found = std::find_if(bsp.entities.begin(), bsp.entities.end(), [&](const BspEntity& o) { return entityValue(o, "targetname") == target; });
+      if (found != bsp.entities.end()) {
+        glm::dvec3 axis = entityVector(*found, "origin") - l.position;
+        double dist = glm::length(axis);
+        axis = dist > 0 ? axis / dist : glm::dvec3(0, 0, -1);
+        double radius = std::atof(entityValue(e, "radius").c_str());
+        if (radius == 0) radius = 64.0;
+        if (dist == 0) dist = 64.0;
+        if (entityValue(e, "_sun") == "1") {
+          l.kind = MapLightKind::kSun;
+          l.towardsSun = -axis;
+          l.color = glm::length(l.color) > 0 ? glm::normalize(l.color) : l.color;
+        } else {
+          l.kind = MapLightKind::kSpot;
+          l.spotAxis = axis;
+          l.spotRadiusByDist = (radius + 16.0) / dist;
+          l.linear = false;  // spots: inverse square with angle attenuation always
+          l.angleAttenuation = true;
+          l.fade = 1.0;
+        }
+      }
+    }
+    lights.push_back(l);
+  }
+  return lights;
+}
+
+Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& map, const MapLightFitOptions& options,
+                                     const MapLightProgress& progress) {
+  const auto report = [&](const std::string& step, std::size_t done, std::size_t total) {
+    if (progress) progress(step, done, total);
+  };
+  const std::string path = "maps/" + map + ".bsp";
+  auto bytes = files.read(path);
+  if (!bytes) return std::unexpected(bytes.error());
+  auto bsp = parseBsp(*bytes, files.archiveOf(path) + ":" + path);
+  if (!bsp) return std::unexpected(bsp.error());
+  auto scripts = ShaderScripts::read(files);
+  if (!scripts) return std::unexpected(scripts.error());
+  auto occluders = buildOccluders(*bsp, *scripts);
+  if (!occluders) return std::unexpected(occluders.error());
+
+  MapLighting result;
+  result.map = map;
+  MapLightFitReport& r = result.report;
+  r.gamma = gammaOf(*bsp);
+
+  // The known emitters, in groups: each light entity, each sun, each surface-light shader.
+  std::vector<EmitterGroup> groups;
+  if (!options.hideEntityLights) result.lights = entityLights(*bsp);
+  r.entityLights = result.lights.size();
+  for (std::size_t i = 0; i < result.lights.size(); ++i) groups.push_back({result.lights[i].source, result.lights[i].color, {i}, {}});
+  std::set<int> usedShaders;
+  for (const BspSurface& s : bsp->surfaces) usedShaders.insert(s.shader);
+  for (int shader : usedShaders) {
+    const ShaderLighting* script = scripts->find(bsp->shaders[static_cast<std::size_t>(shader)].name);
+    if (!script) continue;
+    r.skyLightShaders += script->skyLight > 0;
+    for (const ShaderSun& sun : script->suns) {
+      MapLight l;
+      l.kind = MapLightKind::kSun;
+      l.color = sun.color;
+      l.value = sun.intensity;
+      l.towardsSun = sun.towardsSun;
+      l.source = "sun of " + script->name;
+      groups.push_back({l.source, l.color, {result.lights.size()}, {}});
+      result.lights.push_back(l);
+      ++r.suns;
+    }
+  }
+  result.surfaceLights = surfaceEmitters(*bsp, *scripts, files);
+  r.surfaceEmitters = result.surfaceLights.size();
+  {
+    std::map<int, std::size_t> byShader;
+    for (std::size_t i = 0; i < result.surfaceLights.size(); ++i) {
+      const SurfaceEmitter& e = result.surfaceLights[i];
+      auto [it, fresh] = byShader.emplace(e.shader, groups.size());
+      if (fresh) groups.push_back({"surface light " + bsp->shaders[static_cast<std::size_t>(e.shader)].name, e.color, {}, {}});
+      groups[it->second].surfaces.push_back(i);
+    }
+  }
+  const std::size_t knownLights = result.lights.size(), groupCount = groups.size();
+
+  // Samples: a regular subset of the texels to fit, a disjoint one to judge the fit on.
+  std::size_t texels = 0, clipped = 0;
+  lightmapSamples(*bsp, *scripts, r.gamma, 1, 0, &texels, &clipped);
+  r.texels = texels;
+  r.clippedTexels = clipped;
+  const int stride = std::max(2, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(texels) / std::max(options.fitSamples, 1)))));
+  const std::vector<Sample> fit = lightmapSamples(*bsp, *scripts, r.gamma, stride, 0, nullptr, nullptr);
+  const std::vector<Sample> heldOut = lightmapSamples(*bsp, *scripts, r.gamma, stride, stride / 2, nullptr, nullptr);
+  r.fitSamples = fit.size();
+  r.heldOutSamples = heldOut.size();
+  if (fit.size() < 16) return fail(ErrorCode::kUnsupported, "{}: {} lightmap texels to fit; the map has no lightmaps to recover lights from", path, fit.size());
+  report("known emitters", 0, 1);
+  std::vector<Column> columns = groupColumns(fit, groups, result.lights, result.surfaceLights, *occluders);
+  report("known emitters", 1, 1);
+
+  // Candidates and their columns, after the groups'.
+  const std::vector<glm::dvec3> candidates = openSpaceLattice(*bsp, *occluders, options.maxCandidates, r.latticeSpacing);
+  r.candidates = candidates.size();
+  columns.resize(groupCount + candidates.size());
+  std::atomic<std::size_t> done{0};
+  tbb::parallel_for(std::size_t(0), candidates.size(), [&](std::size_t j) {
+    columns[groupCount + j] = candidateColumn(candidates[j], fit, *occluders);
+    const std::size_t finished = ++done;
+    if (finished % 64 == 0) report("candidate lights", finished, candidates.size());
+  });
+  report("candidate lights", candidates.size(), candidates.size());
+  // A column's colour: its group's, white for a candidate. `channel` 3 is luminance.
+  const auto colorOf = [&](std::size_t column, int channel) {
+    const glm::dvec3 color = column < groupCount ? groups[column].color : glm::dvec3(1.0);
+    return channel == 3 ? luminance(color) : color[channel];
+  };
+
+  // Non-negative least squares over the known groups (each with a weight, q3map2's strength being
+  // 1), the chosen candidates and a constant; candidates chosen greedily on luminance. The chosen
+  // columns' Gram matrix is kept as they come and go (a column's products with the others are
+  // computed once), so a step costs one pass over the candidates, not over the set squared.
+  const std::size_t n = fit.size();
+  std::vector<std::size_t> chosen;            // column indices; the constant is the last unknown
+  std::vector<std::vector<double>> gramRows;  // gramRows[a][b] = column a . column b, a, b in chosen (colourless)
+  std::vector<double> columnSums;             // column a . the constant's column of ones
+  std::vector<double> dense(n, 0.0);
+  const auto addColumn = [&](std::size_t j) {
+    const Column& cj = columns[j];
+    for (std::size_t k = 0; k < cj.rows.size(); ++k) dense[cj.rows[k]] = cj.values[k];
+    std::vector<double> row(chosen.size() + 1);
+    for (std::size_t a = 0; a < chosen.size(); ++a) {
+      row[a] = dot(columns[chosen[a]], dense);
+      gramRows[a].push_back(row[a]);
+    }
+    row[chosen.size()] = cj.norm2;
+    for (std::uint32_t i : cj.rows) dense[i] = 0.0;
+    gramRows.push_back(std::move(row));
+    columnSums.push_back(std::accumulate(cj.values.begin(), cj.values.end(), 0.0));
+    chosen.push_back(j);
+  };
+  const auto removeColumns = [&](const std::vector<char>& drop) {
+    std::vector<std::size_t> keep;
+    for (std::size_t a = 0; a < chosen.size(); ++a)
+      if (!drop[a]) keep.push_back(a);
+    std::vector<std::vector<double>> rows;
+    std::vector<double> sums;
+    std::vector<std::size_t> cols;
+    for (std::size_t a : keep) {
+      std::vector<double> row;
+      for (std::size_t b : keep) row.push_back(gramRows[a][b]);
+      rows.push_back(std::move(row));
+      sums.push_back(columnSums[a]);
+      cols.push_back(chosen[a]);
+    }
+    gramRows = std::move(rows);
+    columnSums = std::move(sums);
+    chosen = std::move(cols);
+  };
+  const auto solve = [&](const std::vector<double>& y, int channel) {
+    const std::size_t m = chosen.size() + 1;
+    std::vector<double> gram(m * m, 0.0), atb(m, 0.0);
+    for (std::size_t a = 0; a < chosen.size(); ++a) {
+      const double ca = colorOf(chosen[a], channel);
+      for (std::size_t b = 0; b < chosen.size(); ++b) gram[a * m + b] = gramRows[a][b] * ca * colorOf(chosen[b], channel);
+      gram[a * m + m - 1] = gram[(m - 1) * m + a] = columnSums[a] * ca;
+      atb[a] = dot(columns[chosen[a]], y) * ca;
+    }
+    gram[(m - 1) * m + m - 1] = static_cast<double>(n);
+    atb[m - 1] = std::accumulate(y.begin(), y.end(), 0.0);
+    return nnls(gram, atb).x;
+  };
+  const auto residualOf = [&](const std::vector<double>& y, const std::vector<double>& x, int channel, std::vector<double>& out) {
+    out.assign(n, 0.0);
+    for (std::size_t i = 0; i < n; ++i) out[i] = y[i] - x.back();
+    for (std::size_t a = 0; a < chosen.size(); ++a) {
+      const Column& c = columns[chosen[a]];
+      const double w = x[a] * colorOf(chosen[a], channel);
+      for (std::size_t k = 0; k < c.rows.size(); ++k) out[c.rows[k]] -= w * c.values[k];
+    }
+    double s = 0;
+    for (double v : out) s += v * v;
+    return s;
+  };
+  std::vector<double> target(n), residual;
+  for (std::size_t i = 0; i < n; ++i) target[i] = luminance(fit[i].value);
+  double signal = 0.0;
+  {
+    const double mean = std::accumulate(target.begin(), target.end(), 0.0) / static_cast<double>(n);
+    for (double t : target) signal += (t - mean) * (t - mean);
+  }
+  for (std::size_t k = 0; k < groupCount; ++k) addColumn(k);
+  double error = residualOf(target, solve(target, 3), 3, residual);
+  std::vector<char> taken(columns.size(), 0);
+  std::fill(taken.begin(), taken.begin() + static_cast<std::ptrdiff_t>(groupCount), 1);
+  std::vector<double> scores(columns.size());
+  while (static_cast<int>(chosen.size() - groupCount) < options.maxLights) {
+    tbb::parallel_for(std::size_t(0), columns.size(), [&](std::size_t j) {
+      scores[j] = taken[j] || columns[j].norm2 <= 0 ? 0.0 : dot(columns[j], residual) / std::sqrt(columns[j].norm2);
+    });
+    std::size_t best = columns.size();
+    double bestScore = 0.0;
+    for (std::size_t j = 0; j < columns.size(); ++j)
+      if (scores[j] > bestScore) {
+        bestScore = scores[j];
+        best = j;
+      }
+    if (best == columns.size()) break;
+    addColumn(best);
+    taken[best] = 1;
+    std::vector<double> nextResidual;
+    const std::vector<double> next = solve(target, 3);
+    const double nextError = residualOf(target, next, 3, nextResidual);
+    std::vector<char> drop(chosen.size(), 0);
+    if (error - nextError < options.minimumGain * signal) {
+      drop.back() = 1;
+      removeColumns(drop);
+      break;
+    }
+    residual = std::move(nextResidual);
+    error = nextError;
+    // candidates NNLS set to zero leave the set (they may be chosen again); groups stay
+    for (std::size_t a = groupCount; a < chosen.size(); ++a)
+      if (!(next[a] > 0)) {
+        drop[a] = 1;
+        taken[chosen[a]] = 0;
+      }
+    removeColumns(drop);
+    report("fitting lights", chosen.size() - groupCount, static_cast<std::size_t>(options.maxLights));
+  }
+
+  // Colours and strengths: the same set fitted per channel. A group's weight is the luminance
+  // fit's (its colour is the map's); a fitted light's colour is its channels' ratio.
+  const std::vector<double> weights = solve(target, 3);
+
+  std::array<std::vector<double>, 3> perChannel;
+  for (int c = 0; c < 3; ++c) {
+    std::vector<double> y(n);
+    for (std::size_t i = 0; i < n; ++i) y[i] = fit[i].value[c];
+    perChannel[static_cast<std::size_t>(c)] = solve(y, c);
+    r.constant[c] = perChannel[static_cast<std::size_t>(c)].back();
+  }
+  for (std::size_t k = 0; k < groupCount; ++k) {
+    r.groupWeights.push_back({groups[k].name, weights[k]});
+    for (std::size_t li : groups[k].lights) result.lights[li].value *= weights[k];
+    for (std::size_t ei : groups[k].surfaces) result.surfaceLights[ei].value *= weights[k];
+  }
+  for (std::size_t a = groupCount; a < chosen.size(); ++a) {
+    const glm::dvec3 v(perChannel[0][a], perChannel[1][a], perChannel[2][a]);
+    const double peak = std::max({v.r, v.g, v.b});
+    if (!(peak > 0)) continue;
+    MapLight l;
+    l.position = candidates[chosen[a] - groupCount];
+    l.color = v / peak;
+    l.value = peak;
+    l.source = "fitted";
+    result.lights.push_back(l);
+  }
+  r.fittedLights = result.lights.size() - knownLights;
+  if (options.hideEntityLights) {
+    // How much of the hidden lights' value has a fitted light near it.
+    double total = 0.0, found = 0.0;
+    for (const MapLight& hidden : entityLights(*bsp)) {
+      if (hidden.kind == MapLightKind::kSun) continue;
+      total += hidden.value;
+      for (std::size_t i = knownLights; i < result.lights.size(); ++i)
+        if (glm::length(result.lights[i].position - hidden.position) <= kRecoveryRadius) {
+          found += hidden.value;
+          break;
+        }
+    }
+    r.hiddenLightValue = total;
+    r.recoveredShare = total > 0 ? found / total : 0.0;
+  }
+
+  // Judged on the held-out texels: the known emitters as q3map2 gives them, and the dataset's
+  // lights (the known ones weighted, the fitted ones).
+  report("held-out texels", 0, 1);
+  std::vector<EmitterGroup> all = groups;
+  std::vector<double> allWeights = weights;
+  allWeights.resize(groupCount);
+  for (std::size_t i = knownLights; i < result.lights.size(); ++i) {
+    all.push_back({"fitted", result.lights[i].color, {i}, {}});
+    allWeights.push_back(1.0);
+  }
+  const std::vector<Column> held = groupColumns(heldOut, all, result.lights, result.surfaceLights, *occluders);
+  std::vector<double> texel(heldOut.size()), knownLum(heldOut.size(), 0.0), allLum(heldOut.size(), 0.0);
+  for (std::size_t i = 0; i < heldOut.size(); ++i) texel[i] = luminance(heldOut[i].value);
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    const double lum = luminance(all[k].color);
+    for (std::size_t q = 0; q < held[k].rows.size(); ++q) {
+      // the groups' columns were made with the weighted values: undo the weight for q3map2's own
+      const double v = held[k].values[q] * lum;
+      allLum[held[k].rows[q]] += v;
+      if (k < groupCount && weights[k] > 0) knownLum[held[k].rows[q]] += v / weights[k];
+    }
+  }
+  r.heldOutCorrelation = pearson(texel, allLum);
+  r.knownCorrelation = pearson(texel, knownLum);
+  const auto explained = [&](const std::vector<double>& model, double offset) {
+    const double mean = std::accumulate(texel.begin(), texel.end(), 0.0) / static_cast<double>(texel.size());
+    double total = 0, rest = 0;
+    for (std::size_t i = 0; i < texel.size(); ++i) {
+      total += (texel[i] - mean) * (texel[i] - mean);
+      rest += (texel[i] - model[i] - offset) * (texel[i] - model[i] - offset);
+    }
+    return total > 0 ? 1.0 - rest / total : 0.0;
+  };
+  r.knownExplained = explained(knownLum, 0.0);
+  r.totalExplained = explained(allLum, weights.back());
+  report("held-out texels", 1, 1);
+  return result;
+}
+
+Expected<void> writeAdapterLights(const std::filesystem::path& file, const MapLighting& lighting, const Bsp& bsp) {
+  std::ostringstream out;
+  out << "# dynbench map lights " << lighting.map << ": q3map2's terms, game axes and units (src/maplight/fit.h)\n";
+  for (const MapLight& l : lighting.lights) {
+    const glm::dvec3& c = l.color;
+    if (l.kind == MapLightKind::kSun)
+      out << fmt::format("sun {:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g}\n", l.towardsSun.x, l.towardsSun.y, l.towardsSun.z, c.r, c.g, c.b, l.value);
+    else
+      out << fmt::format("point {:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g}\n", l.position.x, l.position.y, l.position.z, c.r, c.g, c.b,
+                         l.linear ? l.value : l.value);
+  }
+  std::set<int> shaders;
+  for (const SurfaceEmitter& e : lighting.surfaceLights)
+    if (shaders.insert(e.shader).second)
+      out << fmt::format("surface {} {:.6g} {:.6g} {:.6g} {:.6g}\n", bsp.shaders[static_cast<std::size_t>(e.shader)].name, e.color.r, e.color.g, e.color.b,
+                         e.value);
+  return writeFileAtomic(file, out.str());
+}
+
+}  // namespace dynbench::maplight

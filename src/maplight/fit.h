@@ -1,0 +1,131 @@
+#pragma once
+// An id Tech 3 map's static lighting as q3map2 made it, recovered for a physically based renderer.
+//
+// q3map2 bakes the map's lights into lightmaps and, unless worldspawn sets _keepLights, deletes the
+// light entities from the BSP (writebsp.c), so most shipped maps keep none. What is left: the
+// lightmaps, which hold what the lights did, and the emitters the BSP still names (surface lights
+// of its shaders, a sky shader's sun, the light entities of the maps that keep them). This module
+//   1. reads the lightmap texels as samples (position, normal, linear value),
+//   2. predicts the known emitters' light at them with q3map2's own model (light.c,
+//      LightContributionToSample), with Embree for visibility,
+//   3. fits what is left with non-negative point lights: candidates on a lattice in open space,
+//      chosen greedily, weighted by non-negative least squares, plus a constant term that absorbs
+//      bounced light and ambient and is then dropped (the path tracer makes its own indirect light).
+// The result is deterministic: the same map gives the same lights, byte for byte.
+#include <array>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/error.h"
+#include "maplight/bsp.h"
+#include "maplight/pak.h"
+#include "maplight/shaders.h"
+
+namespace dynbench::maplight {
+
+// q3map2's constants (q3map2.h): a point light of value V gives V pointScale cos / max(d, 16)^2
+// lightmap units; a surface light of value V is a Lambertian emitter of radiance areaScale
+// formFactorValueScale V / pi. The engine shows lightmap byte b as b x 4 (overbright bits), so
+// 63.75 is the full light under which a surface shows its texture as it is.
+inline constexpr double kPointScale = 7500.0;
+inline constexpr double kLinearScale = 1.0 / 8000.0;
+inline constexpr double kAreaScale = 0.25, kFormFactorValueScale = 3.0;
+inline constexpr double kMinimumDistance = 16.0;  // q3map2 clamps a point light's distance to it
+inline constexpr double kFullLight = 63.75;       // lightmap units of the engine's full light
+inline constexpr double kRecoveryRadius = 64.0;   // units: a hidden light counts as found with a fitted light this near
+
+enum class MapLightKind { kPoint, kSpot, kSun };
+
+// A light in q3map2's terms (game axes, game units).
+struct MapLight {
+  MapLightKind kind = MapLightKind::kPoint;
+  glm::dvec3 position{0.0};
+  glm::dvec3 color{1.0};  // largest channel 1 (ColorNormalize); a sun's is unit length (VectorNormalize)
+  double value = 0.0;     // the entity's light value V (photons / pointScale); a sun's intensity
+  bool linear = false;    // spawnflags 1: V pointScale linearScale cos - d fade, not the inverse square
+  double fade = 1.0;
+  bool angleAttenuation = true;  // spawnflags 2 clears it
+  glm::dvec3 spotAxis{0.0};      // a spot's unit axis (towards its target)
+  double spotRadiusByDist = 0.0;  // (radius + 16) / distance to the target: the cone's radius per unit along the axis
+  glm::dvec3 towardsSun{0.0};     // a sun's unit direction towards it
+  std::string source;             // "entity 12", "shader textures/sky/x", "fitted"
+};
+
+// One piece of a surface light's surface (a triangle, subdivided): an emitter of q3map2's value.
+struct SurfaceEmitter {
+  std::array<glm::dvec3, 3> triangle;
+  glm::dvec3 normal{0.0};  // unit, the side it lights
+  glm::dvec3 color{1.0};   // largest channel 1
+  double value = 0.0;      // q3map_surfacelight
+  double backsplashFraction = 0.0, backsplashDistance = 0.0;
+  int shader = -1;         // the BSP's shader index
+};
+
+struct MapLightFitOptions {
+  // Leave the map's light entities out of the known emitters: how the fit's recovery is measured on
+  // the maps that keep them.
+  bool hideEntityLights = false;
+  int maxLights = 256;         // fitted point lights at most
+  int fitSamples = 30000;      // lightmap texels fitted (a regular subset of them)
+  int maxCandidates = 6000;    // lattice points in open space
+  double minimumGain = 0.0001;  // stop when a light lowers the residual by less than this share of the signal
+};
+
+struct MapLightFitReport {
+  std::size_t texels = 0, clippedTexels = 0;  // lit lightmap texels of drawn surfaces; those at 255 (left out)
+  std::size_t fitSamples = 0, heldOutSamples = 0;
+  std::size_t candidates = 0, latticeSpacing = 0;
+  std::size_t entityLights = 0, surfaceEmitters = 0, suns = 0, fittedLights = 0;
+  double gamma = 1.0;  // the map's -gamma (from _q3map2_cmdline), undone
+  glm::dvec3 constant{0.0};  // the fit's constant term, lightmap units (dropped)
+  // Luminance correlation between the lightmap texels and q3map2's model of the static emitters
+  // (known and fitted) on held-out texels; the same for the known emitters alone.
+  double heldOutCorrelation = 0.0, knownCorrelation = 0.0;
+  // The share of the texels' luminance variance explained (1 - residual / total), known emitters
+  // alone as q3map2 gives them (no constant), and the dataset's lights with the constant, on held-out texels.
+  double knownExplained = 0.0, totalExplained = 0.0;
+  std::size_t skyLightShaders = 0;  // shaders with q3map_skylight (not modelled)
+  // With the entity lights hidden: their total value (suns left out), and the share of it whose
+  // light has a fitted light within kRecoveryRadius.
+  double hiddenLightValue = 0.0, recoveredShare = 0.0;
+  // Each known group's weight (a light entity, a sun, a surface-light shader): 1 where the
+  // lightmaps agree with q3map2's model of it; the dataset's emitter is the model times it.
+  std::vector<std::pair<std::string, double>> groupWeights;
+};
+
+struct MapLighting {
+  std::string map;
+  std::vector<MapLight> lights;             // kept entities, suns, fitted lights, in that order
+  std::vector<SurfaceEmitter> surfaceLights;  // the surface lights' pieces
+  MapLightFitReport report;
+};
+
+using MapLightProgress = std::function<void(const std::string& step, std::size_t done, std::size_t total)>;
+
+Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& map, const MapLightFitOptions& options = {},
+                                     const MapLightProgress& progress = {});
+
+// q3map2's light at a point without visibility: lightmap units of luminance per unit colour
+// (LightContributionToSample's `add`, before it is multiplied by the light's colour).
+double lightContribution(const MapLight& light, const glm::dvec3& point, const glm::dvec3& normal);
+// A surface emitter's light at a point (its exact point-to-polygon form factor times
+// formFactorValueScale areaScale V), without visibility.
+double surfaceContribution(const SurfaceEmitter& emitter, const glm::dvec3& point, const glm::dvec3& normal);
+// The projected solid angle of a triangle seen from `point` with normal `normal`, over pi (Lambert's
+// polygon formula; q3map2's PointToPolygonFormFactor): 1 for a triangle filling the hemisphere.
+double formFactor(const std::array<glm::dvec3, 3>& triangle, const glm::dvec3& point, const glm::dvec3& normal);
+
+// The map's light entities (classname light*) as q3map2 reads them (light.c, CreateEntityLights):
+// spots aimed at their target, suns (_sun 1) made directional.
+std::vector<MapLight> entityLights(const Bsp& bsp);
+
+// The lights file the capture adapter reads (integrations/openarena): one light per line,
+// "point X Y Z R G B V" or "sun DX DY DZ R G B V" (game axes and units, q3map2's values), and
+// "surface SHADER R G B V" per light-emitting shader. Written to a temporary name and renamed.
+Expected<void> writeAdapterLights(const std::filesystem::path& file, const MapLighting& lighting, const Bsp& bsp);
+
+}  // namespace dynbench::maplight

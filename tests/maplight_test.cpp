@@ -1,0 +1,250 @@
+// maplight: q3map2's light model (known answers), the NNLS solver (its optimality conditions), the
+// BSP and shader readers (their refusals), and the fit on Debian's OpenArena maps: a map's
+// lightmaps reproduced, real lights recovered when hidden, the same lights every run.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <numbers>
+#include <random>
+
+#include "core/files.h"
+#include "external_tools.h"
+#include "maplight/bsp.h"
+#include "maplight/fit.h"
+#include "maplight/nnls.h"
+#include "maplight/shaders.h"
+#include "run_cli.h"
+
+namespace dynbench::maplight {
+namespace {
+
+TEST(Nnls, HandDerivedKnownAnswer) {
+  // A = [[1, 0], [0, 1], [1, 1]], b = (2, -1, 1): unconstrained (2, -1); with x2 >= 0 the
+  // optimum is x2 = 0 and x1 minimising (x1 - 2)^2 + (x1 - 1)^2, 1.5.
+  const std::vector<double> gram = {2, 1, 1, 2}, atb = {3, 0};
+  const NnlsResult r = nnls(gram, atb);
+  ASSERT_TRUE(r.converged);
+  EXPECT_NEAR(r.x[0], 1.5, 1e-9);
+  EXPECT_EQ(r.x[1], 0.0);
+}
+
+TEST(Nnls, RandomProblemsMeetTheOptimalityConditions) {
+  // Karush-Kuhn-Tucker for min |Ax - b|^2, x >= 0: x >= 0, w = A^T (b - A x) <= 0, and w = 0 where x > 0.
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  for (int trial = 0; trial < 20; ++trial) {
+    const std::size_t rows = 60, cols = 14;
+    std::vector<double> a(rows * cols), b(rows);
+    for (double& v : a) v = std::abs(normal(rng));
+    for (double& v : b) v = normal(rng) * 3.0 + 1.0;
+    std::vector<double> gram(cols * cols, 0.0), atb(cols, 0.0);
+    for (std::size_t i = 0; i < cols; ++i) {
+      for (std::size_t j = 0; j < cols; ++j)
+        for (std::size_t k = 0; k < rows; ++k) gram[i * cols + j] += a[k * cols + i] * a[k * cols + j];
+      for (std::size_t k = 0; k < rows; ++k) atb[i] += a[k * cols + i] * b[k];
+    }
+    const NnlsResult r = nnls(gram, atb);
+    ASSERT_TRUE(r.converged) << trial;
+    std::size_t positive = 0;
+    for (std::size_t i = 0; i < cols; ++i) {
+      ASSERT_GE(r.x[i], 0.0);
+      double w = atb[i];
+      for (std::size_t j = 0; j < cols; ++j) w -= gram[i * cols + j] * r.x[j];
+      const double scale = 1e-8 * (1.0 + std::abs(atb[i]));
+      if (r.x[i] > 0) {
+        ++positive;
+        EXPECT_NEAR(w, 0.0, scale) << trial << " " << i;
+      } else {
+        EXPECT_LE(w, scale) << trial << " " << i;
+      }
+    }
+    EXPECT_GT(positive, 0u);
+  }
+}
+
+// The form factor from a point to a parallel rectangle with one corner straight above it, X = a/h,
+// Y = b/h (the standard differential-area-to-rectangle view factor, e.g. Howell's catalogue, B-3):
+// F = 1/(2 pi) (X/sqrt(1+X^2) atan(Y/sqrt(1+X^2)) + Y/sqrt(1+Y^2) atan(X/sqrt(1+Y^2))).
+TEST(MapLight, FormFactorOfARectangleOverACorner) {
+  const double a = 3.0, b = 5.0, h = 2.0, x = a / h, y = b / h;
+  const double expected = (x / std::sqrt(1 + x * x) * std::atan(y / std::sqrt(1 + x * x)) + y / std::sqrt(1 + y * y) * std::atan(x / std::sqrt(1 + y * y))) /
+                          (2.0 * std::numbers::pi);
+  const glm::dvec3 p00(0, 0, h), p10(a, 0, h), p11(a, b, h), p01(0, b, h);
+  const glm::dvec3 up(0, 0, 1);
+  const double both = formFactor({p00, p10, p11}, glm::dvec3(0.0), up) + formFactor({p00, p11, p01}, glm::dvec3(0.0), up);
+  EXPECT_NEAR(both, expected, 1e-12);
+  // either winding
+  const double reversed = formFactor({p11, p10, p00}, glm::dvec3(0.0), up) + formFactor({p01, p11, p00}, glm::dvec3(0.0), up);
+  EXPECT_NEAR(reversed, expected, 1e-12);
+  // a surface facing away sees it with the opposite sign (q3map2 then gives no light)
+  EXPECT_NEAR(formFactor({p00, p10, p11}, glm::dvec3(0.0), -up), -formFactor({p00, p10, p11}, glm::dvec3(0.0), up), 1e-12);
+  // a surface emitter: formFactorValueScale x areaScale x V times it (beyond 8 units: q3map2 pushes
+  // nearer points 8 units out from the emitter's plane)
+  SurfaceEmitter e;
+  e.triangle = {p00 * 10.0, p10 * 10.0, p11 * 10.0};
+  e.normal = -up;  // lights downwards
+  e.value = 400.0;
+  EXPECT_NEAR(surfaceContribution(e, glm::dvec3(0.0), up), 0.75 * 400.0 * formFactor(e.triangle, glm::dvec3(0.0), up), 1e-9);
+  e.normal = up;  // lights upwards: the point is behind it
+  EXPECT_EQ(surfaceContribution(e, glm::dvec3(0.0), up), 0.0);
+}
+
+TEST(MapLight, PointSpotAndSunFollowQ3map2) {
+  MapLight l;
+  l.value = 300.0;
+  l.position = {0, 0, 100};
+  const glm::dvec3 up(0, 0, 1);
+  EXPECT_DOUBLE_EQ(lightContribution(l, glm::dvec3(0.0), up), 300.0 * 7500.0 / (100.0 * 100.0));  // 225
+  // 60 degrees off the normal: cos = 1/2 at the same distance
+  const glm::dvec3 side(100.0 * std::sin(std::numbers::pi / 3), 0.0, 100.0 - 100.0 * std::cos(std::numbers::pi / 3));
+  EXPECT_NEAR(lightContribution(l, side, up), 112.5, 1e-9);
+  // nearer than 16 units: the distance is clamped
+  EXPECT_DOUBLE_EQ(lightContribution(l, glm::dvec3(0, 0, 92), up), 300.0 * 7500.0 / 256.0);
+  EXPECT_EQ(lightContribution(l, glm::dvec3(0.0), -up), 0.0);  // behind the surface
+  l.angleAttenuation = false;
+  EXPECT_NEAR(lightContribution(l, side, up), 225.0, 1e-9);
+  l.angleAttenuation = true;
+  l.linear = true;  // V pointScale linearScale cos - d fade
+  EXPECT_NEAR(lightContribution(l, glm::dvec3(0.0), up), 300.0 * 7500.0 / 8000.0 - 100.0, 1e-9);
+  l.linear = false;
+  l.kind = MapLightKind::kSpot;
+  l.spotAxis = -up;
+  l.spotRadiusByDist = 0.5;  // 50 units of radius at the floor, 100 below
+  EXPECT_DOUBLE_EQ(lightContribution(l, glm::dvec3(0.0), up), 225.0);
+  EXPECT_EQ(lightContribution(l, glm::dvec3(60, 0, 0), up), 0.0);  // outside the cone
+  const double edge = lightContribution(l, glm::dvec3(34, 0, 0), up);  // in its 32-unit soft edge: (50 - 34) / 32
+  const double d2 = 34.0 * 34.0 + 100.0 * 100.0;
+  EXPECT_NEAR(edge, 300.0 * 7500.0 / d2 * (100.0 / std::sqrt(d2)) * (16.0 / 32.0), 1e-9);
+  MapLight sun;
+  sun.kind = MapLightKind::kSun;
+  sun.value = 80.0;
+  sun.towardsSun = glm::normalize(glm::dvec3(1, 0, 1));
+  EXPECT_NEAR(lightContribution(sun, glm::dvec3(0.0), up), 80.0 / std::sqrt(2.0), 1e-12);
+}
+
+std::string header(const std::vector<std::pair<int, int>>& lumps) {
+  std::string bytes = "IBSP";
+  const int version = 46;
+  bytes.append(reinterpret_cast<const char*>(&version), 4);
+  for (int l = 0; l < 17; ++l) {
+    const std::pair<int, int> lump = l < static_cast<int>(lumps.size()) ? lumps[static_cast<std::size_t>(l)] : std::pair<int, int>{144, 0};
+    bytes.append(reinterpret_cast<const char*>(&lump.first), 4);
+    bytes.append(reinterpret_cast<const char*>(&lump.second), 4);
+  }
+  return bytes;
+}
+
+TEST(Bsp, EntitiesAndLightsAsQ3map2ReadsThem) {
+  const std::string entities =
+      "{ \"classname\" \"worldspawn\" }\n"
+      "{ \"classname\" \"light\" \"origin\" \"0 0 64\" }\n"
+      "{ \"classname\" \"light\" \"origin\" \"10 0 64\" \"light\" \"500\" \"_color\" \"1 0.5 0\" \"target\" \"t1\" \"radius\" \"48\" }\n"
+      "{ \"classname\" \"target_position\" \"origin\" \"10 0 0\" \"targetname\" \"t1\" }\n"
+      "{ \"classname\" \"light\" \"origin\" \"0 0 0\" \"spawnflags\" \"1\" \"_light\" \"200\" }\n";
+  std::string bytes = header({{144, static_cast<int>(entities.size())}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {0, 0}, {static_cast<int>(144 + entities.size()), 40}});
+  bytes += entities;
+  bytes.append(40, '\0');  // one model: the world, no surfaces
+  auto bsp = parseBsp(bytes, "maps/test.bsp");
+  ASSERT_TRUE(bsp) << bsp.error().message;
+  ASSERT_EQ(bsp->entities.size(), 5u);
+  const std::vector<MapLight> lights = entityLights(*bsp);
+  ASSERT_EQ(lights.size(), 3u);
+  EXPECT_EQ(lights[0].value, 300.0);  // q3map2's default
+  EXPECT_EQ(lights[0].kind, MapLightKind::kPoint);
+  EXPECT_EQ(lights[1].kind, MapLightKind::kSpot);
+  EXPECT_EQ(lights[1].value, 500.0);
+  EXPECT_EQ(lights[1].color, glm::dvec3(1, 0.5, 0));
+  EXPECT_EQ(lights[1].spotAxis, glm::dvec3(0, 0, -1));
+  EXPECT_DOUBLE_EQ(lights[1].spotRadiusByDist, (48.0 + 16.0) / 64.0);
+  EXPECT_TRUE(lights[2].linear);
+  EXPECT_FALSE(lights[2].angleAttenuation);
+  EXPECT_EQ(lights[2].value, 200.0);
+}
+
+TEST(Bsp, BrokenFilesAreRefusedNamingTheMapAndLump) {
+  auto shortFile = parseBsp("IBSP", "maps/a.bsp");
+  ASSERT_FALSE(shortFile);
+  EXPECT_NE(shortFile.error().message.find("maps/a.bsp"), std::string::npos);
+  std::string wrong = header({});
+  wrong[0] = 'X';
+  auto ident = parseBsp(wrong, "maps/b.bsp");
+  ASSERT_FALSE(ident);
+  EXPECT_NE(ident.error().message.find("expected 'IBSP'"), std::string::npos);
+  auto outside = parseBsp(header({{144, 0}, {100000, 72}}), "maps/c.bsp");
+  ASSERT_FALSE(outside);
+  EXPECT_NE(outside.error().message.find("maps/c.bsp: lump 1"), std::string::npos) << outside.error().message;
+  auto ragged = parseBsp(header({{144, 0}, {144, 0}, {144, 0}, {144, 0}, {144, 0}, {144, 0}, {144, 0}, {144, 0}, {144, 0}, {144, 0}, {144, 0}, {144, 0}, {144, 0}, {144, 0}}) , "maps/d.bsp");
+  ASSERT_FALSE(ragged);  // no world model
+  EXPECT_NE(ragged.error().message.find("no models"), std::string::npos) << ragged.error().message;
+}
+
+TEST(ShaderScripts, LightKeywordsAndTheFirstDefinitionWin) {
+  ShaderScripts scripts;
+  ASSERT_TRUE(scripts.add("// a comment\n"
+                          "textures/x/lamp\n{\n  q3map_surfacelight 2500\n  q3map_lightRGB 2 1 0\n  q3map_backsplash 10 16\n"
+                          "  { map textures/x/lamp.tga\n  }\n}\n"
+                          "textures/x/sky\n{\n  q3map_sun 1 1 1 120 90 45 /* noon-ish */\n  surfaceparm nolightmap\n}\n",
+                          "a.shader"));
+  ASSERT_TRUE(scripts.add("textures/x/LAMP\n{\n  q3map_surfacelight 1\n}\n", "b.shader"));
+  const ShaderLighting* lamp = scripts.find("textures/X/lamp");
+  ASSERT_NE(lamp, nullptr);
+  EXPECT_EQ(lamp->surfaceLight, 2500.0);  // a.shader's, the first
+  ASSERT_TRUE(lamp->lightRgb);
+  EXPECT_EQ(*lamp->lightRgb, glm::dvec3(1, 0.5, 0));
+  EXPECT_DOUBLE_EQ(lamp->backsplashFraction, 0.1);
+  EXPECT_EQ(lamp->firstStageImage, "textures/x/lamp.tga");
+  const ShaderLighting* sky = scripts.find("textures/x/sky");
+  ASSERT_NE(sky, nullptr);
+  ASSERT_EQ(sky->suns.size(), 1u);
+  EXPECT_TRUE(sky->sky);
+  EXPECT_NEAR(glm::length(sky->suns[0].color), 1.0, 1e-12);
+  EXPECT_NEAR(sky->suns[0].towardsSun.y, std::cos(std::numbers::pi / 4), 1e-12);
+  EXPECT_NEAR(sky->suns[0].towardsSun.z, std::sin(std::numbers::pi / 4), 1e-12);
+  auto unclosed = scripts.add("textures/x/broken\n{\n  q3map_surfacelight 5\n", "c.shader");
+  ASSERT_FALSE(unclosed);
+  EXPECT_NE(unclosed.error().message.find("c.shader:1: shader 'textures/x/broken' is not closed"), std::string::npos) << unclosed.error().message;
+}
+
+TEST(GameFiles, AFolderWithoutArchivesIsAnError) {
+  const auto folder = std::filesystem::temp_directory_path() / "dynbench-no-paks";
+  std::filesystem::create_directories(folder);
+  auto files = GameFiles::open(folder);
+  ASSERT_FALSE(files);
+  EXPECT_NE(files.error().message.find("no .pk3 archives"), std::string::npos);
+  std::filesystem::remove_all(folder);
+}
+
+// On Debian's OpenArena data (no game run): oa_dm1's lightmaps are reproduced by its fitted lights,
+// the same lights twice; kaos's 30 real lights, hidden, are found again.
+TEST(OpenArena, StrippedLightsAreFittedToTheLightmaps) {
+  DYNBENCH_NEEDS(test::missingOpenArena());
+  auto files = GameFiles::open("/usr/lib/openarena/baseoa");
+  ASSERT_TRUE(files) << files.error().message;
+  auto first = fitMapLighting(*files, "oa_dm1");
+  ASSERT_TRUE(first) << first.error().message;
+  EXPECT_GE(first->report.heldOutCorrelation, 0.80);
+  EXPECT_GT(first->report.fittedLights, 20u);
+  auto second = fitMapLighting(*files, "oa_dm1");
+  ASSERT_TRUE(second);
+  auto bytes = files->read("maps/oa_dm1.bsp");
+  ASSERT_TRUE(bytes);
+  auto bsp = parseBsp(*bytes, "oa_dm1");
+  ASSERT_TRUE(bsp);
+  const auto dir = std::filesystem::temp_directory_path() / "dynbench-maplight-test";
+  std::filesystem::create_directories(dir);
+  ASSERT_TRUE(writeAdapterLights(dir / "a.txt", *first, *bsp));
+  ASSERT_TRUE(writeAdapterLights(dir / "b.txt", *second, *bsp));
+  EXPECT_EQ(test::slurp(dir / "a.txt"), test::slurp(dir / "b.txt"));
+  std::filesystem::remove_all(dir);
+
+  MapLightFitOptions hidden;
+  hidden.hideEntityLights = true;
+  auto kaos = fitMapLighting(*files, "kaos", hidden);
+  ASSERT_TRUE(kaos) << kaos.error().message;
+  EXPECT_GT(kaos->report.hiddenLightValue, 0.0);
+  EXPECT_GE(kaos->report.recoveredShare, 0.80);
+}
+
+}  // namespace
+}  // namespace dynbench::maplight
