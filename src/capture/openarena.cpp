@@ -117,7 +117,7 @@ Expected<std::vector<std::string>> openArenaArguments(const OpenArenaOptions& o,
   return a;
 }
 
-Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const OpenArenaProgress& progress) {
+Expected<void> checkOpenArenaOptions(const OpenArenaOptions& o) {
   if (!(o.seconds > 0)) return fail(ErrorCode::kUsage, "--seconds must be positive (got {})", o.seconds);
   if (!(o.warmup >= kOpenArenaMinWarmup))
     return fail(ErrorCode::kUsage, "--warmup must be at least {} s (the camera follows a bot by then)", kOpenArenaMinWarmup);
@@ -125,13 +125,11 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
   if (o.follow != "auto" && o.follow != "one" && (o.follow.empty() || o.follow.find_first_not_of("0123456789") != std::string::npos))
     return fail(ErrorCode::kUsage, "--follow '{}': expected auto, one or a bot's client number (1, 2, ...)", o.follow);
   const std::size_t total = static_cast<std::size_t>(o.seconds * o.fps + 0.5);
-  std::string gameFrames;
   for (const long k : o.gameFrames) {
     // the last frame's image would be read at the frame after it, which is not played
     if (k < 0 || static_cast<std::size_t>(k) + 1 >= total)
       return fail(ErrorCode::kUsage, "--game-frames: frame {} is outside the capture's frames 0 to {} (the last one cannot be kept)", k,
                   static_cast<long>(total) - 2);
-    gameFrames += fmt::format("{}{}", gameFrames.empty() ? "" : ",", k);
   }
   if (auto ok = checkMatch(o); !ok) return std::unexpected(ok.error());
   auto modules = findOpenArenaModules(o.modules);
@@ -144,6 +142,17 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
   if (!o.window && findOnPath("Xvfb").empty()) return fail(ErrorCode::kExternalTool, "Xvfb is missing: install Debian's xvfb (scripts/setup.sh does)");
   if (fs::exists(o.output / "Capture.txt", ec))
     return fail(ErrorCode::kUsage, "{}: already holds a capture; choose an empty folder", o.output.string());
+  return {};
+}
+
+Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const OpenArenaProgress& progress) {
+  if (auto ok = checkOpenArenaOptions(o); !ok) return std::unexpected(ok.error());
+  const std::size_t total = static_cast<std::size_t>(o.seconds * o.fps + 0.5);
+  std::string gameFrames;
+  for (const long k : o.gameFrames) gameFrames += fmt::format("{}{}", gameFrames.empty() ? "" : ",", k);
+  auto modules = findOpenArenaModules(o.modules);
+  if (!modules) return std::unexpected(modules.error());
+  std::error_code ec;
   fs::create_directories(o.output, ec);
   if (ec) return fail(ErrorCode::kIo, "{}: cannot create: {}", o.output.string(), ec.message());
   // A private base (Debian's paks and the capture's modules) and a fresh home (a config saved by
@@ -174,6 +183,7 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
                       {"DYNBENCH_CAPTURE_FOLLOW", o.follow},
                       {"DYNBENCH_CAPTURE_RECORD", o.record ? "1" : "0"}};
   if (!gameFrames.empty()) game.environment.emplace_back("DYNBENCH_CAPTURE_GAME_FRAMES", gameFrames);
+  if (!o.mapLights.empty()) game.environment.emplace_back("DYNBENCH_CAPTURE_MAP_LIGHTS", fs::absolute(o.mapLights).string());
   // The engine loads the modules through the run's base folder (links), so their run path's
   // $ORIGIN/../.. names that folder, not the prefix they are installed in: installed modules
   // (PREFIX/lib/dynbench/openarena) get their prefix's SDK (PREFIX/lib) this way instead. Modules

@@ -39,6 +39,10 @@ struct OpenArenaOptions {
   std::filesystem::path modules;  // folder with cgamex86_64.so and qagamex86_64.so; empty: the build's
   std::filesystem::path engine = "/usr/lib/ioquake3/ioquake3";  // Debian's ioquake3
   std::filesystem::path data = "/usr/lib/openarena";             // Debian's openarena (baseoa/)
+  // The map's lights for the adapter (maplight::cachedAdapterLights: the emitters the BSP names and
+  // the stripped lights fitted to its lightmaps). Empty: the adapter's own rough approximation
+  // (a point light per light-emitting surface and the light grid's mean as ambient).
+  std::filesystem::path mapLights;
   // false: play the same match without writing anything (bench/bench_capture_openarena.sh
   // compares the window's wall time with and without recording)
   bool record = true;
@@ -61,6 +65,10 @@ Expected<std::filesystem::path> findOpenArenaModules(const std::filesystem::path
 // The engine's command line after the executable (exposed for tests).
 Expected<std::vector<std::string>> openArenaArguments(const OpenArenaOptions& options, const std::filesystem::path& basePath,
                                                       const std::filesystem::path& homePath);
+
+// The options' checks captureOpenArena makes before starting the game (usage errors, the engine,
+// data and modules present): callers that do work first (fitting the map's lights) call it first.
+Expected<void> checkOpenArenaOptions(const OpenArenaOptions& options);
 
 Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& options, const OpenArenaProgress& progress = {});
 

@@ -562,7 +562,8 @@ Expected<bool> CaptureReader::next(CaptureFrame& frame) {
         const std::string falloff = l.text(9);
         if (falloff == "linear") r.falloff = LightFalloff::kLinear;
         else if (falloff == "quadratic") r.falloff = LightFalloff::kQuadratic;
-        else if (falloff != "none") l.fail(fmt::format("light falloff '{}'; expected none, linear or quadratic", falloff));
+        else if (falloff == "inverse_square") r.falloff = LightFalloff::kInverseSquare;
+        else if (falloff != "none") l.fail(fmt::format("light falloff '{}'; expected none, linear, quadratic or inverse_square", falloff));
         if ((r.range > 0) != (r.falloff != LightFalloff::kNone)) l.fail("a light has a falloff exactly when it has a range");
         const std::string type = l.text(10);
         if (type == "point") r.type = LightType::kPoint;

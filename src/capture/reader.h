@@ -76,7 +76,8 @@ struct CaptureSettings {
 
 enum class LightType { kPoint, kSpot, kDirectional };
 // How the engine's light fades to nothing at its range: colour x (1 - d/range) or x (1 - (d/range)^2).
-enum class LightFalloff { kNone, kLinear, kQuadratic };
+// kInverseSquare: colour x (range / d)^2, no end (the range is where it gives its colour).
+enum class LightFalloff { kNone, kLinear, kQuadratic, kInverseSquare };
 
 struct CameraRecord {
   std::uint64_t id = 0;

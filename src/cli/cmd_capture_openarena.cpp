@@ -5,6 +5,7 @@
 #include "capture/openarena.h"
 #include "cli/commands.h"
 #include "core/progress.h"
+#include "maplight/cache.h"
 
 namespace dynbench::cli {
 
@@ -35,10 +36,24 @@ void addCaptureOpenArenaCommand(CLI::App* capture, CommandRun& run) {
   cmd->add_option("--modules", o->modules, "Folder with the capture's cgamex86_64.so and qagamex86_64.so (empty: the build's)");
   cmd->add_option("--engine", o->engine, "The ioquake3 executable (Debian's)");
   cmd->add_option("--data", o->data, "OpenArena's base path, holding baseoa/ (Debian's openarena)");
+  auto mapLights = std::make_shared<std::string>("fit");
+  cmd->add_option("--map-lights", *mapLights,
+                  "The map's lights: fit (the emitters its BSP names and the stripped lights fitted to its lightmaps, cached in "
+                  "~/.cache/dynbench/map-lights; `dynbench map-lights MAP` shows how well), none (the adapter's rough "
+                  "approximation), or a file `dynbench map-lights --adapter-lights` wrote")
+      ->capture_default_str();
   cmd->add_flag("--no-record", [o](std::int64_t) { o->record = false; },
                 "Play the same match without writing anything; prints the recording window's wall time (bench/bench_capture_openarena.sh)");
-  cmd->callback([o, &run] {
-    run = [o]() -> Expected<void> {
+  cmd->callback([o, mapLights, &run] {
+    run = [o, mapLights]() -> Expected<void> {
+      if (auto ok = capture::checkOpenArenaOptions(*o); !ok) return std::unexpected(ok.error());
+      if (*mapLights == "fit" && o->record) {
+        auto file = maplight::cachedAdapterLights(o->data / "baseoa", o->map, maplight::defaultCacheFolder());
+        if (!file) return std::unexpected(file.error());
+        o->mapLights = *file;
+      } else if (*mapLights != "none" && *mapLights != "fit") {
+        o->mapLights = *mapLights;
+      }
       std::optional<Progress> progress;
       capture::OpenArenaProgress report;
       if (Progress("capture", 0, "frames").enabled())

@@ -73,9 +73,11 @@ std::pair<glm::dvec3, double> Converter::lightColorIntensity(const glm::dvec3& c
   const double peak = std::max({captured.r, captured.g, captured.b});
   const LightRule& rule = options_.lightRules.rule(modelType);
   const glm::dvec3 color = peak > 0 ? captured / peak : glm::dvec3(1.0);
-  const double perUnit = constantAt > 0 ? luxPerUnit_ * constantAt * constantAt
-                         : range > 0    ? luxPerUnit_ * range * range * fluxFactor(falloff)
-                                        : options_.lightRules.candelaPerUnit;
+  // An inverse-square light is a physical point light already: E_u c (R/d)^2 is I / d^2 with I = E_u c R^2.
+  const double perUnit = constantAt > 0                           ? luxPerUnit_ * constantAt * constantAt
+                         : falloff == LightFalloff::kInverseSquare ? luxPerUnit_ * range * range
+                         : range > 0                              ? luxPerUnit_ * range * range * fluxFactor(falloff)
+                                                                  : options_.lightRules.candelaPerUnit;
   return {color, perUnit * peak * rule.intensityScale * share};
 }
 
@@ -103,7 +105,7 @@ int Converter::lightDefinition(const LightRecord& l, double share) {
                 {"color", vec(color)},
                 {"intensity", intensity},
                 {"name", l.modelType}};
-  if (l.range > 0 && l.type != LightType::kDirectional) light["range"] = l.range;
+  if (l.range > 0 && l.type != LightType::kDirectional && l.falloff != LightFalloff::kInverseSquare) light["range"] = l.range;
   if (l.type == LightType::kSpot) light["spot"] = {{"outerConeAngle", 0.7853981633974483}};
   lights_.push_back(light);
   ++report_.lights;

@@ -123,9 +123,11 @@ double formFactor(const std::array<glm::dvec3, 3>& triangle, const glm::dvec3& p
 // spots aimed at their target, suns (_sun 1) made directional.
 std::vector<MapLight> entityLights(const Bsp& bsp);
 
-// The lights file the capture adapter reads (integrations/openarena): one light per line,
-// "point X Y Z R G B V" or "sun DX DY DZ R G B V" (game axes and units, q3map2's values), and
-// "surface SHADER R G B V" per light-emitting shader. Written to a temporary name and renamed.
+// The lights file the OpenArena capture adapter reads (DYNBENCH_CAPTURE_MAP_LIGHTS,
+// integrations/openarena): game axes and units, light in the capture format's full-light units, one
+// light per line: "point X Y Z R G B D" (an inverse-square light giving R G B at D units), "sun DX
+// DY DZ R G B" (towards the sun), "surface SHADER R G B" (the emission of a light-emitting shader's
+// surfaces). Written to a temporary name and renamed.
 Expected<void> writeAdapterLights(const std::filesystem::path& file, const MapLighting& lighting, const Bsp& bsp);
 
 }  // namespace dynbench::maplight

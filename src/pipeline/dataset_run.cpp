@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "convert/convert.h"
+#include "maplight/cache.h"
 #include "core/files.h"
 
 namespace dynbench::pipeline {
@@ -80,7 +81,14 @@ Expected<void> captureAndConvert(const capture::Cube2Options& options, const fs:
 
 Expected<void> captureAndConvert(const capture::OpenArenaOptions& options, const fs::path& record, const fs::path& dataset, const RunLog& log) {
   return captureAndConvertWith(options, record, dataset, log, [&]() -> Expected<void> {
-    auto captured = capture::captureOpenArena(options);
+    capture::OpenArenaOptions withLights = options;
+    if (auto ok = capture::checkOpenArenaOptions(options); !ok) return std::unexpected(ok.error());
+    if (withLights.mapLights.empty()) {
+      auto lights = maplight::cachedAdapterLights(options.data / "baseoa", options.map, maplight::defaultCacheFolder());
+      if (!lights) return std::unexpected(lights.error());
+      withLights.mapLights = *lights;
+    }
+    auto captured = capture::captureOpenArena(withLights);
     if (!captured) return std::unexpected(captured.error());
     log(fmt::format("  {} frames in {:.0f} s", captured->frames, captured->wallSeconds));
     return {};

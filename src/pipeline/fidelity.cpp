@@ -1,6 +1,7 @@
 #include "pipeline/fidelity.h"
 
 #include <algorithm>
+#include <fstream>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -65,6 +66,37 @@ bool depthAgrees(double rendered, double z, double near, double far) {
 }
 
 }  // namespace
+
+Expected<double> windowDepthNear(const fs::path& file) {
+  std::ifstream in(file);
+  std::string word;
+  double near = 0.0;
+  if (!(in >> word >> near) || word != "near" || !(near > 0))
+    return fail(ErrorCode::kInvalidData, "{}:1: expected 'near Z' with the game's near plane Z > 0", file.string());
+  return near;
+}
+
+WindowDepthView viewDepthFromWindow(const std::vector<float>& window, const std::vector<float>& renderDepth, const std::vector<float>& renderHit,
+                                    double near) {
+  // A perspective depth buffer holds d = (1/n - 1/z) / (1/n - 1/f), so 1/f = 1/n - (1/n - 1/z) / d.
+  // Each pixel where the render has a surface gives one value for it; the median is the game's far
+  // plane (one number per frame: pixels whose geometry differs are outliers of it).
+  std::vector<double> inverseFar;
+  for (std::size_t i = 0; i < window.size(); ++i)
+    if (renderHit[i] > 0 && window[i] > 0.01 && window[i] < 0.999999 && renderDepth[i] > near)
+      inverseFar.push_back(1.0 / near - (1.0 / near - 1.0 / renderDepth[i]) / window[i]);
+  WindowDepthView view;
+  double inverse = 0.0;
+  if (!inverseFar.empty()) {
+    std::nth_element(inverseFar.begin(), inverseFar.begin() + static_cast<std::ptrdiff_t>(inverseFar.size() / 2), inverseFar.end());
+    inverse = std::max(inverseFar[inverseFar.size() / 2], 1e-9);
+  }
+  view.far = inverse > 0 ? 1.0 / inverse : 1e9;
+  view.depth.resize(window.size());
+  for (std::size_t i = 0; i < window.size(); ++i)
+    view.depth[i] = window[i] >= 0.999999 ? 0.0f : static_cast<float>(1.0 / (1.0 / near - window[i] * (1.0 / near - inverse)));
+  return view;
+}
 
 FidelityFrame compareWithGame(const FidelityImages& m) {
   FidelityFrame f;
@@ -147,7 +179,10 @@ Expected<FidelityOutcome> runFidelity(const FidelityStage& stage) {
     const fs::path depthPath = stage.capture / "game" / fmt::format("frame_{:05d}_depth.pfm", k);
     auto colour = readImage(colourPath);
     if (!colour) return std::unexpected(colour.error());
-    auto depth = readImage(depthPath);
+    // Cube 2 keeps the view depth; id Tech 3 the window depth with a far plane it does not expose.
+    const fs::path windowDepthPath = stage.capture / "game" / fmt::format("frame_{:05d}_window_depth.pfm", k);
+    const bool windowDepth = !fs::exists(depthPath) && fs::exists(windowDepthPath);
+    auto depth = readImage(windowDepth ? windowDepthPath : depthPath);
     if (!depth) return std::unexpected(depth.error());
     if (colour->channels < 3 || depth->width != colour->width || depth->height != colour->height)
       return fail(ErrorCode::kInvalidData, "{}: expected an RGB image the size of {}", colourPath.string(), depthPath.string());
@@ -185,6 +220,14 @@ Expected<FidelityOutcome> runFidelity(const FidelityStage& stage) {
     m.renderDirect = rendered->direct;
     m.near = settings.camera->znear;
     m.far = settings.camera->zfar;
+    if (windowDepth) {
+      auto near = windowDepthNear(stage.capture / "game" / "window_depth.txt");
+      if (!near) return std::unexpected(near.error());
+      const WindowDepthView view = viewDepthFromWindow(m.gameDepth, m.renderDepth, m.renderHit, *near);
+      m.gameDepth = view.depth;
+      m.near = *near;
+      m.far = view.far;
+    }
     FidelityFrame f = compareWithGame(m);
     f.frame = k;
     f.time = times[k];

@@ -62,6 +62,17 @@ struct FidelityImages {
 };
 FidelityFrame compareWithGame(const FidelityImages& images);
 
+// id Tech 3's game frames keep the window depth (game/frame_NNNNN_window_depth.pfm, 0 at the near
+// plane, 1 at the far plane and on the sky) and game/window_depth.txt its near plane ("near 4");
+// the engine picks the far plane per frame and does not expose it.
+Expected<double> windowDepthNear(const std::filesystem::path& file);
+struct WindowDepthView {
+  std::vector<float> depth;  // view depth, 0 on the sky
+  double far = 0.0;          // the far plane solved for: the median over the pixels the render hits
+};
+WindowDepthView viewDepthFromWindow(const std::vector<float>& window, const std::vector<float>& renderDepth, const std::vector<float>& renderHit,
+                                    double near);
+
 Expected<FidelityOutcome> runFidelity(const FidelityStage& stage);
 
 }  // namespace dynbench::pipeline

@@ -42,6 +42,7 @@
 #define PATCH_LEVEL 8 /* each 3x3 Bezier sub-patch becomes 8 x 8 quads */
 #define UNOWNED_SLOT (DYNBENCH_LOCAL_SLOT * 2 - 1) /* drawn outside an entity (effects) */
 #define MAX_STATIC_LIGHTS 4096
+#define MAX_MAP_SURFACE_LIGHTS 256
 #define RESTART_AT 2000 /* ms of server time: the level restarts then, the client connected by then */
 
 typedef struct {
@@ -117,8 +118,15 @@ static struct {
   identity_t ids[ID_TABLE_SIZE];
   shader_info_t* shaders; /* hash table, SHADER_TABLE_SIZE */
   /* the map's surface lights, recorded in the first frame (lights are frame records) */
-  float static_lights[MAX_STATIC_LIGHTS][7]; /* position, rgb, range */
+  float static_lights[MAX_STATIC_LIGHTS][8]; /* position, rgb, range, falloff */
   int static_light_count;
+  /* the map's lights from dynbench (DYNBENCH_CAPTURE_MAP_LIGHTS, src/maplight/fit.h) */
+  int have_map_lights;
+  int map_sun;
+  float map_sun_towards[3], map_sun_rgb[3];
+  int map_surface_count;
+  char map_surface_shader[MAX_MAP_SURFACE_LIGHTS][MAX_QPATH];
+  float map_surface_emission[MAX_MAP_SURFACE_LIGHTS][3];
 } g_db;
 
 /* ---------------------------------------------------------------------------------------------- */
@@ -380,9 +388,10 @@ static void mesh_triangle(mesh_builder_t* m, uint32_t a, uint32_t b, uint32_t c)
 }
 
 /* Gives the SDK a built mesh of the model being recorded; 0 when it refuses. */
-static int record_mesh(int mesh_id, const char* name, const char* texture, const mesh_builder_t* m) {
+static int record_mesh(int mesh_id, const char* name, const char* texture, const mesh_builder_t* m, const float* emission) {
   dbc_mesh mesh;
   memset(&mesh, 0, sizeof(mesh));
+  mesh.emission = emission;
   mesh.mesh_id = mesh_id;
   mesh.name = name;
   mesh.texture = texture;
@@ -436,10 +445,20 @@ static int load_bsp(void) {
   return 1;
 }
 
+/* The emission dynbench gives a shader's surfaces (a q3map_surfacelight), or NULL. */
+static const float* map_surface_emission(const char* shader) {
+  for (int i = 0; i < g_db.map_surface_count; ++i)
+    if (!Q_stricmp(g_db.map_surface_shader[i], shader)) return g_db.map_surface_emission[i];
+  return NULL;
+}
+
 static int surface_drawn(const dsurface_t* surface) {
   if (surface->shaderNum < 0 || surface->shaderNum >= g_bsp.shader_count) return 0;
   if (surface->surfaceType == MST_FLARE || surface->surfaceType == MST_BAD) return 0;
   const dshader_t* shader = &g_bsp.shaders[surface->shaderNum];
+  /* a light-emitting surface is drawn, opaque and emissive, even where the game blends it (lava,
+   * flames): its light would be missing otherwise */
+  if (!(shader->surfaceFlags & (SURF_NODRAW | SURF_SKY)) && map_surface_emission(shader->shader)) return 1;
   if (shader->surfaceFlags & (SURF_NODRAW | SURF_SKY)) return 0;
   if (shader->contentFlags & CONTENTS_FOG) return 0;
   const shader_info_t* info = shader_slot(shader->shader, 0);
@@ -524,7 +543,7 @@ static int record_bsp_model(int index, const char* model_path) {
       if (g_bsp.surfaces[k].shaderNum == s->shaderNum && surface_drawn(&g_bsp.surfaces[k])) add_surface(&m, &g_bsp.surfaces[k]);
     if (m.triangles > 0) {
       const char* shader = g_bsp.shaders[s->shaderNum].shader;
-      if (!record_mesh(mesh_id, shader, shader_texture(shader), &m)) { mesh_free(&m); free(done); db_fail("world mesh"); return 0; }
+      if (!record_mesh(mesh_id, shader, shader_texture(shader), &m, map_surface_emission(shader))) { mesh_free(&m); free(done); db_fail("world mesh"); return 0; }
       ++mesh_id;
     }
     mesh_free(&m);
@@ -542,6 +561,17 @@ static int record_bsp_model(int index, const char* model_path) {
  * gets range 3 d_full with the quadratic falloff (1 at the light, 0.89 at d_full, 0 at the range). */
 static void record_map_lighting(void) {
   float sun_direction[3] = {0, 1, 0}, sun_rgb[3] = {0, 0, 0}, ambient[3] = {0, 0, 0}, sky[3] = {0, 0, 0};
+  if (g_db.have_map_lights) {
+    /* dynbench's lights of this map (src/maplight): no ambient floor, the light grid's ambient is
+     * made of the same lights, and the renderer makes its own indirect light */
+    if (g_db.map_sun) {
+      to_capture(g_db.map_sun_towards, sun_direction);
+      memcpy(sun_rgb, g_db.map_sun_rgb, sizeof(sun_rgb));
+    }
+    if (dbc_set_lighting(g_db.session, sun_direction, sun_rgb, ambient, sky) != DBC_OK) db_fail("map lighting");
+    fprintf(stderr, "dynbench-capture: %d map lights, %d light-emitting shaders from dynbench\n", g_db.static_light_count, g_db.map_surface_count);
+    return;
+  }
   for (int i = 0; i < g_bsp.shader_count; ++i) {
     const shader_info_t* info = shader_slot(g_bsp.shaders[i].shader, 0);
     if (!info || !info->has_sun) continue;
@@ -606,6 +636,7 @@ static void record_map_lighting(void) {
     memcpy(light, position, sizeof(position));
     memcpy(light + 3, info->light_rgb, 3 * sizeof(float));
     light[6] = range;
+    light[7] = (float)DBC_FALLOFF_QUADRATIC;
     ++lights;
   }
   fprintf(stderr, "dynbench-capture: %d surface lights, ambient %.3f %.3f %.3f\n", lights, ambient[0], ambient[1], ambient[2]);
@@ -725,7 +756,7 @@ static int record_md3(const char* file, const char* skin, const char* model_path
       if (index[0] < 0 || index[1] < 0 || index[2] < 0 || index[0] >= nv || index[1] >= nv || index[2] >= nv) continue;
       mesh_triangle(&m, (uint32_t)index[0], (uint32_t)index[1], (uint32_t)index[2]);
     }
-    int ok = record_mesh(mesh_id, surface->name, shader[0] ? shader_texture(shader) : NULL, &m);
+    int ok = record_mesh(mesh_id, surface->name, shader[0] ? shader_texture(shader) : NULL, &m, NULL);
     if (ok && key_positions) ok = dbc_model_mesh_frames(g_db.session, mesh_id, (size_t)frames, key_positions, key_normals) == DBC_OK;
     free(key_positions);
     free(key_normals);
@@ -1002,6 +1033,31 @@ static void keep_game_frame(int frame) {
   }
   free(rgb);
   if (!ok || rename(temporary, path) != 0) fprintf(stderr, "dynbench-capture: warning: cannot write %s\n", path);
+  /* The depth buffer as it is (window depth, 0 at r_znear, 1 at the far plane and on the sky, which
+   * the renderer draws at depth 1). The engine picks its far plane per frame from the visible
+   * leaves (R_SetFarClip) and does not expose it: `dynbench fidelity` solves for it. PFM rows run
+   * bottom to top, as glReadPixels returns them. */
+  float* depth = malloc((size_t)w * h * sizeof(float));
+  glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depth);
+  Com_sprintf(path, sizeof(path), "%s/game/frame_%05d_window_depth.pfm", g_db.dir, frame);
+  Com_sprintf(temporary, sizeof(temporary), "%s.part", path);
+  out = fopen(temporary, "wb");
+  ok = out != NULL;
+  if (out) {
+    fprintf(out, "Pf\n%d %d\n-1.0\n", w, h);
+    ok = fwrite(depth, sizeof(float), (size_t)w * h, out) == (size_t)w * h;
+    ok = fclose(out) == 0 && ok;
+  }
+  free(depth);
+  if (!ok || rename(temporary, path) != 0) fprintf(stderr, "dynbench-capture: warning: cannot write %s\n", path);
+  char znear[64];
+  trap_Cvar_VariableStringBuffer("r_znear", znear, sizeof(znear));
+  Com_sprintf(path, sizeof(path), "%s/game/window_depth.txt", g_db.dir);
+  out = fopen(path, "w");
+  if (out) {
+    fprintf(out, "near %s\n", znear[0] ? znear : "4");
+    fclose(out);
+  }
 }
 
 void dynbench_render_scene(const refdef_t* view) {
@@ -1110,7 +1166,8 @@ void dynbench_render_scene(const refdef_t* view) {
     if (dbc_static_model(s, dbc_new_id(s), g_db.world_path, identity_pose) != DBC_OK) { db_fail("world"); return; }
     for (int i = 0; i < g_db.static_light_count; ++i) {
       const float* light = g_db.static_lights[i];
-      if (dbc_light(s, dbc_new_id(s), light, light + 3, light[6], DBC_FALLOFF_QUADRATIC, DBC_LIGHT_POINT, 0, "surfacelight") != DBC_OK) {
+      if (dbc_light(s, dbc_new_id(s), light, light + 3, light[6], (dbc_light_falloff)(int)light[7], DBC_LIGHT_POINT, 0,
+                    g_db.have_map_lights ? "maplight" : "surfacelight") != DBC_OK) {
         db_fail("surface light");
         return;
       }
@@ -1167,6 +1224,47 @@ int dynbench_frame_time(int server_time) {
   return t;
 }
 
+/* dynbench's lights of the map (src/maplight/fit.h, writeAdapterLights): "point X Y Z R G B D",
+ * "sun DX DY DZ R G B", "surface SHADER R G B", game axes, full-light units. */
+static int load_map_lights(const char* path) {
+  if (!path || !path[0]) return 1;
+  FILE* file = fopen(path, "r");
+  if (!file) {
+    db_fail(va("cannot open the map lights %s", path));
+    return 0;
+  }
+  char line[512];
+  int number = 0;
+  while (fgets(line, sizeof(line), file)) {
+    ++number;
+    char kind[16], shader[MAX_QPATH];
+    float v[7];
+    if (line[0] == '#' || line[0] == '\n') continue;
+    if (sscanf(line, "point %f %f %f %f %f %f %f", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6]) == 7) {
+      if (g_db.static_light_count >= MAX_STATIC_LIGHTS) continue;
+      float* light = g_db.static_lights[g_db.static_light_count++];
+      to_capture(v, light);
+      memcpy(light + 3, v + 3, 4 * sizeof(float));
+      light[7] = (float)DBC_FALLOFF_INVERSE_SQUARE;
+    } else if (sscanf(line, "sun %f %f %f %f %f %f", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5]) == 6) {
+      g_db.map_sun = 1;
+      memcpy(g_db.map_sun_towards, v, 3 * sizeof(float));
+      memcpy(g_db.map_sun_rgb, v + 3, 3 * sizeof(float));
+    } else if (sscanf(line, "surface %63s %f %f %f", shader, &v[0], &v[1], &v[2]) == 4) {
+      if (g_db.map_surface_count >= MAX_MAP_SURFACE_LIGHTS) continue;
+      Q_strncpyz(g_db.map_surface_shader[g_db.map_surface_count], shader, MAX_QPATH);
+      memcpy(g_db.map_surface_emission[g_db.map_surface_count++], v, 3 * sizeof(float));
+    } else if (sscanf(line, "%15s", kind) == 1) {
+      fclose(file);
+      db_fail(va("%s:%d: expected point, sun or surface", path, number));
+      return 0;
+    }
+  }
+  fclose(file);
+  g_db.have_map_lights = 1;
+  return 1;
+}
+
 void dynbench_cg_init(void) {
   const char* dir = getenv("DYNBENCH_CAPTURE_DIR");
   if (!dir || !dir[0] || g_db.session) return;
@@ -1210,6 +1308,7 @@ void dynbench_cg_init(void) {
     return;
   }
   g_db.camera_id = dbc_new_id(g_db.session);
+  if (!load_map_lights(getenv("DYNBENCH_CAPTURE_MAP_LIGHTS"))) return;
   if (!record_bsp_model(0, g_db.world_path)) return;
   record_map_lighting();
   fprintf(stderr, "dynbench-capture: recording %d frames of %s after %.1f s\n", g_db.total_frames, g_db.map, g_db.warmup);

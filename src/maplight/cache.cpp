@@ -1,0 +1,36 @@
+#include "maplight/cache.h"
+
+#include <cstdlib>
+
+#include "core/checksum.h"
+
+namespace dynbench::maplight {
+
+std::filesystem::path defaultCacheFolder() {
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::filesystem::path(xdg) / "dynbench" / "map-lights";
+  if (const char* home = std::getenv("HOME"); home && *home) return std::filesystem::path(home) / ".cache" / "dynbench" / "map-lights";
+  return std::filesystem::temp_directory_path() / "dynbench-map-lights";
+}
+
+Expected<std::filesystem::path> cachedAdapterLights(const std::filesystem::path& baseFolder, const std::string& map,
+                                                    const std::filesystem::path& cacheFolder, const MapLightProgress& progress) {
+  auto files = GameFiles::open(baseFolder);
+  if (!files) return std::unexpected(files.error());
+  const std::string path = "maps/" + map + ".bsp";
+  if (!files->contains(path)) return std::filesystem::path();
+  auto bytes = files->read(path);
+  if (!bytes) return std::unexpected(bytes.error());
+  const auto file = cacheFolder / fmt::format("{}-{}-v{}.txt", map, sha256Text(*bytes).substr(0, 16), kFitVersion);
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(file, ec)) return file;
+  auto bsp = parseBsp(*bytes, files->archiveOf(path) + ":" + path);
+  if (!bsp) return std::unexpected(bsp.error());
+  auto lighting = fitMapLighting(*files, map, {}, progress);
+  if (!lighting) return std::unexpected(lighting.error());
+  std::filesystem::create_directories(cacheFolder, ec);
+  if (ec) return fail(ErrorCode::kIo, "{}: cannot create the map-light cache folder: {}", cacheFolder.string(), ec.message());
+  if (auto written = writeAdapterLights(file, *lighting, *bsp); !written) return std::unexpected(written.error());
+  return file;
+}
+
+}  // namespace dynbench::maplight
