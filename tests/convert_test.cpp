@@ -507,6 +507,40 @@ TEST(Convert, TheMapsSunPlacesTheSkysSunAndCalibratesTheLights) {
   }
 }
 
+TEST(Convert, AnInverseSquareLightGivesItsColourAtItsRange) {
+  // id Tech 3's map lights (maplight): colour c x (R / d)^2, no end. In a map lit by a sun of
+  // engine colour 0.5, E_u = E_sun / 0.5 and the light is a point light without a range of
+  // I = E_u x peak(c) x R^2 cd: at d = R it gives E_u x c, the engine's light of colour c.
+  const fs::path dir = freshDir("convert_inverse_square");
+  dbc_session* s = nullptr;
+  ASSERT_EQ(dbc_open((dir / "capture").c_str(), "test", &s), DBC_OK);
+  const float towardsSun[3] = {0.0f, 0.5f, -static_cast<float>(std::sqrt(3.0) / 2)};
+  const float sunColour[3] = {0.5f, 0.5f, 0.5f}, ambient[3] = {0, 0, 0};
+  ASSERT_EQ(dbc_set_lighting(s, towardsSun, sunColour, ambient, ambient), DBC_OK) << dbc_last_error();
+  const uint64_t camera = dbc_new_id(s), lamp = dbc_new_id(s);
+  const float origin[3] = {0, 0, 0}, warm[3] = {2.0f, 1.0f, 0.5f};
+  ASSERT_EQ(dbc_frame_begin(s, 0, 0.0), DBC_OK);
+  ASSERT_EQ(dbc_camera(s, camera, origin, 0, 0, 0), DBC_OK);
+  ASSERT_EQ(dbc_light(s, lamp, origin, warm, 30.0f, DBC_FALLOFF_INVERSE_SQUARE, DBC_LIGHT_POINT, 0, "maplight"), DBC_OK);
+  ASSERT_EQ(dbc_frame_end(s), DBC_OK);
+  ASSERT_EQ(dbc_close(s), DBC_OK);
+  EXPECT_NE(test::slurp(dir / "capture" / "Capture.txt").find(":30:inverse_square:point:0:maplight"), std::string::npos);
+  ConvertOptions options;
+  options.capture = dir / "capture";
+  options.output = dir / "out" / "lamp.gltf";
+  auto report = convertCapture(options);
+  ASSERT_TRUE(report) << report.error().message;
+  const auto j = readJson(options.output);
+  const double sunLux = j["extensions"]["DYNBENCH_environment"]["sky"]["sun_illuminance_lux"].get<double>();
+  const auto& light = j["extensions"]["KHR_lights_punctual"]["lights"][0];
+  EXPECT_FALSE(light.contains("range"));
+  EXPECT_EQ(light["color"], nlohmann::json({1.0, 0.5, 0.25}));
+  EXPECT_NEAR(light["intensity"].get<double>(), sunLux / 0.5 * 2.0 * 900.0, 1e-3 * light["intensity"].get<double>());
+  int status = 0;
+  const std::string validation = test::validateGltf(options.output, status);
+  EXPECT_EQ(status, 0) << validation;
+}
+
 TEST(Convert, AStaticLightTheEngineDoesNotAttenuateGetsItsIrradianceAtTheMapsCentre) {
   // Cube 2 lights a surface with a light of radius 0 at its full colour however far away it is
   // (colos's "sun"). A map of two triangles spanning x, z in [-10, 10] at y = 0 (offset by the map

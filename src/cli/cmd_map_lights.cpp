@@ -35,8 +35,8 @@ Expected<void> runMapLights(const MapLightsCli& cli) {
   fmt::print("{}: {} lightmap texels ({} at 255 left out), gamma {}\n", cli.map, r.texels, r.clippedTexels, r.gamma);
   fmt::print("  known emitters: {} light entities, {} suns, {} surface-light pieces; {} shaders with q3map_skylight (not modelled)\n",
              r.entityLights, r.suns, r.surfaceEmitters, r.skyLightShaders);
-  fmt::print("  fit: {} texels, {} candidates ({}-unit lattice), {} lights fitted, constant {:.2f} {:.2f} {:.2f} (dropped)\n", r.fitSamples,
-             r.candidates, r.latticeSpacing, r.fittedLights, r.constant.r, r.constant.g, r.constant.b);
+  fmt::print("  fit: {} texels, {} candidates ({}-unit lattice), {} lights fitted ({} moved off the lattice), constant {:.2f} {:.2f} {:.2f} (dropped)\n", r.fitSamples,
+             r.candidates, r.latticeSpacing, r.fittedLights, r.refinedLights, r.constant.r, r.constant.g, r.constant.b);
   fmt::print("  held-out texels ({}): correlation {:.3f} (known emitters alone {:.3f}); variance explained {:.3f} (known alone {:.3f})\n",
              r.heldOutSamples, r.heldOutCorrelation, r.knownCorrelation, r.totalExplained, r.knownExplained);
   if (cli.hideEntityLights)

@@ -22,6 +22,11 @@ namespace dynbench::maplight {
 namespace {
 
 constexpr double kNudge = 1.0;  // units a sample is lifted off its surface before tracing (q3map2 nudges too)
+// Units between a candidate light and every surface. Lightmap texels are 16 units apart (q3map2's
+// default sample size), so a light nearer than two of them can fit a few texels' values with a hot
+// spot between them that the held-out texels show up (oa_bases3 at 16 units: variance explained
+// on held-out texels fell below 0).
+constexpr double kCandidateClearance = 32.0;
 
 double luminance(const glm::dvec3& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
 
@@ -77,7 +82,10 @@ Expected<Occluders> buildOccluders(const Bsp& bsp, const ShaderScripts& scripts)
       }
     }
   }
-  auto tracer = render::RayTracingScene::create(scene);
+  // Embree's SSE4.2 kernels whatever the CPU: its AVX2 and AVX-512 kernels hit grazing edges
+  // differently, and a different hit early in the greedy fit gives a different set of lights (seen
+  // on oa_dm1). The fit is a property of the map, so every machine traces it the same way.
+  auto tracer = render::RayTracingScene::create(scene, {}, "max_isa=sse4.2");
   if (!tracer) return std::unexpected(tracer.error());
   if (auto updated = (*tracer)->update(0.0); !updated) return std::unexpected(updated.error());
   return Occluders{std::move(*tracer)};
@@ -316,31 +324,37 @@ Column candidateColumn(const glm::dvec3& position, const std::vector<Sample>& sa
   return c;
 }
 
-// Lattice points at least 16 units from every surface, inside the map's sealed hull: rays in 14
-// directions all end on the front of a surface or on the sky.
+// Whether a point lies in open space: at least kCandidateClearance from every surface, inside the map's
+// sealed hull (rays in 14 directions all end on the front of a surface or on the sky).
+bool inOpenSpace(const glm::dvec3& p, const Occluders& occluders) {
+  static const std::vector<glm::dvec3> directions = [] {
+    std::vector<glm::dvec3> d;
+    for (int a = 0; a < 3; ++a)
+      for (int s : {-1, 1}) {
+        glm::dvec3 axis(0.0);
+        axis[a] = s;
+        d.push_back(axis);
+      }
+    for (int x : {-1, 1})
+      for (int y : {-1, 1})
+        for (int z : {-1, 1}) d.push_back(glm::normalize(glm::dvec3(x, y, z)));
+    return d;
+  }();
+  for (const glm::dvec3& d : directions) {
+    const render::SurfaceHit hit = occluders.tracer->intersect(render::Ray{p, d});
+    if (!hit.hit) return false;
+    if (hit.node == 1) continue;  // the sky
+    // the surface's own side: its vertex normals (the BSP's), not a winding convention
+    if (hit.distance < kCandidateClearance || glm::dot(hit.shadingNormal, d) > 0) return false;
+  }
+  return true;
+}
+
+// Lattice points in open space, the lattice as fine as maxCandidates allows.
 std::vector<glm::dvec3> openSpaceLattice(const Bsp& bsp, const Occluders& occluders, int maxCandidates, std::size_t& spacing) {
   const glm::dvec3 lo = glm::dvec3(bsp.models[0].mins) + kMinimumDistance, hi = glm::dvec3(bsp.models[0].maxs) - kMinimumDistance;
   const glm::dvec3 size = glm::max(hi - lo, glm::dvec3(1.0));
-  std::vector<glm::dvec3> directions;
-  for (int a = 0; a < 3; ++a)
-    for (int s : {-1, 1}) {
-      glm::dvec3 d(0.0);
-      d[a] = s;
-      directions.push_back(d);
-    }
-  for (int x : {-1, 1})
-    for (int y : {-1, 1})
-      for (int z : {-1, 1}) directions.push_back(glm::normalize(glm::dvec3(x, y, z)));
-  const auto open = [&](const glm::dvec3& p) {
-    for (const glm::dvec3& d : directions) {
-      const render::SurfaceHit hit = occluders.tracer->intersect(render::Ray{p, d});
-      if (!hit.hit) return false;
-      if (hit.node == 1) continue;  // the sky
-      // the surface's own side: its vertex normals (the BSP's), not a winding convention
-      if (hit.distance < kMinimumDistance || glm::dot(hit.shadingNormal, d) > 0) return false;
-    }
-    return true;
-  };
+  const auto open = [&](const glm::dvec3& p) { return inOpenSpace(p, occluders); };
   // Coarsen the lattice until the open points are few enough (deterministic: spacing in 8-unit steps).
   for (double step = 32.0;; step += 8.0) {
     const glm::ivec3 n = glm::ivec3(glm::floor(size / step)) + 1;
@@ -562,7 +576,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   report("known emitters", 1, 1);
 
   // Candidates and their columns, after the groups'.
-  const std::vector<glm::dvec3> candidates = openSpaceLattice(*bsp, *occluders, options.maxCandidates, r.latticeSpacing);
+  std::vector<glm::dvec3> candidates = openSpaceLattice(*bsp, *occluders, options.maxCandidates, r.latticeSpacing);
   r.candidates = candidates.size();
   columns.resize(groupCount + candidates.size());
   std::atomic<std::size_t> done{0};
@@ -689,6 +703,80 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
       }
     removeColumns(drop);
     report("fitting lights", chosen.size() - groupCount, static_cast<std::size_t>(options.maxLights));
+  }
+
+  // Refinement: the lattice is coarse (up to ~170 units on large maps), so each fitted light then
+  // moves to the best of its neighbours at half, a quarter and an eighth of the lattice spacing
+  // (in open space), its weight re-solved in closed form with the others held, while that lowers
+  // the residual; the weights are solved together again afterwards.
+  if (options.refine) {
+    const std::vector<double> held = solve(target, 3);
+    residualOf(target, held, 3, residual);
+    const double spacing = static_cast<double>(r.latticeSpacing);
+    for (std::size_t a = groupCount; a < chosen.size(); ++a) {
+      const double w = held[a];
+      if (!(w > 0)) continue;
+      std::vector<double> without = residual;  // the residual without this light
+      {
+        const Column& c = columns[chosen[a]];
+        for (std::size_t k = 0; k < c.rows.size(); ++k) without[c.rows[k]] += w * c.values[k];
+      }
+      double withoutNorm = 0;
+      for (double v : without) withoutNorm += v * v;
+      glm::dvec3 position = candidates[chosen[a] - groupCount];
+      const Column* current = &columns[chosen[a]];
+      double currentWeight = w, currentDot = dot(*current, without);
+      double currentError = withoutNorm - 2.0 * currentWeight * currentDot + currentWeight * currentWeight * current->norm2;
+      Column best;
+      bool moved = false;
+      for (const double step : {spacing / 2, spacing / 4, spacing / 8}) {
+        std::vector<glm::dvec3> trials;
+        for (int axis = 0; axis < 3; ++axis)
+          for (const double sign : {-1.0, 1.0}) {
+            glm::dvec3 p = position;
+            p[axis] += sign * step;
+            trials.push_back(p);
+          }
+        std::vector<Column> trialColumns(trials.size());
+        std::vector<char> usable(trials.size(), 0);
+        tbb::parallel_for(std::size_t(0), trials.size(), [&](std::size_t t) {
+          if (!inOpenSpace(trials[t], *occluders)) return;
+          trialColumns[t] = candidateColumn(trials[t], fit, *occluders);
+          usable[t] = trialColumns[t].norm2 > 0;
+        });
+        for (std::size_t t = 0; t < trials.size(); ++t) {
+          if (!usable[t]) continue;
+          const double d = dot(trialColumns[t], without);
+          const double weight = std::max(0.0, d / trialColumns[t].norm2);
+          const double error = withoutNorm - 2.0 * weight * d + weight * weight * trialColumns[t].norm2;
+          if (error < currentError) {
+            currentError = error;
+            currentWeight = weight;
+            position = trials[t];
+            best = std::move(trialColumns[t]);
+            current = &best;
+            moved = true;
+          }
+        }
+      }
+      if (!moved) continue;
+      // the moved light: a new column (and candidate position) in place of the old one
+      candidates.push_back(position);
+      columns.push_back(std::move(best));
+      const std::size_t j = columns.size() - 1;
+      const Column& cj = columns[j];
+      for (std::size_t k = 0; k < cj.rows.size(); ++k) dense[cj.rows[k]] = cj.values[k];
+      for (std::size_t b = 0; b < chosen.size(); ++b)
+        if (b != a) gramRows[a][b] = gramRows[b][a] = dot(columns[chosen[b]], dense);
+      for (std::uint32_t i : cj.rows) dense[i] = 0.0;
+      gramRows[a][a] = cj.norm2;
+      columnSums[a] = std::accumulate(cj.values.begin(), cj.values.end(), 0.0);
+      chosen[a] = j;
+      residual = std::move(without);
+      for (std::size_t k = 0; k < cj.rows.size(); ++k) residual[cj.rows[k]] -= currentWeight * cj.values[k];
+      ++r.refinedLights;
+      report("refining lights", a - groupCount + 1, chosen.size() - groupCount);
+    }
   }
 
   // Colours and strengths: the same set fitted per channel. A group's weight is the luminance

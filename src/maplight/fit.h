@@ -71,8 +71,9 @@ struct MapLightFitOptions {
   bool hideEntityLights = false;
   int maxLights = 256;         // fitted point lights at most
   int fitSamples = 30000;      // lightmap texels fitted (a regular subset of them)
-  int maxCandidates = 6000;    // lattice points in open space
-  double minimumGain = 0.0001;  // stop when a light lowers the residual by less than this share of the signal
+  int maxCandidates = 12000;   // lattice points in open space
+  double minimumGain = 0.0001;
+  bool refine = true;          // move each fitted light off the lattice where that fits better  // stop when a light lowers the residual by less than this share of the signal
 };
 
 struct MapLightFitReport {
@@ -80,6 +81,7 @@ struct MapLightFitReport {
   std::size_t fitSamples = 0, heldOutSamples = 0;
   std::size_t candidates = 0, latticeSpacing = 0;
   std::size_t entityLights = 0, surfaceEmitters = 0, suns = 0, fittedLights = 0;
+  std::size_t refinedLights = 0;  // fitted lights moved off the lattice by the refinement
   double gamma = 1.0;  // the map's -gamma (from _q3map2_cmdline), undone
   glm::dvec3 constant{0.0};  // the fit's constant term, lightmap units (dropped)
   // Luminance correlation between the lightmap texels and q3map2's model of the static emitters

@@ -129,7 +129,8 @@ namespace {
 // principle differ between machines. DYNBENCH_EMBREE_CONFIG passes an Embree device configuration
 // (rtcNewDevice(3), e.g. "max_isa=avx2") so that one machine can run as another would: the
 // reproducibility checks of issue 45 use it (docs/suite.md, "Pins"). Unset: Embree's defaults.
-RTCDevice newDevice() {
+RTCDevice newDevice(const char* fixedConfig) {
+  if (fixedConfig) return rtcNewDevice(fixedConfig);
   const char* config = std::getenv("DYNBENCH_EMBREE_CONFIG");
   return rtcNewDevice(config && *config ? config : nullptr);
 }
@@ -139,10 +140,10 @@ RTCDevice newDevice() {
 RayTracingScene::RayTracingScene(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 RayTracingScene::~RayTracingScene() = default;
 
-Expected<std::unique_ptr<RayTracingScene>> RayTracingScene::create(const scene::Scene& scene, AlphaTest alphaTest) {
+Expected<std::unique_ptr<RayTracingScene>> RayTracingScene::create(const scene::Scene& scene, AlphaTest alphaTest, const char* deviceConfig) {
   auto impl = std::make_unique<Impl>(scene);
   impl->alphaTest = std::move(alphaTest);
-  impl->device = newDevice();
+  impl->device = newDevice(deviceConfig);
   if (!impl->device) return fail(ErrorCode::kExternalTool, "Embree: cannot create a device (error {})", static_cast<int>(rtcGetDeviceError(nullptr)));
   rtcSetDeviceErrorFunction(impl->device, onEmbreeError, &impl->error);
   impl->staticScene = rtcNewScene(impl->device);
@@ -439,7 +440,7 @@ Expected<void> SphereIndex::build(const std::vector<glm::dvec4>& spheres) {
       return fail(ErrorCode::kInternal, "sphere index: sphere {} has radius {}; expected a finite positive radius", i, spheres[i].w);
   spheres_ = spheres;
   if (!impl_->device) {
-    impl_->device = newDevice();
+    impl_->device = newDevice(nullptr);
     if (!impl_->device) return fail(ErrorCode::kExternalTool, "Embree: cannot create a device (error {})", static_cast<int>(rtcGetDeviceError(nullptr)));
     rtcSetDeviceErrorFunction(impl_->device, onEmbreeError, &impl_->error);
   }
