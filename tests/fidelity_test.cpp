@@ -84,5 +84,46 @@ TEST(Fidelity, ABlackOrSpeckledRenderFails) {
   EXPECT_FALSE(f.passed);
 }
 
+// id Tech 3's window depth with its per-frame far plane: written from known view depths with
+// near 4 and far 3000, read back with the far plane solved from the render's depths. A fifth of
+// the pixels where the render sees other geometry (twice as far) leave the median, so the far plane
+// and the other pixels' depths come back, and those pixels disagree.
+TEST(Fidelity, IdTech3WindowDepthWithItsFarPlaneSolved) {
+  FidelityImages m = corridor();
+  const double near = 4.0, far = 3000.0;
+  std::vector<float> window(m.gameDepth.size());
+  for (std::size_t i = 0; i < window.size(); ++i) {
+    const double z = m.gameDepth[i];
+    window[i] = z > 0 ? static_cast<float>((1.0 / near - 1.0 / z) / (1.0 / near - 1.0 / far)) : 1.0f;  // the sky at depth 1
+    if (i % 5 == 0 && z > 0) m.renderDepth[i] = static_cast<float>(2.0 * z);
+  }
+  const WindowDepthView view = viewDepthFromWindow(window, m.renderDepth, m.renderHit, near);
+  EXPECT_NEAR(view.far, far, 1e-3 * far);
+  std::size_t checked = 0;
+  for (std::size_t i = 0; i < window.size(); ++i) {
+    if (m.gameDepth[i] <= 0) {
+      EXPECT_EQ(view.depth[i], 0.0f);
+      continue;
+    }
+    EXPECT_NEAR(view.depth[i], m.gameDepth[i], 1e-3 * m.gameDepth[i]) << i;
+    ++checked;
+  }
+  EXPECT_GT(checked, 1000u);
+  m.gameDepth = view.depth;
+  m.near = near;
+  m.far = view.far;
+  const FidelityFrame f = compareWithGame(m);
+  EXPECT_NEAR(f.depthAgreement, 0.8, 0.02);  // the fifth placed twice as far disagrees
+  // a frame whose depth the game did not keep: no depth measures, judged on correlation alone
+  m.gameDepthKnown = false;
+  m.gameDepth = m.renderHit;
+  const FidelityFrame g = compareWithGame(m);
+  EXPECT_TRUE(std::isnan(g.depthAgreement));
+  EXPECT_TRUE(std::isnan(g.skyAgreement));
+  EXPECT_GT(g.correlation, 0.99);
+  EXPECT_TRUE(g.passed);
+  EXPECT_FALSE(windowDepthNear("/nonexistent/window_depth.txt"));
+}
+
 }  // namespace
 }  // namespace dynbench::pipeline

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <fstream>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 
@@ -120,6 +121,7 @@ FidelityFrame compareWithGame(const FidelityImages& m) {
   }
   f.depthAgreement = either ? static_cast<double>(agree) / static_cast<double>(either) : 1.0;
   f.skyAgreement = n ? static_cast<double>(sameKind) / static_cast<double>(n) : 0.0;
+  if (!m.gameDepthKnown) f.depthAgreement = f.skyAgreement = std::numeric_limits<double>::quiet_NaN();
   f.unlitShare = geometry ? static_cast<double>(unlit) / static_cast<double>(geometry) : 0.0;
   std::vector<double> game(n), render(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -140,7 +142,7 @@ FidelityFrame compareWithGame(const FidelityImages& m) {
       if (both[i]) sab += (a[i] - ma) * (b[i] - mb), saa += (a[i] - ma) * (a[i] - ma), sbb += (b[i] - mb) * (b[i] - mb);
     f.correlation = saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0.0;
   }
-  f.passed = f.depthAgreement >= kFidelityMinDepthAgreement && f.correlation >= kFidelityMinCorrelation;
+  f.passed = (!m.gameDepthKnown || f.depthAgreement >= kFidelityMinDepthAgreement) && f.correlation >= kFidelityMinCorrelation;
   return f;
 }
 
@@ -182,8 +184,13 @@ Expected<FidelityOutcome> runFidelity(const FidelityStage& stage) {
     // Cube 2 keeps the view depth; id Tech 3 the window depth with a far plane it does not expose.
     const fs::path windowDepthPath = stage.capture / "game" / fmt::format("frame_{:05d}_window_depth.pfm", k);
     const bool windowDepth = !fs::exists(depthPath) && fs::exists(windowDepthPath);
-    auto depth = readImage(windowDepth ? windowDepthPath : depthPath);
+    // A window-depth capture whose frame kept no depth (the engine's buffer read back empty):
+    // measured without it.
+    const bool noDepth = !fs::exists(depthPath) && !windowDepth && fs::exists(stage.capture / "game" / "window_depth.txt");
+    auto depth = noDepth ? Expected<FloatImage>(FloatImage{colour->width, colour->height, 1, {}, {}, {}, {}})
+                         : readImage(windowDepth ? windowDepthPath : depthPath);
     if (!depth) return std::unexpected(depth.error());
+    if (noDepth) depth->pixels.assign(static_cast<std::size_t>(colour->width) * colour->height, 0.0f);
     if (colour->channels < 3 || depth->width != colour->width || depth->height != colour->height)
       return fail(ErrorCode::kInvalidData, "{}: expected an RGB image the size of {}", colourPath.string(), depthPath.string());
     RenderStage render;
@@ -228,6 +235,8 @@ Expected<FidelityOutcome> runFidelity(const FidelityStage& stage) {
       m.near = *near;
       m.far = view.far;
     }
+    m.gameDepthKnown = !noDepth;
+    if (noDepth) m.gameDepth = m.renderHit;  // the render's coverage stands in for the mask of pixels compared
     FidelityFrame f = compareWithGame(m);
     f.frame = k;
     f.time = times[k];
@@ -246,21 +255,28 @@ Expected<FidelityOutcome> runFidelity(const FidelityStage& stage) {
         }
         const bool game = m.gameDepth[i] > 0, hit = m.renderHit[i] > 0;
         const bool ok = game && hit && depthAgrees(m.renderDepth[i], m.gameDepth[i], m.near, m.far);
-        if (game || hit) row[3 * (2 * w + x) + (ok ? 1 : 0)] = 1.0f;
+        if (!m.gameDepthKnown) {
+          if (hit) row[3 * (2 * w + x) + 2] = 1.0f;  // blue: the game's depth was not read
+        } else if (game || hit) {
+          row[3 * (2 * w + x) + (ok ? 1 : 0)] = 1.0f;
+        }
       }
     f.sideBySide = stage.output / fmt::format("fidelity_{:05d}.png", k);
     if (auto ok = writeImage(f.sideBySide, FloatImage{3 * w, h, 3, side, {}, {}, {}}); !ok) return std::unexpected(ok.error());
     out.passed = out.passed && f.passed;
-    framesJson.push_back({{"frame", f.frame}, {"time", f.time}, {"width", w}, {"height", h}, {"depth_agreement", f.depthAgreement},
-                          {"sky_agreement", f.skyAgreement}, {"correlation", f.correlation}, {"unlit_share", f.unlitShare},
+    const auto orNull = [](double v) { return std::isnan(v) ? nlohmann::json(nullptr) : nlohmann::json(v); };
+    framesJson.push_back({{"frame", f.frame}, {"time", f.time}, {"width", w}, {"height", h}, {"depth_agreement", orNull(f.depthAgreement)},
+                          {"sky_agreement", orNull(f.skyAgreement)}, {"correlation", f.correlation}, {"unlit_share", f.unlitShare},
                           {"passed", f.passed}});
     out.frames.push_back(f);
   }
   out.markdown = "| frame | time (s) | depth agreement | sky agreement | luminance correlation | no direct light | pass |\n"
                  "|---:|---:|---:|---:|---:|---:|---|\n";
   for (const auto& f : out.frames)
-    out.markdown += fmt::format("| {} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.1f} % | {} |\n", f.frame, f.time, f.depthAgreement, f.skyAgreement,
-                                f.correlation, 100 * f.unlitShare, f.passed ? "yes" : "no");
+    out.markdown += fmt::format("| {} | {:.3f} | {} | {} | {:.3f} | {:.1f} % | {} |\n", f.frame, f.time,
+                                std::isnan(f.depthAgreement) ? std::string("not read") : fmt::format("{:.3f}", f.depthAgreement),
+                                std::isnan(f.skyAgreement) ? std::string("not read") : fmt::format("{:.3f}", f.skyAgreement), f.correlation,
+                                100 * f.unlitShare, f.passed ? "yes" : "no");
   const nlohmann::json j = {{"capture", stage.capture.string()},
                             {"dataset", stage.dataset.string()},
                             {"thresholds", {{"depth_agreement", kFidelityMinDepthAgreement}, {"correlation", kFidelityMinCorrelation}}},

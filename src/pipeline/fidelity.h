@@ -38,8 +38,8 @@ struct FidelityFrame {
   long frame = 0;                // recorded frame (0-based)
   double time = 0.0;             // s
   int width = 0, height = 0;
-  double depthAgreement = 0.0;   // share, see above
-  double skyAgreement = 0.0;     // share of pixels where both see sky or both see geometry
+  double depthAgreement = 0.0;   // share, see above; NaN when the game kept no depth for the frame
+  double skyAgreement = 0.0;     // share of pixels where both see sky or both see geometry; NaN likewise
   double correlation = 0.0;      // of the tone-mapped, blurred luminance over geometry
   double unlitShare = 0.0;       // share of the render's geometry pixels with no direct light
   bool passed = false;
@@ -59,6 +59,9 @@ struct FidelityImages {
   int width = 0, height = 0;
   std::vector<float> gameColour, gameDepth, renderRadiance, renderDepth, renderHit, renderDirect;
   double near = 0.0, far = 0.0;
+  // false: the game kept no depth for this frame (id Tech 3's buffer read back empty); depth and
+  // sky agreement are NaN and gameDepth is only the mask of pixels compared
+  bool gameDepthKnown = true;
 };
 FidelityFrame compareWithGame(const FidelityImages& images);
 

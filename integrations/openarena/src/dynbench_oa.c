@@ -1039,9 +1039,15 @@ static void keep_game_frame(int frame) {
    * bottom to top, as glReadPixels returns them. */
   float* depth = malloc((size_t)w * h * sizeof(float));
   glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depth);
+  /* On some frames, from run to run, the depth buffer reads back as all zeros after the engine's
+   * swap while the colour is right (Mesa's llvmpipe under Xvfb; not understood): such a frame
+   * keeps no depth, and `dynbench fidelity` says its depth was not read. */
+  int varies = 0;
+  for (int i = 1; i < w * h && !varies; ++i) varies = depth[i] != depth[0];
   Com_sprintf(path, sizeof(path), "%s/game/frame_%05d_window_depth.pfm", g_db.dir, frame);
   Com_sprintf(temporary, sizeof(temporary), "%s.part", path);
-  out = fopen(temporary, "wb");
+  out = varies ? fopen(temporary, "wb") : NULL;
+  if (!varies) fprintf(stderr, "dynbench-capture: warning: frame %d: the depth buffer read back empty; no depth kept\n", frame);
   ok = out != NULL;
   if (out) {
     fprintf(out, "Pf\n%d %d\n-1.0\n", w, h);
@@ -1049,7 +1055,7 @@ static void keep_game_frame(int frame) {
     ok = fclose(out) == 0 && ok;
   }
   free(depth);
-  if (!ok || rename(temporary, path) != 0) fprintf(stderr, "dynbench-capture: warning: cannot write %s\n", path);
+  if (varies && (!ok || rename(temporary, path) != 0)) fprintf(stderr, "dynbench-capture: warning: cannot write %s\n", path);
   char znear[64];
   trap_Cvar_VariableStringBuffer("r_znear", znear, sizeof(znear));
   Com_sprintf(path, sizeof(path), "%s/game/window_depth.txt", g_db.dir);
