@@ -217,7 +217,8 @@ TEST(GameFiles, AFolderWithoutArchivesIsAnError) {
 }
 
 // On Debian's OpenArena data (no game run): oa_dm1's lightmaps are reproduced by its fitted lights,
-// the same lights twice; kaos's 30 real lights, hidden, are found again.
+// and a second fit, run as another machine would run it, gives the same lights byte for byte;
+// kaos's 30 real lights, hidden, are found again.
 TEST(OpenArena, StrippedLightsAreFittedToTheLightmaps) {
   DYNBENCH_NEEDS(test::missingOpenArena());
   auto files = GameFiles::open("/usr/lib/openarena/baseoa");
@@ -226,8 +227,6 @@ TEST(OpenArena, StrippedLightsAreFittedToTheLightmaps) {
   ASSERT_TRUE(first) << first.error().message;
   EXPECT_GE(first->report.heldOutCorrelation, 0.80);
   EXPECT_GT(first->report.fittedLights, 20u);
-  auto second = fitMapLighting(*files, "oa_dm1");
-  ASSERT_TRUE(second);
   auto bytes = files->read("maps/oa_dm1.bsp");
   ASSERT_TRUE(bytes);
   auto bsp = parseBsp(*bytes, "oa_dm1");
@@ -235,8 +234,6 @@ TEST(OpenArena, StrippedLightsAreFittedToTheLightmaps) {
   const auto dir = std::filesystem::temp_directory_path() / "dynbench-maplight-test";
   std::filesystem::create_directories(dir);
   ASSERT_TRUE(writeAdapterLights(dir / "a.txt", *first, *bsp));
-  ASSERT_TRUE(writeAdapterLights(dir / "b.txt", *second, *bsp));
-  EXPECT_EQ(test::slurp(dir / "a.txt"), test::slurp(dir / "b.txt"));
   {
     // as another machine would fit it (Embree's SSE4.2 kernels, glibc's maths without AVX2 and FMA)
     test::OtherMachine other;
