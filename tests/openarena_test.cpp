@@ -339,6 +339,12 @@ TEST(OpenArena, BadOptionsFailClearly) {
     EXPECT_NE(r.err.find("OpenArena stopped after 0 of 50 frames"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("Can't find map maps/no_such_map.bsp"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "f" / "Capture.txt")) << "no capture that looks complete";
+    // A lights file with a line the adapter cannot read: the game quits before writing anything.
+    std::ofstream(dir / "lights.txt") << "point 0 0 64 1 1 1 100\nspot 0 0 0\n";
+    r = dynbench(fmt::format("capture openarena -o {} --seconds 1 --map-lights {}", (dir / "h").string(), (dir / "lights.txt").string()), dir);
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.err.find("lights.txt:2: expected 'point X Y Z R G B D'"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "h" / "Capture.txt"));
   }
 }
 

@@ -1236,7 +1236,7 @@ static int load_map_lights(const char* path) {
   if (!path || !path[0]) return 1;
   FILE* file = fopen(path, "r");
   if (!file) {
-    db_fail(va("cannot open the map lights %s", path));
+    fprintf(stderr, "dynbench-capture: error: %s: cannot open the map's lights\n", path);
     return 0;
   }
   char line[512];
@@ -1262,7 +1262,7 @@ static int load_map_lights(const char* path) {
       memcpy(g_db.map_surface_emission[g_db.map_surface_count++], v, 3 * sizeof(float));
     } else if (sscanf(line, "%15s", kind) == 1) {
       fclose(file);
-      db_fail(va("%s:%d: expected point, sun or surface", path, number));
+      fprintf(stderr, "dynbench-capture: error: %s:%d: expected 'point X Y Z R G B D', 'sun DX DY DZ R G B' or 'surface SHADER R G B'\n", path, number);
       return 0;
     }
   }
@@ -1301,6 +1301,11 @@ void dynbench_cg_init(void) {
     trap_SendConsoleCommand("quit\n");
     return;
   }
+  /* before anything is written: a bad lights file leaves no capture behind */
+  if (!load_map_lights(getenv("DYNBENCH_CAPTURE_MAP_LIGHTS"))) {
+    trap_SendConsoleCommand("quit\n");
+    return;
+  }
   if (dbc_open(dir, "OpenArena 0.8.8 (ioquake3 1.36)", &g_db.session) != DBC_OK) {
     fprintf(stderr, "dynbench-capture: error: %s\n", dbc_last_error());
     trap_SendConsoleCommand("quit\n");
@@ -1314,7 +1319,6 @@ void dynbench_cg_init(void) {
     return;
   }
   g_db.camera_id = dbc_new_id(g_db.session);
-  if (!load_map_lights(getenv("DYNBENCH_CAPTURE_MAP_LIGHTS"))) return;
   if (!record_bsp_model(0, g_db.world_path)) return;
   record_map_lighting();
   fprintf(stderr, "dynbench-capture: recording %d frames of %s after %.1f s\n", g_db.total_frames, g_db.map, g_db.warmup);
