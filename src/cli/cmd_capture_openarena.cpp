@@ -1,5 +1,6 @@
 // `dynbench capture openarena -o DIR`: record a headless, seeded OpenArena bot match
 // (integrations/openarena).
+#include <memory>
 #include <optional>
 
 #include "capture/openarena.h"
@@ -48,7 +49,17 @@ void addCaptureOpenArenaCommand(CLI::App* capture, CommandRun& run) {
     run = [o, mapLights]() -> Expected<void> {
       if (auto ok = capture::checkOpenArenaOptions(*o); !ok) return std::unexpected(ok.error());
       if (*mapLights == "fit" && o->record) {
-        auto file = maplight::cachedAdapterLights(o->data / "baseoa", o->map, maplight::defaultCacheFolder());
+        std::unique_ptr<Progress> bar;
+        std::string step;
+        auto file = maplight::cachedAdapterLights(o->data / "baseoa", o->map, maplight::defaultCacheFolder(),
+                                                  [&](const std::string& s, std::size_t done, std::size_t total) {
+                                                    if (s != step) {
+                                                      bar = std::make_unique<Progress>("map lights: " + s, total, "");
+                                                      step = s;
+                                                    }
+                                                    bar->update(done);
+                                                  });
+        bar.reset();
         if (!file) return std::unexpected(file.error());
         o->mapLights = *file;
       } else if (*mapLights != "none" && *mapLights != "fit") {
