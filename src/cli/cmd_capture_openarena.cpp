@@ -50,15 +50,7 @@ void addCaptureOpenArenaCommand(CLI::App* capture, CommandRun& run) {
       if (auto ok = capture::checkOpenArenaOptions(*o); !ok) return std::unexpected(ok.error());
       if (*mapLights == "fit" && o->record) {
         std::unique_ptr<Progress> bar;
-        std::string step;
-        auto file = maplight::cachedAdapterLights(o->data / "baseoa", o->map, maplight::defaultCacheFolder(),
-                                                  [&](const std::string& s, std::size_t done, std::size_t total) {
-                                                    if (s != step) {
-                                                      bar = std::make_unique<Progress>("map lights: " + s, total, "");
-                                                      step = s;
-                                                    }
-                                                    bar->update(done);
-                                                  });
+        auto file = maplight::cachedAdapterLights(o->data / "baseoa", o->map, maplight::defaultCacheFolder(), stepProgress("map lights", bar));
         bar.reset();
         if (!file) return std::unexpected(file.error());
         o->mapLights = *file;

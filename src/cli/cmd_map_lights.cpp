@@ -21,14 +21,7 @@ Expected<void> runMapLights(const MapLightsCli& cli) {
   maplight::MapLightFitOptions options = cli.options;
   options.hideEntityLights = cli.hideEntityLights;
   std::unique_ptr<Progress> bar;
-  std::string step;
-  auto lighting = maplight::fitMapLighting(*files, cli.map, options, [&](const std::string& s, std::size_t done, std::size_t total) {
-    if (s != step) {
-      bar = std::make_unique<Progress>("map-lights " + s, total, "");
-      step = s;
-    }
-    bar->update(done);
-  });
+  auto lighting = maplight::fitMapLighting(*files, cli.map, options, stepProgress("map-lights", bar));
   bar.reset();
   if (!lighting) return std::unexpected(lighting.error());
   const auto& r = lighting->report;
@@ -43,17 +36,22 @@ Expected<void> runMapLights(const MapLightsCli& cli) {
     fmt::print("  hidden entity lights: {:.0f} of light value, {:.1f} % of it with a fitted light within {} units\n", r.hiddenLightValue,
                100.0 * r.recoveredShare, maplight::kRecoveryRadius);
   for (const auto& [name, weight] : r.groupWeights) fmt::print("  {}: weight {:.3f}\n", name, weight);
-  if (!cli.adapterLights.empty()) {
-    auto bytes = files->read("maps/" + cli.map + ".bsp");
-    if (!bytes) return std::unexpected(bytes.error());
-    auto bsp = maplight::parseBsp(*bytes, cli.map);
-    if (!bsp) return std::unexpected(bsp.error());
-    if (auto written = maplight::writeAdapterLights(cli.adapterLights, *lighting, *bsp); !written) return written;
-  }
+  if (!cli.adapterLights.empty())
+    if (auto written = maplight::writeAdapterLights(cli.adapterLights, *lighting); !written) return written;
   return {};
 }
 
 }  // namespace
+
+StepProgress stepProgress(const std::string& label, std::unique_ptr<Progress>& bar) {
+  return [&bar, label, step = std::string()](const std::string& s, std::size_t done, std::size_t total) mutable {
+    if (s != step) {
+      bar = std::make_unique<Progress>(label + ": " + s, total, "");
+      step = s;
+    }
+    bar->update(done);
+  };
+}
 
 void addMapLightsCommand(CLI::App& app, CommandRun& run) {
   auto cli = std::make_shared<MapLightsCli>();

@@ -1,12 +1,14 @@
 #pragma once
 // Each subcommand registers itself on the CLI11 app and leaves a function to run after parsing.
 #include <functional>
+#include <memory>
 #include <string>
 #include <utility>
 
 #include <CLI/CLI.hpp>
 
 #include "core/error.h"
+#include "core/progress.h"
 #include "pipeline/slurm.h"
 
 namespace dynbench::cli {
@@ -56,6 +58,11 @@ void addSlurmOptions(CLI::App* cmd, bool& slurm, pipeline::slurm::Options& optio
 
 // Registers `suite` and `suite verify`.
 void addSuiteCommand(CLI::App& app, CommandRun& run);
+
+// Progress for work reported in named steps (maplight's fit): a bar per step, kept in `bar`, which
+// the caller resets when the work ends. Silent off a terminal, as Progress is.
+using StepProgress = std::function<void(const std::string& step, std::size_t done, std::size_t total)>;
+StepProgress stepProgress(const std::string& label, std::unique_ptr<Progress>& bar);
 
 // Registers `map-lights`.
 void addMapLightsCommand(CLI::App& app, CommandRun& run);

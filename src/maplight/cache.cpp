@@ -23,13 +23,11 @@ Expected<std::filesystem::path> cachedAdapterLights(const std::filesystem::path&
   const auto file = cacheFolder / fmt::format("{}-{}-v{}.txt", map, sha256Text(*bytes).substr(0, 16), kFitVersion);
   std::error_code ec;
   if (std::filesystem::is_regular_file(file, ec)) return file;
-  auto bsp = parseBsp(*bytes, files->archiveOf(path) + ":" + path);
-  if (!bsp) return std::unexpected(bsp.error());
   auto lighting = fitMapLighting(*files, map, {}, progress);
   if (!lighting) return std::unexpected(lighting.error());
   std::filesystem::create_directories(cacheFolder, ec);
   if (ec) return fail(ErrorCode::kIo, "{}: cannot create the map-light cache folder: {}", cacheFolder.string(), ec.message());
-  if (auto written = writeAdapterLights(file, *lighting, *bsp); !written) return std::unexpected(written.error());
+  if (auto written = writeAdapterLights(file, *lighting); !written) return std::unexpected(written.error());
   return file;
 }
 

@@ -14,6 +14,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/files.h"
+#include "core/math.h"
 #include "maplight/nnls.h"
 #include "render/raytracing_scene.h"
 
@@ -27,8 +28,6 @@ constexpr double kNudge = 1.0;  // units a sample is lifted off its surface befo
 // spot between them that the held-out texels show up (oa_bases3 at 16 units: variance explained
 // on held-out texels fell below 0).
 constexpr double kCandidateClearance = 32.0;
-
-double luminance(const glm::dvec3& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
 
 struct Sample {
   glm::dvec3 position{0.0}, normal{0.0};
@@ -103,12 +102,21 @@ double gammaOf(const Bsp& bsp) {
   return 1.0;
 }
 
-// Lightmap texels of the world's drawn, lightmapped surfaces, each once (the first triangle over a
-// texel's centre owns it), on a regular subset: texels whose page coordinates are multiples of
-// `stride` plus `offset`.
-std::vector<Sample> lightmapSamples(const Bsp& bsp, const ShaderScripts& scripts, double gamma, int stride, int offset, std::size_t* texels,
-                                    std::size_t* clipped) {
-  std::vector<Sample> samples;
+// A lightmap texel of a drawn, lightmapped world surface: where it lies on its page, and its sample.
+struct Texel {
+  int x = 0, y = 0;
+  Sample sample;
+};
+
+struct LightmapTexels {
+  std::vector<Texel> unclipped;  // in surface, triangle and row order
+  std::size_t texels = 0, clipped = 0;
+};
+
+// Every lightmap texel of the world's drawn, lightmapped surfaces, each once (the first triangle
+// over a texel's centre owns it); those at 255 (clipped) are only counted.
+LightmapTexels lightmapTexels(const Bsp& bsp, const ShaderScripts& scripts, double gamma) {
+  LightmapTexels out;
   std::vector<std::vector<char>> owned(bsp.lightmaps.size(), std::vector<char>(kLightmapSize * kLightmapSize, 0));
   const BspModel& world = bsp.models[0];
   for (int i = world.firstSurface; i < world.firstSurface + world.surfaceCount; ++i) {
@@ -138,24 +146,31 @@ std::vector<Sample> lightmapSamples(const Bsp& bsp, const ShaderScripts& scripts
           if (mark) continue;
           mark = 1;
           const std::uint8_t* rgb = &page[static_cast<std::size_t>((y * kLightmapSize + x) * 3)];
-          if (texels) ++*texels;
+          ++out.texels;
           // ColorToBytes normalises a colour whose brightest channel passes 255 to 255: its level is lost
           if (std::max({rgb[0], rgb[1], rgb[2]}) >= 255) {
-            if (clipped) ++*clipped;
+            ++out.clipped;
             continue;
           }
-          if (((x - offset) % stride + stride) % stride != 0 || ((y - offset) % stride + stride) % stride != 0) continue;
-          Sample sample;
           glm::dvec3 n = w0 * t.normal[0] + w1 * t.normal[1] + w2 * t.normal[2];
           if (glm::length(n) <= 0) continue;
           n = glm::normalize(n);
-          sample.normal = n;
-          sample.position = w0 * t.position[0] + w1 * t.position[1] + w2 * t.position[2] + kNudge * n;
-          for (int k = 0; k < 3; ++k) sample.value[k] = 255.0 * std::pow(rgb[k] / 255.0, gamma);  // undo -gamma (ColorToBytes)
-          samples.push_back(sample);
+          Texel texel{x, y, {}};
+          texel.sample.normal = n;
+          texel.sample.position = w0 * t.position[0] + w1 * t.position[1] + w2 * t.position[2] + kNudge * n;
+          for (int k = 0; k < 3; ++k) texel.sample.value[k] = 255.0 * std::pow(rgb[k] / 255.0, gamma);  // undo -gamma (ColorToBytes)
+          out.unclipped.push_back(texel);
         }
     }
   }
+  return out;
+}
+
+// A regular subset of the texels: those whose page coordinates are multiples of `stride` plus `offset`.
+std::vector<Sample> texelSubset(const std::vector<Texel>& texels, int stride, int offset) {
+  std::vector<Sample> samples;
+  for (const Texel& t : texels)
+    if (((t.x - offset) % stride + stride) % stride == 0 && ((t.y - offset) % stride + stride) % stride == 0) samples.push_back(t.sample);
   return samples;
 }
 
@@ -219,6 +234,7 @@ std::vector<SurfaceEmitter> surfaceEmitters(const Bsp& bsp, const ShaderScripts&
         e.backsplashFraction = script->backsplashFraction;
         e.backsplashDistance = script->backsplashDistance;
         e.shader = s.shader;
+        e.shaderName = bsp.shaders[static_cast<std::size_t>(s.shader)].name;
         emitters.push_back(e);
       }
     }
@@ -259,6 +275,19 @@ struct EmitterGroup {
 std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::vector<EmitterGroup>& groups, const std::vector<MapLight>& lights,
                                  const std::vector<SurfaceEmitter>& surfaces, const Occluders& occluders) {
   const std::size_t g = groups.size();
+  // per piece, once: the point traced to, its circumsphere's radius and its area
+  struct Piece {
+    glm::dvec3 centre{0.0};
+    double radius = 0.0, area = 0.0;
+  };
+  std::vector<Piece> pieces(surfaces.size());
+  for (std::size_t ei = 0; ei < surfaces.size(); ++ei) {
+    const SurfaceEmitter& e = surfaces[ei];
+    Piece& p = pieces[ei];
+    p.centre = (e.triangle[0] + e.triangle[1] + e.triangle[2]) / 3.0 + e.normal;
+    p.radius = std::max({glm::length(e.triangle[0] - p.centre), glm::length(e.triangle[1] - p.centre), glm::length(e.triangle[2] - p.centre)});
+    p.area = triangleArea(e.triangle);
+  }
   std::vector<float> dense(samples.size() * g, 0.0f);
   tbb::parallel_for(std::size_t(0), samples.size(), [&](std::size_t i) {
     const Sample& s = samples[i];
@@ -273,11 +302,10 @@ std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::
       }
       for (std::size_t ei : groups[k].surfaces) {
         const SurfaceEmitter& e = surfaces[ei];
-        const glm::dvec3 centre = (e.triangle[0] + e.triangle[1] + e.triangle[2]) / 3.0 + e.normal;
+        const glm::dvec3& centre = pieces[ei].centre;
+        const double area = pieces[ei].area;
         // a bound first: the form factor is at most area / (pi distance^2) from the piece's circumsphere
-        const double radius = std::max({glm::length(e.triangle[0] - centre), glm::length(e.triangle[1] - centre), glm::length(e.triangle[2] - centre)});
-        const double distance = glm::length(s.position - centre) - radius;
-        const double area = triangleArea(e.triangle);
+        const double distance = glm::length(s.position - centre) - pieces[ei].radius;
         const bool negligible = distance > 0 && area / (std::numbers::pi * distance * distance) * e.value * kFormFactorValueScale * kAreaScale < 0.01;
         if (!negligible) {
           const double add = surfaceContribution(e, s.position, s.normal);
@@ -554,20 +582,20 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
     for (std::size_t i = 0; i < result.surfaceLights.size(); ++i) {
       const SurfaceEmitter& e = result.surfaceLights[i];
       auto [it, fresh] = byShader.emplace(e.shader, groups.size());
-      if (fresh) groups.push_back({"surface light " + bsp->shaders[static_cast<std::size_t>(e.shader)].name, e.color, {}, {}});
+      if (fresh) groups.push_back({"surface light " + e.shaderName, e.color, {}, {}});
       groups[it->second].surfaces.push_back(i);
     }
   }
   const std::size_t knownLights = result.lights.size(), groupCount = groups.size();
 
   // Samples: a regular subset of the texels to fit, a disjoint one to judge the fit on.
-  std::size_t texels = 0, clipped = 0;
-  lightmapSamples(*bsp, *scripts, r.gamma, 1, 0, &texels, &clipped);
-  r.texels = texels;
-  r.clippedTexels = clipped;
-  const int stride = std::max(2, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(texels) / std::max(options.fitSamples, 1)))));
-  const std::vector<Sample> fit = lightmapSamples(*bsp, *scripts, r.gamma, stride, 0, nullptr, nullptr);
-  const std::vector<Sample> heldOut = lightmapSamples(*bsp, *scripts, r.gamma, stride, stride / 2, nullptr, nullptr);
+  const LightmapTexels texels = lightmapTexels(*bsp, *scripts, r.gamma);
+  r.texels = texels.texels;
+  r.clippedTexels = texels.clipped;
+  const int stride =
+      std::max(2, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(texels.texels) / std::max(options.fitSamples, 1)))));
+  const std::vector<Sample> fit = texelSubset(texels.unclipped, stride, 0);
+  const std::vector<Sample> heldOut = texelSubset(texels.unclipped, stride, stride / 2);
   r.fitSamples = fit.size();
   r.heldOutSamples = heldOut.size();
   if (fit.size() < 16) return fail(ErrorCode::kUnsupported, "{}: {} lightmap texels to fit; the map has no lightmaps to recover lights from", path, fit.size());
@@ -862,7 +890,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   return result;
 }
 
-Expected<void> writeAdapterLights(const std::filesystem::path& file, const MapLighting& lighting, const Bsp& bsp) {
+Expected<void> writeAdapterLights(const std::filesystem::path& file, const MapLighting& lighting) {
   // In the engine's full light (kFullLight lightmap units), as the capture format counts light.
   std::ostringstream out;
   out << "# dynbench map lights of " << lighting.map << " (src/maplight/fit.h): game axes and units, colours in full-light units\n";
@@ -884,7 +912,7 @@ Expected<void> writeAdapterLights(const std::filesystem::path& file, const MapLi
       // radiance formFactorValueScale areaScale V / pi lightmap units: a surface facing it closely
       // gets formFactorValueScale areaScale V, the emission (full-light units) it is given
       const glm::dvec3 emission = e.color * kFormFactorValueScale * kAreaScale * e.value / kFullLight;
-      out << fmt::format("surface {} {:.6g} {:.6g} {:.6g}\n", bsp.shaders[static_cast<std::size_t>(e.shader)].name, emission.r, emission.g, emission.b);
+      out << fmt::format("surface {} {:.6g} {:.6g} {:.6g}\n", e.shaderName, emission.r, emission.g, emission.b);
     }
   return writeFileAtomic(file, out.str());
 }

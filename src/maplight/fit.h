@@ -63,6 +63,7 @@ struct SurfaceEmitter {
   double value = 0.0;      // q3map_surfacelight
   double backsplashFraction = 0.0, backsplashDistance = 0.0;
   int shader = -1;         // the BSP's shader index
+  std::string shaderName;
 };
 
 struct MapLightFitOptions {
@@ -130,6 +131,6 @@ std::vector<MapLight> entityLights(const Bsp& bsp);
 // light per line: "point X Y Z R G B D" (an inverse-square light giving R G B at D units), "sun DX
 // DY DZ R G B" (towards the sun), "surface SHADER R G B" (the emission of a light-emitting shader's
 // surfaces). Written to a temporary name and renamed.
-Expected<void> writeAdapterLights(const std::filesystem::path& file, const MapLighting& lighting, const Bsp& bsp);
+Expected<void> writeAdapterLights(const std::filesystem::path& file, const MapLighting& lighting);
 
 }  // namespace dynbench::maplight
