@@ -7,11 +7,21 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <memory>
+#include <mutex>
 #include <string>
 
 #include <OpenImageIO/imageio.h>
 
 namespace {
+
+// OpenImageIO 2.4 (Debian bookworm's 2.4.7) is not thread-safe in ImageInput::open for files with
+// an ICC profile: decoding it names fields and tags through static std::unordered_maps with
+// operator[], which inserts unknown keys, so two threads corrupt the maps (OpenImageIO issue #3756;
+// upstream now looks keys up with find). Cube 2's textures carry such profiles and textures
+// load in parallel: `fidelity` crashed in about 1 run of 15. Opening (the header) is serialised;
+// reading pixels is not.
+std::mutex openMutex;
 
 void setError(char* error, std::size_t size, const std::string& message) {
   if (!error || size == 0) return;
@@ -61,7 +71,11 @@ int dynbench_image_write_v2(const char* path, const char* temporary, int width, 
 // `formats` receives one character per channel: 'h' for half, 'f' for any other type.
 int dynbench_image_read_v2(const char* path, int* width, int* height, int* channels, float** pixels, char* names, std::size_t namesSize,
                            char* formats, std::size_t formatsSize, char* error, std::size_t errorSize) {
-  auto in = OIIO::ImageInput::open(path);
+  std::unique_ptr<OIIO::ImageInput> in;
+  {
+    const std::lock_guard<std::mutex> lock(openMutex);
+    in = OIIO::ImageInput::open(path);
+  }
   if (!in) {
     setError(error, errorSize, "not a readable image: " + OIIO::geterror());
     return 1;
