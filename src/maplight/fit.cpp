@@ -28,6 +28,8 @@ constexpr double kNudge = 1.0;  // units a sample is lifted off its surface befo
 // spot between them that the held-out texels show up (oa_bases3 at 16 units: variance explained
 // on held-out texels fell below 0).
 constexpr double kCandidateClearance = 32.0;
+// Steps a fitted light may take at one scale of the refinement before the scale halves.
+constexpr int kRefineStepsPerScale = 8;
 
 struct Sample {
   glm::dvec3 position{0.0}, normal{0.0};
@@ -734,9 +736,9 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   }
 
   // Refinement: the lattice is coarse (up to ~170 units on large maps), so each fitted light then
-  // moves to the best of its neighbours at half, a quarter and an eighth of the lattice spacing
-  // (in open space), its weight re-solved in closed form with the others held, while that lowers
-  // the residual; the weights are solved together again afterwards.
+  // moves among its neighbours at half, a quarter, an eighth and a sixteenth of the lattice
+  // spacing (in open space), its weight re-solved in closed form with the others held, while that
+  // lowers the residual; the weights are solved together again afterwards.
   if (options.refine) {
     const std::vector<double> held = solve(target, 3);
     residualOf(target, held, 3, residual);
@@ -757,34 +759,40 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
       double currentError = withoutNorm - 2.0 * currentWeight * currentDot + currentWeight * currentWeight * current->norm2;
       Column best;
       bool moved = false;
-      for (const double step : {spacing / 2, spacing / 4, spacing / 8}) {
-        std::vector<glm::dvec3> trials;
-        for (int axis = 0; axis < 3; ++axis)
-          for (const double sign : {-1.0, 1.0}) {
-            glm::dvec3 p = position;
-            p[axis] += sign * step;
-            trials.push_back(p);
+      // A pattern search: at each scale the light keeps stepping to its best axis neighbour
+      // while that lowers the residual (up to kRefineStepsPerScale steps), then the scale halves.
+      for (const double step : {spacing / 2, spacing / 4, spacing / 8, spacing / 16}) {
+        for (int stepsTaken = 0; stepsTaken < kRefineStepsPerScale; ++stepsTaken) {
+          std::vector<glm::dvec3> trials;
+          for (int axis = 0; axis < 3; ++axis)
+            for (const double sign : {-1.0, 1.0}) {
+              glm::dvec3 p = position;
+              p[axis] += sign * step;
+              trials.push_back(p);
+            }
+          std::vector<Column> trialColumns(trials.size());
+          std::vector<char> usable(trials.size(), 0);
+          tbb::parallel_for(std::size_t(0), trials.size(), [&](std::size_t t) {
+            if (!inOpenSpace(trials[t], *occluders)) return;
+            trialColumns[t] = candidateColumn(trials[t], fit, *occluders);
+            usable[t] = trialColumns[t].norm2 > 0;
+          });
+          bool improved = false;
+          for (std::size_t t = 0; t < trials.size(); ++t) {
+            if (!usable[t]) continue;
+            const double d = dot(trialColumns[t], without);
+            const double weight = std::max(0.0, d / trialColumns[t].norm2);
+            const double error = withoutNorm - 2.0 * weight * d + weight * weight * trialColumns[t].norm2;
+            if (error < currentError) {
+              currentError = error;
+              currentWeight = weight;
+              position = trials[t];
+              best = std::move(trialColumns[t]);
+              current = &best;
+              moved = improved = true;
+            }
           }
-        std::vector<Column> trialColumns(trials.size());
-        std::vector<char> usable(trials.size(), 0);
-        tbb::parallel_for(std::size_t(0), trials.size(), [&](std::size_t t) {
-          if (!inOpenSpace(trials[t], *occluders)) return;
-          trialColumns[t] = candidateColumn(trials[t], fit, *occluders);
-          usable[t] = trialColumns[t].norm2 > 0;
-        });
-        for (std::size_t t = 0; t < trials.size(); ++t) {
-          if (!usable[t]) continue;
-          const double d = dot(trialColumns[t], without);
-          const double weight = std::max(0.0, d / trialColumns[t].norm2);
-          const double error = withoutNorm - 2.0 * weight * d + weight * weight * trialColumns[t].norm2;
-          if (error < currentError) {
-            currentError = error;
-            currentWeight = weight;
-            position = trials[t];
-            best = std::move(trialColumns[t]);
-            current = &best;
-            moved = true;
-          }
+          if (!improved) break;
         }
       }
       if (!moved) continue;

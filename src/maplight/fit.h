@@ -73,8 +73,8 @@ struct MapLightFitOptions {
   int maxLights = 256;         // fitted point lights at most
   int fitSamples = 30000;      // lightmap texels fitted (a regular subset of them)
   int maxCandidates = 12000;   // lattice points in open space
-  double minimumGain = 0.0001;
-  bool refine = true;          // move each fitted light off the lattice where that fits better  // stop when a light lowers the residual by less than this share of the signal
+  double minimumGain = 0.0001; // stop when a light lowers the residual by less than this share of the signal
+  bool refine = true;          // move each fitted light off the lattice where that fits better
 };
 
 struct MapLightFitReport {
