@@ -325,6 +325,77 @@ TEST(Convert, MaterialFactorsEmissionAndVertexColours) {
   EXPECT_TRUE(sawColours);
 }
 
+// OpenArena's light-emitting shaders (record m): the capture's emission is the surface's mean and
+// the texture only shapes it, so the converter divides by the texture's linear mean. A texture of
+// a white and a black texel (sRGB 1 and 0: linear mean 0.5) doubles the emission; a channel the
+// texture lacks (blue 0) carries none. The same mesh with record E keeps its emission as it is.
+TEST(Convert, AnEmissionMapThatOnlyShapesTheEmissionKeepsItsMean) {
+  const fs::path dir = freshDir("convert_emission_mean");
+  fs::create_directories(dir / "data");
+  ASSERT_TRUE(writeImage(dir / "data/glow.png", FloatImage{2, 1, 3, {1, 1, 0, 0, 0, 0}, {}, {}, {}}));
+  dbc_session* s = nullptr;
+  ASSERT_EQ(dbc_open((dir / "capture").c_str(), "test", &s), DBC_OK);
+  ASSERT_EQ(dbc_set_data_root(s, (dir / "data").c_str()), DBC_OK);
+  const float positions[] = {0, 0, 0, 1, 0, 0, 1, 0, 1, 0, 0, 1}, uvs[] = {0, 0, 1, 0, 1, 1, 0, 1};
+  const float normals[] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0}, emission[] = {1.5f, 0.75f, 0.5f};
+  const uint32_t quad[] = {0, 1, 2, 0, 2, 3};
+  dbc_mesh shaped{};
+  shaped.name = "shaped";
+  shaped.texture = shaped.emission_texture = "glow.png";
+  shaped.emission_texture_mean_one = 1;
+  shaped.vertex_count = 4;
+  shaped.positions = positions;
+  shaped.normals = normals;
+  shaped.uvs = uvs;
+  shaped.triangle_count = 2;
+  shaped.indices = quad;
+  shaped.emission = emission;
+  dbc_mesh multiplied = shaped;
+  multiplied.mesh_id = 1;
+  multiplied.name = "multiplied";
+  multiplied.emission_texture_mean_one = 0;
+  ASSERT_EQ(dbc_model_begin(s, "map"), DBC_OK);
+  for (const dbc_mesh* m : {&shaped, &multiplied}) ASSERT_EQ(dbc_model_mesh(s, m), DBC_OK) << dbc_last_error();
+  ASSERT_EQ(dbc_model_end(s), DBC_OK);
+  const uint64_t camera = dbc_new_id(s), map = dbc_new_id(s);
+  const float eye[] = {0.5f, 2, 0.5f};
+  const dbc_dual_quat identity{0, 0, 0, 1, 0, 0, 0, 0};
+  for (int f = 0; f < 2; ++f) {
+    ASSERT_EQ(dbc_frame_begin(s, static_cast<uint64_t>(f), f / 60.0), DBC_OK);
+    ASSERT_EQ(dbc_camera(s, camera, eye, -90, 0, 0), DBC_OK);
+    if (f == 0) ASSERT_EQ(dbc_static_model(s, map, "map", identity), DBC_OK) << dbc_last_error();
+    ASSERT_EQ(dbc_frame_end(s), DBC_OK);
+  }
+  ASSERT_EQ(dbc_close(s), DBC_OK);
+  std::string records;
+  for (const auto& e : fs::recursive_directory_iterator(dir / "capture" / "models")) records += test::slurp(e.path());
+  EXPECT_NE(records.find("m:0:glow.png"), std::string::npos) << records;
+  EXPECT_NE(records.find("E:1:glow.png"), std::string::npos) << records;
+  ConvertOptions options;
+  options.capture = dir / "capture";
+  options.output = dir / "out" / "emission.gltf";
+  options.lightRules.luxPerUnit = 20000.0;
+  auto report = convertCapture(options);
+  ASSERT_TRUE(report) << report.error().message;
+  const auto j = readJson(options.output);
+  ASSERT_EQ(j["materials"].size(), 2u);
+  const auto& a = j["materials"][0];
+  EXPECT_EQ(a["name"], "glow");
+  EXPECT_TRUE(a.contains("emissiveTexture"));
+  // mean (0.5, 0.5, 0): emission (3, 1.5, 0), strength E_u 3 / pi
+  ASSERT_EQ(a["emissiveFactor"].size(), 3u);
+  EXPECT_NEAR(a["emissiveFactor"][0].get<double>(), 1.0, 1e-6);
+  EXPECT_NEAR(a["emissiveFactor"][1].get<double>(), 0.5, 1e-6);
+  EXPECT_EQ(a["emissiveFactor"][2].get<double>(), 0.0);
+  EXPECT_NEAR(a["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"].get<double>(), 20000.0 * 3.0 / kPi, 1e-3);
+  const auto& b = j["materials"][1];
+  EXPECT_NEAR(b["emissiveFactor"][2].get<double>(), 0.5 / 1.5, 1e-6);
+  EXPECT_NEAR(b["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"].get<double>(), 20000.0 * 1.5 / kPi, 1e-3);
+  int status = -1;
+  const std::string validation = test::validateGltf(options.output, status);
+  EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
+}
+
 // Blender's own glTF importer reads the dataset (the thesis rendered its datasets with Blender).
 
 TEST(Convert, BlenderImportsTheDataset) {

@@ -74,6 +74,8 @@ typedef struct dbc_mesh {
   const float* emission;          /* 3: light the surface gives off, in the light colours' units (1: as bright
                                      as a white surface under the engine's full light); default none */
   const char* emission_texture;   /* emission map multiplying `emission`, relative to the data root */
+  int emission_texture_mean_one;  /* 1: `emission` is the surface's mean emission and the map only shapes it
+                                     (the converter scales the map to a mean of 1: record m, not E) */
   const float* colors;            /* 4 per vertex: linear RGBA multiplying base_color; an alpha below 1 (here
                                      or in base_color) becomes glTF's alphaMode BLEND */
 } dbc_mesh;

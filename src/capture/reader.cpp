@@ -183,9 +183,10 @@ CapturedModel parseModelMesh(const fs::path& path) {
       l.expectFields(4, "mesh_id:a:b:c");
       auto& mesh = meshAt(1);
       for (std::size_t k = 2; k <= 4; ++k) mesh.indices.push_back(l.integer<std::uint32_t>(k, "vertex index"));
-    } else if (token == "a" || token == "g" || token == "E") {
+    } else if (token == "a" || token == "g" || token == "E" || token == "m") {
       l.expectFields(2, "mesh_id:texture");
       (token == "a" ? meshAt(1).texture : token == "g" ? meshAt(1).maskTexture : meshAt(1).emissionTexture) = l.text(2);
+      if (token == "m") meshAt(1).emissionTextureMeanOne = true;
     } else if (token == "f" || token == "c") {
       l.expectFields(5, "mesh_id:r:g:b:a");
       const glm::vec4 rgba(l.real(2, "r"), l.real(3, "g"), l.real(4, "b"), l.real(5, "a"));
@@ -242,7 +243,7 @@ CapturedModel parseModelMesh(const fs::path& path) {
         inverseBound.insert(id);
       }
     } else {
-      l.fail(fmt::format("unknown record '{}'; a ModelMesh file has o, M, p, n, t, c, j, w, i, a, g, f, r, e, E, b, x, K, P, N", token),
+      l.fail(fmt::format("unknown record '{}'; a ModelMesh file has o, M, p, n, t, c, j, w, i, a, g, f, r, e, E, m, b, x, K, P, N", token),
              ErrorCode::kParse);
     }
   }

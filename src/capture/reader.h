@@ -26,6 +26,7 @@ struct CapturedMesh {
   std::optional<glm::vec2> metallicRoughness;      // unset: from the mask map, or the converter's default
   glm::vec3 emission{0.0f};                        // in the light colours' units (1: the engine's full light on white)
   std::string emissionTexture;                     // multiplies emission; empty when none
+  bool emissionTextureMeanOne = false;             // emission is the mean; the map is scaled to mean 1 (record m)
   std::vector<glm::vec3> positions, normals;
   std::vector<glm::vec2> uvs;
   std::vector<glm::vec4> colors;  // `c`: linear RGBA per vertex, multiplying baseColor; empty when none

@@ -227,7 +227,8 @@ int dbc_model_mesh(dbc_session* s, const dbc_mesh* m) {
     return error(DBC_ERROR_ARGUMENT, fmt::format("mesh {}: metallic_roughness needs 2 finite values in [0, 1]", m->mesh_id));
   if (!factors('e', m->emission, 3, std::numeric_limits<float>::max()))
     return error(DBC_ERROR_ARGUMENT, fmt::format("mesh {}: emission needs 3 finite values >= 0", m->mesh_id));
-  if (m->emission_texture) text += fmt::format("E:{}:{}\n", m->mesh_id, escapeField(m->emission_texture));
+  if (m->emission_texture)
+    text += fmt::format("{}:{}:{}\n", m->emission_texture_mean_one ? 'm' : 'E', m->mesh_id, escapeField(m->emission_texture));
   auto row = [&](char token, const float* data, std::size_t width, std::size_t v) {
     std::string line = fmt::format("{}:{}", token, m->mesh_id);
     for (std::size_t c = 0; c < width; ++c) {

@@ -110,15 +110,28 @@ bool blended(const CapturedMesh& mesh) {
 }
 }  // namespace
 
+std::optional<glm::dvec3> Converter::linearMean(const std::string& texture) {
+  const fs::path source = textureSource(texture);
+  if (source.empty()) return std::nullopt;
+  auto pixels = readImage(source);
+  if (!pixels || pixels->channels < 1 || pixels->pixels.empty()) return std::nullopt;
+  glm::dvec3 sum(0.0);
+  const std::size_t n = static_cast<std::size_t>(pixels->width) * static_cast<std::size_t>(pixels->height);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c)
+      sum[c] += srgbToLinear<double>(pixels->pixels[i * static_cast<std::size_t>(pixels->channels) + static_cast<std::size_t>(std::min(c, pixels->channels - 1))]);
+  return sum / static_cast<double>(n);
+}
+
 // Material per distinct set of maps and factors (docs/dataset.md): base colour from the texture
 // map times the captured factor; metallic and roughness from the captured values, else from the
 // mask map, else dielectric with roughness 0.8; emission in cd/m2.
 int Converter::material(const CapturedMesh& mesh) {
   const bool blend = blended(mesh);
   const auto& c = mesh.baseColor;
-  const std::string key = fmt::format("{}\n{}\n{}\n{} {} {} {}\n{}\n{} {} {}\n{}", mesh.texture, mesh.maskTexture, mesh.emissionTexture, c.r, c.g,
+  const std::string key = fmt::format("{}\n{}\n{}\n{} {} {} {}\n{}\n{} {} {}\n{}\n{}", mesh.texture, mesh.maskTexture, mesh.emissionTexture, c.r, c.g,
                                       c.b, c.a, mesh.metallicRoughness ? fmt::format("{} {}", mesh.metallicRoughness->x, mesh.metallicRoughness->y) : "",
-                                      mesh.emission.r, mesh.emission.g, mesh.emission.b, blend);
+                                      mesh.emission.r, mesh.emission.g, mesh.emission.b, blend, mesh.emissionTextureMeanOne);
   if (auto it = materialByMaps_.find(key); it != materialByMaps_.end()) return it->second;
   json m = {{"name", mesh.texture.empty() ? "untextured" : fs::path(mesh.texture).stem().string()},
             {"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.8}}}};
@@ -136,8 +149,19 @@ int Converter::material(const CapturedMesh& mesh) {
   // Emission e in the lights' units shows as bright as a white Lambertian surface under the
   // engine's full light, E_u lux: radiance E_u e / pi cd/m2. glTF keeps emissiveFactor within
   // [0, 1]; KHR_materials_emissive_strength carries the rest.
-  if (const float peak = std::max({mesh.emission.r, mesh.emission.g, mesh.emission.b}); peak > 0) {
-    const glm::vec3 factor = mesh.emission / peak;
+  glm::vec3 emission = mesh.emission;
+  if (mesh.emissionTextureMeanOne && !mesh.emissionTexture.empty() && glm::any(glm::greaterThan(emission, glm::vec3(0.0f)))) {
+    // The capture's emission is the surface's mean (record m): divided by the map's mean, the map
+    // times it averages to it again, so the surface gives off the light the capture says. A channel
+    // the map lacks (mean 0) cannot carry light and is left out.
+    if (const auto mean = linearMean(mesh.emissionTexture)) {
+      for (int k = 0; k < 3; ++k) emission[k] = (*mean)[k] > 1e-6 ? static_cast<float>(emission[k] / (*mean)[k]) : 0.0f;
+    } else {
+      report_.warnings.push_back(fmt::format("emission map '{}' cannot be read; its surface gives off its mean emission evenly", mesh.emissionTexture));
+    }
+  }
+  if (const float peak = std::max({emission.r, emission.g, emission.b}); peak > 0) {
+    const glm::vec3 factor = emission / peak;
     m["emissiveFactor"] = {factor.r, factor.g, factor.b};
     m["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", luxPerUnit_ * peak / kPi}};
     usesEmissiveStrength_ = true;

@@ -156,6 +156,9 @@ class Converter {
 
   // A texture's file under the data root, or empty (with a warning) when it cannot be used.
   fs::path textureSource(const std::string& texture);
+  // A texture's mean linear RGB (its sRGB bytes decoded), for emission maps that only shape a mean
+  // emission (record m); nullopt when it cannot be read.
+  std::optional<glm::dvec3> linearMean(const std::string& texture);
 
   int addTexture(const std::string& relativeUri, const std::string& mime);
 

@@ -392,6 +392,10 @@ static int record_mesh(int mesh_id, const char* name, const char* texture, const
   dbc_mesh mesh;
   memset(&mesh, 0, sizeof(mesh));
   mesh.emission = emission;
+  /* the game shows a light-emitting shader's texture; q3map2 spreads its light evenly, so the
+   * texture only shapes the emission, whose mean stays what dynbench's lights give (record m) */
+  mesh.emission_texture = emission ? texture : NULL;
+  mesh.emission_texture_mean_one = emission != NULL;
   mesh.mesh_id = mesh_id;
   mesh.name = name;
   mesh.texture = texture;
