@@ -11,6 +11,7 @@
 #include "capture_fixture.h"
 #include "convert/convert.h"
 #include "convert/merge_camera.h"
+#include "convert/sky.h"
 #include "core/files.h"
 #include "core/image_io.h"
 #include "frames/frame_io.h"
@@ -610,6 +611,59 @@ TEST(Convert, AnInverseSquareLightGivesItsColourAtItsRange) {
   int status = 0;
   const std::string validation = test::validateGltf(options.output, status);
   EXPECT_EQ(status, 0) << validation;
+}
+
+// An engine that records its lighting with neither a sky light nor an ambient floor (id Tech 3 with
+// dynbench's map lights) says its sky gives no light but its sun: the dataset's sky is black but
+// the sun disc (all of the sky's light on a horizontal surface comes from the disc, as much as
+// before), and black without a sun, the lights calibrated as before (E_u = E_dome).
+TEST(Convert, ASkyThatGivesNoLightButItsSunHasNoDome) {
+  for (const bool sun : {true, false}) {
+    const fs::path dir = freshDir(sun ? "convert_dark_sky_sun" : "convert_dark_sky");
+    dbc_session* s = nullptr;
+    ASSERT_EQ(dbc_open((dir / "capture").c_str(), "test", &s), DBC_OK);
+    const float towardsSun[3] = {0.0f, 0.5f, -static_cast<float>(std::sqrt(3.0) / 2)};
+    const float sunColour[3] = {0.5f, 0.5f, 0.5f}, none[3] = {0, 0, 0};
+    ASSERT_EQ(dbc_set_lighting(s, towardsSun, sun ? sunColour : none, none, none), DBC_OK) << dbc_last_error();
+    const uint64_t camera = dbc_new_id(s), lamp = dbc_new_id(s);
+    const float origin[3] = {0, 0, 0}, white[3] = {1, 1, 1};
+    ASSERT_EQ(dbc_frame_begin(s, 0, 0.0), DBC_OK);
+    ASSERT_EQ(dbc_camera(s, camera, origin, 0, 0, 0), DBC_OK);
+    ASSERT_EQ(dbc_light(s, lamp, origin, white, 30.0f, DBC_FALLOFF_INVERSE_SQUARE, DBC_LIGHT_POINT, 0, "maplight"), DBC_OK);
+    ASSERT_EQ(dbc_frame_end(s), DBC_OK);
+    ASSERT_EQ(dbc_close(s), DBC_OK);
+    ConvertOptions options;
+    options.capture = dir / "capture";
+    options.output = dir / "out" / "dark.gltf";
+    auto report = convertCapture(options);
+    ASSERT_TRUE(report) << report.error().message;
+    const auto j = readJson(options.output);
+    const auto& env = j["extensions"]["DYNBENCH_environment"];
+    EXPECT_EQ(env["light_calibration"]["source"], sun ? "map sun" : "sky dome = full light") << env;
+    EXPECT_TRUE(env["light_calibration"].contains("sky_dome")) << env;
+    auto image = readImage(options.output.parent_path() / env["uri"].get<std::string>());
+    ASSERT_TRUE(image) << image.error().message;
+    std::vector<float> rgb(static_cast<std::size_t>(image->width) * image->height * 3);
+    for (std::size_t i = 0; i < rgb.size() / 3; ++i)
+      for (int c = 0; c < 3; ++c) rgb[3 * i + c] = image->pixels[i * static_cast<std::size_t>(image->channels) + c];
+    // the dome gives nothing: a horizontal surface gets light only from within 2 degrees of the sun
+    const double towards = horizontalIlluminance(rgb, image->width, image->height);
+    const glm::dvec3 sunDirection(0.0, 0.5, -std::sqrt(3.0) / 2);
+    EXPECT_EQ(horizontalIlluminance(rgb, image->width, image->height, sunDirection, radians(2.0)), 0.0);
+    const double lux = env["light_calibration"]["lux_per_unit"].get<double>();
+    const double intensity = j["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"].get<double>();
+    EXPECT_NEAR(intensity, lux * 900.0, 1e-6 * intensity);
+    if (sun) {
+      const double sunLux = env["sky"]["sun_illuminance_lux"].get<double>();
+      EXPECT_EQ(env["sky"]["model"], "ESRA sun disc alone, no sky dome");
+      EXPECT_NEAR(lux, sunLux / 0.5, 1e-6 * lux);
+      EXPECT_NEAR(towards, sunLux * 0.5, 0.02 * sunLux);  // the disc at 30 degrees' elevation: E_sun sin 30
+    } else {
+      EXPECT_EQ(env["sky"]["model"], "black: no sky dome, no sun");
+      EXPECT_EQ(towards, 0.0);
+      EXPECT_GT(lux, 5000.0);  // the daylight dome's illuminance still calibrates the lights
+    }
+  }
 }
 
 TEST(Convert, AStaticLightTheEngineDoesNotAttenuateGetsItsIrradianceAtTheMapsCentre) {

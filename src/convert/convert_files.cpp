@@ -51,7 +51,9 @@ json Converter::environment() {
     target = outDir_ / (stem_ + "_sky.hdr");
     if (auto ok = writeImage(target, FloatImage{sky.width, sky.height, 3, sky.rgb, {}, {}, {}}); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
     ext["source"] = "dynbench Preetham sky";
-    ext["sky"] = {{"model", skyParameters_.sunDisc ? "Preetham 1999 + ESRA sun" : "Preetham 1999, no sun disc"},
+    ext["sky"] = {{"model", !skyParameters_.dome ? (skyParameters_.sunDisc ? "ESRA sun disc alone, no sky dome" : "black: no sky dome, no sun")
+                            : skyParameters_.sunDisc ? "Preetham 1999 + ESRA sun"
+                                                     : "Preetham 1999, no sun disc"},
                   {"turbidity", skyParameters_.turbidity}, {"sun_disc", skyParameters_.sunDisc},
                   {"sun_elevation_degrees", skyParameters_.sunElevationDegrees}, {"sun_azimuth_degrees", skyParameters_.sunAzimuthDegrees},
                   {"sun_direction", vec(sky.sunDirection)}, {"sun_illuminance_lux", sky.sunIlluminanceLux},

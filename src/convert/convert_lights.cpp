@@ -63,6 +63,17 @@ void Converter::calibrateLighting() {
                     {"sky_dome_lux", dome}};
   }
   calibration_["lux_per_unit"] = luxPerUnit_;
+  // An engine that records its lighting with neither a sky light nor an ambient floor says its sky
+  // gives no light but its sun (id Tech 3 with dynbench's map lights: q3map2 lights a map from the
+  // sky only through q3map_sun, q3map_skylight and sky surface lights, which the capture's lights
+  // and sun carry). The dataset's sky then keeps only its sun disc, E_u as calibrated above: a
+  // daylight dome would light a space map's platforms the game shows against a starfield.
+  if (sky_ && lighting && std::max({lighting->sky.r, lighting->sky.g, lighting->sky.b}) <= 0 &&
+      std::max({lighting->ambient.r, lighting->ambient.g, lighting->ambient.b}) <= 0) {
+    skyParameters_.dome = false;
+    sky_ = preethamSky(skyParameters_);
+    calibration_["sky_dome"] = "none: the engine's sky gives no light but its sun (no sky light, no ambient)";
+  }
 }
 
 std::pair<glm::dvec3, double> Converter::lightColorIntensity(const glm::dvec3& capturedColor, double range, LightFalloff falloff,

@@ -62,7 +62,7 @@ SkyImage preethamSky(const SkyParameters& p) {
 
   // The ground below the horizon: grey, albedo 0.2, lit like the horizon above it.
   constexpr double kGroundAlbedo = 0.2;
-  for (int row = 0; row < sky.height; ++row) {
+  for (int row = 0; row < (p.dome ? sky.height : 0); ++row) {
     for (int col = 0; col < sky.width; ++col) {
       const glm::dvec3 d = equirectDirection((col + 0.5) / sky.width, (row + 0.5) / sky.height);
       const bool ground = d.y < 0.0;

@@ -26,6 +26,7 @@ struct SkyParameters {
   double sunAzimuthDegrees = 135.0;   // from -Z (the image centre) towards +X
   int width = 1024;                   // equirectangular: height = width / 2
   bool sunDisc = true;                // false: the sky dome alone (a map the engine lights without a sun)
+  bool dome = true;                   // false: no sky dome, black but the sun disc (an engine whose sky gives no light but its sun)
 };
 
 struct SkyImage {
