@@ -42,6 +42,12 @@ for f in dynbench_capture.h dynbench_capture.cpp dynbench_models.h; do
     rm -f "$src"/engine/{main,dynlight,rendermodel,dynbench_capture}.o
   fi
 done
+# Nor the SDK's header: a changed dbc_mesh (a field added) read by objects compiled with the old one
+# crashed the client; those objects are dropped when the header changes.
+if ! cmp -s "$repo/include/dynbench/capture.h" "$src/.dynbench-capture.h"; then
+  rm -f "$src"/engine/{main,dynlight,rendermodel,dynbench_capture}.o
+  cp "$repo/include/dynbench/capture.h" "$src/.dynbench-capture.h"
+fi
 for lib in libdynbench_capture_engine.a; do
   [[ -f "$dynbench_build/$lib" ]] || { echo "cube2: $dynbench_build/$lib missing: build dynbench first (cmake --build build/release)" >&2; exit 1; }
 done
