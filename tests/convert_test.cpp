@@ -232,6 +232,26 @@ TEST(Convert, MaskMapBecomesMetallicRoughness) {
   EXPECT_EQ(status, 0) << validation;
 }
 
+// A two-frame capture of a static map made of `meshes` (textures under dir/data), seen from above.
+void captureStaticMeshes(const fs::path& dir, std::initializer_list<const dbc_mesh*> meshes) {
+  dbc_session* s = nullptr;
+  ASSERT_EQ(dbc_open((dir / "capture").c_str(), "test", &s), DBC_OK);
+  ASSERT_EQ(dbc_set_data_root(s, (dir / "data").c_str()), DBC_OK);
+  ASSERT_EQ(dbc_model_begin(s, "map"), DBC_OK);
+  for (const dbc_mesh* m : meshes) ASSERT_EQ(dbc_model_mesh(s, m), DBC_OK) << dbc_last_error();
+  ASSERT_EQ(dbc_model_end(s), DBC_OK);
+  const uint64_t camera = dbc_new_id(s), map = dbc_new_id(s);
+  const float eye[] = {0.5f, 2, 0.5f};
+  const dbc_dual_quat identity{0, 0, 0, 1, 0, 0, 0, 0};
+  for (int f = 0; f < 2; ++f) {
+    ASSERT_EQ(dbc_frame_begin(s, static_cast<uint64_t>(f), f / 60.0), DBC_OK);
+    ASSERT_EQ(dbc_camera(s, camera, eye, -90, 0, 0), DBC_OK);
+    if (f == 0) ASSERT_EQ(dbc_static_model(s, map, "map", identity), DBC_OK) << dbc_last_error();
+    ASSERT_EQ(dbc_frame_end(s), DBC_OK);
+  }
+  ASSERT_EQ(dbc_close(s), DBC_OK);
+}
+
 // A mesh's material beyond its maps (Cube 2's lava and water): base colour factor, metallic and
 // roughness, emission in cd/m2 (E_u e / pi, docs/dataset.md) and vertex colours as COLOR_0 with
 // alpha blending; the Khronos validator accepts it and dynbench's loader reads it back.
@@ -239,9 +259,6 @@ TEST(Convert, MaterialFactorsEmissionAndVertexColours) {
   const fs::path dir = freshDir("convert_materials");
   fs::create_directories(dir / "data");
   std::ofstream(dir / "data/lava.png", std::ios::binary).write(reinterpret_cast<const char*>(kPng), sizeof kPng);
-  dbc_session* s = nullptr;
-  ASSERT_EQ(dbc_open((dir / "capture").c_str(), "test", &s), DBC_OK);
-  ASSERT_EQ(dbc_set_data_root(s, (dir / "data").c_str()), DBC_OK);
   const float positions[] = {0, 0, 0, 1, 0, 0, 1, 0, 1, 0, 0, 1}, uvs[] = {0, 0, 1, 0, 1, 1, 0, 1};
   const float normals[] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
   const float colors[] = {1, 1, 1, 1, 0.5f, 0.5f, 0.5f, 0.25f, 1, 1, 1, 1, 1, 1, 1, 1};
@@ -270,19 +287,8 @@ TEST(Convert, MaterialFactorsEmissionAndVertexColours) {
   layer.base_color = nullptr;
   layer.metallic_roughness = nullptr;
   layer.colors = colors;
-  ASSERT_EQ(dbc_model_begin(s, "map"), DBC_OK);
-  for (const dbc_mesh* m : {&lava, &pool, &layer}) ASSERT_EQ(dbc_model_mesh(s, m), DBC_OK) << dbc_last_error();
-  ASSERT_EQ(dbc_model_end(s), DBC_OK);
-  const uint64_t camera = dbc_new_id(s), map = dbc_new_id(s);
-  const float eye[] = {0.5f, 2, 0.5f};
-  const dbc_dual_quat identity{0, 0, 0, 1, 0, 0, 0, 0};
-  for (int f = 0; f < 2; ++f) {
-    ASSERT_EQ(dbc_frame_begin(s, static_cast<uint64_t>(f), f / 60.0), DBC_OK);
-    ASSERT_EQ(dbc_camera(s, camera, eye, -90, 0, 0), DBC_OK);
-    if (f == 0) ASSERT_EQ(dbc_static_model(s, map, "map", identity), DBC_OK) << dbc_last_error();
-    ASSERT_EQ(dbc_frame_end(s), DBC_OK);
-  }
-  ASSERT_EQ(dbc_close(s), DBC_OK);
+  captureStaticMeshes(dir, {&lava, &pool, &layer});
+  if (HasFatalFailure()) return;
   ConvertOptions options;
   options.capture = dir / "capture";
   options.output = dir / "out" / "materials.gltf";
@@ -334,9 +340,6 @@ TEST(Convert, AnEmissionMapThatOnlyShapesTheEmissionKeepsItsMean) {
   const fs::path dir = freshDir("convert_emission_mean");
   fs::create_directories(dir / "data");
   ASSERT_TRUE(writeImage(dir / "data/glow.png", FloatImage{2, 1, 3, {1, 1, 0, 0, 0, 0}, {}, {}, {}}));
-  dbc_session* s = nullptr;
-  ASSERT_EQ(dbc_open((dir / "capture").c_str(), "test", &s), DBC_OK);
-  ASSERT_EQ(dbc_set_data_root(s, (dir / "data").c_str()), DBC_OK);
   const float positions[] = {0, 0, 0, 1, 0, 0, 1, 0, 1, 0, 0, 1}, uvs[] = {0, 0, 1, 0, 1, 1, 0, 1};
   const float normals[] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0}, emission[] = {1.5f, 0.75f, 0.5f};
   const uint32_t quad[] = {0, 1, 2, 0, 2, 3};
@@ -355,19 +358,8 @@ TEST(Convert, AnEmissionMapThatOnlyShapesTheEmissionKeepsItsMean) {
   multiplied.mesh_id = 1;
   multiplied.name = "multiplied";
   multiplied.emission_texture_mean_one = 0;
-  ASSERT_EQ(dbc_model_begin(s, "map"), DBC_OK);
-  for (const dbc_mesh* m : {&shaped, &multiplied}) ASSERT_EQ(dbc_model_mesh(s, m), DBC_OK) << dbc_last_error();
-  ASSERT_EQ(dbc_model_end(s), DBC_OK);
-  const uint64_t camera = dbc_new_id(s), map = dbc_new_id(s);
-  const float eye[] = {0.5f, 2, 0.5f};
-  const dbc_dual_quat identity{0, 0, 0, 1, 0, 0, 0, 0};
-  for (int f = 0; f < 2; ++f) {
-    ASSERT_EQ(dbc_frame_begin(s, static_cast<uint64_t>(f), f / 60.0), DBC_OK);
-    ASSERT_EQ(dbc_camera(s, camera, eye, -90, 0, 0), DBC_OK);
-    if (f == 0) ASSERT_EQ(dbc_static_model(s, map, "map", identity), DBC_OK) << dbc_last_error();
-    ASSERT_EQ(dbc_frame_end(s), DBC_OK);
-  }
-  ASSERT_EQ(dbc_close(s), DBC_OK);
+  captureStaticMeshes(dir, {&shaped, &multiplied});
+  if (HasFatalFailure()) return;
   std::string records;
   for (const auto& e : fs::recursive_directory_iterator(dir / "capture" / "models")) records += test::slurp(e.path());
   EXPECT_NE(records.find("m:0:glow.png"), std::string::npos) << records;
@@ -532,30 +524,47 @@ TEST(Convert, NegativeLightColoursBecomeZero) {
   EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
 }
 
+// A one-frame capture of a map's lighting (a sun from elevation 30 degrees, azimuth 0, of colour
+// `sun`; the ambient floor; the sky light) and one static point light at the origin, converted:
+// the dataset's path, or empty after a test failure.
+struct OneLight {
+  glm::vec3 sun{0.0f}, ambient{0.0f}, sky{0.0f}, colour{1.0f};
+  float range = 20.0f;
+  dbc_light_falloff falloff = DBC_FALLOFF_QUADRATIC;
+  const char* type = "none";
+};
+fs::path convertOneLight(const fs::path& dir, const OneLight& l) {
+  dbc_session* s = nullptr;
+  const fs::path failed;
+  if (dbc_open((dir / "capture").c_str(), "test", &s) != DBC_OK) return ADD_FAILURE() << dbc_last_error(), failed;
+  const float towardsSun[3] = {0.0f, 0.5f, -static_cast<float>(std::sqrt(3.0) / 2)};
+  const uint64_t camera = dbc_new_id(s), lamp = dbc_new_id(s);
+  const float origin[3] = {0, 0, 0};
+  const bool ok = dbc_set_lighting(s, towardsSun, &l.sun.x, &l.ambient.x, &l.sky.x) == DBC_OK && dbc_frame_begin(s, 0, 0.0) == DBC_OK &&
+                  dbc_camera(s, camera, origin, 0, 0, 0) == DBC_OK &&
+                  dbc_light(s, lamp, origin, &l.colour.x, l.range, l.falloff, DBC_LIGHT_POINT, 0, l.type) == DBC_OK &&
+                  dbc_frame_end(s) == DBC_OK && dbc_close(s) == DBC_OK;
+  if (!ok) return ADD_FAILURE() << dbc_last_error(), failed;
+  ConvertOptions options;
+  options.capture = dir / "capture";
+  options.output = dir / "out" / "map.gltf";
+  auto report = convertCapture(options);
+  if (!report) return ADD_FAILURE() << report.error().message, failed;
+  return options.output;
+}
+
 TEST(Convert, TheMapsSunPlacesTheSkysSunAndCalibratesTheLights) {
   // A map lit by a sun of engine colour 0.5 from elevation 30 degrees: the generated sky's sun
   // stands there, and a light of colour 1 and radius R gets I = (E_sun / 0.5) x R^2 x k, k = 1/6
   // for a quadratic falloff. A map without a sun gets a sky without a sun disc.
   for (const bool sun : {true, false}) {
-    const fs::path dir = freshDir(sun ? "convert_map_sun" : "convert_map_no_sun");
-    dbc_session* s = nullptr;
-    ASSERT_EQ(dbc_open((dir / "capture").c_str(), "test", &s), DBC_OK);
-    const float towardsSun[3] = {0.0f, 0.5f, -static_cast<float>(std::sqrt(3.0) / 2)};  // elevation 30, azimuth 0
-    const float sunColour[3] = {0.5f, 0.5f, 0.4f}, none[3] = {0, 0, 0}, ambient[3] = {0.1f, 0.1f, 0.1f}, skyLight[3] = {0.4f, 0.4f, 0.4f};
-    ASSERT_EQ(dbc_set_lighting(s, towardsSun, sun ? sunColour : none, ambient, skyLight), DBC_OK) << dbc_last_error();
-    const uint64_t camera = dbc_new_id(s), lamp = dbc_new_id(s);
-    const float origin[3] = {0, 0, 0}, white[3] = {1, 1, 1};
-    ASSERT_EQ(dbc_frame_begin(s, 0, 0.0), DBC_OK);
-    ASSERT_EQ(dbc_camera(s, camera, origin, 0, 0, 0), DBC_OK);
-    ASSERT_EQ(dbc_light(s, lamp, origin, white, 20.0f, DBC_FALLOFF_QUADRATIC, DBC_LIGHT_POINT, 0, "none"), DBC_OK);
-    ASSERT_EQ(dbc_frame_end(s), DBC_OK);
-    ASSERT_EQ(dbc_close(s), DBC_OK);
-    ConvertOptions options;
-    options.capture = dir / "capture";
-    options.output = dir / "out" / "map.gltf";
-    auto report = convertCapture(options);
-    ASSERT_TRUE(report) << report.error().message;
-    const auto j = readJson(options.output);
+    OneLight l;
+    if (sun) l.sun = {0.5f, 0.5f, 0.4f};
+    l.ambient = glm::vec3(0.1f);
+    l.sky = glm::vec3(0.4f);
+    const fs::path dataset = convertOneLight(freshDir(sun ? "convert_map_sun" : "convert_map_no_sun"), l);
+    ASSERT_FALSE(dataset.empty());
+    const auto j = readJson(dataset);
     const auto& env = j["extensions"]["DYNBENCH_environment"];
     const double intensity = j["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"].get<double>();
     if (sun) {
@@ -573,7 +582,7 @@ TEST(Convert, TheMapsSunPlacesTheSkysSunAndCalibratesTheLights) {
       EXPECT_NEAR(intensity, dome / 0.4 * 400.0 / 6.0, 1e-3 * intensity);
     }
     int status = 0;
-    const std::string validation = test::validateGltf(options.output, status);
+    const std::string validation = test::validateGltf(dataset, status);
     EXPECT_EQ(status, 0) << validation;
     EXPECT_NE(validation.find("errors=0"), std::string::npos) << validation;
   }
@@ -583,33 +592,24 @@ TEST(Convert, AnInverseSquareLightGivesItsColourAtItsRange) {
   // id Tech 3's map lights (maplight): colour c x (R / d)^2, no end. In a map lit by a sun of
   // engine colour 0.5, E_u = E_sun / 0.5 and the light is a point light without a range of
   // I = E_u x peak(c) x R^2 cd: at d = R it gives E_u x c, the engine's light of colour c.
+  OneLight l;
+  l.sun = glm::vec3(0.5f);
+  l.colour = {2.0f, 1.0f, 0.5f};
+  l.range = 30.0f;
+  l.falloff = DBC_FALLOFF_INVERSE_SQUARE;
+  l.type = "maplight";
   const fs::path dir = freshDir("convert_inverse_square");
-  dbc_session* s = nullptr;
-  ASSERT_EQ(dbc_open((dir / "capture").c_str(), "test", &s), DBC_OK);
-  const float towardsSun[3] = {0.0f, 0.5f, -static_cast<float>(std::sqrt(3.0) / 2)};
-  const float sunColour[3] = {0.5f, 0.5f, 0.5f}, ambient[3] = {0, 0, 0};
-  ASSERT_EQ(dbc_set_lighting(s, towardsSun, sunColour, ambient, ambient), DBC_OK) << dbc_last_error();
-  const uint64_t camera = dbc_new_id(s), lamp = dbc_new_id(s);
-  const float origin[3] = {0, 0, 0}, warm[3] = {2.0f, 1.0f, 0.5f};
-  ASSERT_EQ(dbc_frame_begin(s, 0, 0.0), DBC_OK);
-  ASSERT_EQ(dbc_camera(s, camera, origin, 0, 0, 0), DBC_OK);
-  ASSERT_EQ(dbc_light(s, lamp, origin, warm, 30.0f, DBC_FALLOFF_INVERSE_SQUARE, DBC_LIGHT_POINT, 0, "maplight"), DBC_OK);
-  ASSERT_EQ(dbc_frame_end(s), DBC_OK);
-  ASSERT_EQ(dbc_close(s), DBC_OK);
+  const fs::path dataset = convertOneLight(dir, l);
+  ASSERT_FALSE(dataset.empty());
   EXPECT_NE(test::slurp(dir / "capture" / "Capture.txt").find(":30:inverse_square:point:0:maplight"), std::string::npos);
-  ConvertOptions options;
-  options.capture = dir / "capture";
-  options.output = dir / "out" / "lamp.gltf";
-  auto report = convertCapture(options);
-  ASSERT_TRUE(report) << report.error().message;
-  const auto j = readJson(options.output);
+  const auto j = readJson(dataset);
   const double sunLux = j["extensions"]["DYNBENCH_environment"]["sky"]["sun_illuminance_lux"].get<double>();
   const auto& light = j["extensions"]["KHR_lights_punctual"]["lights"][0];
   EXPECT_FALSE(light.contains("range"));
   EXPECT_EQ(light["color"], nlohmann::json({1.0, 0.5, 0.25}));
   EXPECT_NEAR(light["intensity"].get<double>(), sunLux / 0.5 * 2.0 * 900.0, 1e-3 * light["intensity"].get<double>());
   int status = 0;
-  const std::string validation = test::validateGltf(options.output, status);
+  const std::string validation = test::validateGltf(dataset, status);
   EXPECT_EQ(status, 0) << validation;
 }
 
@@ -619,29 +619,18 @@ TEST(Convert, AnInverseSquareLightGivesItsColourAtItsRange) {
 // before), and black without a sun, the lights calibrated as before (E_u = E_dome).
 TEST(Convert, ASkyThatGivesNoLightButItsSunHasNoDome) {
   for (const bool sun : {true, false}) {
-    const fs::path dir = freshDir(sun ? "convert_dark_sky_sun" : "convert_dark_sky");
-    dbc_session* s = nullptr;
-    ASSERT_EQ(dbc_open((dir / "capture").c_str(), "test", &s), DBC_OK);
-    const float towardsSun[3] = {0.0f, 0.5f, -static_cast<float>(std::sqrt(3.0) / 2)};
-    const float sunColour[3] = {0.5f, 0.5f, 0.5f}, none[3] = {0, 0, 0};
-    ASSERT_EQ(dbc_set_lighting(s, towardsSun, sun ? sunColour : none, none, none), DBC_OK) << dbc_last_error();
-    const uint64_t camera = dbc_new_id(s), lamp = dbc_new_id(s);
-    const float origin[3] = {0, 0, 0}, white[3] = {1, 1, 1};
-    ASSERT_EQ(dbc_frame_begin(s, 0, 0.0), DBC_OK);
-    ASSERT_EQ(dbc_camera(s, camera, origin, 0, 0, 0), DBC_OK);
-    ASSERT_EQ(dbc_light(s, lamp, origin, white, 30.0f, DBC_FALLOFF_INVERSE_SQUARE, DBC_LIGHT_POINT, 0, "maplight"), DBC_OK);
-    ASSERT_EQ(dbc_frame_end(s), DBC_OK);
-    ASSERT_EQ(dbc_close(s), DBC_OK);
-    ConvertOptions options;
-    options.capture = dir / "capture";
-    options.output = dir / "out" / "dark.gltf";
-    auto report = convertCapture(options);
-    ASSERT_TRUE(report) << report.error().message;
-    const auto j = readJson(options.output);
+    OneLight l;
+    if (sun) l.sun = glm::vec3(0.5f);
+    l.range = 30.0f;
+    l.falloff = DBC_FALLOFF_INVERSE_SQUARE;
+    l.type = "maplight";
+    const fs::path dataset = convertOneLight(freshDir(sun ? "convert_dark_sky_sun" : "convert_dark_sky"), l);
+    ASSERT_FALSE(dataset.empty());
+    const auto j = readJson(dataset);
     const auto& env = j["extensions"]["DYNBENCH_environment"];
     EXPECT_EQ(env["light_calibration"]["source"], sun ? "map sun" : "sky dome = full light") << env;
     EXPECT_TRUE(env["light_calibration"].contains("sky_dome")) << env;
-    auto image = readImage(options.output.parent_path() / env["uri"].get<std::string>());
+    auto image = readImage(dataset.parent_path() / env["uri"].get<std::string>());
     ASSERT_TRUE(image) << image.error().message;
     std::vector<float> rgb(static_cast<std::size_t>(image->width) * image->height * 3);
     for (std::size_t i = 0; i < rgb.size() / 3; ++i)
