@@ -166,6 +166,10 @@ TEST(CaptureSdk, RejectsBadCallsAndWritesNothingForThem) {
   EXPECT_EQ(dbc_frame_begin(s, 2, 0.1), DBC_ERROR_ORDER);  // frame 1 has not ended
   ASSERT_EQ(dbc_frame_end(s), DBC_OK);
   EXPECT_EQ(dbc_frame_begin(s, 1, 0.2), DBC_ERROR_ARGUMENT);  // frame numbers must increase
+  // the lens is set once, before any frame: readers refuse a 'C' record between frames (OpenArena's
+  // underwater view changed its field of view mid-match and left a capture no reader took)
+  EXPECT_EQ(dbc_set_camera_settings(s, 16.0f / 9, 60.0f, 0.1f, 100.0f), DBC_ERROR_ORDER);
+  EXPECT_NE(std::string(dbc_last_error()).find("set once, before any frame"), std::string::npos) << dbc_last_error();
   ASSERT_EQ(dbc_close(s), DBC_OK);
   auto summary = checkCapture(dir);
   ASSERT_TRUE(summary) << summary.error().message;  // only the valid records were written

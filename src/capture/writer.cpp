@@ -176,6 +176,9 @@ int dbc_set_lighting(dbc_session* s, const float sunDirection[3], const float su
 
 int dbc_set_camera_settings(dbc_session* s, float aspect, float yfov_degrees, float znear, float zfar) {
   if (!s) return error(DBC_ERROR_ARGUMENT, "dbc_set_camera_settings: session is NULL");
+  // Capture.txt's lens is one record of its header (docs/capture-format.md): readers refuse a
+  // second one between frames, so it is refused here, before the capture is left unreadable.
+  if (s->anyFrame) return error(DBC_ERROR_ORDER, "dbc_set_camera_settings after the first frame: the camera's lens is set once, before any frame");
   if (!finite({aspect, yfov_degrees, znear, zfar}) || !(aspect > 0) || !(yfov_degrees > 0 && yfov_degrees < 180) ||
       !(znear > 0) || !(zfar > znear))
     return error(DBC_ERROR_ARGUMENT, fmt::format("camera settings need aspect > 0, 0 < yfov < 180, 0 < znear < zfar "

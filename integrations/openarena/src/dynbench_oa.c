@@ -97,6 +97,7 @@ static struct {
   int last_client, last_teleport, last_dead, have_last;
   float last_position[3];
   float camera_fov;
+  int fov_change_reported; /* the note that the view's field of view changed was printed */
   int last_camera_width, last_camera_height;
   char map[MAX_QPATH];        /* "oa_dm1" */
   char world_path[MAX_QPATH]; /* "maps/oa_dm1" */
@@ -1136,11 +1137,18 @@ void dynbench_render_scene(const refdef_t* view) {
     return;
   }
   dbc_session* s = g_db.session;
-  if (view->width != g_db.last_camera_width || view->height != g_db.last_camera_height || view->fov_y != g_db.camera_fov) {
+  /* The capture's lens is set once, before the first frame. The view's field of view can change
+   * later (CG_CalcFov waves it while the followed player is under water, and zooms): the capture
+   * keeps the first, and says so once. */
+  if (!g_db.last_camera_width) {
     g_db.last_camera_width = view->width;
     g_db.last_camera_height = view->height;
     g_db.camera_fov = view->fov_y;
     if (dbc_set_camera_settings(s, (float)view->width / (float)view->height, view->fov_y, 4.0f, 16384.0f) != DBC_OK) { db_fail("camera settings"); return; }
+  } else if (!g_db.fov_change_reported && (view->width != g_db.last_camera_width || view->height != g_db.last_camera_height || view->fov_y != g_db.camera_fov)) {
+    g_db.fov_change_reported = 1;
+    fprintf(stderr, "dynbench-capture: note: the view's field of view changed at frame %d (%.3f to %.3f degrees, under water or zoomed); the capture keeps the first\n",
+            g_db.frame, g_db.camera_fov, view->fov_y);
   }
   /* models are recorded between frames: every drawn one first */
   static char paths[MAX_PENDING][3 * MAX_QPATH];
