@@ -87,7 +87,7 @@ int dbc_close(dbc_session* session);
 /* What the last failing call on this thread said. */
 const char* dbc_last_error(void);
 
-/* Capture-wide settings (before or between frames; camera settings also inside a frame). */
+/* Capture-wide settings (before or between frames; the camera settings once, before the first frame). */
 int dbc_set_data_root(dbc_session* session, const char* path);
 int dbc_set_metres_per_unit(dbc_session* session, float metres);
 int dbc_set_map(dbc_session* session, const char* map_name, const float offset[3]);
