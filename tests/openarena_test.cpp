@@ -11,11 +11,13 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <optional>
 #include <sstream>
 #include <tuple>
+#include <vector>
 
 #include "capture/openarena.h"
 #include "core/files.h"
@@ -119,18 +121,35 @@ TEST(OpenArena, MatchConvertsWithMorphTargetsWhereTheGamePutThem) {
   DYNBENCH_NEEDS(test::missingOpenArena());
   DYNBENCH_NEEDS(test::missingGltfValidator());
   const auto dir = test::freshDir("openarena_dataset");
-  auto r = dynbench(fmt::format("capture openarena -o {} --map oa_dm1 --bots 4 --seconds 6 --seed 3 --game-frames 100", (dir / "cap").string()), dir);
+  auto r = dynbench(fmt::format("capture openarena -o {} --map oa_dm1 --bots 4 --seconds 6 --seed 3 --game-frames 100,250", (dir / "cap").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;
-  // The game's own image of frame 100: the window's size, and a lit room, not a black buffer.
-  {
-    const std::string ppm = test::slurp(dir / "cap" / "game" / "frame_00100.ppm");
+  // The game's own image of frames 100 and 250: the window's size, and a lit room, not a black
+  // buffer; and its depth buffer, read before the swap from the classic renderer (read after it
+  // from Debian's default renderer, these two frames' depth read back as zeros on every run).
+  for (const char* frame : {"00100", "00250"}) {
+    const std::string ppm = test::slurp(dir / "cap" / "game" / fmt::format("frame_{}.ppm", frame));
     const std::string header = "P6\n640 360\n255\n";
     ASSERT_EQ(ppm.substr(0, header.size()), header);
     ASSERT_EQ(ppm.size(), header.size() + 640u * 360u * 3u);
     double mean = 0;
     for (std::size_t i = header.size(); i < ppm.size(); ++i) mean += static_cast<unsigned char>(ppm[i]);
     mean /= 640.0 * 360.0 * 3.0 * 255.0;
-    EXPECT_GT(mean, 0.05) << "the game's frame is black";
+    EXPECT_GT(mean, 0.05) << "the game's frame " << frame << " is black";
+    const fs::path depthPath = dir / "cap" / "game" / fmt::format("frame_{}_window_depth.pfm", frame);
+    ASSERT_TRUE(fs::exists(depthPath)) << "frame " << frame << " kept no depth";
+    const std::string pfm = test::slurp(depthPath);
+    const std::string pfmHeader = "Pf\n640 360\n-1.0\n";
+    ASSERT_EQ(pfm.substr(0, pfmHeader.size()), pfmHeader);
+    ASSERT_EQ(pfm.size(), pfmHeader.size() + 640u * 360u * sizeof(float));
+    std::vector<float> depth(640u * 360u);
+    std::memcpy(depth.data(), pfm.data() + pfmHeader.size(), depth.size() * sizeof(float));
+    // window depth: in [0, 1], 1 on the sky; a room in view covers most of the frame nearer than that
+    const auto [lowest, highest] = std::minmax_element(depth.begin(), depth.end());
+    EXPECT_GE(*lowest, 0.0f);
+    EXPECT_LE(*highest, 1.0f);
+    const auto geometry = std::count_if(depth.begin(), depth.end(), [](float d) { return d > 0.0f && d < 1.0f; });
+    EXPECT_GT(static_cast<double>(geometry) / static_cast<double>(depth.size()), 0.5) << "frame " << frame;
+    EXPECT_LT(*lowest, *highest) << "frame " << frame << ": a uniform depth buffer";
   }
   r = dynbench(fmt::format("convert {} -o {}", (dir / "cap").string(), (dir / "ds" / "dm1.gltf").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err;

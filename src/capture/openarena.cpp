@@ -101,6 +101,12 @@ Expected<std::vector<std::string>> openArenaArguments(const OpenArenaOptions& o,
       "+set", "vm_cgame", "0", "+set", "vm_game", "0", "+set", "vm_ui", "0", "+set", "sv_pure", "0", "+set", "s_initsound", "0",
       "+set", "ttycon", "0", "+set", "r_mode", "-1", "+set", "r_fullscreen", "0", "+set", "r_customwidth", std::to_string(o.width),
       "+set", "r_customheight", std::to_string(o.height),
+      // the game's own frames (--game-frames) from ioquake3's classic renderer, drawn straight into
+      // the window: lightmap bytes times 4, clipped, as q3map2's model and docs/fidelity.md take
+      // them, with no hardware gamma ramp (which a read-back would not see). Debian's default,
+      // opengl2, draws the view into an off-screen HDR framebuffer and tone-maps it with an
+      // exposure that adapts over frames; the depth buffer of the window then holds nothing.
+      "+set", "cl_renderer", "opengl1", "+set", "r_ignorehwgamma", "1",
       // the fixed clock from the first frame (the server's first frames too: set later, the bots'
       // first moves would follow the machine's speed), frames as fast as the machine goes
       "+set", "fixedtime", std::to_string(1000 / o.fps), "+set", "com_maxfps", "0",

@@ -90,7 +90,7 @@ static struct {
   int restart_sent, restarted, connected_at;
   int record;       /* 0: play the same match without writing anything (the overhead benchmark) */
   char game_frames[1024]; /* ",60,120,": recorded frames whose own image the game keeps in game/ */
-  int pending_game_frame; /* a frame whose image is on screen at the next frame's start, or -1 */
+  int pending_game_frame; /* a recorded frame whose own image is read once its scene is drawn, or -1 */
   int window_start; /* wall-clock ms when recording started */
   int follow_target;
   uint64_t camera_id;
@@ -1014,14 +1014,20 @@ static int ensure_following(void) {
   return 0;
 }
 
-/* The game's own image of recorded frame `frame`, read at the start of the next frame, before
- * anything of it is drawn (the renderer draws at the end of the engine's frame, after this module
- * has queued the scene): Mesa's software OpenGL (llvmpipe, under Xvfb) swaps by copying, so the
- * back buffer still holds the frame shown last. (Its front buffer, read the same way, was black
- * in 2 of 6 frames.) The HUD is off (cg_draw2D 0). 8-bit sRGB, binary PPM, top row first, written
- * to a temporary name and renamed. */
+/* The game's own image of recorded frame `frame`: colour and depth, read right after the renderer
+ * drew the frame's main view, before the swap. The renderer queues its commands and draws them at
+ * the end of the engine's frame, after this module returns; registering a font makes it draw what
+ * is queued first (RE_RegisterFont calls R_IssuePendingRenderCommands before anything else, and
+ * OpenArena ships no font, so nothing is registered: the engine prints one warning per kept
+ * frame). Reading at the start of the next frame instead, after the swap, kept the colour (Mesa's
+ * llvmpipe under Xvfb swaps by copying) but the depth buffer read back as zeros on about a third
+ * of the frames whenever llvmpipe rasterised in more than one thread or in the calling one. The
+ * HUD is off (cg_draw2D 0) and nothing but the view is drawn before the read. 8-bit sRGB, binary
+ * PPM, top row first, written to a temporary name and renamed. */
 static void keep_game_frame(int frame) {
   const int w = cgs.glconfig.vidWidth, h = cgs.glconfig.vidHeight;
+  static fontInfo_t no_font;
+  trap_R_RegisterFont("dynbench-draw-queued-commands", 12, &no_font);
   unsigned char* rgb = malloc((size_t)w * h * 3);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadBuffer(GL_BACK);
@@ -1044,9 +1050,8 @@ static void keep_game_frame(int frame) {
    * bottom to top, as glReadPixels returns them. */
   float* depth = malloc((size_t)w * h * sizeof(float));
   glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depth);
-  /* On some frames, from run to run, the depth buffer reads back as all zeros after the engine's
-   * swap while the colour is right (Mesa's llvmpipe under Xvfb; not understood): such a frame
-   * keeps no depth, and `dynbench fidelity` says its depth was not read. */
+  /* A depth buffer that reads back uniform (as it did after the swap) is not kept: `dynbench
+   * fidelity` then says the frame's depth was not read. */
   int varies = 0;
   for (int i = 1; i < w * h && !varies; ++i) varies = depth[i] != depth[0];
   Com_sprintf(path, sizeof(path), "%s/game/frame_%05d_window_depth.pfm", g_db.dir, frame);
@@ -1071,13 +1076,15 @@ static void keep_game_frame(int frame) {
   }
 }
 
+void dynbench_scene_rendered(const refdef_t* view) {
+  if (g_db.pending_game_frame < 0 || (view->rdflags & RDF_NOWORLDMODEL)) return;
+  keep_game_frame(g_db.pending_game_frame);
+  g_db.pending_game_frame = -1;
+}
+
 void dynbench_render_scene(const refdef_t* view) {
   if (!g_db.active || (view->rdflags & RDF_NOWORLDMODEL) || !cg.snap) return;
   ++g_db.pass;
-  if (g_db.pending_game_frame >= 0) {
-    keep_game_frame(g_db.pending_game_frame);
-    g_db.pending_game_frame = -1;
-  }
   /* How many frames the client takes to connect and load depends on the machine's load, and the
    * client shares the C library's random numbers with the game and the bots (native modules in
    * one process), so a match that ran while the client connected would differ from run to run.

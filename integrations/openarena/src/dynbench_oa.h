@@ -35,5 +35,7 @@ void dynbench_map_restart(void);
 
 /* The main view (not the HUD's 3D icons) is recorded here, as one frame. */
 void dynbench_render_scene(const refdef_t* view);
+/* The engine has queued the main view: the game's own image of a frame --game-frames keeps. */
+void dynbench_scene_rendered(const refdef_t* view);
 
 #endif
