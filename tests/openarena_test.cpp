@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -328,6 +329,42 @@ TEST(OpenArena, DemoMakesItsDatasetsFromAnOpenArenaMatch) {
   r = dynbench(command, dir);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE((r.out + r.err).find("exists, reused"), std::string::npos) << r.out << r.err;
+}
+
+// A map-lights file's colours are the game's (lightmap tints, shown through 8-bit sRGB): the
+// capture records them as linear colours of the same peak, each channel over the peak decoded as
+// sRGB (IEC 61966-2-1), the level unchanged.
+TEST(OpenArena, MapLightColoursAreRecordedLinear) {
+  DYNBENCH_NEEDS(test::missingOpenArena());
+  const auto dir = test::freshDir("openarena_light_colours");
+  std::ofstream(dir / "lights.txt") << "# known answers\n"
+                                       "point 0 0 64 1 0.5 0.5 100\n"
+                                       "point 0 64 64 0.2 0.2 0.1 50\n"
+                                       "point 64 0 64 0.02 0.02 0.02 30\n"
+                                       "sun 0 0 1 0.5 0.25 0\n";
+  auto r = dynbench(fmt::format("capture openarena -o {} --seconds 1 --bots 1 --map-lights {}", (dir / "cap").string(),
+                                (dir / "lights.txt").string()),
+                    dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  // decode(0.5) = ((0.5 + 0.055) / 1.055)^2.4 = 0.2140411; decode(0.1 / 0.2) the same
+  const std::vector<std::array<double, 4>> expected = {
+      {1.0, 0.2140411, 0.2140411, 100.0}, {0.2, 0.2, 0.2 * 0.2140411, 50.0}, {0.02, 0.02, 0.02, 30.0}};
+  std::vector<std::array<double, 4>> recorded;
+  std::vector<double> sun;
+  std::ifstream capture(dir / "cap" / "Capture.txt");
+  for (std::string line; std::getline(capture, line);) {
+    const auto f = splitFields(line);
+    if (f[0] == "l" && f.size() >= 13 && f[12] == "maplight")
+      recorded.push_back({std::stod(f[5]), std::stod(f[6]), std::stod(f[7]), std::stod(f[8])});
+    if (f[0] == "L" && f.size() >= 7) sun = {std::stod(f[4]), std::stod(f[5]), std::stod(f[6])};
+  }
+  ASSERT_EQ(recorded.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i)
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(recorded[i][k], expected[i][k], 1e-6) << "light " << i << " value " << k;
+  ASSERT_EQ(sun.size(), 3u);
+  EXPECT_NEAR(sun[0], 0.5, 1e-6);
+  EXPECT_NEAR(sun[1], 0.5 * 0.2140411, 1e-6);
+  EXPECT_NEAR(sun[2], 0.0, 1e-9);
 }
 
 TEST(OpenArena, BadOptionsFailClearly) {

@@ -1249,8 +1249,25 @@ int dynbench_frame_time(int server_time) {
   return t;
 }
 
+/* A light colour of the game's (a lightmap's tint) as a linear colour of the same peak. The engine
+ * multiplies texture and lightmap bytes and shows the product as an 8-bit sRGB image: a light of
+ * colour c (peak 1) and level k displays as decode(texture) x decode(k c), whose hue is decode(c)
+ * (exactly for a pure power law, closely for sRGB's curve). So a
+ * (1, 0.5, 0.5) light shows dark red in the game and is (1, 0.21, 0.21) in linear light; taken as
+ * linear, it lit a grey floor pale pink (oa_ctf2, docs/fidelity.md). The level stays linear (q3map2
+ * adds lights' levels in lightmap bytes, and the fit did). */
+static void game_colour_to_linear(float rgb[3]) {
+  const float peak = fmaxf(rgb[0], fmaxf(rgb[1], rgb[2]));
+  if (peak <= 0) return;
+  for (int k = 0; k < 3; ++k) {
+    const float c = fmaxf(rgb[k], 0.0f) / peak; /* the sRGB decoding (IEC 61966-2-1) */
+    rgb[k] = peak * (c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f));
+  }
+}
+
 /* dynbench's lights of the map (src/maplight/fit.h, writeAdapterLights): "point X Y Z R G B D",
- * "sun DX DY DZ R G B", "surface SHADER R G B", game axes, full-light units. */
+ * "sun DX DY DZ R G B", "surface SHADER R G B", game axes, full-light units; their colours made
+ * linear here (game_colour_to_linear). */
 static int load_map_lights(const char* path) {
   if (!path || !path[0]) return 1;
   FILE* file = fopen(path, "r");
@@ -1269,15 +1286,18 @@ static int load_map_lights(const char* path) {
       if (g_db.static_light_count >= MAX_STATIC_LIGHTS) continue;
       float* light = g_db.static_lights[g_db.static_light_count++];
       to_capture(v, light);
+      game_colour_to_linear(v + 3);
       memcpy(light + 3, v + 3, 4 * sizeof(float));
       light[7] = (float)DBC_FALLOFF_INVERSE_SQUARE;
     } else if (sscanf(line, "sun %f %f %f %f %f %f", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5]) == 6) {
       g_db.map_sun = 1;
       memcpy(g_db.map_sun_towards, v, 3 * sizeof(float));
+      game_colour_to_linear(v + 3);
       memcpy(g_db.map_sun_rgb, v + 3, 3 * sizeof(float));
     } else if (sscanf(line, "surface %63s %f %f %f", shader, &v[0], &v[1], &v[2]) == 4) {
       if (g_db.map_surface_count >= MAX_MAP_SURFACE_LIGHTS) continue;
       Q_strncpyz(g_db.map_surface_shader[g_db.map_surface_count], shader, MAX_QPATH);
+      game_colour_to_linear(v);
       memcpy(g_db.map_surface_emission[g_db.map_surface_count++], v, 3 * sizeof(float));
     } else if (sscanf(line, "%15s", kind) == 1) {
       fclose(file);
