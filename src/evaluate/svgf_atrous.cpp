@@ -8,6 +8,7 @@
 
 #include <algorithm>
 
+#include "core/simd.h"
 #include "evaluate/svgf_atrous.h"
 
 #ifndef DYNBENCH_SVGF_ATROUS_ARGS
@@ -309,6 +310,7 @@ void atrousIteration(AtrousPlanes& p, int step, const AtrousWeights& weights, At
                         p.gradY.data(), p.r.data(),    p.g.data(),        p.b.data(),          p.variance.data(),  p.luminance.data(),
                         out.r.data(),   out.g.data(),  out.b.data(),      out.variance.data(), out.luminance.data(), w,
                         h,              p.stride,      step,              weights.sigmaZ,      weights.sigmaL,      remodulation};
+  core::useMachineIndependentSimd();
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& rows) {
     const FlushDenormals flush;
     HWY_DYNAMIC_DISPATCH(AtrousRows)(&args, rows.begin(), rows.end());
@@ -321,6 +323,7 @@ void estimateVariance(AtrousPlanes& p, float sigmaZ, float momentsSigmaL) {
                          p.gradX.data(),    p.gradY.data(),   p.luminance.data(),    p.moment1.data(),  p.temporalVariance.data(),
                          p.historyLength.data(), p.variance.data(), w,             p.stride,          sigmaZ,
                          momentsSigmaL};
+  core::useMachineIndependentSimd();
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& rows) {
     const FlushDenormals flush;
     HWY_DYNAMIC_DISPATCH(MomentsRows)(&args, rows.begin(), rows.end());

@@ -3,7 +3,7 @@
 namespace dynbench::evaluate {
 
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
-#define DYNBENCH_VECTOR_CLONES [[gnu::target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")]]
+#define DYNBENCH_VECTOR_CLONES [[gnu::target_clones("default", "arch=x86-64-v3")]]
 #else
 #define DYNBENCH_VECTOR_CLONES
 #endif

@@ -7,6 +7,7 @@
 #include <hwy/highway.h>
 #include <hwy/contrib/math/math-inl.h>
 
+#include "core/simd.h"
 #include "render/bsdf_batch.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -260,7 +261,10 @@ bool BsdfBatch::sample(std::size_t lane, BsdfSample& out) const {
   return true;
 }
 
-void BsdfBatch::run(std::size_t count) { HWY_DYNAMIC_DISPATCH(RunBsdfBatch)(lanes_.data(), capacity(), std::min(count, capacity())); }
+void BsdfBatch::run(std::size_t count) {
+  core::useMachineIndependentSimd();
+  HWY_DYNAMIC_DISPATCH(RunBsdfBatch)(lanes_.data(), capacity(), std::min(count, capacity()));
+}
 
 }  // namespace dynbench::render
 #endif

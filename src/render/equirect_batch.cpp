@@ -7,6 +7,7 @@
 #include <hwy/highway.h>
 #include <hwy/contrib/math/math-inl.h>
 
+#include "core/simd.h"
 #include "render/equirect_batch.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -89,6 +90,7 @@ void EquirectBatch::setPoint(std::size_t lane, glm::dvec2 uv) {
 }
 
 void EquirectBatch::directions(std::size_t count) {
+  core::useMachineIndependentSimd();
   HWY_DYNAMIC_DISPATCH(RunEquirectDirections)(lanes_.data(), lanes_.capacity(), std::min(count, lanes_.capacity()));
 }
 
@@ -104,6 +106,7 @@ void EquirectBatch::setDirection(std::size_t lane, const glm::dvec3& direction) 
 }
 
 void EquirectBatch::coordinates(std::size_t count) {
+  core::useMachineIndependentSimd();
   HWY_DYNAMIC_DISPATCH(RunEquirectCoordinates)(lanes_.data(), lanes_.capacity(), std::min(count, lanes_.capacity()));
 }
 

@@ -7,6 +7,7 @@
 
 #include <embree3/rtcore.h>
 
+#include "core/simd.h"
 #include "render/prefetch.h"
 #include "scene/queries.h"
 
@@ -125,14 +126,15 @@ struct RayTracingScene::Impl {
 
 namespace {
 
-// Embree picks its kernels for the CPU at run time (SSE4.2 to AVX-512), so its hits could in
-// principle differ between machines. DYNBENCH_EMBREE_CONFIG passes an Embree device configuration
-// (rtcNewDevice(3), e.g. "max_isa=avx2") so that one machine can run as another would: the
-// reproducibility checks of issue 45 use it (docs/suite.md, "Pins"). Unset: Embree's defaults.
+// Embree picks its kernels for the CPU at run time (SSE4.2 to AVX-512), and its AVX-512 and AVX2
+// kernels hit differently (core/simd.h): every scene gets the AVX2 ones (core::kEmbreeDeviceConfig)
+// unless DYNBENCH_EMBREE_CONFIG passes another device configuration (rtcNewDevice(3), e.g.
+// "max_isa=sse4.2"), so that one machine can run as another would: the reproducibility checks of
+// issue 45 use it (docs/suite.md, "Pins").
 RTCDevice newDevice(const char* fixedConfig) {
   if (fixedConfig) return rtcNewDevice(fixedConfig);
   const char* config = std::getenv("DYNBENCH_EMBREE_CONFIG");
-  return rtcNewDevice(config && *config ? config : nullptr);
+  return rtcNewDevice(config && *config ? config : core::kEmbreeDeviceConfig);
 }
 
 }  // namespace
