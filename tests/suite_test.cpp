@@ -85,7 +85,7 @@ TEST(Suite, ValidityRanksEachMeasureAgainstEachMethodsError) {
   for (int k = 0; k < 3; ++k) {
     suite::DatasetResult d;
     d.name = fmt::format("d{}", k);
-    d.measures = {{"direct", 10.0 * k}, {"frustum", 5.0 - k}};
+    d.measures = {{"direct_radiance", 10.0 * k}, {"frustum", 5.0 - k}};
     d.errors["none"] = {{"flip", 0.2}, {"warped_error_change", 0.1}, {"flip_over_none", 0.0}};
     d.errors["taa"] = {{"flip", 0.1 + 0.01 * k}, {"warped_error_change", 0.05}, {"flip_over_none", -0.1 + 0.01 * k}};
     datasets.push_back(d);
@@ -97,10 +97,10 @@ TEST(Suite, ValidityRanksEachMeasureAgainstEachMethodsError) {
     ADD_FAILURE() << measure << " " << method << " " << error;
     return suite::ValidityCell{};
   };
-  EXPECT_DOUBLE_EQ(*cell("direct", "taa", "flip_over_none").correlation.rho, 1.0);
+  EXPECT_DOUBLE_EQ(*cell("direct_radiance", "taa", "flip_over_none").correlation.rho, 1.0);
   EXPECT_DOUBLE_EQ(*cell("frustum", "taa", "flip_over_none").correlation.rho, -1.0);
-  EXPECT_EQ(cell("direct", "taa", "flip_over_none").datasets, 3);
-  EXPECT_FALSE(cell("direct", "none", "flip").correlation.rho);  // none's error is constant: no ranking
+  EXPECT_EQ(cell("direct_radiance", "taa", "flip_over_none").datasets, 3);
+  EXPECT_FALSE(cell("direct_radiance", "none", "flip").correlation.rho);  // none's error is constant: no ranking
   EXPECT_EQ(suite::rankingError("taa"), "flip_over_none");
   EXPECT_EQ(suite::rankingError("none"), "flip");
 }
@@ -120,7 +120,7 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
   for (const auto& d : doc["datasets"]) {
     const fs::path run = out / d["run"].get<std::string>();
     const auto discard = nlohmann::json::parse(test::slurp(run / "discard.json"));
-    EXPECT_NEAR(d["measures"]["direct"].get<double>(), discard["mean"]["direct_radiance"].get<double>(), 1e-9) << d["name"];
+    EXPECT_NEAR(d["measures"]["direct_radiance"].get<double>(), discard["mean"]["direct_radiance"].get<double>(), 1e-9) << d["name"];
     EXPECT_NEAR(d["measures"]["frustum"].get<double>(), discard["mean"]["frustum"].get<double>(), 1e-9) << d["name"];
     const auto evaluation = nlohmann::json::parse(test::slurp(run / "evaluate.json"));
     double noneFlip = -1;
@@ -185,9 +185,9 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
   // The validity table: a cell per measure, method and error, rho from the recorded numbers.
   ASSERT_FALSE(doc["validity"].empty());
   for (const auto& c : doc["validity"]) {
-    if (c["measure"] != "direct" || c["method"] != "taa" || c["error"] != "flip_over_none") continue;
+    if (c["measure"] != "direct_radiance" || c["method"] != "taa" || c["error"] != "flip_over_none") continue;
     std::vector<double> x, y;
-    for (const auto& d : doc["datasets"]) x.push_back(d["measures"]["direct"]), y.push_back(d["errors"]["taa"]["flip_over_none"]);
+    for (const auto& d : doc["datasets"]) x.push_back(d["measures"]["direct_radiance"]), y.push_back(d["errors"]["taa"]["flip_over_none"]);
     EXPECT_NEAR(c["rho"].get<double>(), *metrics::spearman(x, y), 1e-12);
   }
   const std::string md = test::slurp(out / "suite.md");

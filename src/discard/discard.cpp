@@ -578,8 +578,8 @@ std::vector<float> maskImage(const FeatureFrame& frame, const std::vector<unsign
 namespace {
 
 nlohmann::json percentagesJson(const FramePercentages& p) {
-  nlohmann::json j = {{"frustum", p.frustum}, {"world_position", p.position}, {"shading_normal", p.normal}, {"direct_radiance", p.direct},
-                      {"indirect_radiance", p.indirect}};
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& column : kTable67Columns) j[column.key] = p.*column.member;
   if (p.directInterval && p.indirectInterval) {
     j["interval"] = {{"direct_radiance", {p.directInterval->low, p.directInterval->high}},
                      {"indirect_radiance", {p.indirectInterval->low, p.indirectInterval->high}}};
@@ -620,11 +620,10 @@ namespace {
 
 Expected<FramePercentages> readPercentages(const JsonFields& f, const std::string& base) {
   FramePercentages p;
-  for (auto [key, target] : {std::pair{"frustum", &p.frustum}, {"world_position", &p.position}, {"shading_normal", &p.normal},
-                             {"direct_radiance", &p.direct}, {"indirect_radiance", &p.indirect}}) {
-    auto v = f.number(base + "/" + key);
+  for (const auto& column : kTable67Columns) {
+    auto v = f.number(base + "/" + column.key);
     if (!v) return std::unexpected(v.error());
-    *target = *v;
+    p.*column.member = *v;
   }
   // Intervals: optional (files of the other radiance tests and of earlier versions have none).
   if (f.has(base + "/interval")) {

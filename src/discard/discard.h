@@ -6,6 +6,7 @@
 // §3.2.2). Percentages are of all w x h pixels (Eq. 3.4), averaged over the frames (Eq. 3.5).
 // docs/metrics.md states every definition, default and the treatment of pixels that hit nothing.
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <functional>
 #include <optional>
@@ -109,6 +110,20 @@ struct FramePercentages {
   double directNoisy = 0, indirectNoisy = 0;
   bool cut = false;  // frame i's sidecar marks a camera cut: a jump, not motion
 };
+
+// Table 6.7's five columns, in its order: each one's key, the one spelling every machine-readable
+// output uses (discard.json, discard.csv, suite.json), its label in tables and plots, and the
+// FramePercentages member holding it.
+struct Table67Column {
+  const char* key;
+  const char* label;
+  double FramePercentages::*member;
+};
+inline constexpr std::array<Table67Column, 5> kTable67Columns{{{"frustum", "frustum", &FramePercentages::frustum},
+                                                                {"world_position", "world position", &FramePercentages::position},
+                                                                {"shading_normal", "shading normal", &FramePercentages::normal},
+                                                                {"direct_radiance", "direct radiance", &FramePercentages::direct},
+                                                                {"indirect_radiance", "indirect radiance", &FramePercentages::indirect}}};
 
 // The share of uncertain pixels (FramePercentages::directNoisy) above which discard warns and the
 // report marks the column: kExpected's noisy pixels, and kPairs' undecided ones.

@@ -139,8 +139,9 @@ Expected<DiscardOutcome> runDiscard(const DiscardStage& stage, const discard::Di
   if (!stage.json.empty())
     if (auto ok = writeFileAtomic(stage.json, discard::discardJson(*run, stage.frames.string())); !ok) return std::unexpected(ok.error());
   if (!stage.csv.empty()) {
-    std::string csv =
-        "frame,time,frustum,world_position,shading_normal,direct_radiance,indirect_radiance,direct_low,direct_high,indirect_low,indirect_high,cut\n";
+    std::string csv = "frame,time";
+    for (const auto& column : discard::kTable67Columns) csv += fmt::format(",{}", column.key);
+    csv += ",direct_low,direct_high,indirect_low,indirect_high,cut\n";
     // Interval columns are empty for the tests that give none.
     auto bound = [](const std::optional<discard::Interval>& i, bool high) { return i ? fmt::format("{}", high ? i->high : i->low) : std::string(); };
     for (const auto& f : run->frames)

@@ -27,17 +27,24 @@ using pipeline::DatasetRunSettings;
 namespace {
 
 // The measures, in the order tables list them.
-const std::vector<std::string> kMeasures{"frustum", "world_position", "normal", "direct", "indirect",
-                                         "camera_position", "camera_rotation", "camera_yaw", "camera_pitch", "camera_cuts"};
+// Table 6.7's columns by their keys (discard::kTable67Columns), then the camera's motion.
+const std::vector<std::string> kMeasures = [] {
+  std::vector<std::string> measures;
+  for (const auto& column : discard::kTable67Columns) measures.push_back(column.key);
+  for (const char* camera : {"camera_position", "camera_rotation", "camera_yaw", "camera_pitch", "camera_cuts"}) measures.push_back(camera);
+  return measures;
+}();
 const std::vector<std::string> kErrors{"flip", "warped_error_change", "flip_over_none"};
 // Axis labels with units.
 std::string measureLabel(const std::string& measure) {
-  static const std::map<std::string, std::string> labels{
-      {"frustum", "frustum discard (%)"},       {"world_position", "world-position discard (%)"}, {"normal", "shading-normal discard (%)"},
-      {"direct", "direct-radiance discard (%)"}, {"indirect", "indirect-radiance discard (%)"},
+  static const std::map<std::string, std::string> labels = [] {
+    std::map<std::string, std::string> l{
       {"camera_position", "camera position change (scene units per frame)"}, {"camera_rotation", "camera rotation (degrees per frame)"},
       {"camera_yaw", "camera yaw change (degrees per frame)"}, {"camera_pitch", "camera pitch change (degrees per frame)"},
       {"camera_cuts", "camera cuts in the window"}};
+    for (const auto& column : discard::kTable67Columns) l[column.key] = fmt::format("{} discard (%)", column.label);
+    return l;
+  }();
   const auto it = labels.find(measure);
   return it == labels.end() ? measure : it->second;
 }
@@ -228,7 +235,8 @@ namespace {
 
 // The difficulty measures of one dataset's window (DatasetResult).
 std::map<std::string, double> measuresOf(const metrics::CameraMotion& motion, long first, long last, const discard::FramePercentages& d) {
-  std::map<std::string, double> m{{"frustum", d.frustum}, {"world_position", d.position}, {"normal", d.normal}, {"direct", d.direct}, {"indirect", d.indirect}};
+  std::map<std::string, double> m;
+  for (const auto& column : discard::kTable67Columns) m[column.key] = d.*column.member;
   std::vector<double> position, rotation, yaw, pitch;
   double cuts = 0;
   for (long i = first + 1; i <= last && i < static_cast<long>(motion.frames.size()); ++i) {

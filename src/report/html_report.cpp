@@ -244,8 +244,8 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
         s.name = row.dataset;
         s.published = true;
         discard::FramePercentages m;
-        double* cells[5] = {&m.frustum, &m.position, &m.normal, &m.direct, &m.indirect};
-        for (std::size_t c = 0; c < 5 && c < row.cells.size(); ++c) *cells[c] = std::strtod(row.cells[c].c_str(), nullptr);
+        for (std::size_t c = 0; c < discard::kTable67Columns.size() && c < row.cells.size(); ++c)
+          m.*discard::kTable67Columns[c].member = std::strtod(row.cells[c].c_str(), nullptr);
         s.mean = m;
         series.push_back(std::move(s));
       }

@@ -108,9 +108,14 @@ Expected<std::vector<fs::path>> writeRotationPlotsFromCsv(const std::string& csv
 
 Expected<std::vector<fs::path>> writeDiscardPlot(const std::vector<discard::FramePercentages>& frames, const std::string& title,
                                                  const fs::path& dir, const std::string& stem) {
-  std::string csv = "frame,frustum,world position,shading normal,direct radiance,indirect radiance\n";
-  for (const auto& f : frames)
-    csv += fmt::format("{},{},{},{},{},{}\n", f.frame, f.frustum, f.position, f.normal, f.direct, f.indirect);
+  std::string csv = "frame";
+  for (const auto& column : discard::kTable67Columns) csv += fmt::format(",{}", column.label);
+  csv += "\n";
+  for (const auto& f : frames) {
+    csv += std::to_string(f.frame);
+    for (const auto& column : discard::kTable67Columns) csv += fmt::format(",{}", f.*column.member);
+    csv += "\n";
+  }
   std::string plot = "plot ";
   for (int column = 2; column <= 6; ++column)
     plot += fmt::format("{}{{data}} using 1:{} with lines lw 1.5 title columnhead", column > 2 ? ", " : "", column);
@@ -166,7 +171,6 @@ std::string columnName(std::string name) {
 
 std::string cell(double v) { return std::isfinite(v) ? fmt::format("{}", v) : std::string(); }
 
-const char* const kDiscardFeatures[5] = {"frustum", "world position", "shading normal", "direct radiance", "indirect radiance"};
 
 }  // namespace
 
@@ -238,28 +242,27 @@ Expected<std::vector<fs::path>> writeComparisonPlots(const std::vector<Compariso
   if (!discarding.empty()) {
     std::size_t length = 0;
     std::string csv = "frame in window";
-    for (int f = 0; f < 5; ++f)
-      for (const auto* s : discarding) csv += fmt::format(",{} {}", columnName(s->name), kDiscardFeatures[f]);
+    for (std::size_t f = 0; f < discard::kTable67Columns.size(); ++f)
+      for (const auto* s : discarding) csv += fmt::format(",{} {}", columnName(s->name), discard::kTable67Columns[f].label);
     for (const auto* s : discarding) length = std::max(length, s->discard.size());
     csv += "\n";
     for (std::size_t k = 0; k < length; ++k) {
       csv += std::to_string(k);
-      for (int f = 0; f < 5; ++f)
+      for (std::size_t f = 0; f < discard::kTable67Columns.size(); ++f)
         for (const auto* s : discarding) {
           if (k >= s->discard.size() || s->discard[k].cut) {
             csv += ",";
             continue;
           }
           const auto& p = s->discard[k];
-          const double v[5] = {p.frustum, p.position, p.normal, p.direct, p.indirect};
           csv += ',';
-          csv += cell(v[f]);
+          csv += cell(p.*discard::kTable67Columns[f].member);
         }
       csv += "\n";
     }
     std::string plot = "set datafile missing ''\nset multiplot layout 5,1\nset xlabel 'frame pair in the rendered window'\n";
-    for (int f = 0; f < 5; ++f) {
-      plot += fmt::format("set title '{} discard per frame, every dataset (cut pairs left out)'\nplot ", kDiscardFeatures[f]);
+    for (std::size_t f = 0; f < discard::kTable67Columns.size(); ++f) {
+      plot += fmt::format("set title '{} discard per frame, every dataset (cut pairs left out)'\nplot ", discard::kTable67Columns[f].label);
       for (std::size_t d = 0; d < discarding.size(); ++d)
         plot += fmt::format("{}{{data}} using 1:{} with lines lw 1.2 title {}", d ? ", " : "", 2 + f * discarding.size() + d, quoted(discarding[d]->name));
       plot += "\n";
@@ -277,13 +280,13 @@ Expected<std::vector<fs::path>> writeComparisonPlots(const std::vector<Compariso
     std::string csv = "feature";
     for (const auto* s : means) csv += fmt::format(",{}{},low,high", columnName(s->name), s->published ? " (published)" : "");
     csv += "\n";
-    for (int f = 0; f < 5; ++f) {
+    for (std::size_t f = 0; f < discard::kTable67Columns.size(); ++f) {
       csv += std::to_string(f);
       for (const auto* s : means) {
         const auto& m = *s->mean;
-        const double v[5] = {m.frustum, m.position, m.normal, m.direct, m.indirect};
+        const double v = m.*discard::kTable67Columns[f].member;
         const std::optional<discard::Interval>& interval = f == 3 ? m.directInterval : f == 4 ? m.indirectInterval : std::optional<discard::Interval>{};
-        csv += fmt::format(",{},{},{}", v[f], interval ? interval->low : v[f], interval ? interval->high : v[f]);
+        csv += fmt::format(",{},{},{}", v, interval ? interval->low : v, interval ? interval->high : v);
       }
       csv += "\n";
     }
