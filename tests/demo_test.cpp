@@ -14,7 +14,7 @@
 #include "core/files.h"
 #include "core/math.h"
 #include "pipeline/demo.h"
-#include "pipeline/flythrough.h"
+#include "flythrough/flythrough.h"
 #include "render/raytracing_scene.h"
 #include "scene/evaluate.h"
 #include "scene/load.h"

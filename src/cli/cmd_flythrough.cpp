@@ -1,10 +1,10 @@
 // `dynbench flythrough DATASET -o OUT.gltf`: the demo's fly-through for any dataset with an animated
-// camera, with its ORCA-range check (pipeline/flythrough.h).
+// camera, with its ORCA-range check (flythrough/flythrough.h).
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
 #include "core/files.h"
-#include "pipeline/flythrough.h"
+#include "flythrough/flythrough.h"
 
 namespace dynbench::cli {
 namespace {

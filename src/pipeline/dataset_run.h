@@ -14,7 +14,7 @@
 #include "discard/discard.h"
 #include "evaluate/evaluate.h"
 #include "metrics/camera_motion.h"
-#include "pipeline/flythrough.h"
+#include "flythrough/flythrough.h"
 #include "pipeline/stages.h"
 
 namespace dynbench::pipeline {

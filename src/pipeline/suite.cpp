@@ -13,7 +13,7 @@
 #include "core/files.h"
 #include "core/json_fields.h"
 #include "dynbench/version.h"
-#include "pipeline/flythrough.h"
+#include "flythrough/flythrough.h"
 #include "report/plots.h"
 #include "report/stats_output.h"
 #include "scene/load.h"

@@ -1,4 +1,4 @@
-#include "pipeline/flythrough.h"
+#include "flythrough/flythrough.h"
 
 #include <algorithm>
 #include <cstdlib>
