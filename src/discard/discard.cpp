@@ -580,11 +580,13 @@ namespace {
 nlohmann::json percentagesJson(const FramePercentages& p) {
   nlohmann::json j = nlohmann::json::object();
   for (const auto& column : kTable67Columns) j[column.key] = p.*column.member;
-  if (p.directInterval && p.indirectInterval) {
-    j["interval"] = {{"direct_radiance", {p.directInterval->low, p.directInterval->high}},
-                     {"indirect_radiance", {p.indirectInterval->low, p.indirectInterval->high}}};
-    j["noisy"] = {{"direct_radiance", p.directNoisy}, {"indirect_radiance", p.indirectNoisy}};
-  }
+  if (p.directInterval && p.indirectInterval)
+    for (const auto& column : kTable67Columns) {
+      if (!column.interval) continue;
+      const Interval& interval = *(p.*column.interval);
+      j["interval"][column.key] = {interval.low, interval.high};
+      j["noisy"][column.key] = p.*column.noisy;
+    }
   return j;
 }
 
@@ -625,24 +627,23 @@ Expected<FramePercentages> readPercentages(const JsonFields& f, const std::strin
     if (!v) return std::unexpected(v.error());
     p.*column.member = *v;
   }
-  // Intervals: optional (files of the other radiance tests and of earlier versions have none).
-  if (f.has(base + "/interval")) {
-    for (auto [key, target] : {std::pair{"direct_radiance", &p.directInterval}, {"indirect_radiance", &p.indirectInterval}}) {
-      const std::string pointer = base + "/interval/" + key;
+  // The radiance columns' intervals (files of the other radiance tests and of earlier versions have
+  // none) and uncertain shares (files of earlier versions have none): both optional.
+  for (const auto& column : kTable67Columns) {
+    if (!column.interval) continue;
+    if (f.has(base + "/interval")) {
+      const std::string pointer = base + "/interval/" + column.key;
       auto low = f.number(pointer + "/0");
       if (!low) return std::unexpected(low.error());
       auto high = f.number(pointer + "/1");
       if (!high) return std::unexpected(high.error());
-      *target = Interval{*low, *high};
+      p.*column.interval = Interval{*low, *high};
     }
-  }
-  // Uncertain shares: optional (files of earlier versions have none).
-  for (auto [key, target] : {std::pair{"direct_radiance", &p.directNoisy}, {"indirect_radiance", &p.indirectNoisy}}) {
-    const std::string pointer = base + "/noisy/" + key;
+    const std::string pointer = base + "/noisy/" + column.key;
     if (!f.has(pointer)) continue;
     auto v = f.number(pointer);
     if (!v) return std::unexpected(v.error());
-    *target = *v;
+    p.*column.noisy = *v;
   }
   return p;
 }

@@ -113,17 +113,21 @@ struct FramePercentages {
 
 // Table 6.7's five columns, in its order: each one's key, the one spelling every machine-readable
 // output uses (discard.json, discard.csv, suite.json), its label in tables and plots, and the
-// FramePercentages member holding it.
+// FramePercentages members holding it (a radiance column also its interval and uncertain share;
+// null for the geometric columns).
 struct Table67Column {
   const char* key;
   const char* label;
   double FramePercentages::*member;
+  std::optional<Interval> FramePercentages::*interval = nullptr;
+  double FramePercentages::*noisy = nullptr;
 };
-inline constexpr std::array<Table67Column, 5> kTable67Columns{{{"frustum", "frustum", &FramePercentages::frustum},
-                                                                {"world_position", "world position", &FramePercentages::position},
-                                                                {"shading_normal", "shading normal", &FramePercentages::normal},
-                                                                {"direct_radiance", "direct radiance", &FramePercentages::direct},
-                                                                {"indirect_radiance", "indirect radiance", &FramePercentages::indirect}}};
+inline constexpr std::array<Table67Column, 5> kTable67Columns{
+    {{"frustum", "frustum", &FramePercentages::frustum},
+     {"world_position", "world position", &FramePercentages::position},
+     {"shading_normal", "shading normal", &FramePercentages::normal},
+     {"direct_radiance", "direct radiance", &FramePercentages::direct, &FramePercentages::directInterval, &FramePercentages::directNoisy},
+     {"indirect_radiance", "indirect radiance", &FramePercentages::indirect, &FramePercentages::indirectInterval, &FramePercentages::indirectNoisy}}};
 
 // The share of uncertain pixels (FramePercentages::directNoisy) above which discard warns and the
 // report marks the column: kExpected's noisy pixels, and kPairs' undecided ones.

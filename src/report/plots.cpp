@@ -171,7 +171,6 @@ std::string columnName(std::string name) {
 
 std::string cell(double v) { return std::isfinite(v) ? fmt::format("{}", v) : std::string(); }
 
-
 }  // namespace
 
 Expected<std::vector<fs::path>> writeComparisonPlots(const std::vector<ComparisonSeries>& series, const fs::path& dir,
@@ -284,8 +283,9 @@ Expected<std::vector<fs::path>> writeComparisonPlots(const std::vector<Compariso
       csv += std::to_string(f);
       for (const auto* s : means) {
         const auto& m = *s->mean;
-        const double v = m.*discard::kTable67Columns[f].member;
-        const std::optional<discard::Interval>& interval = f == 3 ? m.directInterval : f == 4 ? m.indirectInterval : std::optional<discard::Interval>{};
+        const auto& column = discard::kTable67Columns[f];
+        const double v = m.*column.member;
+        const std::optional<discard::Interval> interval = column.interval ? m.*column.interval : std::nullopt;
         csv += fmt::format(",{},{},{}", v, interval ? interval->low : v, interval ? interval->high : v);
       }
       csv += "\n";
