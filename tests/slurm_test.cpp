@@ -21,7 +21,7 @@
 #include "external_tools.h"
 #include "frames/frame_io.h"
 #include "gltf_builder.h"
-#include "pipeline/slurm.h"
+#include "pipeline/cluster_jobs.h"
 #include "run_cli.h"
 
 namespace dynbench {
@@ -116,7 +116,14 @@ TEST_F(Slurm, RenderArrayOfSixTasksMatchesALocalRender) {
   EXPECT_NE(script.find("chunks=(0:3 4:7 8:11 12:15 16:19 20:23)"), std::string::npos) << script;
   EXPECT_NE(script.find("#SBATCH --requeue\n"), std::string::npos);
   EXPECT_NE(script.find("#SBATCH --signal=B:USR1@"), std::string::npos);
-  EXPECT_NE(script.find(fmt::format(" render {} -o {} ", kOrbit.string(), out.string())), std::string::npos) << script;
+  // Every task runs the one job file (docs/cli.md, "Job files"), which holds the job as given.
+  EXPECT_NE(script.find(fmt::format(" render --job {} --frames \"$frames\"", (out / "slurm" / "render-job.json").string())), std::string::npos)
+      << script;
+  const auto jobFile = nlohmann::json::parse(test::slurp(out / "slurm" / "render-job.json"));
+  EXPECT_EQ(jobFile["dataset"], kOrbit.string());
+  EXPECT_EQ(jobFile["output"], out.string());
+  EXPECT_EQ(jobFile["samples_per_pixel"], 2);
+  EXPECT_EQ(jobFile["seed"], 7);
   ASSERT_NO_FATAL_FAILURE(waitUntilGone(job));
   std::set<int> tasks;  // every task ran and logged its render
   for (const auto& e : fs::directory_iterator(out / "slurm")) {
@@ -261,7 +268,12 @@ TEST_F(Slurm, CaptureArrayOfSeedsMatchesLocalCaptures) {
   auto r = dynbench(fmt::format("capture cube2 -o {} {} --slurm --seeds 4:5", (dir / "cluster").string(), match), dir);
   ASSERT_EQ(r.status, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("2 capture(s)"), std::string::npos) << r.out;
-  EXPECT_NE(test::slurp(dir / "cluster" / "slurm" / "capture.sbatch").find("seeds=(4 5)"), std::string::npos);
+  const std::string script = test::slurp(dir / "cluster" / "slurm" / "capture.sbatch");
+  EXPECT_NE(script.find("seeds=(4 5)"), std::string::npos);
+  // Every task runs the one job file, with its own output and seed.
+  EXPECT_NE(script.find(fmt::format(" capture cube2 --job {} -o \"$partial\" --seed \"$seed\"", (dir / "cluster" / "slurm" / "capture-job.json").string())),
+            std::string::npos)
+      << script;
   for (int seed : {4, 5}) EXPECT_FALSE(fs::exists(dir / "cluster" / fmt::format("seed_{}.partial", seed)));
   // Each task's capture is the one a local capture with its seed makes, byte for byte.
   r = dynbench(fmt::format("capture cube2 -o {} {} --seed 5", (dir / "local5").string(), match), dir);
@@ -289,6 +301,15 @@ TEST_F(Slurm, DemoAsAChainOfJobsGivesTheLocalDemosTables) {
   for (const char* script : {"datasets.sbatch", "render.sbatch", "report.sbatch"})
     EXPECT_TRUE(fs::exists(dir / "cluster" / "slurm" / script)) << script;
   EXPECT_NE(test::slurp(dir / "cluster" / "slurm" / "render.sbatch").find("#SBATCH --array=0-3\n"), std::string::npos);
+  // Each job runs the demo's one job file, which holds the options as given.
+  const fs::path jobFile = dir / "cluster" / "slurm" / "demo-job.json";
+  for (const char* script : {"datasets.sbatch", "render.sbatch", "report.sbatch"})
+    EXPECT_NE(test::slurp(dir / "cluster" / "slurm" / script).find(" demo --job " + jobFile.string()), std::string::npos) << script;
+  const auto job = nlohmann::json::parse(test::slurp(jobFile));
+  EXPECT_FALSE(job.contains("render"));  // flat, as docs/cli.md spells it
+  EXPECT_EQ(job["width"], 32);
+  EXPECT_EQ(job["frames"], 12);
+  EXPECT_EQ(job["max_spp"], 32);
   r = dynbench(fmt::format("demo -o {} {}", (dir / "local").string(), options), dir);
   ASSERT_EQ(r.status, 0) << r.err;
   // The same tables, every cell (the figures' file names aside).
@@ -335,7 +356,7 @@ TEST_F(Slurm, SuiteAsAChainOfJobsGivesTheLocalSuitesNumbers) {
 }
 
 TEST(SlurmScript, TimesAndQuotingAsSlurmAndTheShellRead) {
-  using pipeline::slurm::parseSlurmTime;
+  using cluster::parseSlurmTime;
   EXPECT_EQ(parseSlurmTime("30"), 30 * 60);  // minutes
   EXPECT_EQ(parseSlurmTime("5:30"), 5 * 60 + 30);
   EXPECT_EQ(parseSlurmTime("02:00:00"), 7200);
@@ -349,15 +370,15 @@ TEST(SlurmScript, TimesAndQuotingAsSlurmAndTheShellRead) {
   EXPECT_FALSE(parseSlurmTime("99999999999999999999-00"));
   EXPECT_FALSE(parseSlurmTime("1:99999999999999999999"));
   EXPECT_EQ(parseSlurmTime("999999999"), 999999999L * 60);
-  EXPECT_EQ(pipeline::slurm::shellQuote("/data/run-1/frames"), "/data/run-1/frames");
-  EXPECT_EQ(pipeline::slurm::shellQuote("my frames"), "'my frames'");
-  EXPECT_EQ(pipeline::slurm::shellQuote("it's"), "'it'\\''s'");
+  EXPECT_EQ(cluster::shellQuote("/data/run-1/frames"), "/data/run-1/frames");
+  EXPECT_EQ(cluster::shellQuote("my frames"), "'my frames'");
+  EXPECT_EQ(cluster::shellQuote("it's"), "'it'\\''s'");
   // The signal comes at most a quarter of a short time limit before it.
-  pipeline::slurm::Options o;
+  cluster::Options o;
   o.time = "00:04:00";
-  EXPECT_NE(pipeline::slurm::scriptHeader("x", 3, "/logs", o).find("#SBATCH --signal=B:USR1@60\n"), std::string::npos);
+  EXPECT_NE(cluster::scriptHeader("x", 3, "/logs", o).find("#SBATCH --signal=B:USR1@60\n"), std::string::npos);
   o.time = "10:00:00";
-  EXPECT_NE(pipeline::slurm::scriptHeader("x", 3, "/logs", o).find("#SBATCH --signal=B:USR1@120\n"), std::string::npos);
+  EXPECT_NE(cluster::scriptHeader("x", 3, "/logs", o).find("#SBATCH --signal=B:USR1@120\n"), std::string::npos);
 }
 
 }  // namespace

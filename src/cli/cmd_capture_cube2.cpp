@@ -2,6 +2,7 @@
 #include <optional>
 
 #include "capture/cube2.h"
+#include "capture/cube2_job.h"
 #include "cli/commands.h"
 #include "core/progress.h"
 
@@ -28,15 +29,15 @@ Expected<void> runCube2(const capture::Cube2Options& options) {
   return {};
 }
 
-// capture cube2 --slurm --seeds A:B: one capture per seed as a Slurm job array (pipeline/slurm.h).
-Expected<void> captureOnSlurm(const capture::Cube2Options& options, const std::string& seeds, const pipeline::slurm::Options& slurm) {
+// capture cube2 --slurm --seeds A:B: one capture per seed as a Slurm job array (pipeline/cluster_jobs.h).
+Expected<void> captureOnSlurm(const capture::Cube2Options& options, const std::string& seeds, const cluster::Options& slurm) {
   unsigned first = 0, last = 0;
   char colon = 0, extra = 0;
   const int n = std::sscanf(seeds.c_str(), "%u%c%u%c", &first, &colon, &last, &extra);
   if (n == 1) last = first;
   else if (n != 3 || colon != ':') return fail(ErrorCode::kUsage, "--seeds '{}': expected A:B (seeds A to B) or A", seeds);
   std::optional<Progress> progress;
-  auto outcome = pipeline::slurm::captureArray(options, first, last, slurm, [&](const pipeline::slurm::ArrayStatus& s) {
+  auto outcome = pipeline::captureArray(options, first, last, slurm, [&](const cluster::ArrayStatus& s) {
     if (!progress) progress.emplace("slurm capture", static_cast<std::size_t>(last - first + 1), "captures");
     progress->update(static_cast<std::size_t>(s.done), fmt::format("tasks {} pending, {} running, {} failed", s.pending, s.running, s.failed));
   });
@@ -75,8 +76,12 @@ void addCaptureCommand(CLI::App& app, CommandRun& run) {
               "person and records --seconds of game time after --warmup. The same --seed and options give a byte-identical\n"
               "Capture.txt. Then: dynbench convert DIR -o dataset.gltf\n"
               "Example: dynbench capture cube2 -o captures/colos --map colos --bots 6 --seconds 10");
-  std::string output;
-  cmd->add_option("-o,--output", o->output, "Capture folder (new or empty)")->required();
+  cmd->add_option("-o,--output", o->output, "Capture folder (new or empty)");
+  auto jobFile = std::make_shared<std::filesystem::path>();
+  cmd->add_option("--job", *jobFile,
+                  "The capture's options from a JSON file (docs/cli.md, \"Job files\"; what a Slurm task runs) instead of the options "
+                  "below; -o and --seed may still be given")
+      ->check(CLI::ExistingFile);
   auto preset = std::make_shared<std::string>();
   cmd->add_option("--preset", *preset, "calm, fps or hard: map, mode, bots, skill and follow together (docs/presets.md); options given explicitly win")
       ->check(CLI::IsMember(presetNames()));
@@ -100,15 +105,26 @@ void addCaptureCommand(CLI::App& app, CommandRun& run) {
   cmd->add_flag("--window", o->window, "Use the current display instead of Xvfb");
   cmd->add_option("--client", o->client, "The Cube 2 client with the capture hooks (empty: the one the build made)");
   cmd->add_option("--data", o->data, "Game data (Debian's cube2-data)");
-  auto slurm = std::make_shared<std::pair<bool, pipeline::slurm::Options>>();
+  auto slurm = std::make_shared<std::pair<bool, cluster::Options>>();
   auto seeds = std::make_shared<std::string>();
   addSlurmOptions(cmd, slurm->first, slurm->second, "DIR/slurm/capture.sbatch, one task per seed of --seeds, each into DIR/seed_N", false);
   cmd->add_option("--seeds", *seeds, "With --slurm: capture seeds A to B (A:B), one array task each")->group("Slurm (with --slurm)");
-  cmd->callback([o, preset, cmd, slurm, seeds, &run] {
+  cmd->callback([o, preset, cmd, slurm, seeds, jobFile, &run] {
     std::vector<std::string> given;
     for (const char* field : {"map", "mode", "bots", "skill", "follow"})
       if (cmd->count(std::string("--") + field) > 0) given.push_back(field);
-    run = [o, preset, given, slurm, seeds]() -> Expected<void> {
+    const bool outputGiven = cmd->count("--output") > 0, seedGiven = cmd->count("--seed") > 0;
+    const auto besideJob = jobFile->empty() ? std::vector<std::string>{} : optionsGivenBesideJob(cmd, {"--output", "--seed", "--seeds"});
+    run = [o, preset, given, slurm, seeds, jobFile, outputGiven, seedGiven, besideJob]() -> Expected<void> {
+      if (!jobFile->empty()) {
+        if (auto ok = nothingBesideJob(*jobFile, besideJob, "-o, --seed, --seeds"); !ok) return ok;
+        auto job = capture::readCube2Job(*jobFile);
+        if (!job) return std::unexpected(job.error());
+        if (outputGiven) job->output = o->output;
+        if (seedGiven) job->seed = o->seed;
+        *o = *job;
+      }
+      if (o->output.empty()) return fail(ErrorCode::kUsage, "capture cube2: -o DIR is required (in the command or the --job file)");
       if (!preset->empty())
         if (auto ok = capture::applyCube2Preset(*preset, *o, given); !ok) return ok;
       if (slurm->first) return captureOnSlurm(*o, seeds->empty() ? std::to_string(o->seed) : *seeds, slurm->second);

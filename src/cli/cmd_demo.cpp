@@ -3,7 +3,7 @@
 #include "cli/commands.h"
 #include "core/progress.h"
 #include "pipeline/demo.h"
-#include "pipeline/slurm.h"
+#include "pipeline/cluster_jobs.h"
 
 namespace dynbench::cli {
 namespace {
@@ -13,16 +13,19 @@ struct DemoCli {
   std::string resolution = fmt::format("{}x{}", demo::DemoOptions{}.width, demo::DemoOptions{}.height);
   std::string part = "all";
   bool slurm = false;
-  pipeline::slurm::Options slurmOptions;
+  cluster::Options slurmOptions;
+  std::filesystem::path jobFile;          // --job: the options from a file (pipeline/demo.h)
+  std::vector<std::string> givenWithJob;  // options given beside --job (an error)
+  bool threadsGiven = false;
 };
 
-// demo --slurm: the chain of jobs (pipeline/slurm.h), waited for with progress.
-Expected<void> demoOnSlurm(const demo::DemoOptions& o, pipeline::slurm::Options slurm) {
+// demo --slurm: the chain of jobs (cluster/slurm.h), waited for with progress.
+Expected<void> demoOnSlurm(const demo::DemoOptions& o, cluster::Options slurm) {
   slurm.framesPerTask = o.framesPerTask;
   std::optional<Progress> progress;
   const bool terminal = Progress("slurm demo", 3, "jobs").enabled();
   std::string last;
-  auto outcome = demo::demoChain(o, slurm, [&](const pipeline::slurm::ChainStatus& s) {
+  auto outcome = demo::demoChain(o, slurm, [&](const cluster::ChainStatus& s) {
     const std::string line = fmt::format("datasets {}, render tasks {} pending, {} running, {} done, report {}", s.datasets, s.render.pending,
                                          s.render.running, s.render.done, s.report);
     if (terminal) {
@@ -49,9 +52,19 @@ Expected<void> demoOnSlurm(const demo::DemoOptions& o, pipeline::slurm::Options 
 
 Expected<void> runDemo(const DemoCli& cli) {
   demo::DemoOptions o = cli.options;
-  auto res = parseResolution(cli.resolution);
-  if (!res) return std::unexpected(res.error());
-  std::tie(o.width, o.height) = *res;
+  if (!cli.jobFile.empty()) {
+    if (auto ok = nothingBesideJob(cli.jobFile, cli.givenWithJob, "--part, --render-task, --frames-per-task, --threads"); !ok) return ok;
+    auto job = demo::readDemoJob(cli.jobFile);
+    if (!job) return std::unexpected(job.error());
+    job->renderTask = o.renderTask;
+    job->framesPerTask = o.framesPerTask;
+    if (cli.threadsGiven) job->threads = o.threads;
+    o = *job;
+  } else {
+    auto res = parseResolution(cli.resolution);
+    if (!res) return std::unexpected(res.error());
+    std::tie(o.width, o.height) = *res;
+  }
   o.part = cli.part == "datasets" ? demo::DemoPart::kDatasets : cli.part == "render" ? demo::DemoPart::kRenderTask : demo::DemoPart::kAll;
   if (cli.slurm) {
     if (o.part != demo::DemoPart::kAll) return fail(ErrorCode::kUsage, "--part: not with --slurm (the jobs it submits run the parts)");
@@ -102,7 +115,15 @@ void addDemoCommand(CLI::App& app, CommandRun& run) {
   addSlurmOptions(cmd, o->slurm, o->slurmOptions,
                   "OUT/slurm: datasets, then an array of render tasks of --frames-per-task frame renders, then the report, chained with afterok",
                   false);
-  cmd->callback([o, &run] { run = [o] { return runDemo(*o); }; });
+  cmd->add_option("--job", o->jobFile,
+                  "The demo's options from a JSON file (docs/cli.md, \"Job files\"; what demo --slurm's jobs run) instead of the "
+                  "options above; --part, --render-task, --frames-per-task and --threads may still be given")
+      ->check(CLI::ExistingFile);
+  cmd->callback([o, cmd, &run] {
+    o->threadsGiven = cmd->count("--threads") > 0;
+    if (!o->jobFile.empty()) o->givenWithJob = optionsGivenBesideJob(cmd, {"--part", "--render-task", "--frames-per-task", "--threads"});
+    run = [o] { return runDemo(*o); };
+  });
 }
 
 }  // namespace dynbench::cli

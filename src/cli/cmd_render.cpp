@@ -8,7 +8,8 @@
 #include "frames/radiance_change.h"
 #include "core/progress.h"
 #include "render/backend.h"
-#include "pipeline/slurm.h"
+#include "render/render_job_json.h"
+#include "pipeline/cluster_jobs.h"
 #include "pipeline/stages.h"
 
 namespace dynbench::cli {
@@ -26,20 +27,23 @@ struct RenderCli {
   std::optional<double> pixelFilterWidth;
   std::optional<bool> pairs;  // --pairs / --no-pairs; unset: with --converge on the embree engine
   bool slurm = false;
-  pipeline::slurm::Options slurmOptions;
+  cluster::Options slurmOptions;
+  std::filesystem::path jobFile;           // --job: the whole job from a file (render/render_job_json.h)
+  std::vector<std::string> givenWithJob;   // the job options given beside --job (an error)
+  bool threadsGiven = false;
 };
 
-// render --slurm: the same job as a Slurm job array (pipeline/slurm.h), waited for on a terminal
+// render --slurm: the same job as a Slurm job array (pipeline/cluster_jobs.h), waited for on a terminal
 // with progress, and a non-zero exit naming what is missing when tasks failed.
-Expected<void> renderOnSlurm(const render::RenderJob& job, const pipeline::slurm::Options& options) {
+Expected<void> renderOnSlurm(const render::RenderJob& job, const cluster::Options& options) {
   std::optional<Progress> progress;
   const auto started = std::chrono::steady_clock::now();
-  pipeline::slurm::RenderArrayProgress report = [&](const pipeline::slurm::RenderArrayStatus& s) {
+  pipeline::RenderArrayProgress report = [&](const pipeline::RenderArrayStatus& s) {
     if (!progress) progress.emplace("slurm render", s.framesTotal, "frames");
     progress->update(s.framesComplete,
                      fmt::format("tasks {} pending, {} running, {} failed", s.tasks.pending, s.tasks.running, s.tasks.failed));
   };
-  auto outcome = pipeline::slurm::renderArray({job}, options, report);
+  auto outcome = pipeline::renderArray({job}, options, report);
   progress.reset();
   if (!outcome) return std::unexpected(outcome.error());
   fmt::print("{}: Slurm job {}, {} task(s) of at most {} frame(s), script {}\n", job.output.string(), outcome->jobId, outcome->tasks,
@@ -50,7 +54,7 @@ Expected<void> renderOnSlurm(const render::RenderJob& job, const pipeline::slurm
     std::size_t missing = 0;
     for (const auto& [task, frames] : outcome->missing) missing += frames.size();
     return fail(ErrorCode::kIncomplete, "Slurm job {} ended with {} frame(s) missing:\n{}Rerun only those tasks: {}", outcome->jobId, missing,
-                pipeline::slurm::missingFramesText(*outcome), outcome->resubmit);
+                pipeline::missingFramesText(*outcome), outcome->resubmit);
   }
   std::size_t frames = 0;
   for (const auto& c : outcome->chunks) frames += c.size();
@@ -58,7 +62,30 @@ Expected<void> renderOnSlurm(const render::RenderJob& job, const pipeline::slurm
   return {};
 }
 
+Expected<void> renderJob(const render::RenderJob& job);
+
+// The job of `render --job FILE [--frames A:B] [--threads N]`: the file's, with this run's frames and threads.
+Expected<render::RenderJob> jobFromFile(const RenderCli& cli) {
+  if (auto ok = nothingBesideJob(cli.jobFile, cli.givenWithJob, "--frames, --threads"); !ok) return std::unexpected(ok.error());
+  auto job = render::readRenderJob(cli.jobFile);
+  if (!job) return std::unexpected(job.error());
+  if (!cli.frames.empty()) {
+    auto range = render::parseFrameRange(cli.frames);
+    if (!range) return std::unexpected(range.error());
+    job->frames = *range;
+  }
+  if (cli.threadsGiven) job->threads = cli.job.threads;
+  return job;
+}
+
 Expected<void> runRender(const RenderCli& cli) {
+  if (!cli.jobFile.empty()) {
+    auto job = jobFromFile(cli);
+    if (!job) return std::unexpected(job.error());
+    return cli.slurm ? renderOnSlurm(*job, cli.slurmOptions) : renderJob(*job);
+  }
+  if (cli.job.dataset.empty() || cli.job.output.empty())
+    return fail(ErrorCode::kUsage, "render: DATASET and -o DIR are required (or --job FILE)");
   render::RenderJob job = cli.job;
   auto res = parseResolution(cli.resolution);
   if (!res) return std::unexpected(res.error());
@@ -83,7 +110,11 @@ Expected<void> runRender(const RenderCli& cli) {
     job.frames = *range;
   }
   if (cli.slurm) return renderOnSlurm(job, cli.slurmOptions);
+  return renderJob(job);
+}
 
+// Renders `job` here, with progress on a terminal and a summary line.
+Expected<void> renderJob(const render::RenderJob& job) {
   // Progress on a terminal only: rows (of all frames) done, frames done, samples per second.
   std::optional<Progress> progress;
   render::RenderProgress report;
@@ -136,8 +167,12 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
   cmd->footer("Writes DIR/frame_NNNNN.exr and DIR/frame_NNNNN.json per frame (docs/feature-buffers.md). Frames already\n"
               "complete with the same settings are skipped, so an interrupted render resumes.\n"
               "Example: dynbench render dataset.gltf -o frames --frames 0:47 --spp 64");
-  cmd->add_option("DATASET", o->job.dataset, "Animated dataset (glTF, GLB, FBX, DAE, ...)")->required();
-  cmd->add_option("-o,--output", o->job.output, "Output folder")->required();
+  cmd->add_option("DATASET", o->job.dataset, "Animated dataset (glTF, GLB, FBX, DAE, ...)");
+  cmd->add_option("-o,--output", o->job.output, "Output folder");
+  cmd->add_option("--job", o->jobFile,
+                  "The whole job from a JSON file (docs/cli.md, \"Job files\"; what a Slurm task runs) instead of DATASET, -o and the "
+                  "options below; --frames and --threads may still be given")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--res", o->resolution, "Resolution WIDTHxHEIGHT (the thesis used 1920x1080)");
   cmd->add_option("--spp", o->job.settings.samplesPerPixel, "Samples per pixel (the thesis used 1024)")->check(positive());
   cmd->add_option("--bounces", o->job.settings.bounces, "Bounces after the first hit, as Cycles counts them (the thesis used 12)")
@@ -191,7 +226,11 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
       ->check(CLI::Range(0, 64))
       ->capture_default_str();
   addSlurmOptions(cmd, o->slurm, o->slurmOptions, "DIR/slurm/render.sbatch, one task per --frames-per-task frames", true);
-  cmd->callback([o, &run] { run = [o] { return runRender(*o); }; });
+  cmd->callback([o, cmd, &run] {
+    o->threadsGiven = cmd->count("--threads") > 0;
+    if (!o->jobFile.empty()) o->givenWithJob = optionsGivenBesideJob(cmd, {"--frames", "--threads"});
+    run = [o] { return runRender(*o); };
+  });
 }
 
 }  // namespace dynbench::cli

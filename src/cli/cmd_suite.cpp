@@ -13,7 +13,7 @@ struct SuiteCli {
   std::string part = "all";
   int renderTask = 0, framesPerTask = 8;
   bool slurm = false;
-  pipeline::slurm::Options slurmOptions;
+  cluster::Options slurmOptions;
 };
 
 // One line per stage, flushed: a suite runs for an hour, and its log (redirected, so fully
@@ -24,10 +24,10 @@ void printLine(const std::string& line) {
 }
 
 // suite --slurm: the chain of jobs, its changes of state printed once each.
-Expected<void> suiteOnSlurm(const suite::SuiteOptions& options, pipeline::slurm::Options slurm) {
+Expected<void> suiteOnSlurm(const suite::SuiteOptions& options, cluster::Options slurm) {
   slurm.framesPerTask = options.framesPerTask;
   std::string last;
-  auto outcome = suite::runSuiteOnSlurm(options, slurm, [&](const pipeline::slurm::ChainStatus& s) {
+  auto outcome = suite::runSuiteOnSlurm(options, slurm, [&](const cluster::ChainStatus& s) {
     const std::string line = fmt::format("datasets {}, render tasks {} pending, {} running, {} done, suite {}", s.datasets, s.render.pending,
                                          s.render.running, s.render.done, s.report);
     if (line != last) printLine(line);

@@ -1,15 +1,19 @@
 #pragma once
 // Each subcommand registers itself on the CLI11 app and leaves a function to run after parsing.
+#include <filesystem>
 #include <functional>
+#include <initializer_list>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <utility>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "core/error.h"
 #include "core/progress.h"
-#include "pipeline/slurm.h"
+#include "pipeline/cluster_jobs.h"
 
 namespace dynbench::cli {
 
@@ -54,7 +58,14 @@ void addEvaluateCommand(CLI::App& app, CommandRun& run);
 
 // The --slurm flag and its sbatch options (docs/cluster.md); `what` says what the array runs,
 // perTask adds --frames-per-task.
-void addSlurmOptions(CLI::App* cmd, bool& slurm, pipeline::slurm::Options& options, const std::string& what, bool perTask);
+void addSlurmOptions(CLI::App* cmd, bool& slurm, cluster::Options& options, const std::string& what, bool perTask);
+
+// Job files (--job FILE, docs/cli.md "Job files"): the options given on `cmd`'s command line other
+// than --job, --help, `allowed` and --slurm's, by name; each is an error beside --job, as the file
+// holds the whole job. Call it in the subcommand's callback (after parsing).
+std::vector<std::string> optionsGivenBesideJob(const CLI::App* cmd, std::initializer_list<std::string_view> allowed);
+// A usage error naming them, or nothing when `given` is empty.
+Expected<void> nothingBesideJob(const std::filesystem::path& jobFile, const std::vector<std::string>& given, std::string_view allowedText);
 
 // Registers `suite` and `suite verify`.
 void addSuiteCommand(CLI::App& app, CommandRun& run);

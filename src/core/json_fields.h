@@ -2,10 +2,15 @@
 // Typed reads of JSON values by JSON pointer, with errors that name the file and the pointer
 // ("run/stats.json: /datasets/0/properties/faces: expected a whole number >= 0"). For the JSON
 // files dynbench reads back from its own stages (stats.json, discard.json, frame sidecars).
+#include <algorithm>
 #include <cstdint>
+#include <iterator>
 #include <filesystem>
 #include <string>
+#include <vector>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
@@ -65,6 +70,91 @@ class JsonFields {
   std::filesystem::path file_;
 };
 
+// Typed reads of a settings document's optional keys, each with the range its command-line option
+// checks; an absent key keeps the value it has (the struct's default). For job files (--job).
+class JsonSettingsReader {
+ public:
+  JsonSettingsReader(const nlohmann::json& document, const std::filesystem::path& source) : document_(document), fields_(document, source), source_(source) {}
+
+  // A job document's frame: an object of `what` ("the render job") with no top-level key but
+  // `keys` (a misspelt setting is not silently ignored) and `versionKey` equal to `version`.
+  template <typename Keys>
+  Expected<void> jobDocument(const std::string& what, const Keys& keys, const std::string& versionKey, int version) const {
+    if (!document_.is_object()) return bad("", fmt::format("an object ({}, docs/cli.md)", what));
+    for (const auto& [key, value] : document_.items())
+      if (std::find_if(std::begin(keys), std::end(keys), [&](const char* k) { return key == k; }) == std::end(keys))
+        return bad("/" + key, fmt::format("one of {}'s keys ({}), not \"{}\"", what, fmt::join(keys, ", "), key));
+    const std::string pointer = "/" + versionKey;
+    if (!has(pointer)) return bad(pointer, fmt::format("{} (the version of {} this dynbench reads), missing", version, what));
+    int found = 0;
+    return integer(pointer, found, version, version);
+  }
+
+  template <typename Int>
+  Expected<void> integer(const std::string& pointer, Int& value, long long low, long long high) const {
+    if (!fields_.has(pointer)) return {};
+    auto v = fields_.integer(pointer);
+    if (!v) return std::unexpected(v.error());
+    if (*v < low || *v > high) return bad(pointer, fmt::format("a whole number in [{}, {}], found {}", low, high, *v));
+    value = static_cast<Int>(*v);
+    return {};
+  }
+  // A whole number >= 0 of any size (seeds).
+  Expected<void> count(const std::string& pointer, std::uint64_t& value) const {
+    if (!fields_.has(pointer)) return {};
+    auto v = fields_.count(pointer);
+    if (!v) return std::unexpected(v.error());
+    value = *v;
+    return {};
+  }
+  Expected<void> number(const std::string& pointer, double& value, double low, double high, bool lowOpen = false) const {
+    if (!fields_.has(pointer)) return {};
+    auto v = fields_.number(pointer);
+    if (!v) return std::unexpected(v.error());
+    if (!(lowOpen ? *v > low : *v >= low) || !(*v <= high))
+      return bad(pointer, fmt::format("a number in {}{}, {}], found {}", lowOpen ? "(" : "[", low, high, *v));
+    value = *v;
+    return {};
+  }
+  Expected<void> boolean(const std::string& pointer, bool& value) const {
+    if (!fields_.has(pointer)) return {};
+    auto v = fields_.boolean(pointer);
+    if (!v) return std::unexpected(v.error());
+    value = *v;
+    return {};
+  }
+  template <typename T>
+  Expected<void> string(const std::string& pointer, T& value) const {
+    if (!fields_.has(pointer)) return {};
+    auto v = fields_.string(pointer);
+    if (!v) return std::unexpected(v.error());
+    value = *v;
+    return {};
+  }
+  // An array of strings.
+  Expected<std::vector<std::string>> strings(const std::string& pointer) const {
+    auto v = fields_.value(pointer);
+    if (!v) return std::unexpected(v.error());
+    if (!(*v)->is_array()) return bad(pointer, fmt::format("an array of strings, found {}", (*v)->dump()));
+    std::vector<std::string> out;
+    for (std::size_t i = 0; i < (*v)->size(); ++i) {
+      auto item = fields_.string(fmt::format("{}/{}", pointer, i));
+      if (!item) return std::unexpected(item.error());
+      out.push_back(*item);
+    }
+    return out;
+  }
+  bool has(const std::string& pointer) const { return fields_.has(pointer); }
+  std::unexpected<Error> bad(const std::string& pointer, const std::string& expected) const {
+    return fail(ErrorCode::kInvalidData, "{}: {}: expected {}", source_.string(), pointer, expected);
+  }
+
+ private:
+  const nlohmann::json& document_;
+  JsonFields fields_;
+  std::filesystem::path source_;
+};
+
 // A whole JSON file, or an error naming it (missing: kIo, bad syntax: kParse).
 inline Expected<nlohmann::json> readJsonFile(const std::filesystem::path& path) {
   auto text = readWholeFile(path);
@@ -72,6 +162,14 @@ inline Expected<nlohmann::json> readJsonFile(const std::filesystem::path& path) 
   nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
   if (j.is_discarded()) return fail(ErrorCode::kParse, "{}: not valid JSON", path.string());
   return j;
+}
+
+// A JSON file read and given to `parse(document, path)` (a job file's reader).
+template <typename Parse>
+auto readJsonDocument(const std::filesystem::path& path, Parse parse) -> decltype(parse(nlohmann::json{}, path)) {
+  auto document = readJsonFile(path);
+  if (!document) return std::unexpected(document.error());
+  return parse(*document, path);
 }
 
 }  // namespace dynbench

@@ -231,4 +231,48 @@ Expected<void> renderTask(const std::vector<DatasetJob>& datasets, int task, int
   return {};
 }
 
+nlohmann::json datasetRunSettingsJson(const DatasetRunSettings& s, bool all) {
+  nlohmann::json j = {{"width", s.width},   {"height", s.height},   {"frames", s.renderFrames},          {"spp", s.samplesPerPixel},
+                      {"max_spp", s.maxSamplesPerPixel}, {"bounces", s.bounces}, {"input_spp", s.inputSamplesPerPixel}, {"tolerance", s.tolerance},
+                      {"fps", s.fps}};
+  if (all) {
+    j["max_pairs"] = s.maxPairs;
+    j["methods"] = s.methods;
+    j["seed"] = s.seed;
+    j["threads"] = s.threads;
+  }
+  return j;
+}
+
+const std::vector<const char*>& datasetRunSettingsKeys(bool all) {
+  static const std::vector<const char*> manifest = {"width", "height", "frames", "spp", "max_spp", "bounces", "input_spp", "tolerance", "fps"};
+  static const std::vector<const char*> every = [] {
+    auto keys = manifest;
+    keys.insert(keys.end(), {"max_pairs", "methods", "seed", "threads"});
+    return keys;
+  }();
+  return all ? every : manifest;
+}
+
+Expected<void> readDatasetRunSettings(const JsonSettingsReader& r, const std::string& prefix, DatasetRunSettings& s, bool all) {
+  for (auto ok : {r.integer(prefix + "/width", s.width, 8, 7680), r.integer(prefix + "/height", s.height, 8, 4320),
+                  r.integer(prefix + "/frames", s.renderFrames, 2, 100000), r.integer(prefix + "/spp", s.samplesPerPixel, 1, 1 << 20),
+                  r.integer(prefix + "/max_spp", s.maxSamplesPerPixel, 1, 1 << 20), r.integer(prefix + "/bounces", s.bounces, 0, 64),
+                  r.integer(prefix + "/input_spp", s.inputSamplesPerPixel, 1, 1 << 20), r.number(prefix + "/tolerance", s.tolerance, 1e-4, 10.0),
+                  r.number(prefix + "/fps", s.fps, 1.0, 1000.0)})
+    if (!ok) return ok;
+  if (s.maxSamplesPerPixel < s.samplesPerPixel) return r.bad(prefix + "/max_spp", "at least " + prefix + "/spp");
+  if (!all) return {};
+  for (auto ok : {r.integer(prefix + "/max_pairs", s.maxPairs, 4, 1 << 20), r.integer(prefix + "/seed", s.seed, 0, 4294967295LL),
+                  r.integer(prefix + "/threads", s.threads, 0, 4096)})
+    if (!ok) return ok;
+  if (r.has(prefix + "/methods")) {
+    auto methods = r.strings(prefix + "/methods");
+    if (!methods) return std::unexpected(methods.error());
+    if (methods->empty()) return r.bad(prefix + "/methods", "a non-empty array of method names");
+    s.methods = *methods;
+  }
+  return {};
+}
+
 }  // namespace dynbench::pipeline

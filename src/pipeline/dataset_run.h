@@ -11,6 +11,7 @@
 #include "capture/cube2.h"
 #include "capture/openarena.h"
 #include "core/error.h"
+#include "core/json_fields.h"
 #include "discard/discard.h"
 #include "evaluate/evaluate.h"
 #include "metrics/camera_motion.h"
@@ -39,6 +40,16 @@ struct DatasetRunSettings {
   unsigned seed = 1;  // the reference's; the input's is seed + 1
   int threads = 0;    // render threads (0: all cores)
 };
+
+// The settings' JSON spelling, shared by a suite manifest's "render" object and the demo's job file
+// (docs/suite.md, docs/cli.md "Job files"): width, height, frames, spp, max_spp, bounces, input_spp,
+// tolerance, fps; and, with `all`, max_pairs, methods, seed and threads, which a manifest does not hold.
+nlohmann::json datasetRunSettingsJson(const DatasetRunSettings& settings, bool all);
+// Reads those keys under `prefix` ("/render" or ""), each optional, into `settings`; the values'
+// ranges are checked, and max_spp against spp.
+Expected<void> readDatasetRunSettings(const JsonSettingsReader& reader, const std::string& prefix, DatasetRunSettings& settings, bool all);
+// The keys readDatasetRunSettings knows (for a job file's unknown-key check).
+const std::vector<const char*>& datasetRunSettingsKeys(bool all);
 
 // One line per stage (for the terminal and logs).
 using RunLog = std::function<void(const std::string&)>;

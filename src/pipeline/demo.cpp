@@ -73,28 +73,55 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
   return files->html;
 }
 
-std::vector<std::string> demoArguments(const DemoOptions& o) {
-  return {"-o", fs::absolute(o.output).lexically_normal().string(), "--engine", o.engine, "--map", demoMap(o), "--bots", std::to_string(o.bots), "--seconds",
-          fmt::format("{:.17g}", o.seconds), "--seed", std::to_string(o.seed), "--fps", fmt::format("{:.17g}", o.fps), "--res",
-          fmt::format("{}x{}", o.width, o.height), "--spp", std::to_string(o.samplesPerPixel), "--tolerance", fmt::format("{:.17g}", o.tolerance),
-          "--max-spp", std::to_string(o.maxSamplesPerPixel), "--render-frames", std::to_string(o.renderFrames), "--bounces",
-          std::to_string(o.bounces), "--input-spp", std::to_string(o.inputSamplesPerPixel), "--methods", fmt::format("{}", fmt::join(o.methods, ","))};
+nlohmann::json demoJobJson(const DemoOptions& o) {
+  nlohmann::json j = pipeline::datasetRunSettingsJson(o, true);
+  j["dynbench_demo"] = kDemoJobVersion;
+  j["output"] = o.output.string();
+  j["engine"] = o.engine;
+  j["map"] = o.map;
+  j["bots"] = o.bots;
+  j["seconds"] = o.seconds;
+  return j;
 }
 
-Expected<pipeline::slurm::ChainOutcome> demoChain(const DemoOptions& demoIn, const pipeline::slurm::Options& options,
-                                                  const std::function<void(const pipeline::slurm::ChainStatus&)>& progress) {
+Expected<DemoOptions> parseDemoJob(const nlohmann::json& document, const fs::path& source) {
+  const JsonSettingsReader r(document, source);
+  std::vector<const char*> keys = {"dynbench_demo", "output", "engine", "map", "bots", "seconds"};
+  for (const char* k : pipeline::datasetRunSettingsKeys(true)) keys.push_back(k);
+  if (auto ok = r.jobDocument("the demo job", keys, "dynbench_demo", kDemoJobVersion); !ok) return std::unexpected(ok.error());
+  DemoOptions o;
+  std::string output = o.output.string();
+  for (auto ok : {r.string("/output", output), r.string("/engine", o.engine), r.string("/map", o.map),
+                  r.integer("/bots", o.bots, capture::kBotsRange.first, capture::kBotsRange.second), r.number("/seconds", o.seconds, 0.0, 1e6, true)})
+    if (!ok) return std::unexpected(ok.error());
+  if (o.engine != "cube2" && o.engine != "openarena") return r.bad("/engine", fmt::format("\"cube2\" or \"openarena\", found \"{}\"", o.engine));
+  o.output = output;
+  if (auto ok = pipeline::readDatasetRunSettings(r, "", o, true); !ok) return std::unexpected(ok.error());
+  return o;
+}
+
+Expected<DemoOptions> readDemoJob(const fs::path& path) { return readJsonDocument(path, parseDemoJob); }
+
+Expected<cluster::ChainOutcome> demoChain(const DemoOptions& demoIn, const cluster::Options& options,
+                                                  const std::function<void(const cluster::ChainStatus&)>& progress) {
   DemoOptions demo = demoIn;
   demo.output = fs::absolute(demo.output).lexically_normal();
-  pipeline::slurm::ChainSpec spec;
+  cluster::ChainSpec spec;
   spec.name = "demo";
   spec.output = demo.output;
-  spec.arguments = demoArguments(demo);
+  // Every job runs the one job file.
+  const fs::path jobFile = demo.output / "slurm" / "demo-job.json";
+  std::error_code ec;
+  fs::create_directories(jobFile.parent_path(), ec);
+  if (ec) return fail(ErrorCode::kIo, "{}: cannot create the jobs' folder: {}", jobFile.parent_path().string(), ec.message());
+  if (auto ok = writeFileAtomic(jobFile, demoJobJson(demo).dump(2) + "\n"); !ok) return std::unexpected(ok.error());
+  spec.arguments = {"--job", jobFile.string()};
   spec.frameRenders = demoFrameRenders(demo);
   spec.datasetsWhat = "capture, convert and the fly-through";
   spec.finalWhat = "the whole demo, reusing the datasets and frames: stats, discard, evaluate, report";
   spec.datasetsDone = demo.output / "datasets" / (demoMap(demo) + "_flythrough.gltf");
   spec.finalFile = demo.output / "report.html";
-  return pipeline::slurm::chainOfJobs(spec, options, progress);
+  return cluster::chainOfJobs(spec, options, progress);
 }
 
 }  // namespace dynbench::demo

@@ -10,7 +10,7 @@
 
 #include "core/error.h"
 #include "pipeline/dataset_run.h"
-#include "pipeline/slurm.h"
+#include "cluster/slurm.h"
 
 namespace dynbench::demo {
 
@@ -49,16 +49,23 @@ using DemoLog = std::function<void(const std::string&)>;
 // Returns the report's path (kAll), the fly-through dataset (kDatasets) or the output folder.
 Expected<std::filesystem::path> runDemo(const DemoOptions& options, const DemoLog& log);
 
-// ---- the demo as a chain of Slurm jobs (pipeline/slurm.h's chainOfJobs) ---------------------------
-// The demo's command-line options but its part (the inverse of `dynbench demo`'s parsing).
-std::vector<std::string> demoArguments(const DemoOptions& options);
+// ---- the demo as a job file (docs/cli.md, "Job files") ----------------------------------------------
+// The demo's options but its part as one JSON document: what `demo --job FILE` reads and each of
+// `demo --slurm`'s jobs runs (OUT/slurm/demo-job.json), so the options are spelled once.
+inline constexpr int kDemoJobVersion = 1;  // the document's "dynbench_demo"
+nlohmann::json demoJobJson(const DemoOptions& options);
+// Keys left out take DemoOptions' defaults; an unknown key, a wrong type or a value out of range is
+// an error naming `source` and the JSON pointer.
+Expected<DemoOptions> parseDemoJob(const nlohmann::json& document, const std::filesystem::path& source);
+Expected<DemoOptions> readDemoJob(const std::filesystem::path& path);
 
+// ---- the demo as a chain of Slurm jobs (cluster/slurm.h's chainOfJobs) ---------------------------
 // `demo --slurm`: three jobs in OUT/slurm, each the demo itself: datasets.sbatch (capture, convert,
 // fly-through), render.sbatch (an array: the frame renders, options.framesPerTask a task) after it,
 // and report.sbatch (the whole demo, reusing everything, so only stats, discard, evaluate and the
 // report are left) after the renders, chained with --dependency=afterok and
 // --kill-on-invalid-dep=yes. Waits for the report unless submitOnly.
-Expected<pipeline::slurm::ChainOutcome> demoChain(const DemoOptions& demo, const pipeline::slurm::Options& options,
-                                                  const std::function<void(const pipeline::slurm::ChainStatus&)>& progress = {});
+Expected<cluster::ChainOutcome> demoChain(const DemoOptions& demo, const cluster::Options& options,
+                                                  const std::function<void(const cluster::ChainStatus&)>& progress = {});
 
 }  // namespace dynbench::demo

@@ -87,31 +87,8 @@ Expected<Manifest> parseManifest(const nlohmann::json& document, const fs::path&
     m.description = *d;
   }
   // The render window: every field optional, defaulting to DatasetRunSettings'.
+  if (auto ok = readDatasetRunSettings(JsonSettingsReader(m.document, path), "/render", m.run, false); !ok) return std::unexpected(ok.error());
   DatasetRunSettings& r = m.run;
-  struct IntField {
-    const char* key;
-    int* value;
-    int low, high;
-  };
-  for (const IntField& field : {IntField{"width", &r.width, 8, 7680}, IntField{"height", &r.height, 8, 4320}, IntField{"frames", &r.renderFrames, 2, 100000},
-                                IntField{"spp", &r.samplesPerPixel, 1, 1 << 20}, IntField{"max_spp", &r.maxSamplesPerPixel, 1, 1 << 20},
-                                IntField{"bounces", &r.bounces, 0, 64}, IntField{"input_spp", &r.inputSamplesPerPixel, 1, 1 << 20}}) {
-    const std::string pointer = std::string("/render/") + field.key;
-    if (!f.has(pointer)) continue;
-    auto v = f.integer(pointer);
-    if (!v) return std::unexpected(v.error());
-    if (*v < field.low || *v > field.high) return bad(pointer, fmt::format("a whole number in [{}, {}], found {}", field.low, field.high, *v));
-    *field.value = static_cast<int>(*v);
-  }
-  for (const auto& [key, value, low, high] : {std::tuple{"tolerance", &r.tolerance, 1e-4, 10.0}, std::tuple{"fps", &r.fps, 1.0, 1000.0}}) {
-    const std::string pointer = std::string("/render/") + key;
-    if (!f.has(pointer)) continue;
-    auto v = f.number(pointer);
-    if (!v) return std::unexpected(v.error());
-    if (!(*v >= low && *v <= high)) return bad(pointer, fmt::format("a number in [{}, {}], found {}", low, high, *v));
-    *value = *v;
-  }
-  if (r.maxSamplesPerPixel < r.samplesPerPixel) return bad("/render/max_spp", "at least /render/spp");
   if (f.has("/methods")) {
     auto methods = f.value("/methods");
     if (!(*methods)->is_array() || (*methods)->empty()) return bad("/methods", "a non-empty array of method names");
@@ -562,12 +539,12 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
   return outcome;
 }
 
-Expected<pipeline::slurm::ChainOutcome> runSuiteOnSlurm(const SuiteOptions& options, const pipeline::slurm::Options& slurm,
-                                                        const std::function<void(const pipeline::slurm::ChainStatus&)>& progress) {
+Expected<cluster::ChainOutcome> runSuiteOnSlurm(const SuiteOptions& options, const cluster::Options& slurm,
+                                                        const std::function<void(const cluster::ChainStatus&)>& progress) {
   auto manifest = readManifest(options.manifest);
   if (!manifest) return std::unexpected(manifest.error());
   const fs::path root = fs::absolute(options.output).lexically_normal();
-  pipeline::slurm::ChainSpec spec;
+  cluster::ChainSpec spec;
   spec.name = "suite";
   spec.output = root;
   spec.arguments = {fs::absolute(options.manifest).lexically_normal().string(), "-o", root.string()};
@@ -578,7 +555,7 @@ Expected<pipeline::slurm::ChainOutcome> runSuiteOnSlurm(const SuiteOptions& opti
   if (!lastDataset) return std::unexpected(lastDataset.error());
   spec.datasetsDone = *lastDataset;
   spec.finalFile = root / "suite.json";
-  return pipeline::slurm::chainOfJobs(spec, slurm, progress);
+  return cluster::chainOfJobs(spec, slurm, progress);
 }
 
 Expected<VerifyOutcome> verifySuite(const fs::path& root, const pipeline::RunLog& log) {

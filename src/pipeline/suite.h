@@ -16,7 +16,7 @@
 #include "core/error.h"
 #include "metrics/rank_correlation.h"
 #include "pipeline/dataset_run.h"
-#include "pipeline/slurm.h"
+#include "cluster/slurm.h"
 
 namespace dynbench::suite {
 
@@ -105,12 +105,12 @@ struct SuiteOutcome {
 // settings.
 Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::RunLog& log);
 
-// `suite --slurm`: the chain of three jobs (pipeline/slurm.h's chainOfJobs) in DIR/slurm: every
+// `suite --slurm`: the chain of three jobs (cluster/slurm.h's chainOfJobs) in DIR/slurm: every
 // dataset's capture, convert and fly-through; an array of render tasks (slurm.framesPerTask frame
 // renders each); and the whole suite again, which reuses both and writes suite.json. Waits for
 // suite.json unless slurm.submitOnly.
-Expected<pipeline::slurm::ChainOutcome> runSuiteOnSlurm(const SuiteOptions& options, const pipeline::slurm::Options& slurm,
-                                                        const std::function<void(const pipeline::slurm::ChainStatus&)>& progress = {});
+Expected<cluster::ChainOutcome> runSuiteOnSlurm(const SuiteOptions& options, const cluster::Options& slurm,
+                                                        const std::function<void(const cluster::ChainStatus&)>& progress = {});
 
 struct VerifyOutcome {
   std::size_t files = 0, numbers = 0;    // checked

@@ -14,11 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "capture/cube2.h"
 #include "core/error.h"
-#include "pipeline/stages.h"
 
-namespace dynbench::pipeline::slurm {
+namespace dynbench::cluster {
 
 // What sbatch is asked for (each maps to one sbatch option; docs/cluster.md has the table).
 struct Options {
@@ -75,61 +73,14 @@ std::string scriptHeader(const std::string& name, int tasks, const std::filesyst
 // command that removes what the work left unfinished; the work runs in the background as $child.
 std::string signalTrap(const std::string& work, const std::string& cleanup);
 
+// A job's command line: the dynbench the job runs (jobExecutable), the verb, each argument quoted.
+std::string jobCommand(const Options& options, const std::string& verb, const std::vector<std::string>& arguments);
+
 // A word for a POSIX shell script, single-quoted when it needs to be.
 std::string shellQuote(const std::string& word);
 
 // Seconds of a Slurm time ("[D-]HH:MM:SS", "HH:MM:SS", "MM:SS", "MM"); nullopt when malformed.
 std::optional<long> parseSlurmTime(const std::string& text);
-
-// ---- render as an array ------------------------------------------------------------------------
-// The render job's command-line options, so that the job's `dynbench render` makes the frames the
-// local one would (the inverse of `dynbench render`'s parsing; the tests check they agree).
-std::vector<std::string> renderArguments(const render::RenderJob& job);
-
-struct RenderArrayStatus {
-  std::size_t framesComplete = 0, framesTotal = 0;
-  ArrayStatus tasks;
-};
-using RenderArrayProgress = std::function<void(const RenderArrayStatus&)>;
-
-struct RenderArrayOutcome {
-  std::string jobId;
-  std::filesystem::path script;
-  int tasks = 0;
-  std::vector<std::vector<long>> chunks;           // task k's frames
-  std::map<int, std::vector<long>> missing;        // after the wait: task -> its frames not complete
-  std::map<int, std::string> taskStates;           // scontrol's final state of the tasks that missed frames
-  std::string resubmit;                            // the command that reruns only those tasks
-  bool waited = false;
-};
-
-// Renders `stage`'s frames as a Slurm job array: DIR/slurm/render.sbatch, one task per
-// options.framesPerTask frames, each `dynbench render` of its chunk with the same settings and seed
-// (frames are the same bytes as a local render: the seed is per frame). Waits unless submitOnly.
-Expected<RenderArrayOutcome> renderArray(const RenderStage& stage, const Options& options, const RenderArrayProgress& progress = {});
-
-// The missing frames by task, one line each: "  task 3 (CANCELLED): frames 12-15".
-std::string missingFramesText(const RenderArrayOutcome& outcome);
-
-// ---- capture as an array -----------------------------------------------------------------------
-// The capture's command-line options but its output and seed (the inverse of `capture cube2`'s parsing).
-std::vector<std::string> captureArguments(const capture::Cube2Options& options);
-
-struct CaptureArrayOutcome {
-  std::string jobId;
-  std::filesystem::path script;
-  std::vector<unsigned> seeds;               // task k captures seeds[k] into DIR/seed_N
-  std::vector<std::filesystem::path> captures;
-  std::vector<int> failed;                   // tasks whose capture is missing after the wait
-  std::string resubmit;
-  bool waited = false;
-};
-using CaptureArrayProgress = std::function<void(const ArrayStatus&)>;
-// One Cube 2 capture per seed, firstSeed..lastSeed, as a Slurm job array: DIR/slurm/capture.sbatch,
-// task k capturing seed firstSeed + k into DIR/seed_N (through DIR/seed_N.partial, renamed when
-// complete, so a folder under its final name is a whole capture). Waits unless submitOnly.
-Expected<CaptureArrayOutcome> captureArray(const capture::Cube2Options& capture, unsigned firstSeed, unsigned lastSeed, const Options& options,
-                                           const CaptureArrayProgress& progress = {});
 
 // ---- a command as a chain of jobs ---------------------------------------------------------------
 // A chain of three jobs (demo --slurm, suite --slurm): the datasets, an array of render tasks, and
@@ -160,4 +111,4 @@ struct ChainSpec {
 // --dependency=afterok and --kill-on-invalid-dep=yes; waits for the last unless submitOnly.
 Expected<ChainOutcome> chainOfJobs(const ChainSpec& spec, const Options& options, const std::function<void(const ChainStatus&)>& progress = {});
 
-}  // namespace dynbench::pipeline::slurm
+}  // namespace dynbench::cluster
