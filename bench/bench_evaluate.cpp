@@ -63,7 +63,7 @@ frames::FeatureFrame syntheticFrame(int w, int h, long index, double noise) {
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
-      const glm::dvec3 d = discard::pixelDirection(c, x + 0.5, y + 0.5);
+      const glm::dvec3 d = reprojection::pixelDirection(c, x + 0.5, y + 0.5);
       const glm::dvec3 p = d * (5.0 / -d.z);
       const double texture = 0.5 + 0.4 * std::sin(0.05 * x) * std::cos(0.07 * y), light = (x / 64 + y / 64) % 5 == 0 ? 20.0 : 1.0;
       for (int k = 0; k < 3; ++k) {

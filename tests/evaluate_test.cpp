@@ -48,7 +48,7 @@ frames::FeatureFrame planeFrame(long index, double sigma, std::uint32_t seed) {
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * kW + x;
-      const glm::dvec3 d = discard::pixelDirection(c, x + 0.5, y + 0.5);
+      const glm::dvec3 d = reprojection::pixelDirection(c, x + 0.5, y + 0.5);
       const glm::dvec3 p = d * (5.0 / -d.z);
       for (int k = 0; k < 3; ++k) {
         f.position[3 * i + k] = static_cast<float>(p[k]);

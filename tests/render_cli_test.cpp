@@ -157,7 +157,7 @@ TEST(RenderCli, JitterOffsetsEachFramesSamplesByTheHaltonSequence) {
       for (int x = 0; x < frame->width; ++x) {
         const std::size_t i = static_cast<std::size_t>(y) * frame->width + x;
         if (frame->hit[i] <= 0) continue;
-        const auto q = discard::reproject(frame->camera, {frame->position[3 * i], frame->position[3 * i + 1], frame->position[3 * i + 2]});
+        const auto q = reprojection::reproject(frame->camera, {frame->position[3 * i], frame->position[3 * i + 1], frame->position[3 * i + 2]});
         ASSERT_TRUE(q.has_value());
         EXPECT_NEAR(q->x, x + 0.5 + frame->camera.jitter.x, 2e-3);
         EXPECT_NEAR(q->y, y + 0.5 + frame->camera.jitter.y, 2e-3);

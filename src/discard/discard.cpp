@@ -17,19 +17,13 @@
 namespace dynbench::discard {
 namespace {
 
+using namespace reprojection;
+
 glm::dvec3 at3(const std::vector<float>& b, std::size_t i) { return {b[3 * i], b[3 * i + 1], b[3 * i + 2]}; }
 
 }  // namespace
 
 namespace {
-
-// Sum of weight x value over a set of taps (bilinear or cubic).
-template <typename Taps>
-glm::dvec3 weightedSum3(const std::vector<float>& buffer, const Taps& taps) {
-  glm::dvec3 s(0.0);
-  for (std::size_t k = 0; k < std::size(taps.weight); ++k) s += taps.weight[k] * at3(buffer, taps.index[k]);
-  return s;
-}
 
 // The variance of such a sum of independent pixels: sum of weight^2 x variance.
 template <typename Taps>
@@ -40,68 +34,6 @@ double weightedVariance(const std::vector<float>& variance, const Taps& taps) {
 }
 
 }  // namespace
-
-glm::dvec3 sample3(const std::vector<float>& buffer, const BilinearTaps& taps) { return weightedSum3(buffer, taps); }
-glm::dvec3 sample3(const std::vector<float>& buffer, const CubicTaps& taps) { return weightedSum3(buffer, taps); }
-
-CubicTaps catmullRomTaps(double x, double y, int width, int height) {
-  // Texel space: pixel (i, j)'s centre at (i + 0.5, j + 0.5); the taps are the 4 x 4 centres
-  // around, the first one pixel left of and above the bilinear cell's.
-  const double u = x - 0.5, v = y - 0.5;
-  const double fx = std::floor(u), fy = std::floor(v);
-  const auto wx = catmullRomWeights(u - fx), wy = catmullRomWeights(v - fy);
-  const int x0 = static_cast<int>(fx) - 1, y0 = static_cast<int>(fy) - 1;
-  CubicTaps taps{};
-  taps.inside = x0 >= 0 && y0 >= 0 && x0 + 3 < width && y0 + 3 < height;
-  for (int j = 0; j < 4; ++j)
-    for (int k = 0; k < 4; ++k) {
-      const auto tap = static_cast<std::size_t>(4 * j + k);
-      taps.index[tap] = static_cast<std::size_t>(std::clamp(y0 + j, 0, height - 1)) * static_cast<std::size_t>(width) +
-                        static_cast<std::size_t>(std::clamp(x0 + k, 0, width - 1));
-      taps.weight[tap] = wx[static_cast<std::size_t>(k)] * wy[static_cast<std::size_t>(j)];
-    }
-  return taps;
-}
-
-double sample1(const std::vector<float>& buffer, const BilinearTaps& taps) {
-  double s = 0;
-  for (int k = 0; k < 4; ++k) s += taps.weight[k] * buffer[taps.index[k]];
-  return s;
-}
-
-namespace {
-
-// Clip coordinates to continuous pixel coordinates: perspective division and Eq. (2.3), row 0 at
-// the top; nullopt behind the camera (clip w <= 0).
-std::optional<glm::dvec2> toPixels(const glm::dvec4& clip, int width, int height) {
-  if (clip.w <= 0) return std::nullopt;
-  const glm::dvec2 ndc(clip.x / clip.w, clip.y / clip.w);
-  return glm::dvec2((ndc.x + 1.0) * 0.5 * width, (1.0 - ndc.y) * 0.5 * height);
-}
-
-}  // namespace
-
-Projector::Projector(const FrameCamera& camera)
-    : viewProjection(camera.projection * camera.view), inverseViewProjection(glm::inverse(viewProjection)), width(camera.width), height(camera.height) {}
-
-std::optional<glm::dvec2> Projector::point(const glm::dvec3& p) const { return toPixels(viewProjection * glm::dvec4(p, 1.0), width, height); }  // Eq. (2.2)
-
-std::optional<glm::dvec2> Projector::direction(const glm::dvec3& d) const { return toPixels(viewProjection * glm::dvec4(d, 0.0), width, height); }
-
-glm::dvec3 Projector::pixelDirection(double x, double y) const {
-  // The direction from the near to the far plane through the pixel coordinates.
-  const glm::dvec2 ndc(2.0 * x / width - 1.0, 1.0 - 2.0 * y / height);
-  const glm::dvec4 near = inverseViewProjection * glm::dvec4(ndc, -1.0, 1.0), far = inverseViewProjection * glm::dvec4(ndc, 1.0, 1.0);
-  return glm::normalize(glm::dvec3(far) / far.w - glm::dvec3(near) / near.w);
-}
-
-std::optional<glm::dvec2> reproject(const FrameCamera& camera, const glm::dvec3& p) { return Projector(camera).point(p); }
-
-std::optional<glm::dvec2> reprojectDirection(const FrameCamera& camera, const glm::dvec3& direction) {
-  return Projector(camera).direction(direction);
-}
-
-glm::dvec3 pixelDirection(const FrameCamera& camera, double x, double y) { return Projector(camera).pixelDirection(x, y); }
 
 double sceneSize(const FeatureFrame& frame) {
   glm::dvec3 lo(1e300), hi(-1e300);
@@ -148,68 +80,6 @@ const char* radianceTestName(Thresholds::RadianceTest test) {
 
 const char* geometryTestName(Thresholds::GeometryTest test) {
   return test == Thresholds::GeometryTest::kTaps ? "taps" : "bilinear";
-}
-
-bool onTangentPlane(const glm::dvec3& p, const glm::dvec3& n, const glm::dvec3& q, double viewDepth, const Thresholds& t) {
-  return std::abs(glm::dot(n, q - p)) <= t.position * std::abs(viewDepth);
-}
-
-HistoryTest testHistory(const glm::dvec3& p, const glm::dvec3& n, double viewDepth, const FeatureFrame& previous, const BilinearTaps& taps,
-                        const Thresholds& t) {
-  HistoryTest result;
-  result.history = taps;
-  if (t.geometryTest == Thresholds::GeometryTest::kBilinear) {
-    // Position and normal history of a surface cannot come from the background.
-    bool historyMissesGeometry = false;
-    for (int k = 0; k < 4; ++k)
-      if (taps.weight[k] > 0 && previous.hit[taps.index[k]] <= 0) historyMissesGeometry = true;
-    result.position = !historyMissesGeometry && glm::length(p - sample3(previous.position, taps)) <= t.position;
-    result.normal = !historyMissesGeometry && glm::length(n - sample3(previous.normal, taps)) <= t.normal;
-    result.consistent = result.position && result.normal;
-    return result;
-  }
-  // Per tap: is the tap's point within position x Z of the current point's tangent plane (NRD's
-  // relative plane distance), and is its normal within the normal threshold? Position (normal)
-  // has history when some tap passes its test: each test on its own, as the thesis's columns are.
-  // The normal has history when a single tap's matches, or the interpolation of the same-surface
-  // taps' normals does: across a crease the taps of both faces lie near the tangent plane and
-  // their mean normal is neither face's, but a tap of the pixel's own face matches; on a curved
-  // surface a pixel wide or less, neighbouring taps differ by more than the threshold and none
-  // matches a point between them, but their interpolation does (to second order in the turn
-  // across a pixel), as the surface's normal there was in the previous frame. Radiance is read
-  // from the taps of the same surface, renormalised (all the taps on geometry where none is:
-  // another surface, whose comparison then fails as it should).
-  BilinearTaps same{}, onGeometry{};
-  double sameWeight = 0.0, geometryWeight = 0.0;
-  bool sameNormal = false;
-  glm::dvec3 sameNormalSum(0.0);
-  for (int k = 0; k < 4; ++k) {
-    same.index[k] = onGeometry.index[k] = taps.index[k];
-    same.weight[k] = onGeometry.weight[k] = 0.0;
-    if (!(taps.weight[k] > 0) || previous.hit[taps.index[k]] <= 0) continue;
-    onGeometry.weight[k] = taps.weight[k];
-    geometryWeight += taps.weight[k];
-    const bool normalMatches = glm::length(n - at3(previous.normal, taps.index[k])) <= t.normal;
-    result.normal |= normalMatches;
-    if (onTangentPlane(p, n, at3(previous.position, taps.index[k]), viewDepth, t)) {
-      same.weight[k] = taps.weight[k];
-      sameWeight += taps.weight[k];
-      sameNormal |= normalMatches;
-      sameNormalSum += taps.weight[k] * at3(previous.normal, taps.index[k]);
-    }
-  }
-  if (sameWeight > 0 && !sameNormal && glm::length(sameNormalSum) > 0) {
-    sameNormal = glm::length(n - glm::normalize(sameNormalSum)) <= t.normal;
-    result.normal |= sameNormal;
-  }
-  result.position = sameWeight > 0;
-  result.consistent = result.position && sameNormal;
-  const double total = result.position ? sameWeight : geometryWeight;
-  if (total <= 0) return result;  // every tap is background: no history of a surface
-  BilinearTaps& read = result.history;
-  read = result.position ? same : onGeometry;
-  for (double& w : read.weight) w /= total;
-  return result;
 }
 
 namespace {
@@ -314,7 +184,7 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
           const BilinearTaps taps = bilinearTaps(q->x - previous.camera.jitter.x, q->y - previous.camera.jitter.y, previous.width, previous.height);
           const double viewDepth = -(current.camera.view * glm::dvec4(p, 1.0)).z;
           const glm::dvec3 normal = at3(current.normal, i);
-          const HistoryTest history = testHistory(p, normal, viewDepth, previous, taps, t);
+          const HistoryTest history = testHistory(p, normal, viewDepth, previous, taps, t.surface());
           if (!history.position) bits |= kPosition;
           if (!history.normal) bits |= kNormal;
           // The radiance history: in the taps test, where the 4 x 4 taps around the point are all
@@ -327,7 +197,7 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
                                           : CubicTaps{};
           bool cubic = tapsTest && history.position && cubicTaps.inside;
           for (std::size_t k = 0; k < 16 && cubic; ++k)
-            cubic = previous.hit[cubicTaps.index[k]] > 0 && onTangentPlane(p, normal, at3(previous.position, cubicTaps.index[k]), viewDepth, t);
+            cubic = previous.hit[cubicTaps.index[k]] > 0 && onTangentPlane(p, normal, at3(previous.position, cubicTaps.index[k]), viewDepth, t.surface());
           // At an edge (the surface has history but its 4 x 4 taps are not all of it) the
           // pixel-filtered radiance mixes surfaces in both frames, in proportions that move with
           // the edge: there the history is the range of the 2 x 2 taps around the point (TAA's

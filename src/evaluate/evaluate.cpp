@@ -52,7 +52,7 @@ struct ReferencePair {
   double scale = 1.0;
   const RgbImage* display = nullptr;  // the current reference's (PreparedReference's)
   RgbImage previousDisplay;
-  std::vector<std::optional<discard::BilinearTaps>> warp;
+  std::vector<std::optional<reprojection::BilinearTaps>> warp;
   long warped = 0;  // pixels with a warp
 };
 ReferencePair referencePair(const PreparedReference& ref, const RgbImage& refPrev, const frames::FeatureFrame& refFrame,
@@ -62,7 +62,7 @@ ReferencePair referencePair(const PreparedReference& ref, const RgbImage& refPre
   pair.scale = ref.displayScale;
   pair.display = &ref.display, pair.previousDisplay = toDisplay(refPrev, pair.scale);
   pair.warp.resize(refFrame.pixelCount());
-  const HistoryLookup lookup(refFrame, refPrevFrame, absolute, /*useMotion=*/true);
+  const reprojection::HistoryLookup lookup(refFrame, refPrevFrame, absolute.surface(), /*useMotion=*/true);
   tbb::parallel_for(0, refFrame.height, [&](int y) {
     for (int x = 0; x < refFrame.width; ++x) pair.warp[static_cast<std::size_t>(y) * refFrame.width + x] = lookup(x, y);
   });
@@ -93,7 +93,7 @@ TemporalScores temporalScores(const RgbImage& out, const RgbImage& outPrev, cons
   double change = 0.0;
   for (std::size_t i = 0; i < ref.warp.size(); ++i) {
     if (!ref.warp[i]) continue;
-    const discard::BilinearTaps& taps = *ref.warp[i];
+    const reprojection::BilinearTaps& taps = *ref.warp[i];
     for (int c = 0; c < 3; ++c) {
       double previousError = 0.0;
       for (int k = 0; k < 4; ++k)

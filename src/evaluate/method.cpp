@@ -12,43 +12,6 @@ RgbImage frameRadiance(const frames::FeatureFrame& frame) {
   return img;
 }
 
-HistoryLookup::HistoryLookup(const frames::FeatureFrame& current, const frames::FeatureFrame& previous, const discard::Thresholds& absolute,
-                             bool useMotion)
-    : current_(current), previous_(previous), absolute_(absolute), useMotion_(useMotion), currentProjector_(current.camera), previousProjector_(previous.camera) {}
-
-std::optional<discard::BilinearTaps> HistoryLookup::operator()(int px, int py) const {
-  const frames::FeatureFrame &current = current_, &previous = previous_;
-  const std::size_t i = static_cast<std::size_t>(py) * current.width + px;
-  const glm::dvec2 sample(px + 0.5 + current.camera.jitter.x, py + 0.5 + current.camera.jitter.y);
-  const bool hit = current.hit[i] > 0;
-  const glm::dvec3 p(hit ? glm::dvec3(current.position[3 * i], current.position[3 * i + 1], current.position[3 * i + 2]) : glm::dvec3(0.0));
-  std::optional<glm::dvec2> q;
-  if (!hit) {
-    q = previousProjector_.direction(currentProjector_.pixelDirection(sample.x, sample.y));
-  } else if (useMotion_ && !current.motion.empty()) {
-    const glm::dvec2 motion(current.motion[2 * i], current.motion[2 * i + 1]);
-    if (std::abs(motion.x) < 1e8 && std::abs(motion.y) < 1e8) q = sample + motion;  // -1e9: behind the previous camera
-  } else {
-    q = previousProjector_.point(p);
-  }
-  if (!q || q->x < 0 || q->y < 0 || q->x > previous.width || q->y > previous.height) return std::nullopt;
-  // The previous frame's buffers are at its samples: centre + its jitter.
-  const discard::BilinearTaps taps =
-      discard::bilinearTaps(q->x - previous.camera.jitter.x, q->y - previous.camera.jitter.y, previous.width, previous.height);
-  if (!hit) {
-    // The background's history is the background.
-    for (int k = 0; k < 4; ++k)
-      if (taps.weight[k] > 0 && previous.hit[taps.index[k]] > 0) return std::nullopt;
-    return taps;
-  }
-  // A surface's: the taps the discard's geometry test keeps (discard::testHistory).
-  const glm::dvec3 n(current.normal[3 * i], current.normal[3 * i + 1], current.normal[3 * i + 2]);
-  const double viewDepth = -(current.camera.view * glm::dvec4(p, 1.0)).z;
-  const discard::HistoryTest test = discard::testHistory(p, n, viewDepth, previous, taps, absolute_);
-  if (!test.consistent) return std::nullopt;
-  return test.history;
-}
-
 long sumOverRows(int height, const std::function<long(int)>& row) {
   std::vector<long> perRow(static_cast<std::size_t>(std::max(height, 0)), 0);
   tbb::parallel_for(0, height, [&](int y) { perRow[static_cast<std::size_t>(y)] = row(y); });

@@ -68,32 +68,12 @@ RgbImage frameRadiance(const frames::FeatureFrame& frame);
 // Interpolates (a pixel centre returns that pixel) and keeps constants; its lobes may overshoot.
 glm::dvec3 sampleCatmullRom(const RgbImage& image, double x, double y);
 
-// Where pixel (px, py) of `current` finds its history in `previous`: the bilinear taps in the
-// previous frame's sample grid, or nullopt when it has none (off screen, Eq. 3.3; or a surface
-// whose history fails the discard stage's world-position and normal tests, or comes from the
-// background, and the other way round). Surfaces are followed by their motion vector (useMotion)
-// or by the camera matrices (thesis Eqs. 2.2-2.3); the background always by the matrices.
-// `absolute` are discard::absoluteThresholds. One per pair of frames (the cameras' matrices are
-// multiplied once); the frames and thresholds must outlive it.
-class HistoryLookup {
- public:
-  HistoryLookup(const frames::FeatureFrame& current, const frames::FeatureFrame& previous, const discard::Thresholds& absolute, bool useMotion);
-  std::optional<discard::BilinearTaps> operator()(int px, int py) const;
-
- private:
-  const frames::FeatureFrame& current_;
-  const frames::FeatureFrame& previous_;
-  const discard::Thresholds& absolute_;
-  bool useMotion_;
-  discard::Projector currentProjector_, previousProjector_;
-};
-
 // Runs row(y) for every row y in [0, height), rows in parallel (each row's work must depend on
 // the inputs alone), and returns the sum of what they return: a method's count of pixels that kept
 // their history, independent of the schedule.
 long sumOverRows(int height, const std::function<long(int)>& row);
 
-// The parts of a frame that HistoryLookup reads of the previous one (number, camera, size,
+// The parts of a frame that reprojection::HistoryLookup reads of the previous one (number, camera, size,
 // position, normal, hit): what a method keeps as its history's geometry, instead of a copy of
 // every buffer (at 1080p about 150 MB a frame).
 frames::FeatureFrame historyFrame(const frames::FeatureFrame& frame);

@@ -30,7 +30,7 @@ class AccumulateMethod final : public TemporalMethod {
       const frames::FeatureFrame& prev = previous_->frame;
       const discard::Thresholds t = discard::absoluteThresholds(context_.thresholds, frame, context_.sceneSize);
       const int w = frame.width, h = frame.height;
-      const HistoryLookup lookup(frame, prev, t, /*useMotion=*/false);
+      const reprojection::HistoryLookup lookup(frame, prev, t.surface(), /*useMotion=*/false);
       // Rows in parallel: each pixel reads the previous output only.
       kept = sumOverRows(h, [&](int py) {
         long keptInRow = 0;
@@ -38,9 +38,9 @@ class AccumulateMethod final : public TemporalMethod {
           const std::size_t i = static_cast<std::size_t>(py) * w + px;
           const auto found = lookup(px, py);
           if (!found) continue;
-          const discard::BilinearTaps& taps = *found;
-          const glm::dvec3 history = discard::sample3(previous_->output.rgb, taps);
-          const double n = discard::sample1(previous_->count, taps) + 1.0, alpha = std::max(1.0 / n, kAlphaMin);
+          const reprojection::BilinearTaps& taps = *found;
+          const glm::dvec3 history = reprojection::sample3(previous_->output.rgb, taps);
+          const double n = reprojection::sample1(previous_->count, taps) + 1.0, alpha = std::max(1.0 / n, kAlphaMin);
           for (int k = 0; k < 3; ++k) out.rgb[3 * i + k] = static_cast<float>(history[k] + alpha * (out.rgb[3 * i + k] - history[k]));
           count[i] = static_cast<float>(n);
           ++keptInRow;

@@ -143,7 +143,7 @@ class SvgfMethod final : public TemporalMethod {
       // The motion vector starts at this pixel's sample; the previous buffers are at its samples.
       const glm::dvec2 q = glm::dvec2(x + 0.5, y + 0.5) + jitterShift + glm::dvec2(motion[2 * x], motion[2 * x + 1]);
       if (!(q.x >= 0 && q.y >= 0 && q.x <= w && q.y <= h)) continue;
-      const discard::BilinearTaps taps = discard::bilinearTaps(q.x, q.y, w, h, p.stride, p.at(0, 0));
+      const reprojection::BilinearTaps taps = reprojection::bilinearTaps(q.x, q.y, w, h, p.stride, p.at(0, 0));
       const float fwidthZ = std::abs(pgx[x]) + std::abs(pgy[x]);
       float weight[4], sumW = 0.0f;
       for (int k = 0; k < 4; ++k) {

@@ -21,7 +21,7 @@ glm::dvec3 fromYCoCg(glm::dvec3 v) { return {v.x + v.y - v.z, v.x + v.z, v.x - v
 }  // namespace
 
 glm::dvec3 sampleCatmullRom(const RgbImage& image, double x, double y) {
-  return discard::sample3(image.rgb, discard::catmullRomTaps(x, y, image.width, image.height));
+  return reprojection::sample3(image.rgb, reprojection::catmullRomTaps(x, y, image.width, image.height));
 }
 
 namespace {
