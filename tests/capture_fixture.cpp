@@ -1,5 +1,7 @@
 #include "capture_fixture.h"
 
+#include <fstream>
+
 #include <gtest/gtest.h>
 
 #include "gltf_builder.h"
@@ -80,6 +82,38 @@ std::filesystem::path writeCapture(const std::string& name) {
   recordFrames(s);
   EXPECT_EQ(dbc_close(s), DBC_OK) << dbc_last_error();
   return dir;
+}
+
+
+
+Converted convertFixture(const std::string& name, convert::ConvertOptions options) {
+  Converted c;
+  c.capture = writeCapture(name + "_capture");
+  const std::filesystem::path dataRoot = freshDir(name + "_data");
+  std::filesystem::create_directories(dataRoot / "chars");
+  for (const char* texture : {"chars/arm.png", "chars/arm_mask.png"})
+    std::ofstream(dataRoot / texture, std::ios::binary).write(reinterpret_cast<const char*>(kPng), sizeof kPng);
+  options.capture = c.capture;
+  options.dataRoot = dataRoot;
+  if (options.output.empty()) options.output = freshDir(name + "_out") / (options.glb ? "dataset.glb" : "dataset.gltf");
+  c.dataset = options.output;
+  auto report = convert::convertCapture(options);
+  EXPECT_TRUE(report) << report.error().message;
+  if (report) c.report = *report;
+  return c;
+}
+
+int nodeNamed(const scene::Scene& s, const std::string& name) {
+  for (std::size_t i = 0; i < s.nodes.size(); ++i)
+    if (s.nodes[i].name == name) return static_cast<int>(i);
+  ADD_FAILURE() << "no node named " << name;
+  return -1;
+}
+
+// |a - b| <= 1e-5 relative (absolute below 1).
+void expectClose(const glm::dvec3& a, const glm::dvec3& b, const std::string& what) {
+  EXPECT_LE(glm::length(a - b), 1e-5 * std::max(1.0, glm::length(b))) << what << ": (" << a.x << ", " << a.y << ", " << a.z
+                                                                        << ") vs (" << b.x << ", " << b.y << ", " << b.z << ")";
 }
 
 }  // namespace dynbench::test

@@ -14,7 +14,7 @@
 #include "core/files.h"
 #include "core/math.h"
 #include "pipeline/demo.h"
-#include "flythrough/flythrough.h"
+#include "camera/flythrough.h"
 #include "render/raytracing_scene.h"
 #include "scene/evaluate.h"
 #include "scene/load.h"
@@ -72,7 +72,7 @@ std::pair<fs::path, double> writeUTurn(const fs::path& dir) {
 // its Tables 6.4-6.6 (the smallest and largest of Bistro Interior, Bistro Exterior and Emerald
 // Square), and the fly-through's bounds are those ranges' ends.
 TEST(Flythrough, OrcaRangesAreTheThesisRowsExtremes) {
-  using flythrough::orcaRange;
+  using camera::orcaRange;
   EXPECT_DOUBLE_EQ(orcaRange("6.4", 0).low, 0.013);
   EXPECT_DOUBLE_EQ(orcaRange("6.4", 2).high, 0.248);
   EXPECT_DOUBLE_EQ(orcaRange("6.5", 0).low, 0.134);  // Bistro Exterior, below the Wine camera's 0.136
@@ -82,7 +82,7 @@ TEST(Flythrough, OrcaRangesAreTheThesisRowsExtremes) {
   EXPECT_DOUBLE_EQ(orcaRange("6.6", 5).high, 0.0);
   EXPECT_TRUE(std::isnan(orcaRange("6.6", 9).low));  // no such column
   EXPECT_TRUE(std::isnan(orcaRange("9.9", 0).low));  // no such table
-  const flythrough::FlythroughOptions o;
+  const camera::FlythroughOptions o;
   EXPECT_DOUBLE_EQ(o.maxYawMean, 0.511);
   EXPECT_DOUBLE_EQ(o.maxPitchVariance, 0.004);
   EXPECT_DOUBLE_EQ(o.minPitchMean, 0.014);
@@ -96,7 +96,7 @@ TEST(Demo, FlythroughFollowsTheBotsLongestStretchAroundAWallAndTurnsGently) {
   const fs::path dir = test::freshDir("demo_fly");
   const auto [dataset, stretchEnd] = writeUTurn(dir);
   const double t = stretchEnd + 1.0;
-  const auto report = flythrough::writeFlythroughCsv(dataset, dir / "fly.csv");
+  const auto report = camera::writeFlythroughCsv(dataset, dir / "fly.csv");
   ASSERT_TRUE(report) << report.error().message;
   EXPECT_NEAR(report->stretchStart, 0.0, 1e-9);
   EXPECT_NEAR(report->stretchEnd, stretchEnd, 1.0 / 60);
@@ -140,14 +140,14 @@ TEST(Demo, FlythroughFollowsTheBotsLongestStretchAroundAWallAndTurnsGently) {
   // Per frame at 24 fps the yaw turns about turned / (24 duration) degrees on average; the bounds
   // hold unless even a window as long as the flight could not meet them.
   EXPECT_NEAR(report->yawMean, turned / (24.0 * duration), 0.1 * report->yawMean);
-  const flythrough::FlythroughOptions bounds;
+  const camera::FlythroughOptions bounds;
   if (report->headingWindow <= duration) {
     EXPECT_LE(report->yawMean, bounds.maxYawMean);
     EXPECT_LE(report->yawVariance, bounds.maxYawVariance);
   }
   // A flat path has no pitch of its own: the nod gives it ORCA's (at least the least row's 0.014°
   // a frame, about the target 0.03).
-  const flythrough::FlythroughOptions defaults;
+  const camera::FlythroughOptions defaults;
   EXPECT_GT(report->nodAmplitude, 0.0);
   EXPECT_GE(report->pitchMean, defaults.pitchTarget);
   EXPECT_LT(report->pitchMean, 1.2 * defaults.pitchTarget);
@@ -159,9 +159,9 @@ TEST(Demo, FlythroughFollowsTheBotsLongestStretchAroundAWallAndTurnsGently) {
   EXPECT_LT(forward(rows.back()).z, -0.9);  // down the second leg, towards -Z
   for (const auto& r : rows) EXPECT_LE(std::abs(forward(r).y), std::sin(radians(report->nodAmplitude)) + 1e-9);
   // Without the nod the flat path is flown level.
-  flythrough::FlythroughOptions level;
+  camera::FlythroughOptions level;
   level.pitchTarget = 0;
-  const auto flat = flythrough::writeFlythroughCsv(dataset, dir / "level.csv", level);
+  const auto flat = camera::writeFlythroughCsv(dataset, dir / "level.csv", level);
   ASSERT_TRUE(flat) << flat.error().message;
   EXPECT_EQ(flat->nodAmplitude, 0.0);
   EXPECT_LE(flat->pitchMean, 1e-9);
@@ -171,7 +171,7 @@ TEST(Demo, FlythroughFollowsTheBotsLongestStretchAroundAWallAndTurnsGently) {
   // An empty dataset (no camera animation) is an error naming the file.
   test::GltfBuilder still;
   still.node({{"name", "eye"}, {"camera", still.perspectiveCamera()}});
-  const auto none = flythrough::writeFlythroughCsv(still.write(dir, "still"), dir / "none.csv");
+  const auto none = camera::writeFlythroughCsv(still.write(dir, "still"), dir / "none.csv");
   ASSERT_FALSE(none);
   EXPECT_NE(none.error().message.find("still.gltf"), std::string::npos) << none.error().message;
   EXPECT_FALSE(fs::exists(dir / "none.csv"));
@@ -229,7 +229,7 @@ TEST(Demo, WholeChainOnAShortMatch) {
   double pitchMean = 0, pitchVariance = 0, yawMean = 0, yawVariance = 0;
   ASSERT_EQ(std::sscanf(md.c_str() + md.find('|', row + 2), "| %lf | %lf | %lf | %lf", &pitchMean, &pitchVariance, &yawMean, &yawVariance), 4)
       << md.substr(row, 80);
-  const flythrough::FlythroughOptions orca;
+  const camera::FlythroughOptions orca;
   EXPECT_LE(yawMean, orca.maxYawMean + 1e-3);
   EXPECT_LE(yawVariance, orca.maxYawVariance + 1e-3);
   EXPECT_LE(pitchMean, orca.maxPitchMean + 1e-3);

@@ -1,10 +1,10 @@
 // `dynbench flythrough DATASET -o OUT.gltf`: the demo's fly-through for any dataset with an animated
-// camera, with its ORCA-range check (flythrough/flythrough.h).
+// camera, with its ORCA-range check (camera/flythrough.h).
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
 #include "core/files.h"
-#include "flythrough/flythrough.h"
+#include "camera/flythrough.h"
 
 namespace dynbench::cli {
 namespace {
@@ -12,15 +12,15 @@ namespace {
 struct FlythroughCli {
   std::string dataset, output, csv, json;
   bool requireOrca = false;
-  flythrough::FlythroughOptions options;
+  camera::FlythroughOptions options;
 };
 
 Expected<void> runFlythrough(const FlythroughCli& cli) {
   const std::filesystem::path output(cli.output);
   const std::filesystem::path csv = cli.csv.empty() ? std::filesystem::path(output).replace_extension(".csv") : std::filesystem::path(cli.csv);
-  auto made = flythrough::makeFlythroughDataset(cli.dataset, output, csv, cli.options);
+  auto made = camera::makeFlythroughDataset(cli.dataset, output, csv, cli.options);
   if (!made) return std::unexpected(made.error());
-  fmt::print("{}: {}\n", output.string(), flythrough::describe(*made));
+  fmt::print("{}: {}\n", output.string(), camera::describe(*made));
   fmt::print("{:<42} {:>10} {:>10} {:>10}\n", "measure (the new dataset at --fps)", "value", "ORCA low", "ORCA high");
   for (const auto& c : made->checks)
     fmt::print("{:<42} {:>10.4f} {:>10.3f} {:>10.3f}{}\n", c.measure, c.value, c.low, c.high, c.inside() ? "" : "  outside");

@@ -2,7 +2,7 @@
 #include <optional>
 
 #include "cli/commands.h"
-#include "convert/merge_camera.h"
+#include "camera/merge_camera.h"
 
 namespace dynbench::cli {
 namespace {
@@ -14,13 +14,13 @@ struct MergeCli {
 };
 
 Expected<void> runMerge(const MergeCli& cli) {
-  convert::MergeCameraOptions options;
+  camera::MergeCameraOptions options;
   options.dataset = cli.dataset;
   options.run = cli.run;
   options.output = cli.output;
   options.camera = cli.camera;
   options.offsetSeconds = cli.offset;
-  auto report = convert::mergeCamera(options);
+  auto report = camera::mergeCamera(options);
   if (!report) return std::unexpected(report.error());
   fmt::print("{}: camera node {} now follows {} ({} keys, {:.3f} s to {:.3f} s)\n", cli.output, report->cameraNode, cli.run,
              report->keys, report->startTime, report->endTime);

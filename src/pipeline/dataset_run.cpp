@@ -95,16 +95,16 @@ Expected<void> captureAndConvert(const capture::OpenArenaOptions& options, const
   });
 }
 
-Expected<void> flyThroughUnlessNewer(const fs::path& bot, const fs::path& fly, const fs::path& csv, const flythrough::FlythroughOptions& options,
+Expected<void> flyThroughUnlessNewer(const fs::path& bot, const fs::path& fly, const fs::path& csv, const camera::FlythroughOptions& options,
                                      const RunLog& log) {
   if (isNewerThan(fly, bot)) {
     log("fly-through: " + fly.string() + " is newer than its source, reused");
     return {};
   }
   log("fly-through: a smooth camera over the same match -> " + fly.string());
-  auto flown = flythrough::makeFlythroughDataset(bot, fly, csv, options);
+  auto flown = camera::makeFlythroughDataset(bot, fly, csv, options);
   if (!flown) return std::unexpected(flown.error());
-  log("  " + flythrough::describe(*flown));
+  log("  " + camera::describe(*flown));
   return {};
 }
 

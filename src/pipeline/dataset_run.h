@@ -15,7 +15,7 @@
 #include "discard/discard.h"
 #include "evaluate/evaluate.h"
 #include "metrics/camera_motion.h"
-#include "flythrough/flythrough.h"
+#include "camera/flythrough.h"
 #include "pipeline/stages.h"
 
 namespace dynbench::pipeline {
@@ -66,7 +66,7 @@ Expected<void> captureAndConvert(const capture::OpenArenaOptions& options, const
 // The fly-through of `bot` as the dataset `fly` (its pose log `csv`), made unless `fly` is newer
 // than `bot`.
 Expected<void> flyThroughUnlessNewer(const std::filesystem::path& bot, const std::filesystem::path& fly, const std::filesystem::path& csv,
-                                     const flythrough::FlythroughOptions& options, const RunLog& log);
+                                     const camera::FlythroughOptions& options, const RunLog& log);
 
 // The two renders of a dataset: converged reference frames (RUN/frames) and the temporal methods'
 // input (RUN/input), of the same window of frames around the middle of the dataset.

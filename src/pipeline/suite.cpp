@@ -13,7 +13,7 @@
 #include "core/files.h"
 #include "core/json_fields.h"
 #include "dynbench/version.h"
-#include "flythrough/flythrough.h"
+#include "camera/flythrough.h"
 #include "report/plots.h"
 #include "report/stats_output.h"
 #include "scene/load.h"
@@ -294,7 +294,7 @@ Expected<fs::path> prepareDataset(const DatasetSpec& d, const fs::path& root, do
                               : pipeline::captureAndConvert(plan->options, folder / "capture-options.json", bot, indented);
   if (!made) return std::unexpected(made.error());
   if (d.camera == "bot") return bot;
-  flythrough::FlythroughOptions o;
+  camera::FlythroughOptions o;
   o.frameRate = fps;  // the rate the suite renders and measures at
   const fs::path fly = folder / "flythrough.gltf";
   if (auto ok = pipeline::flyThroughUnlessNewer(bot, fly, folder / "flythrough.csv", o, indented); !ok) return std::unexpected(ok.error());

@@ -1,4 +1,4 @@
-#include "flythrough/flythrough.h"
+#include "camera/flythrough.h"
 
 #include <algorithm>
 #include <cstdlib>
@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "convert/merge_camera.h"
+#include "camera/merge_camera.h"
 #include "core/files.h"
 #include "core/math.h"
 #include "render/raytracing_scene.h"
@@ -17,7 +17,7 @@
 #include "scene/queries.h"
 #include "report/reference.h"
 
-namespace dynbench::flythrough {
+namespace dynbench::camera {
 
 namespace fs = std::filesystem;
 
@@ -323,11 +323,11 @@ Expected<FlythroughDataset> makeFlythroughDataset(const fs::path& dataset, const
   auto flight = writeFlythroughCsv(dataset, csv, o);
   if (!flight) return std::unexpected(flight.error());
   made.flight = *flight;
-  convert::MergeCameraOptions merge;
+  MergeCameraOptions merge;
   merge.dataset = dataset;
   merge.run = csv;
   merge.output = output;
-  if (auto merged = convert::mergeCamera(merge); !merged) return std::unexpected(merged.error());
+  if (auto merged = mergeCamera(merge); !merged) return std::unexpected(merged.error());
   auto scene = scene::loadScene(output);
   if (!scene) return std::unexpected(scene.error());
   auto motion = metrics::measureCameraMotion(*scene, o.frameRate, std::nullopt);
@@ -352,4 +352,4 @@ std::string describe(const FlythroughDataset& made) {
                      r.pitchMean, r.pitchVariance, verdict);
 }
 
-}  // namespace dynbench::flythrough
+}  // namespace dynbench::camera

@@ -15,7 +15,7 @@
 #include "core/error.h"
 #include "metrics/camera_motion.h"
 
-namespace dynbench::flythrough {
+namespace dynbench::camera {
 
 // A column of the thesis's Tables 6.4-6.6 over its three ORCA rows (Bistro Interior, Bistro
 // Exterior, Emerald Square; Table 6.5's Bistro Interior row is its "Wine" camera): the smallest and
@@ -94,4 +94,4 @@ Expected<FlythroughDataset> makeFlythroughDataset(const std::filesystem::path& d
 // One line: the stretch, the widths and rates chosen, and the ORCA verdict (the checks outside).
 std::string describe(const FlythroughDataset& made);
 
-}  // namespace dynbench::flythrough
+}  // namespace dynbench::camera

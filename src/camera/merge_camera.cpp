@@ -1,4 +1,4 @@
-#include "convert/merge_camera.h"
+#include "camera/merge_camera.h"
 
 #include <charconv>
 #include <cmath>
@@ -17,11 +17,13 @@
 #include "scene/load.h"
 #include "scene/queries.h"
 
-namespace dynbench::convert {
+namespace dynbench::camera {
 namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
+// The one glTF writer (convert/gltf_writer.h) writes the merged dataset.
+using convert::BinaryBuffer, convert::addDataAccessor, convert::kFloat, convert::writeDataset;
 
 Expected<std::vector<CameraPoseKey>> readCaptureRun(const fs::path& dir) {
   auto reader = capture::CaptureReader::open(dir);
@@ -204,4 +206,4 @@ Expected<MergeCameraReport> mergeCamera(const MergeCameraOptions& options) {
   return MergeCameraReport{*node, times.size(), times.front(), times.back()};
 }
 
-}  // namespace dynbench::convert
+}  // namespace dynbench::camera

@@ -11,7 +11,7 @@
 
 #include "core/error.h"
 
-namespace dynbench::convert {
+namespace dynbench::camera {
 
 struct CameraPoseKey {
   double time = 0.0;  // seconds
@@ -40,4 +40,4 @@ struct MergeCameraReport {
 
 Expected<MergeCameraReport> mergeCamera(const MergeCameraOptions& options);
 
-}  // namespace dynbench::convert
+}  // namespace dynbench::camera
