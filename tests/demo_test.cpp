@@ -13,7 +13,7 @@
 #include "capture/cube2.h"
 #include "core/files.h"
 #include "core/math.h"
-#include "pipeline/demo.h"
+#include "suite/demo.h"
 #include "camera/flythrough.h"
 #include "render/raytracing_scene.h"
 #include "scene/evaluate.h"

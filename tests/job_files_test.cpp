@@ -10,7 +10,7 @@
 #include "capture/cube2_job.h"
 #include "core/files.h"
 #include "gltf_builder.h"
-#include "pipeline/demo.h"
+#include "suite/demo.h"
 #include "render/render_job_json.h"
 #include "run_cli.h"
 

@@ -9,7 +9,7 @@
 #include "core/files.h"
 #include "frames/frame_io.h"
 #include "metrics/rank_correlation.h"
-#include "pipeline/suite.h"
+#include "suite/suite.h"
 #include "external_tools.h"
 #include "gltf_builder.h"
 #include "other_machine.h"

@@ -1,8 +1,8 @@
-// `dynbench demo [-o DIR]`: the whole chain on a seeded Cube 2 match (src/pipeline/demo.h).
+// `dynbench demo [-o DIR]`: the whole chain on a seeded Cube 2 match (src/suite/demo.h).
 #include "capture/cube2.h"
 #include "cli/commands.h"
 #include "core/progress.h"
-#include "pipeline/demo.h"
+#include "suite/demo.h"
 #include "pipeline/cluster_jobs.h"
 
 namespace dynbench::cli {
@@ -14,7 +14,7 @@ struct DemoCli {
   std::string part = "all";
   bool slurm = false;
   cluster::Options slurmOptions;
-  std::filesystem::path jobFile;          // --job: the options from a file (pipeline/demo.h)
+  std::filesystem::path jobFile;          // --job: the options from a file (suite/demo.h)
   std::vector<std::string> givenWithJob;  // options given beside --job (an error)
   bool threadsGiven = false;
 };

@@ -1,8 +1,9 @@
-// `dynbench suite MANIFEST -o DIR` and `dynbench suite verify DIR` (pipeline/suite.h).
+// `dynbench suite MANIFEST -o DIR` and `dynbench suite verify DIR` (suite/suite.h, suite/verify.h).
 #include <cstdio>
 
 #include "cli/commands.h"
-#include "pipeline/suite.h"
+#include "suite/suite.h"
+#include "suite/verify.h"
 
 namespace dynbench::cli {
 namespace {

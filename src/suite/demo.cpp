@@ -1,4 +1,4 @@
-#include "pipeline/demo.h"
+#include "suite/demo.h"
 
 #include <algorithm>
 #include <cmath>

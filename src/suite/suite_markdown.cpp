@@ -1,0 +1,108 @@
+#include "suite/suite_markdown.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "dynbench/version.h"
+#include "report/plots.h"
+#include "report/stats_output.h"
+
+namespace dynbench::suite {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Below this many datasets a bootstrap interval is not shown: resamples of a few points are
+// mostly ties and duplicates, and their rho takes only a handful of values.
+constexpr int kMinDatasetsForInterval = 8;
+
+std::string cellText(const ValidityCell& c) {
+  if (!c.correlation.rho) return "—";
+  if (!c.correlation.low || c.datasets < kMinDatasetsForInterval) return fmt::format("{:+.2f}", *c.correlation.rho);
+  const bool sure = *c.correlation.low > 0 || *c.correlation.high < 0;  // the interval excludes 0
+  return fmt::format("{}{:+.2f} [{:+.2f}, {:+.2f}]{}", sure ? "**" : "", *c.correlation.rho, *c.correlation.low, *c.correlation.high, sure ? "**" : "");
+}
+
+
+}  // namespace
+
+nlohmann::json validityJson(const std::vector<ValidityCell>& cells) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const ValidityCell& c : cells) {
+    auto number = [](const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); };
+    out.push_back({{"measure", c.measure}, {"method", c.method}, {"error", c.error}, {"rho", number(c.correlation.rho)}, {"low", number(c.correlation.low)},
+                   {"high", number(c.correlation.high)}, {"datasets", c.datasets}, {"resamples", c.correlation.resamples}});
+  }
+  return out;
+}
+
+// suite.md: the datasets' numbers, the validity table (each method's ranking error), and a
+// scatter plot per method of that error against its best-correlated measure.
+Expected<std::string> suiteMarkdown(const Manifest& manifest, const std::vector<DatasetResult>& datasets, const std::vector<ValidityCell>& cells,
+                                    const fs::path& root) {
+  std::string md = fmt::format("# Suite {}\n\n{}\n\n", manifest.name, manifest.description);
+  const auto& r = manifest.run;
+  md += fmt::format("{} datasets; each a window of {} frames at {}x{}, references converged (tolerance {}, {}-{} spp, {} bounces), "
+                    "input {} spp; dynbench {}.\n\n",
+                    datasets.size(), r.renderFrames, r.width, r.height, r.tolerance, r.samplesPerPixel, r.maxSamplesPerPixel, r.bounces,
+                    r.inputSamplesPerPixel, kVersion);
+  std::vector<std::string> methods;
+  if (!datasets.empty())
+    for (const auto& [method, errors] : datasets.front().errors) methods.push_back(method);
+  {
+    std::vector<std::string> header{"dataset"};
+    for (const auto& m : measureKeys()) header.push_back(m);
+    for (const auto& m : methods) header.push_back(m + " ꟻLIP");
+    std::vector<std::vector<std::string>> rows;
+    for (const DatasetResult& d : datasets) {
+      std::vector<std::string> row{d.name};
+      for (const auto& m : measureKeys()) row.push_back(fmt::format("{:.3f}", d.measures.at(m)));
+      for (const auto& m : methods) row.push_back(fmt::format("{:.4f}", d.errors.at(m).at("flip")));
+      rows.push_back(row);
+    }
+    md += "## Datasets\n\nTable 6.7's columns over the window (%), the camera over the same frames (units or degrees per frame, cuts counted), "
+          "each method's mean ꟻLIP.\n\n" + report::markdownTable(header, rows) + "\n";
+  }
+  {
+    std::vector<std::string> header{"measure"};
+    for (const auto& m : methods) header.push_back(fmt::format("{} ({})", m, rankingError(m)));
+    std::vector<std::vector<std::string>> rows;
+    for (const auto& measure : measureKeys()) {
+      std::vector<std::string> row{measure};
+      for (const auto& m : methods) {
+        const auto c = std::find_if(cells.begin(), cells.end(), [&](const ValidityCell& v) { return v.measure == measure && v.method == m && v.error == rankingError(m); });
+        row.push_back(c == cells.end() ? "—" : cellText(*c));
+      }
+      rows.push_back(row);
+    }
+    md += "## Validity\n\nSpearman's rank correlation of each difficulty measure with each method's error over the datasets, with its "
+          "bootstrap 95 % interval (2000 resamples of the datasets); in bold where the interval excludes 0. Methods are ranked by "
+          "their ꟻLIP minus `none`'s on the same frames (what history costs or gains: the content's own difficulty, the same for "
+          "every method, cancels), `none` by its ꟻLIP. Every error's table is in suite.json." +
+          (datasets.size() < static_cast<std::size_t>(kMinDatasetsForInterval)
+               ? fmt::format(" With fewer than {} datasets no interval is shown: a bootstrap of so few points says nothing.", kMinDatasetsForInterval)
+               : std::string()) +
+          "\n\n" +
+          report::markdownTable(header, rows) + "\n";
+  }
+  // A scatter plot per method: its ranking error against the measure with the largest |rho|.
+  md += "## Each method against its best-correlated measure\n\n";
+  for (const auto& m : methods) {
+    const ValidityCell* best = nullptr;
+    for (const ValidityCell& c : cells)
+      if (c.method == m && c.error == rankingError(m) && c.correlation.rho && (!best || std::abs(*c.correlation.rho) > std::abs(*best->correlation.rho)))
+        best = &c;
+    if (!best) continue;
+    std::vector<report::ScatterPoint> points;
+    for (const DatasetResult& d : datasets) points.push_back({d.name, d.measures.at(best->measure), d.errors.at(m).at(rankingError(m))});
+    auto plot = report::writeScatterPlot(points, measureLabel(best->measure), fmt::format("{}: {}", m, m == "none" ? "mean ꟻLIP" : "mean ꟻLIP minus none's"),
+                                         fmt::format("{}: rho {:+.2f}", m, *best->correlation.rho), root / "plots", "scatter_" + m);
+    if (!plot) return std::unexpected(plot.error());
+    md += fmt::format("![{} against {}](plots/scatter_{}.png)\n\n", m, best->measure, m);
+  }
+  return md;
+}
+}  // namespace dynbench::suite

@@ -1,0 +1,22 @@
+#pragma once
+// suite.md and suite.json's validity table: the datasets' numbers, the validity table (each
+// method's ranking error, with bootstrap intervals) and a scatter plot per method.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "suite/manifest.h"
+#include "suite/validity.h"
+
+namespace dynbench::suite {
+
+// suite.json's /validity: one object per cell.
+nlohmann::json validityJson(const std::vector<ValidityCell>& cells);
+// suite.md, with its scatter plots written into root/plots.
+Expected<std::string> suiteMarkdown(const Manifest& manifest, const std::vector<DatasetResult>& datasets, const std::vector<ValidityCell>& cells,
+                                    const std::filesystem::path& root);
+
+}  // namespace dynbench::suite

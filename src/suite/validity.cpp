@@ -1,0 +1,96 @@
+#include "suite/validity.h"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+namespace dynbench::suite {
+
+const std::vector<std::string>& measureKeys() {
+  static const std::vector<std::string> measures = [] {
+    std::vector<std::string> m;
+    for (const auto& column : discard::kTable67Columns) m.push_back(column.key);
+    for (const char* camera : {"camera_position", "camera_rotation", "camera_yaw", "camera_pitch", "camera_cuts"}) m.push_back(camera);
+    return m;
+  }();
+  return measures;
+}
+
+const std::vector<std::string>& errorKeys() {
+  static const std::vector<std::string> errors{"flip", "warped_error_change", "flip_over_none"};
+  return errors;
+}
+
+std::string measureLabel(const std::string& measure) {
+  static const std::map<std::string, std::string> labels = [] {
+    std::map<std::string, std::string> l{
+      {"camera_position", "camera position change (scene units per frame)"}, {"camera_rotation", "camera rotation (degrees per frame)"},
+      {"camera_yaw", "camera yaw change (degrees per frame)"}, {"camera_pitch", "camera pitch change (degrees per frame)"},
+      {"camera_cuts", "camera cuts in the window"}};
+    for (const auto& column : discard::kTable67Columns) l[column.key] = fmt::format("{} discard (%)", column.label);
+    return l;
+  }();
+  const auto it = labels.find(measure);
+  return it == labels.end() ? measure : it->second;
+}
+// Below this many datasets a bootstrap interval is not shown: resamples of a few points are
+// mostly ties and duplicates, and their rho takes only a handful of values.
+
+std::string rankingError(const std::string& method) { return method == "none" ? "flip" : "flip_over_none"; }
+
+std::vector<ValidityCell> validity(const std::vector<DatasetResult>& datasets) {
+  std::vector<ValidityCell> cells;
+  if (datasets.empty()) return cells;
+  std::vector<std::string> methods;
+  for (const auto& [method, errors] : datasets.front().errors) methods.push_back(method);
+  for (const std::string& measure : measureKeys())
+    for (const std::string& method : methods)
+      for (const std::string& error : errorKeys()) {
+        std::vector<double> x, y;
+        for (const DatasetResult& d : datasets) {
+          const auto m = d.measures.find(measure);
+          const auto e = d.errors.find(method);
+          if (m == d.measures.end() || e == d.errors.end()) continue;
+          const auto v = e->second.find(error);
+          if (v == e->second.end()) continue;
+          x.push_back(m->second), y.push_back(v->second);
+        }
+        if (x.empty()) continue;
+        cells.push_back({measure, method, error, metrics::rankCorrelation(x, y), static_cast<int>(x.size())});
+      }
+  return cells;
+}
+
+// The difficulty measures of one dataset's window (DatasetResult).
+std::map<std::string, double> measuresOf(const metrics::CameraMotion& motion, long first, long last, const discard::FramePercentages& d) {
+  std::map<std::string, double> m;
+  for (const auto& column : discard::kTable67Columns) m[column.key] = d.*column.member;
+  std::vector<double> position, rotation, yaw, pitch;
+  double cuts = 0;
+  for (long i = first + 1; i <= last && i < static_cast<long>(motion.frames.size()); ++i) {
+    const metrics::CameraFrame& f = motion.frames[static_cast<std::size_t>(i)];
+    if (f.cut) {
+      ++cuts;
+      continue;
+    }
+    position.push_back(f.positionDelta), rotation.push_back(f.rotationDelta), yaw.push_back(f.yawDelta), pitch.push_back(f.pitchDelta);
+  }
+  m["camera_position"] = metrics::summarize(position).mean;
+  m["camera_rotation"] = metrics::summarize(rotation).mean;
+  m["camera_yaw"] = metrics::summarize(yaw).mean;
+  m["camera_pitch"] = metrics::summarize(pitch).mean;
+  m["camera_cuts"] = cuts;
+  return m;
+}
+
+std::map<std::string, std::map<std::string, double>> errorsOf(const std::vector<evaluate::MethodScores>& methods) {
+  std::map<std::string, std::map<std::string, double>> e;
+  const auto none = std::find_if(methods.begin(), methods.end(), [](const auto& m) { return m.name == "none"; });
+  for (const auto& m : methods) {
+    e[m.name]["flip"] = m.flip.mean;
+    e[m.name]["warped_error_change"] = m.warpedErrorChange.mean;
+    if (none != methods.end()) e[m.name]["flip_over_none"] = m.flip.mean - none->flip.mean;
+  }
+  return e;
+}
+}  // namespace dynbench::suite

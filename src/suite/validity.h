@@ -1,0 +1,52 @@
+#pragma once
+// A suite's numbers and whether its difficulty measures predict the methods' errors: each
+// dataset's measures and errors, and the rank correlation of every (measure, method, error) over
+// the datasets (docs/suite.md, "Validity").
+#include <map>
+#include <string>
+#include <vector>
+
+#include "discard/discard.h"
+#include "evaluate/evaluate.h"
+#include "metrics/camera_motion.h"
+#include "metrics/rank_correlation.h"
+
+namespace dynbench::suite {
+
+// One dataset's numbers. Difficulty measures (docs/suite.md): Table 6.7's five columns over the
+// render window (percent) and the camera's motion over the same frames (Tables 6.4-6.6: position
+// in scene units and rotation, yaw and pitch in degrees per frame, cuts left out; cuts counted).
+// Method errors: "flip" (mean ꟻLIP), "warped_error_change" and "flip_over_none" (the method's
+// ꟻLIP minus `none`'s on the same frames: what history costs or gains).
+struct DatasetResult {
+  std::string name;
+  std::map<std::string, double> measures;
+  std::map<std::string, std::map<std::string, double>> errors;  // method -> error name -> value
+};
+
+// The rank correlation of one measure with one method's error over the suite's datasets.
+struct ValidityCell {
+  std::string measure, method, error;
+  metrics::RankCorrelation correlation;
+  int datasets = 0;
+};
+
+// The error each method is ranked by: flip_over_none, or flip for `none` itself.
+std::string rankingError(const std::string& method);
+// Every (measure, method, error) cell, over the datasets' numbers.
+std::vector<ValidityCell> validity(const std::vector<DatasetResult>& datasets);
+
+// The measures, in the order tables list them: Table 6.7's columns by their keys
+// (discard::kTable67Columns), then the camera's motion; and the errors of each method.
+const std::vector<std::string>& measureKeys();
+const std::vector<std::string>& errorKeys();
+// A measure's axis label, with its unit.
+std::string measureLabel(const std::string& measure);
+
+// The difficulty measures of one dataset's window, frames first..last (DatasetResult::measures):
+// its discard mean and the camera's motion over the same frames, cuts left out and counted.
+std::map<std::string, double> measuresOf(const metrics::CameraMotion& motion, long first, long last, const discard::FramePercentages& discarded);
+// Each method's errors (DatasetResult::errors).
+std::map<std::string, std::map<std::string, double>> errorsOf(const std::vector<evaluate::MethodScores>& methods);
+
+}  // namespace dynbench::suite
