@@ -1,4 +1,4 @@
-// dynbench fidelity's comparison against known answers: a render that matches the game's frame
+// dynbench fidelity's comparison (evaluate/game_agreement.h) against known answers: a render that matches the game's frame
 // passes with full agreement; one whose depth is off, or that is black or speckled where the game
 // shows lit walls, fails (docs/fidelity.md).
 #include <cmath>
@@ -8,12 +8,12 @@
 
 #include "pipeline/fidelity.h"
 
-namespace dynbench::pipeline {
+namespace dynbench::evaluate {
 namespace {
 
 // A corridor-like frame: depth rising towards the centre, a lit band and a dark band, sky on top.
-FidelityImages corridor(int w = 96, int h = 54) {
-  FidelityImages m;
+GameImages corridor(int w = 96, int h = 54) {
+  GameImages m;
   m.width = w;
   m.height = h;
   m.near = 0.54;
@@ -44,7 +44,7 @@ FidelityImages corridor(int w = 96, int h = 54) {
 }
 
 TEST(Fidelity, ARenderOfTheSameFramePassesWithFullAgreement) {
-  const FidelityFrame f = compareWithGame(corridor());
+  const GameAgreement f = compareWithGame(corridor());
   EXPECT_EQ(f.depthAgreement, 1.0);
   EXPECT_EQ(f.skyAgreement, 1.0);
   EXPECT_GT(f.correlation, 0.99);  // exposure and tone curve do not matter
@@ -53,9 +53,9 @@ TEST(Fidelity, ARenderOfTheSameFramePassesWithFullAgreement) {
 }
 
 TEST(Fidelity, ADepthOffByMoreThanItsToleranceFails) {
-  FidelityImages m = corridor();
+  GameImages m = corridor();
   for (auto& z : m.renderDepth) z *= 1.03f;  // 3 %: beyond 1 % + four 24-bit depth steps at these depths
-  FidelityFrame f = compareWithGame(m);
+  GameAgreement f = compareWithGame(m);
   EXPECT_LT(f.depthAgreement, 0.05);
   EXPECT_FALSE(f.passed);
   m = corridor();
@@ -64,16 +64,16 @@ TEST(Fidelity, ADepthOffByMoreThanItsToleranceFails) {
 }
 
 TEST(Fidelity, ABlackOrSpeckledRenderFails) {
-  FidelityImages black = corridor();
+  GameImages black = corridor();
   for (auto& v : black.renderRadiance) v = 0.0f;
   for (auto& v : black.renderDirect) v = 0.0f;
-  FidelityFrame f = compareWithGame(black);
+  GameAgreement f = compareWithGame(black);
   EXPECT_EQ(f.depthAgreement, 1.0);  // the geometry is right
   EXPECT_EQ(f.unlitShare, 1.0);
   EXPECT_FALSE(f.passed);
   // Speckle: each pixel black or bright at random (what two_towers rendered as when its lights were
   // culled), whatever the game shows.
-  FidelityImages speckle = corridor();
+  GameImages speckle = corridor();
   std::mt19937 rng(1);
   for (std::size_t i = 0; i < speckle.renderRadiance.size() / 3; ++i) {
     const float v = rng() % 8 == 0 ? 5000.0f : 0.0f;
@@ -89,7 +89,7 @@ TEST(Fidelity, ABlackOrSpeckledRenderFails) {
 // the pixels where the render sees other geometry (twice as far) leave the median, so the far plane
 // and the other pixels' depths come back, and those pixels disagree.
 TEST(Fidelity, IdTech3WindowDepthWithItsFarPlaneSolved) {
-  FidelityImages m = corridor();
+  GameImages m = corridor();
   const double near = 4.0, far = 3000.0;
   std::vector<float> window(m.gameDepth.size());
   for (std::size_t i = 0; i < window.size(); ++i) {
@@ -112,18 +112,18 @@ TEST(Fidelity, IdTech3WindowDepthWithItsFarPlaneSolved) {
   m.gameDepth = view.depth;
   m.near = near;
   m.far = view.far;
-  const FidelityFrame f = compareWithGame(m);
+  const GameAgreement f = compareWithGame(m);
   EXPECT_NEAR(f.depthAgreement, 0.8, 0.02);  // the fifth placed twice as far disagrees
   // a frame whose depth the game did not keep: no depth measures, judged on correlation alone
   m.gameDepthKnown = false;
   m.gameDepth = m.renderHit;
-  const FidelityFrame g = compareWithGame(m);
+  const GameAgreement g = compareWithGame(m);
   EXPECT_TRUE(std::isnan(g.depthAgreement));
   EXPECT_TRUE(std::isnan(g.skyAgreement));
   EXPECT_GT(g.correlation, 0.99);
   EXPECT_TRUE(g.passed);
-  EXPECT_FALSE(windowDepthNear("/nonexistent/window_depth.txt"));
+  EXPECT_FALSE(pipeline::windowDepthNear("/nonexistent/window_depth.txt"));
 }
 
 }  // namespace
-}  // namespace dynbench::pipeline
+}  // namespace dynbench::evaluate

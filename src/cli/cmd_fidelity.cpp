@@ -25,7 +25,7 @@ void addFidelityCommand(CLI::App& app, CommandRun& run) {
       fmt::print("{}", outcome->markdown);
       if (!outcome->passed)
         return fail(ErrorCode::kInvalidData, "{}: a frame does not look like the game's (depth agreement below {} or correlation below {})",
-                    o->dataset.string(), pipeline::kFidelityMinDepthAgreement, pipeline::kFidelityMinCorrelation);
+                    o->dataset.string(), evaluate::kFidelityMinDepthAgreement, evaluate::kFidelityMinCorrelation);
       return {};
     };
   });
