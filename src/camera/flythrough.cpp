@@ -352,4 +352,24 @@ std::string describe(const FlythroughDataset& made) {
                      r.pitchMean, r.pitchVariance, verdict);
 }
 
+nlohmann::json flythroughJson(const FlythroughDataset& made, const fs::path& dataset, const fs::path& output, const fs::path& csv) {
+  const auto& f = made.flight;
+  nlohmann::json doc = {{"dataset", dataset.string()},
+                        {"output", output.string()},
+                        {"csv", csv.string()},
+                        {"stretch", {{"start", f.stretchStart}, {"end", f.stretchEnd}, {"length", f.stretchLength}}},
+                        {"stretches_compared", f.stretchesCompared},
+                        {"length", f.length},
+                        {"speed", f.speed},
+                        {"smoothing", f.smoothing},
+                        {"heading_window", f.headingWindow},
+                        {"pitch_window", f.pitchWindow},
+                        {"nod_amplitude", f.nodAmplitude},
+                        {"inside_orca", made.insideOrca()},
+                        {"checks", nlohmann::json::array()}};
+  for (const auto& c : made.checks)
+    doc["checks"].push_back({{"measure", c.measure}, {"value", c.value}, {"low", c.low}, {"high", c.high}, {"inside", c.inside()}});
+  return doc;
+}
+
 }  // namespace dynbench::camera

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "core/error.h"
 #include "metrics/camera_motion.h"
 
@@ -93,5 +95,9 @@ Expected<FlythroughDataset> makeFlythroughDataset(const std::filesystem::path& d
                                                   const std::filesystem::path& csv, const FlythroughOptions& options = {});
 // One line: the stretch, the widths and rates chosen, and the ORCA verdict (the checks outside).
 std::string describe(const FlythroughDataset& made);
+// The `flythrough --json` document (docs/cli.md): the files, the stretch, widths and rates, and the
+// ORCA checks.
+nlohmann::json flythroughJson(const FlythroughDataset& made, const std::filesystem::path& dataset, const std::filesystem::path& output,
+                              const std::filesystem::path& csv);
 
 }  // namespace dynbench::camera

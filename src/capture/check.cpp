@@ -99,7 +99,7 @@ std::string summaryText(const std::filesystem::path& directory, const CaptureSum
   return out;
 }
 
-std::string summaryJson(const std::filesystem::path& directory, const CaptureSummary& s) {
+nlohmann::json summaryJson(const std::filesystem::path& directory, const CaptureSummary& s) {
   nlohmann::json camera = nullptr;
   if (s.settings.camera)
     camera = {{"aspect", s.settings.camera->aspect}, {"yfov_degrees", s.settings.camera->yfovDegrees},
@@ -123,7 +123,7 @@ std::string summaryJson(const std::filesystem::path& directory, const CaptureSum
                    {"vertex_frames", s.vertexFrameRecords}, {"light", s.lightRecords}}},
       {"camera_cuts", s.cutsByReason},
       {"warnings", s.warnings}};
-  return j.dump(2) + "\n";
+  return j;
 }
 
 }  // namespace dynbench::capture

@@ -2,6 +2,8 @@
 // `dynbench capture-check`: validates a whole capture and summarises it.
 #include <cstdint>
 #include <filesystem>
+
+#include <nlohmann/json.hpp>
 #include <functional>
 #include <map>
 #include <string>
@@ -36,6 +38,6 @@ Expected<CaptureSummary> checkCapture(const std::filesystem::path& directory,
                                       const std::function<void(std::size_t)>& onFrame = {});
 
 std::string summaryText(const std::filesystem::path& directory, const CaptureSummary& summary);
-std::string summaryJson(const std::filesystem::path& directory, const CaptureSummary& summary);
+nlohmann::json summaryJson(const std::filesystem::path& directory, const CaptureSummary& summary);
 
 }  // namespace dynbench::capture

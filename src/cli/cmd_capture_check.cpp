@@ -3,6 +3,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "core/json_fields.h"
 #include "capture/check.h"
 #include "cli/commands.h"
 #include "core/files.h"
@@ -26,7 +27,7 @@ Expected<void> runCheck(const CheckOptions& options) {
   for (const auto& warning : summary->warnings) spdlog::warn("{}", warning);
   fmt::print("{}", capture::summaryText(options.directory, *summary));
   if (!options.json.empty())
-    if (auto ok = writeFileAtomic(options.json, capture::summaryJson(options.directory, *summary)); !ok) return ok;
+    if (auto ok = writeFileAtomic(options.json, jsonFileText(capture::summaryJson(options.directory, *summary))); !ok) return ok;
   return {};
 }
 

@@ -2,6 +2,7 @@
 // camera, with its ORCA-range check (camera/flythrough.h).
 #include <nlohmann/json.hpp>
 
+#include "core/json_fields.h"
 #include "cli/commands.h"
 #include "core/files.h"
 #include "camera/flythrough.h"
@@ -25,23 +26,7 @@ Expected<void> runFlythrough(const FlythroughCli& cli) {
   for (const auto& c : made->checks)
     fmt::print("{:<42} {:>10.4f} {:>10.3f} {:>10.3f}{}\n", c.measure, c.value, c.low, c.high, c.inside() ? "" : "  outside");
   if (!cli.json.empty()) {
-    const auto& f = made->flight;
-    nlohmann::json doc = {{"dataset", cli.dataset},
-                          {"output", cli.output},
-                          {"csv", csv.string()},
-                          {"stretch", {{"start", f.stretchStart}, {"end", f.stretchEnd}, {"length", f.stretchLength}}},
-                          {"stretches_compared", f.stretchesCompared},
-                          {"length", f.length},
-                          {"speed", f.speed},
-                          {"smoothing", f.smoothing},
-                          {"heading_window", f.headingWindow},
-                          {"pitch_window", f.pitchWindow},
-                          {"nod_amplitude", f.nodAmplitude},
-                          {"inside_orca", made->insideOrca()},
-                          {"checks", nlohmann::json::array()}};
-    for (const auto& c : made->checks)
-      doc["checks"].push_back({{"measure", c.measure}, {"value", c.value}, {"low", c.low}, {"high", c.high}, {"inside", c.inside()}});
-    if (auto ok = writeFileAtomic(cli.json, doc.dump(2) + "\n"); !ok) return std::unexpected(ok.error());
+    if (auto ok = writeFileAtomic(cli.json, jsonFileText(camera::flythroughJson(*made, cli.dataset, output, csv))); !ok) return std::unexpected(ok.error());
   }
   if (cli.requireOrca && !made->insideOrca())
     return fail(ErrorCode::kInvalidData, "{}: the fly-through is outside ORCA's ranges (--require-orca); the dataset is written", output.string());

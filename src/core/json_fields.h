@@ -164,6 +164,11 @@ inline Expected<nlohmann::json> readJsonFile(const std::filesystem::path& path) 
   return j;
 }
 
+// The text of a JSON document as every dynbench stage writes its files: indented by 2, a newline at
+// the end. A stage's document is an nlohmann::json (`xJson(const XRun&)`, beside its reader); the
+// CLI writes this text of it and the Python module converts the object itself.
+inline std::string jsonFileText(const nlohmann::json& document) { return document.dump(2) + "\n"; }
+
 // A JSON file read and given to `parse(document, path)` (a job file's reader).
 template <typename Parse>
 auto readJsonDocument(const std::filesystem::path& path, Parse parse) -> decltype(parse(nlohmann::json{}, path)) {

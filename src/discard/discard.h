@@ -186,7 +186,7 @@ Expected<DiscardRun> discardFolder(const std::filesystem::path& dir, const Thres
 
 // The `discard --json` document: frames folder, size, thresholds, mean and per-frame percentages
 // (docs/cli.md); what `dynbench report` reads.
-std::string discardJson(const DiscardRun& run, const std::string& framesDir);
+nlohmann::json discardJson(const DiscardRun& run, const std::string& framesDir);
 // Reads back what discardJson wrote: size, mean and per-frame percentages (thresholds and warnings
 // are not read). Errors name the file and the JSON pointer of a missing or malformed value.
 Expected<DiscardRun> readDiscardJson(const std::filesystem::path& path);

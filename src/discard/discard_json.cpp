@@ -35,7 +35,7 @@ nlohmann::json percentagesJson(const FramePercentages& p) {
 
 }  // namespace
 
-std::string discardJson(const DiscardRun& run, const std::string& framesDir) {
+nlohmann::json discardJson(const DiscardRun& run, const std::string& framesDir) {
   const auto& t = run.thresholds;
   nlohmann::json j;
   j["frames_dir"] = framesDir;
@@ -58,7 +58,7 @@ std::string discardJson(const DiscardRun& run, const std::string& framesDir) {
     j["frames"].push_back(row);
   }
   j["warnings"] = run.warnings;
-  return j.dump(2) + "\n";
+  return j;
 }
 
 namespace {

@@ -1,3 +1,4 @@
+#include "core/json_fields.h"
 #include "evaluate/compare.h"
 
 #include <algorithm>
@@ -131,7 +132,7 @@ ScoredImage scoreImage(const RgbImage& reference, const RgbImage& test, bool hdr
   return scoreImage(PreparedReference(reference, hdr, ppd), test);
 }
 
-std::string scoresJson(const ImageScores& s, int indent) {
+nlohmann::json scoresJson(const ImageScores& s) {
   nlohmann::json j;
   j["mode"] = s.hdr ? "hdr" : "ldr";
   j["flip"] = {{"mean", s.flip.mean},
@@ -144,7 +145,7 @@ std::string scoresJson(const ImageScores& s, int indent) {
   j["ssim"] = s.ssim ? nlohmann::json(*s.ssim) : nlohmann::json(nullptr);
   j["relmse"] = s.relMse;
   j["smape"] = s.smape;
-  return j.dump(indent);
+  return j;
 }
 
 Expected<CompareResult> runCompare(const CompareOptions& options) {
@@ -169,7 +170,7 @@ Expected<CompareResult> runCompare(const CompareOptions& options) {
                   test->hdr ? "HDR" : "LDR", options.reference.string(), reference->hdr ? "HDR" : "LDR");
     ScoredImage scored = scoreImage(reference->linear, test->linear, reference->hdr, options.pixelsPerDegree);
     const ImageScores& s = scored.scores;
-    nlohmann::json entry = nlohmann::json::parse(scoresJson(s));
+    nlohmann::json entry = scoresJson(s);
     entry["test"] = path.string();
     doc["images"].push_back(entry);
     result.markdown += fmt::format("| {} | {:.4f} | {:.4f} | {:.4f} | {:.4f} | {} | {} | {:.4g} | {:.4g} |\n", path.filename().string(), s.flip.mean,
@@ -186,7 +187,7 @@ Expected<CompareResult> runCompare(const CompareOptions& options) {
     result.scores.push_back(s);
   }
   if (!options.json.empty()) {
-    auto written = writeFileAtomic(options.json, doc.dump(2) + "\n");
+    auto written = writeFileAtomic(options.json, jsonFileText(doc));
     if (!written) return std::unexpected(written.error());
   }
   result.document = std::move(doc);

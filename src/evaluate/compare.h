@@ -65,6 +65,6 @@ Expected<CompareResult> runCompare(const CompareOptions& options);
 
 // ImageScores as JSON: flip {mean, weighted_median, weighted_q1, weighted_q3, max}, exposures,
 // psnr (null when infinite), ssim (null when absent), relmse, smape.
-std::string scoresJson(const ImageScores& scores, int indent = -1);
+nlohmann::json scoresJson(const ImageScores& scores);
 
 }  // namespace dynbench::evaluate

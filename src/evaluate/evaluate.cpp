@@ -257,7 +257,7 @@ Expected<EvaluateRun> runEvaluate(const EvaluateOptions& options, const Evaluate
   }
 
   if (!options.json.empty())
-    if (auto w = writeFileAtomic(options.json, evaluateJson(run).dump(2) + "\n"); !w) return std::unexpected(w.error());
+    if (auto w = writeFileAtomic(options.json, jsonFileText(evaluateJson(run))); !w) return std::unexpected(w.error());
   if (!options.csv.empty()) {
     std::string csv = "method,frame,cut,flip,psnr,ssim,relmse,tpsnr,trelmse,warped_error_change,warp_valid,history_use\n";
     auto num = [](const std::optional<double>& v) { return v && std::isfinite(*v) ? fmt::format("{:.6g}", *v) : std::string(); };

@@ -1,3 +1,4 @@
+#include "core/json_fields.h"
 #include "pipeline/fidelity.h"
 
 #include <algorithm>
@@ -58,7 +59,6 @@ Expected<FidelityOutcome> runFidelity(const FidelityStage& stage) {
   fs::create_directories(stage.output, ec);
   FidelityOutcome out;
   out.passed = true;
-  nlohmann::json framesJson = nlohmann::json::array();
   for (const long k : gameFrames) {
     if (!times.count(k)) return fail(ErrorCode::kInvalidData, "{}: game frame {} is not a frame of the capture", stage.capture.string(), k);
     const fs::path colourPath = stage.capture / "game" / fmt::format("frame_{:05d}.ppm", k);
@@ -149,10 +149,6 @@ Expected<FidelityOutcome> runFidelity(const FidelityStage& stage) {
     f.sideBySide = stage.output / fmt::format("fidelity_{:05d}.png", k);
     if (auto ok = writeImage(f.sideBySide, FloatImage{3 * w, h, 3, side, {}, {}, {}}); !ok) return std::unexpected(ok.error());
     out.passed = out.passed && f.passed;
-    const auto orNull = [](double v) { return std::isnan(v) ? nlohmann::json(nullptr) : nlohmann::json(v); };
-    framesJson.push_back({{"frame", f.frame}, {"time", f.time}, {"width", w}, {"height", h}, {"depth_agreement", orNull(f.depthAgreement)},
-                          {"sky_agreement", orNull(f.skyAgreement)}, {"correlation", f.correlation}, {"unlit_share", f.unlitShare},
-                          {"passed", f.passed}});
     out.frames.push_back(f);
   }
   out.markdown = "| frame | time (s) | depth agreement | sky agreement | luminance correlation | no direct light | pass |\n"
@@ -162,13 +158,22 @@ Expected<FidelityOutcome> runFidelity(const FidelityStage& stage) {
                                 std::isnan(f.depthAgreement) ? std::string("not read") : fmt::format("{:.3f}", f.depthAgreement),
                                 std::isnan(f.skyAgreement) ? std::string("not read") : fmt::format("{:.3f}", f.skyAgreement), f.correlation,
                                 100 * f.unlitShare, f.passed ? "yes" : "no");
-  const nlohmann::json j = {{"capture", stage.capture.string()},
-                            {"dataset", stage.dataset.string()},
-                            {"thresholds", {{"depth_agreement", evaluate::kFidelityMinDepthAgreement}, {"correlation", evaluate::kFidelityMinCorrelation}}},
-                            {"frames", framesJson},
-                            {"passed", out.passed}};
-  if (auto ok = writeFileAtomic(stage.output / "fidelity.json", j.dump(2) + "\n"); !ok) return std::unexpected(ok.error());
+  if (auto ok = writeFileAtomic(stage.output / "fidelity.json", jsonFileText(fidelityJson(out, stage))); !ok) return std::unexpected(ok.error());
   return out;
+}
+
+nlohmann::json fidelityJson(const FidelityOutcome& outcome, const FidelityStage& stage) {
+  const auto orNull = [](double v) { return std::isnan(v) ? nlohmann::json(nullptr) : nlohmann::json(v); };
+  nlohmann::json frames = nlohmann::json::array();
+  for (const FidelityFrame& f : outcome.frames)
+    frames.push_back({{"frame", f.frame}, {"time", f.time}, {"width", f.width}, {"height", f.height}, {"depth_agreement", orNull(f.depthAgreement)},
+                      {"sky_agreement", orNull(f.skyAgreement)}, {"correlation", f.correlation}, {"unlit_share", f.unlitShare},
+                      {"passed", f.passed}});
+  return {{"capture", stage.capture.string()},
+          {"dataset", stage.dataset.string()},
+          {"thresholds", {{"depth_agreement", evaluate::kFidelityMinDepthAgreement}, {"correlation", evaluate::kFidelityMinCorrelation}}},
+          {"frames", frames},
+          {"passed", outcome.passed}};
 }
 
 }  // namespace dynbench::pipeline

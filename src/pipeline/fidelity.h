@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "core/error.h"
 #include "evaluate/game_agreement.h"
 
@@ -37,5 +39,7 @@ struct FidelityOutcome {
 // evaluate::viewDepthFromWindow) and game/window_depth.txt its near plane ("near 4"): that plane.
 Expected<double> windowDepthNear(const std::filesystem::path& file);
 Expected<FidelityOutcome> runFidelity(const FidelityStage& stage);
+// fidelity.json (docs/fidelity.md): the capture, the dataset, the thresholds and each frame's measures.
+nlohmann::json fidelityJson(const FidelityOutcome& outcome, const FidelityStage& stage);
 
 }  // namespace dynbench::pipeline

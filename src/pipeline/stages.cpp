@@ -1,3 +1,4 @@
+#include "core/json_fields.h"
 #include "pipeline/stages.h"
 
 #include <cctype>
@@ -69,7 +70,7 @@ Expected<StatsOutcome> runStats(const StatsStage& stage, const StatsProgress& pr
   }
   out.markdown = report::statsMarkdown(out.rows);
   if (!stage.json.empty())
-    if (auto ok = writeFileAtomic(stage.json, report::statsJson(out.rows, stage.fps)); !ok) return std::unexpected(ok.error());
+    if (auto ok = writeFileAtomic(stage.json, jsonFileText(report::statsJson(out.rows, stage.fps))); !ok) return std::unexpected(ok.error());
   if (!stage.csv.empty())
     if (auto ok = writeFileAtomic(stage.csv, report::statsCsv(out.rows)); !ok) return std::unexpected(ok.error());
   for (const auto& row : out.rows) {
@@ -137,7 +138,7 @@ Expected<DiscardOutcome> runDiscard(const DiscardStage& stage, const discard::Di
                                                                               : fmt::format(" of which {} camera cuts are left out", run->cutPairs),
                                                             run->width, run->height)));
   if (!stage.json.empty())
-    if (auto ok = writeFileAtomic(stage.json, discard::discardJson(*run, stage.frames.string())); !ok) return std::unexpected(ok.error());
+    if (auto ok = writeFileAtomic(stage.json, jsonFileText(discard::discardJson(*run, stage.frames.string()))); !ok) return std::unexpected(ok.error());
   if (!stage.csv.empty()) {
     std::string csv = "frame,time";
     for (const auto& column : discard::kTable67Columns) csv += fmt::format(",{}", column.key);

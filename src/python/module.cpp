@@ -2,6 +2,7 @@
 // function returns what the CLI's --json writes for the same arguments, as a dict; errors raise
 // dynbench.Error with the library's message and the CLI's exit status; nothing exits the
 // interpreter. The package's dynbench/__init__.py re-exports these and adds frames().
+#include <cmath>
 #include <fstream>
 #include <optional>
 #include <sstream>
@@ -52,10 +53,16 @@ void warnAll(const std::vector<std::string>& warnings) {
     if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) < 0) throw py::error_already_set();
 }
 
-// A JSON document as the CLI writes it and json.load reads it back (non-finite numbers as None):
-// from the text the CLI writes, or from the document it dumps.
-py::object document(const std::string& text) { return pyjson::from_json(nlohmann::json::parse(text)); }
-py::object document(const nlohmann::json& json) { return document(json.dump()); }
+// A stage's JSON document as Python objects, converted directly (no text in between), as the CLI
+// writes it and json.load reads it back: JSON has no NaN or infinity, the CLI's text has null for
+// them (nlohmann's dump), so they become None here too.
+nlohmann::json nonFiniteAsNull(nlohmann::json json) {
+  if (json.is_number_float() && !std::isfinite(json.get<double>())) return nullptr;
+  if (json.is_structured())
+    for (auto& item : json) item = nonFiniteAsNull(std::move(item));
+  return json;
+}
+py::object document(const nlohmann::json& json) { return pyjson::from_json(nonFiniteAsNull(json)); }
 
 Frame readFrame(const fs::path& path) {
   const frames::FrameEntry entry = unwrap(frames::frameEntry(path));
@@ -159,7 +166,7 @@ py::object compareImages(const py::object& reference, const py::object& test, do
     py::gil_scoped_release release;
     scored = evaluate::scoreImage(ref, image, hdr, ppd);
   }
-  nlohmann::json entry = nlohmann::json::parse(evaluate::scoresJson(scored.scores));
+  nlohmann::json entry = evaluate::scoresJson(scored.scores);
   entry["test"] = nullptr;
   return document(nlohmann::json{{"reference", nullptr}, {"pixels_per_degree", ppd}, {"images", nlohmann::json::array({entry})}});
 }

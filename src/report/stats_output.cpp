@@ -71,7 +71,7 @@ std::string statsMarkdown(const std::vector<StatsRow>& rows) {
   return out;
 }
 
-std::string statsJson(const std::vector<StatsRow>& rows, double fps) {
+nlohmann::json statsJson(const std::vector<StatsRow>& rows, double fps) {
   nlohmann::json datasets = nlohmann::json::array();
   for (const auto& r : rows) {
     const auto& p = r.properties;
@@ -134,7 +134,7 @@ std::string statsJson(const std::vector<StatsRow>& rows, double fps) {
   }
   nlohmann::json root = {{"tool", "dynbench"}, {"version", kVersion}, {"command", "stats"},
                          {"fps", fps}, {"datasets", datasets}};
-  return root.dump(2) + "\n";
+  return root;
 }
 
 std::string statsCsv(const std::vector<StatsRow>& rows) {

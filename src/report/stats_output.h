@@ -26,7 +26,7 @@ std::string formatBytes(std::uint64_t bytes);  // "1.50 MiB"
 std::string markdownTable(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows);
 
 std::string statsMarkdown(const std::vector<StatsRow>& rows);
-std::string statsJson(const std::vector<StatsRow>& rows, double fps);
+nlohmann::json statsJson(const std::vector<StatsRow>& rows, double fps);
 // The inverse of statsJson for what the tables show: dataset `index` of a stats.json document
 // (`fps` from its root). Errors name the file and the JSON pointer of a missing or malformed value.
 Expected<StatsRow> readStatsRow(const nlohmann::json& document, const std::filesystem::path& file, std::size_t index);
