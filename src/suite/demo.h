@@ -23,8 +23,8 @@ enum class DemoPart {
 };
 
 // The demo's datasets are measured with DatasetRunSettings' defaults: converged feature buffers
-// (render --converge) of 48 frames in the middle of the match at 96x54, a resolution two cores
-// render in about two minutes a dataset (fewer pixels rather than less convergence, so Table 6.7
+// (render --converge, 16-128 spp) of 24 frames in the middle of the match at 96x54, which two
+// cores render in about 30 s a dataset (fewer pixels rather than less convergence, so Table 6.7
 // describes the match, not the noise), and the methods' 4-spp input.
 struct DemoOptions : pipeline::DatasetRunSettings {
   std::filesystem::path output = "dynbench-demo";
