@@ -16,6 +16,7 @@
 #include "discard/discard.h"
 #include "gltf_builder.h"
 #include "render/camera.h"
+#include "render_scenes.h"
 #include "frames/frame_io.h"
 #include "golden.h"
 #include "run_cli.h"
@@ -25,15 +26,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A camera at the origin with the given yaw (degrees, about +Y) and horizontal field of view.
-render::RenderCamera camera(double yawDegrees, int w, int h, double yfovDegrees) {
-  glm::dmat4 world = glm::mat4_cast(quatFromYawPitchRoll(radians(yawDegrees), 0.0, 0.0));
-  scene::Camera lens;
-  lens.yfov = radians(yfovDegrees);
-  lens.znear = 0.1;
-  lens.zfar = 1000;
-  return render::RenderCamera(world, lens, w, h);
-}
+using render::yawCamera;
 
 // What a frame sees: the hit point along a ray (or nothing), its normal and radiances.
 struct Surface {
@@ -98,7 +91,7 @@ Thresholds absolute(double position, double normal, double direct, double indire
 }
 
 TEST(Discard, StaticCameraAndSceneDiscardNothing) {
-  const auto cam = camera(30.0, 64, 36, 50.0);
+  const auto cam = yawCamera(30.0, 64, 36, 50.0);
   const FeatureFrame a = makeFrame(0, cam, farSphere), b = makeFrame(1, cam, farSphere);
   const auto r = discardFrame(b, a, absolute(1e-3, 1e-3, 1e-3, 1e-3));
   EXPECT_EQ(r.percentages.frustum, 0.0);
@@ -117,7 +110,7 @@ TEST(Discard, YawTurnDiscardsTheColumnsThatLeaveTheFrustum) {
   // A single row keeps the vertical coordinate at the centre (y_cam = 0) whatever the yaw.
   const int w = 1000, h = 1;
   const double yfov = degrees(2.0 * std::atan(1.0 / w));  // square pixels: tan(yfov/2) = tan(hfov/2) h / w
-  const auto now = camera(0.0, w, h, yfov), before = camera(10.0, w, h, yfov);
+  const auto now = yawCamera(0.0, w, h, yfov), before = yawCamera(10.0, w, h, yfov);
   for (bool background : {false, true}) {
     auto scene = [&](const render::Ray& ray, int x, int y) { return background ? Surface{} : farSphere(ray, x, y); };
     const auto r = discardFrame(makeFrame(1, now, scene), makeFrame(0, before, scene), absolute(1e-2, 1e-2, 1e-2, 1e-2));
@@ -134,7 +127,7 @@ TEST(Discard, SlidingQuadDiscardsItsCoveredAndUncoveredArea) {
   // frames the ray meets the quad's plane at the same world point, so only the area it newly
   // covers (wall before, quad now) and the area it uncovers (quad before, wall now) is discarded.
   const int w = 80, h = 60;
-  const auto cam = camera(0.0, w, h, 60.0);
+  const auto cam = yawCamera(0.0, w, h, 60.0);
   auto quadAt = [](double cx) {
     return [cx](const render::Ray& ray, int, int) {
       const double tq = (-5.0 - ray.origin.z) / ray.direction.z;
@@ -165,7 +158,7 @@ TEST(Discard, NoiseAloneIsNotChangeWhenNoiseAware) {
   // per pixel, and say so in their variance channels (0.05^2). A threshold of 0.02 discards most
   // pixels; --noise-aware asks for 3 standard deviations of the difference (sqrt(2) x 0.05), which
   // noise exceeds with probability 0.27%.
-  const auto cam = camera(0.0, 100, 100, 50.0);
+  const auto cam = yawCamera(0.0, 100, 100, 50.0);
   std::mt19937 random(7);
   std::normal_distribution<double> noise(0.0, 0.05);
   auto noisy = [&](const render::Ray& ray, int x, int y) {
@@ -198,7 +191,7 @@ TEST(Discard, ExpectedTestCountsEachPixelWithTheProbabilityOfARealChange) {
   // tau + sigma: each pixel counts P(|N(d, sigma^2)| > tau) = Phi(1) + Phi(-(2 tau + sigma) /
   // sigma) = Phi(1) + Phi(-5), and the 95 % interval is 1.96 sqrt(N p (1 - p)) / N.
   const int w = 50, h = 40;
-  const auto cam = camera(0.0, w, h, 50.0);
+  const auto cam = yawCamera(0.0, w, h, 50.0);
   const double tau = 0.1, sigma = 0.05, delta = (tau + sigma) / std::sqrt(3.0);
   auto grey = [](double value) {
     return [value](const render::Ray& ray, int x, int y) {
@@ -270,7 +263,7 @@ TEST(Discard, ALightSwitchedOffDiscardsTheLitArea) {
   // The left half of the image was lit (direct 1) and is dark now: 100% of the lit area, 50% of
   // the image, is a direct-radiance discard; nothing else changed.
   const int w = 64, h = 32;
-  const auto cam = camera(0.0, w, h, 50.0);
+  const auto cam = yawCamera(0.0, w, h, 50.0);
   auto lit = [](bool on) {
     return [on](const render::Ray& ray, int x, int y) {
       Surface s = farSphere(ray, x, y);
@@ -448,7 +441,7 @@ TEST(Discard, APixelFilteredSilhouetteIsNoChangeOfLighting) {
 // that frame's sidecar says cut.
 void writeFrames(const fs::path& dir, int count, int w, int h, bool variance = true, int cutAt = -1) {
   for (int k = 0; k < count; ++k) {
-    const auto cam = camera(2.0 * k + (cutAt >= 0 && k >= cutAt ? 40.0 : 0.0), w, h, 50.0);
+    const auto cam = yawCamera(2.0 * k + (cutAt >= 0 && k >= cutAt ? 40.0 : 0.0), w, h, 50.0);
     const FeatureFrame f = makeFrame(k, cam, farSphere);
     FloatImage image;
     image.width = w;

@@ -59,6 +59,15 @@ scene::Scene load(test::GltfBuilder& b, const std::string& name) {
 }
 
 // A camera at `position` looking along `forward` (up +Y, or -Z when looking straight down).
+RenderCamera yawCamera(double yawDegrees, int w, int h, double yfovDegrees) {
+  const glm::dmat4 world = glm::mat4_cast(quatFromYawPitchRoll(radians(yawDegrees), 0.0, 0.0));
+  scene::Camera lens;
+  lens.yfov = radians(yfovDegrees);
+  lens.znear = 0.1;
+  lens.zfar = 1000;
+  return RenderCamera(world, lens, w, h);
+}
+
 RenderCamera lookCamera(glm::dvec3 position, glm::dvec3 forward, double yfovDegrees, int w, int h) {
   forward = glm::normalize(forward);
   const glm::dvec3 up = std::abs(forward.y) > 0.99 ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);

@@ -23,6 +23,8 @@ int addSphere(test::GltfBuilder& b, glm::dvec3 centre, double radius, int materi
 int addPlane(test::GltfBuilder& b, double half, double height, int material);
 // Writes the builder's glTF into a fresh folder named `name` and loads it (a failed load fails the test).
 scene::Scene load(test::GltfBuilder& b, const std::string& name);
+// A camera at the origin turned by `yawDegrees` about +Y (discard's and reprojection's tests).
+RenderCamera yawCamera(double yawDegrees, int w, int h, double yfovDegrees);
 // A camera at `position` looking along `forward` (up +Y, or -Z when looking straight down).
 RenderCamera lookCamera(glm::dvec3 position, glm::dvec3 forward, double yfovDegrees, int w, int h);
 // The path tracer for a scene (a failed creation fails the test and returns null).

@@ -5,20 +5,13 @@
 
 #include "core/math.h"
 #include "render/camera.h"
+#include "render_scenes.h"
 #include "reprojection/reprojection.h"
 
 namespace dynbench::reprojection {
 namespace {
 
-// A camera at the origin with the given yaw (degrees, about +Y) and vertical field of view.
-render::RenderCamera camera(double yawDegrees, int w, int h, double yfovDegrees) {
-  glm::dmat4 world = glm::mat4_cast(quatFromYawPitchRoll(radians(yawDegrees), 0.0, 0.0));
-  scene::Camera lens;
-  lens.yfov = radians(yfovDegrees);
-  lens.znear = 0.1;
-  lens.zfar = 1000;
-  return render::RenderCamera(world, lens, w, h);
-}
+using render::yawCamera;
 
 TEST(Reprojection, BilinearSamplingAtCentresEdgesAndCorners) {
   // A 3 x 2 image with value = 10 x column + row.
@@ -35,7 +28,7 @@ TEST(Reprojection, BilinearSamplingAtCentresEdgesAndCorners) {
 }
 
 TEST(Reprojection, ReprojectionRoundTripsThroughThePixelDirection) {
-  const auto cam = camera(25.0, 320, 180, 40.0);
+  const auto cam = yawCamera(25.0, 320, 180, 40.0);
   const FrameCamera fc = cam.frameCamera();
   for (double x : {0.5, 100.25, 319.5})
     for (double y : {0.5, 90.0, 179.5}) {

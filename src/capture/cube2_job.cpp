@@ -1,7 +1,6 @@
 #include "capture/cube2_job.h"
 
 #include <array>
-#include <climits>
 
 #include "core/files.h"
 #include "core/json_fields.h"
@@ -42,12 +41,11 @@ Expected<Cube2Options> parseCube2Job(const nlohmann::json& document, const fs::p
   if (auto ok = r.jobDocument("the Cube 2 capture job", kKeys, "dynbench_cube2_capture", kCube2JobVersion); !ok) return std::unexpected(ok.error());
   Cube2Options o;
   std::string output = o.output.string(), client = o.client.string(), data = o.data.string();
-  for (auto ok : {r.string("/output", output), r.string("/map", o.map), r.string("/mode", o.mode), r.integer("/bots", o.bots, INT_MIN, INT_MAX),
-                  r.integer("/skill", o.skill, INT_MIN, INT_MAX), r.number("/seconds", o.seconds, -1e300, 1e300),
-                  r.number("/fps", o.fps, -1e300, 1e300), r.integer("/seed", o.seed, 0, UINT_MAX), r.string("/follow", o.follow),
-                  r.number("/warmup", o.warmup, -1e300, 1e300), r.integer("/width", o.width, INT_MIN, INT_MAX),
-                  r.integer("/height", o.height, INT_MIN, INT_MAX), r.boolean("/window", o.window), r.string("/client", client),
-                  r.string("/data", data)})
+  // The values' ranges are the capture's to check (captureCube2), as for the command line's.
+  for (auto ok : {r.string("/output", output), r.string("/map", o.map), r.string("/mode", o.mode), r.integer("/bots", o.bots),
+                  r.integer("/skill", o.skill), r.number("/seconds", o.seconds), r.number("/fps", o.fps), r.integer("/seed", o.seed),
+                  r.string("/follow", o.follow), r.number("/warmup", o.warmup), r.integer("/width", o.width), r.integer("/height", o.height),
+                  r.boolean("/window", o.window), r.string("/client", client), r.string("/data", data)})
     if (!ok) return std::unexpected(ok.error());
   o.output = output;
   o.client = client;
@@ -58,7 +56,7 @@ Expected<Cube2Options> parseCube2Job(const nlohmann::json& document, const fs::p
     o.gameFrames.clear();
     for (std::size_t i = 0; i < frames.size(); ++i) {
       long frame = 0;
-      if (auto ok = r.integer(fmt::format("/game_frames/{}", i), frame, 0, LONG_MAX); !ok) return std::unexpected(ok.error());
+      if (auto ok = r.integer(fmt::format("/game_frames/{}", i), frame, 0); !ok) return std::unexpected(ok.error());
       o.gameFrames.push_back(frame);
     }
   }
@@ -68,7 +66,7 @@ Expected<Cube2Options> parseCube2Job(const nlohmann::json& document, const fs::p
 Expected<Cube2Options> readCube2Job(const fs::path& path) { return readJsonDocument(path, parseCube2Job); }
 
 Expected<void> writeCube2Job(const Cube2Options& options, const fs::path& path) {
-  return writeFileAtomic(path, cube2JobJson(options).dump(2) + "\n");
+  return writeFileAtomic(path, jsonFileText(cube2JobJson(options)));
 }
 
 }  // namespace dynbench::capture

@@ -182,13 +182,11 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--camera", o->job.camera, "Camera node: index or name (default: the first animated camera)");
   cmd->add_option("--animation", o->job.animation, "Play only this animation (index or name)");
   cmd->add_option("--seed", o->job.settings.seed, "Random seed; the same seed and options give the same images");
-  std::vector<std::string> engines;
   std::string engineHelp = "Renderer:";
   for (const auto& b : render::renderBackends()) {
-    engines.emplace_back(b.name);
     engineHelp += fmt::format(" {} ({}){}", b.name, b.description, &b == &render::renderBackends().back() ? "" : ";");
   }
-  cmd->add_option("--engine", o->job.engine, engineHelp)->check(CLI::IsMember(engines));
+  cmd->add_option("--engine", o->job.engine, engineHelp)->check(CLI::IsMember(render::backendNames()));
   cmd->add_option("--threads", o->job.threads, "Threads for loading, rendering and writing frames (0: all cores)")->check(nonNegative());
   cmd->add_option("--blender", o->job.blender, "Blender executable for --engine cycles");
   cmd->add_option("--env-constant", o->envConstant, "Light with a constant environment of radiance L or R,G,B instead of the dataset's");

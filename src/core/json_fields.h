@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <iterator>
+#include <limits>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -74,7 +75,7 @@ class JsonFields {
 // checks; an absent key keeps the value it has (the struct's default). For job files (--job).
 class JsonSettingsReader {
  public:
-  JsonSettingsReader(const nlohmann::json& document, const std::filesystem::path& source) : document_(document), fields_(document, source), source_(source) {}
+  JsonSettingsReader(const nlohmann::json& document, const std::filesystem::path& source) : document_(document), fields_(document, source) {}
 
   // A job document's frame: an object of `what` ("the render job") with no top-level key but
   // `keys` (a misspelt setting is not silently ignored) and `versionKey` equal to `version`.
@@ -90,8 +91,10 @@ class JsonSettingsReader {
     return integer(pointer, found, version, version);
   }
 
+  // Without a range: any value of Int (the range is then checked by whoever uses it).
   template <typename Int>
-  Expected<void> integer(const std::string& pointer, Int& value, long long low, long long high) const {
+  Expected<void> integer(const std::string& pointer, Int& value, long long low = std::numeric_limits<Int>::min(),
+                         long long high = std::numeric_limits<Int>::max()) const {
     if (!fields_.has(pointer)) return {};
     auto v = fields_.integer(pointer);
     if (!v) return std::unexpected(v.error());
@@ -107,7 +110,8 @@ class JsonSettingsReader {
     value = *v;
     return {};
   }
-  Expected<void> number(const std::string& pointer, double& value, double low, double high, bool lowOpen = false) const {
+  Expected<void> number(const std::string& pointer, double& value, double low = -std::numeric_limits<double>::infinity(),
+                        double high = std::numeric_limits<double>::infinity(), bool lowOpen = false) const {
     if (!fields_.has(pointer)) return {};
     auto v = fields_.number(pointer);
     if (!v) return std::unexpected(v.error());
@@ -146,13 +150,12 @@ class JsonSettingsReader {
   }
   bool has(const std::string& pointer) const { return fields_.has(pointer); }
   std::unexpected<Error> bad(const std::string& pointer, const std::string& expected) const {
-    return fail(ErrorCode::kInvalidData, "{}: {}: expected {}", source_.string(), pointer, expected);
+    return fail(ErrorCode::kInvalidData, "{}: {}: expected {}", fields_.file().string(), pointer, expected);
   }
 
  private:
   const nlohmann::json& document_;
   JsonFields fields_;
-  std::filesystem::path source_;
 };
 
 // A whole JSON file, or an error naming it (missing: kIo, bad syntax: kParse).

@@ -12,13 +12,16 @@ const std::vector<BackendEntry>& renderBackends() {
   return backends;
 }
 
+std::vector<std::string> backendNames() {
+  std::vector<std::string> names;
+  for (const auto& b : renderBackends()) names.emplace_back(b.name);
+  return names;
+}
+
 Expected<const BackendEntry*> findBackend(const std::string& name) {
-  std::string names;
-  for (const auto& b : renderBackends()) {
+  for (const auto& b : renderBackends())
     if (name == b.name) return &b;
-    names += fmt::format("{}{}", names.empty() ? "" : ", ", b.name);
-  }
-  return fail(ErrorCode::kUsage, "--engine '{}': expected one of {}", name, names);
+  return fail(ErrorCode::kUsage, "--engine '{}': expected one of {}", name, fmt::join(backendNames(), ", "));
 }
 
 }  // namespace dynbench::render

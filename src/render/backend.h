@@ -51,6 +51,8 @@ struct BackendEntry {
 
 // Every backend this build has, the default first.
 const std::vector<BackendEntry>& renderBackends();
+// Their names, in that order.
+std::vector<std::string> backendNames();
 // The backend named `name`, or a usage error listing the names.
 Expected<const BackendEntry*> findBackend(const std::string& name);
 

@@ -89,11 +89,7 @@ Expected<RenderJob> parseRenderJob(const nlohmann::json& document, const fs::pat
   job.animation = animation;
   if (job.frames.last >= 0 && job.frames.last < job.frames.first)
     return r.bad("/frames/last", fmt::format("-1 (to the end) or at least /frames/first ({}), found {}", job.frames.first, job.frames.last));
-  if (!findBackend(job.engine)) {
-    std::vector<std::string> names;
-    for (const auto& b : renderBackends()) names.emplace_back(b.name);
-    return r.bad("/engine", fmt::format("one of {}, found \"{}\"", fmt::join(names, ", "), job.engine));
-  }
+  if (!findBackend(job.engine)) return r.bad("/engine", fmt::format("one of {}, found \"{}\"", fmt::join(backendNames(), ", "), job.engine));
   auto filter = parsePixelFilter(pixelFilter);
   if (!filter) return r.bad("/pixel_filter/type", fmt::format("a pixel filter ({})", filter.error().message));
   s.pixelFilter.type = *filter;
@@ -118,6 +114,6 @@ Expected<RenderJob> parseRenderJob(const nlohmann::json& document, const fs::pat
 
 Expected<RenderJob> readRenderJob(const fs::path& path) { return readJsonDocument(path, parseRenderJob); }
 
-Expected<void> writeRenderJob(const RenderJob& job, const fs::path& path) { return writeFileAtomic(path, renderJobJson(job).dump(2) + "\n"); }
+Expected<void> writeRenderJob(const RenderJob& job, const fs::path& path) { return writeFileAtomic(path, jsonFileText(renderJobJson(job))); }
 
 }  // namespace dynbench::render

@@ -114,7 +114,7 @@ Expected<cluster::ChainOutcome> demoChain(const DemoOptions& demoIn, const clust
   std::error_code ec;
   fs::create_directories(jobFile.parent_path(), ec);
   if (ec) return fail(ErrorCode::kIo, "{}: cannot create the jobs' folder: {}", jobFile.parent_path().string(), ec.message());
-  if (auto ok = writeFileAtomic(jobFile, demoJobJson(demo).dump(2) + "\n"); !ok) return std::unexpected(ok.error());
+  if (auto ok = writeFileAtomic(jobFile, jsonFileText(demoJobJson(demo))); !ok) return std::unexpected(ok.error());
   spec.arguments = {"--job", jobFile.string()};
   spec.frameRenders = demoFrameRenders(demo);
   spec.datasetsWhat = "capture, convert and the fly-through";

@@ -237,7 +237,7 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
   if (!md) return std::unexpected(md.error());
   if (auto ok = writeFileAtomic(outcome.markdown, *md); !ok) return std::unexpected(ok.error());
   // suite.json last: its presence says the run is complete.
-  if (auto ok = writeFileAtomic(outcome.json, doc.dump(2) + "\n"); !ok) return std::unexpected(ok.error());
+  if (auto ok = writeFileAtomic(outcome.json, jsonFileText(doc)); !ok) return std::unexpected(ok.error());
   return outcome;
 }
 
