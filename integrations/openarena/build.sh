@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds OpenArena's game modules with dynbench's capture hooks: the game code from Debian's
 # source package `openarena` (0.8.8+dfsg, GPL-2), patched by capture-hooks.patch, with the adapter
-# (src/dynbench_oa.{c,h}) in the client game module, linked with the capture SDK *as installed*
+# (src/dynbench_oa*.{c,h}) in the client game module, linked with the capture SDK *as installed*
 # (found with pkg-config, like any engine outside dynbench's build):
 #   bash integrations/openarena/build.sh BUILD_DIR SDK_PREFIX
 # SDK_PREFIX is where `cmake --install BUILD --component sdk --prefix SDK_PREFIX` put the SDK (the
@@ -42,13 +42,13 @@ if ! cmp -s "$here/capture-hooks.patch" "$src/.dynbench-patch" 2>/dev/null; then
   patch -d "$src" -p1 --quiet < "$here/capture-hooks.patch"
   cp "$here/capture-hooks.patch" "$src/.dynbench-patch"
 fi
-for f in dynbench_oa.c dynbench_oa.h; do
+for f in dynbench_oa.h dynbench_oa_internal.h dynbench_oa.c dynbench_oa_assets.c dynbench_oa_bsp.c dynbench_oa_md3.c; do
   cmp -s "$here/src/$f" "$src/code/cgame/$f" || cp "$here/src/$f" "$src/code/cgame/$f"
 done
 out="$src/build/release-linux-x86_64/baseq3"
-# The game's Makefile does not know the adapter's header, the SDK or this script's link flags:
+# The game's Makefile does not know the adapter's headers, the SDK or this script's link flags:
 # rebuild the client module when any of them is newer.
-for dep in "$src/code/cgame/dynbench_oa.h" "$sdk/lib/libdynbench_capture.so" "$here/build.sh"; do
+for dep in "$src/code/cgame/dynbench_oa.h" "$src/code/cgame/dynbench_oa_internal.h" "$sdk/lib/libdynbench_capture.so" "$here/build.sh"; do
   [[ -f "$out/cgamex86_64.so" && "$dep" -nt "$out/cgamex86_64.so" ]] && rm -f "$out/cgamex86_64.so" "$out"/cgame/*.o
 done
 make -C "$src" -j"$(nproc)" release BUILD_GAME_QVM=0 BUILD_MISSIONPACK=0 \
