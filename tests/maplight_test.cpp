@@ -217,8 +217,10 @@ TEST(GameFiles, AFolderWithoutArchivesIsAnError) {
 }
 
 // On Debian's OpenArena data (no game run): oa_dm1's lightmaps are reproduced by its fitted lights;
-// q3dm6ish's real lights, hidden, are found again; and a fit run as another machine would run it
-// gives the same lights byte for byte (a smaller fit of q3dm6ish, to keep the suite's time).
+// oa_ctf2's real lights, hidden, are found again (its 48 dim lights in narrow corridors are the
+// hardest of the four maps that keep their lights: 48 % of their value with the lattice's candidates
+// alone, before the residual's hot spots added theirs); and a fit run as another machine would run
+// it gives the same lights byte for byte (a smaller fit of q3dm6ish, to keep the suite's time).
 TEST(OpenArena, StrippedLightsAreFittedToTheLightmaps) {
   DYNBENCH_NEEDS(test::missingOpenArena());
   auto files = GameFiles::open("/usr/lib/openarena/baseoa");
@@ -230,10 +232,11 @@ TEST(OpenArena, StrippedLightsAreFittedToTheLightmaps) {
 
   MapLightFitOptions hidden;
   hidden.hideEntityLights = true;
-  auto recovered = fitMapLighting(*files, "q3dm6ish", hidden);
+  auto recovered = fitMapLighting(*files, "oa_ctf2", hidden);
   ASSERT_TRUE(recovered) << recovered.error().message;
-  EXPECT_GT(recovered->report.hiddenLightValue, 0.0);
-  EXPECT_GE(recovered->report.recoveredShare, 0.80);
+  EXPECT_EQ(recovered->report.hiddenLightValue, 48 * 60.0);
+  EXPECT_GT(recovered->report.candidates, recovered->report.latticeCandidates) << "candidates at the residual's hot spots";
+  EXPECT_GE(recovered->report.recoveredShare, 0.70);
 
   MapLightFitOptions small = hidden;
   small.fitSamples = 6000;

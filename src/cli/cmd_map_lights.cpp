@@ -28,8 +28,8 @@ Expected<void> runMapLights(const MapLightsCli& cli) {
   fmt::print("{}: {} lightmap texels ({} at 255 left out), gamma {}\n", cli.map, r.texels, r.clippedTexels, r.gamma);
   fmt::print("  known emitters: {} light entities, {} suns, {} surface-light pieces; {} shaders with q3map_skylight (not modelled)\n",
              r.entityLights, r.suns, r.surfaceEmitters, r.skyLightShaders);
-  fmt::print("  fit: {} texels, {} candidates ({}-unit lattice), {} lights fitted ({} moved off the lattice), constant {:.2f} {:.2f} {:.2f} (dropped)\n", r.fitSamples,
-             r.candidates, r.latticeSpacing, r.fittedLights, r.refinedLights, r.constant.r, r.constant.g, r.constant.b);
+  fmt::print("  fit: {} texels, {} candidates ({} on a {}-unit lattice, {} at hot spots), {} lights fitted ({} moved off the lattice), constant {:.2f} {:.2f} {:.2f} (dropped)\n",
+             r.fitSamples, r.candidates, r.latticeCandidates, r.latticeSpacing, r.candidates - r.latticeCandidates, r.fittedLights, r.refinedLights, r.constant.r, r.constant.g, r.constant.b);
   fmt::print("  held-out texels ({}): correlation {:.3f} (known emitters alone {:.3f}); variance explained {:.3f} (known alone {:.3f})\n",
              r.heldOutSamples, r.heldOutCorrelation, r.knownCorrelation, r.totalExplained, r.knownExplained);
   if (cli.hideEntityLights)
@@ -63,7 +63,10 @@ void addMapLightsCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--max-lights", cli->options.maxLights, "Fitted lights at most")->capture_default_str()->check(CLI::Range(0, 4096));
   cmd->add_option("--minimum-gain", cli->options.minimumGain, "Stop when a light explains less than this share of the signal")->capture_default_str();
   cmd->add_option("--fit-samples", cli->options.fitSamples, "Lightmap texels fitted")->capture_default_str();
-  cmd->add_option("--max-candidates", cli->options.maxCandidates, "Candidate light positions at most")->capture_default_str();
+  cmd->add_option("--max-candidates", cli->options.maxCandidates, "Candidate light positions on the lattice at most")->capture_default_str();
+  cmd->add_option("--hot-spot-peaks", cli->options.hotSpotPeaks, "Peaks of the lightmaps' residual that add candidates along their normals (0: the lattice alone)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100000));
   cmd->add_option("--adapter-lights", cli->adapterLights, "Write the lights file the OpenArena capture adapter reads");
   cmd->callback([cli, &run] { run = [cli] { return runMapLights(*cli); }; });
 }

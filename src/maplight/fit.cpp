@@ -408,6 +408,38 @@ std::vector<glm::dvec3> openSpaceLattice(const Bsp& bsp, const Occluders& occlud
   }
 }
 
+// Candidates where the lightmaps point at a light. A point light near a surface makes a hot spot
+// at the foot of its perpendicular, so each peak of the residual (the texels less the known
+// emitters and the constant) gets candidates along its normal. The lattice alone misses lights in
+// spaces about as narrow as its spacing: oa_ctf2's dim lights (value 60) hang in corridors where
+// its 64-unit-clear band holds few lattice points. Peaks: the samples in falling order of residual,
+// each at least kPeakSeparation from every brighter one, down to a quarter of full light.
+std::vector<glm::dvec3> hotSpotCandidates(const std::vector<Sample>& samples, const std::vector<double>& residual, const Occluders& occluders,
+                                          std::size_t maxPeaks) {
+  constexpr double kPeakSeparation = 48.0;  // units: three texels
+  constexpr std::array kDistances{32.0, 48.0, 64.0, 96.0, 128.0};
+  std::vector<std::size_t> order(samples.size());
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return residual[a] > residual[b]; });
+  std::vector<std::size_t> peaks;
+  for (std::size_t i : order) {
+    if (residual[i] < 0.25 * kFullLight || peaks.size() >= maxPeaks) break;
+    const bool nearBrighter = std::any_of(peaks.begin(), peaks.end(), [&](std::size_t p) {
+      return glm::length(samples[p].position - samples[i].position) < kPeakSeparation;
+    });
+    if (!nearBrighter) peaks.push_back(i);
+  }
+  std::vector<glm::dvec3> trials;
+  for (std::size_t p : peaks)
+    for (double d : kDistances) trials.push_back(samples[p].position + d * samples[p].normal);
+  std::vector<char> open(trials.size(), 0);
+  tbb::parallel_for(std::size_t(0), trials.size(), [&](std::size_t t) { open[t] = inOpenSpace(trials[t], occluders) ? 1 : 0; });
+  std::vector<glm::dvec3> candidates;
+  for (std::size_t t = 0; t < trials.size(); ++t)
+    if (open[t]) candidates.push_back(trials[t]);
+  return candidates;
+}
+
 double dot(const Column& c, const std::vector<double>& dense) {
   double s = 0;
   for (std::size_t k = 0; k < c.rows.size(); ++k) s += c.values[k] * dense[c.rows[k]];
@@ -605,17 +637,6 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   std::vector<Column> columns = groupColumns(fit, groups, result.lights, result.surfaceLights, *occluders);
   report("known emitters", 1, 1);
 
-  // Candidates and their columns, after the groups'.
-  std::vector<glm::dvec3> candidates = openSpaceLattice(*bsp, *occluders, options.maxCandidates, r.latticeSpacing);
-  r.candidates = candidates.size();
-  columns.resize(groupCount + candidates.size());
-  std::atomic<std::size_t> done{0};
-  tbb::parallel_for(std::size_t(0), candidates.size(), [&](std::size_t j) {
-    columns[groupCount + j] = candidateColumn(candidates[j], fit, *occluders);
-    const std::size_t finished = ++done;
-    if (finished % 64 == 0) report("candidate lights", finished, candidates.size());
-  });
-  report("candidate lights", candidates.size(), candidates.size());
   // A column's colour: its group's, white for a candidate. `channel` 3 is luminance.
   const auto colorOf = [&](std::size_t column, int channel) {
     const glm::dvec3 color = column < groupCount ? groups[column].color : glm::dvec3(1.0);
@@ -697,6 +718,23 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   }
   for (std::size_t k = 0; k < groupCount; ++k) addColumn(k);
   double error = residualOf(target, solve(target, 3), 3, residual);
+
+  // Candidates and their columns, after the groups': the lattice, then the residual's hot spots.
+  std::vector<glm::dvec3> candidates = openSpaceLattice(*bsp, *occluders, options.maxCandidates, r.latticeSpacing);
+  r.latticeCandidates = candidates.size();
+  if (options.hotSpotPeaks > 0) {
+    const std::vector<glm::dvec3> hot = hotSpotCandidates(fit, residual, *occluders, static_cast<std::size_t>(options.hotSpotPeaks));
+    candidates.insert(candidates.end(), hot.begin(), hot.end());
+  }
+  r.candidates = candidates.size();
+  columns.resize(groupCount + candidates.size());
+  std::atomic<std::size_t> done{0};
+  tbb::parallel_for(std::size_t(0), candidates.size(), [&](std::size_t j) {
+    columns[groupCount + j] = candidateColumn(candidates[j], fit, *occluders);
+    const std::size_t finished = ++done;
+    if (finished % 64 == 0) report("candidate lights", finished, candidates.size());
+  });
+  report("candidate lights", candidates.size(), candidates.size());
   std::vector<char> taken(columns.size(), 0);
   std::fill(taken.begin(), taken.begin() + static_cast<std::ptrdiff_t>(groupCount), 1);
   std::vector<double> scores(columns.size());

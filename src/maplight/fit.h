@@ -8,8 +8,8 @@
 //   1. reads the lightmap texels as samples (position, normal, linear value),
 //   2. predicts the known emitters' light at them with q3map2's own model (light.c,
 //      LightContributionToSample), with Embree for visibility,
-//   3. fits what is left with non-negative point lights: candidates on a lattice in open space,
-//      chosen greedily, weighted by non-negative least squares, plus a constant term that absorbs
+//   3. fits what is left with non-negative point lights: candidates on a lattice in open space and
+//      along the normals of the residual's hot spots, chosen greedily, weighted by non-negative least squares, plus a constant term that absorbs
 //      bounced light and ambient and is then dropped (the path tracer makes its own indirect light).
 // The result is deterministic: the same map gives the same lights, byte for byte.
 #include <array>
@@ -73,6 +73,7 @@ struct MapLightFitOptions {
   int maxLights = 256;         // fitted point lights at most
   int fitSamples = 30000;      // lightmap texels fitted (a regular subset of them)
   int maxCandidates = 12000;   // lattice points in open space
+  int hotSpotPeaks = 600;      // residual peaks that add candidates along their normals (0: the lattice alone)
   double minimumGain = 0.0001; // stop when a light lowers the residual by less than this share of the signal
   bool refine = true;          // move each fitted light off the lattice where that fits better
 };
@@ -80,7 +81,7 @@ struct MapLightFitOptions {
 struct MapLightFitReport {
   std::size_t texels = 0, clippedTexels = 0;  // lit lightmap texels of drawn surfaces; those at 255 (left out)
   std::size_t fitSamples = 0, heldOutSamples = 0;
-  std::size_t candidates = 0, latticeSpacing = 0;
+  std::size_t candidates = 0, latticeCandidates = 0, latticeSpacing = 0;  // all candidates; those on the lattice
   std::size_t entityLights = 0, surfaceEmitters = 0, suns = 0, fittedLights = 0;
   std::size_t refinedLights = 0;  // fitted lights moved off the lattice by the refinement
   double gamma = 1.0;  // the map's -gamma (from _q3map2_cmdline), undone
