@@ -215,7 +215,7 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
   game.argv = {"timeout", std::to_string(timeout), o.engine.string()};
   game.argv.insert(game.argv.end(), arguments->begin(), arguments->end());
   std::size_t frames = 0;
-  unsigned long windowMs = 0;
+  unsigned long windowMs = 0, offClock = 0;
   bool complete = false;
   std::string adapterErrors;
   game.onLine = [&](std::string_view line) {
@@ -225,7 +225,9 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
       if (progress) progress(frames, total);
     }
     unsigned long n = 0;
-    if (std::sscanf(std::string(line).c_str(), "dynbench-capture: window of %lu frames took %lu ms", &n, &windowMs) == 2) complete = true;
+    if (std::sscanf(std::string(line).c_str(), "dynbench-capture: window of %lu frames took %lu ms of wall time (recorded; %lu frames off", &n,
+                    &windowMs, &offClock) >= 2)
+      complete = true;
     if (line.starts_with("dynbench-capture: error")) adapterErrors += std::string(line) + "\n";
     // The engine stays at its console after a map it cannot load; stop it then.
     if (line.starts_with("Can't find map")) {
@@ -244,6 +246,7 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
   OpenArenaReport report;
   report.frames = frames;
   report.windowWallSeconds = static_cast<double>(windowMs) / 1000.0;
+  report.framesOffClock = offClock;
   report.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   if (!o.record) return report;
   auto summary = checkCapture(o.output);

@@ -52,6 +52,7 @@ struct OpenArenaReport {
   std::size_t frames = 0;
   double wallSeconds = 0.0;        // the whole run: start, loading, warm-up, recording, exit
   double windowWallSeconds = 0.0;  // the recorded frames alone (the adapter's own clock)
+  std::size_t framesOffClock = 0;  // recorded frames without their own server snapshot (the adapter's count)
 };
 
 using OpenArenaProgress = std::function<void(std::size_t, std::size_t)>;  // (recorded, total)

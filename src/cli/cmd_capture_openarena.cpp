@@ -77,6 +77,7 @@ void addCaptureOpenArenaCommand(CLI::App* capture, CommandRun& run) {
                  "dynbench convert {} -o DATASET.gltf\n",
                  o->output.string(), result->frames, static_cast<double>(result->frames) / o->fps, o->fps, result->wallSeconds,
                  result->windowWallSeconds, perFrame, o->output.string());
+      if (result->framesOffClock > 0) fmt::print(stderr, "warning: {} frames off the fixed clock\n", result->framesOffClock);
       return {};
     };
   });
