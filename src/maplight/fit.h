@@ -9,8 +9,9 @@
 //   2. predicts the known emitters' light at them with q3map2's own model (light.c,
 //      LightContributionToSample), with Embree for visibility,
 //   3. fits what is left with non-negative point lights: candidates on a lattice in open space and
-//      along the normals of the residual's hot spots, chosen greedily, weighted by non-negative least squares, plus a constant term that absorbs
-//      bounced light and ambient and is then dropped (the path tracer makes its own indirect light).
+//      along the normals of the residual's hot spots, chosen greedily, weighted by non-negative
+//      least squares, plus a constant term that absorbs bounced light and ambient and is then
+//      dropped (the path tracer makes its own indirect light).
 // The result is deterministic: the same map gives the same lights, byte for byte.
 #include <array>
 #include <filesystem>

@@ -90,7 +90,9 @@ Expected<void> captureAndConvert(const capture::OpenArenaOptions& options, const
     }
     auto captured = capture::captureOpenArena(withLights);
     if (!captured) return std::unexpected(captured.error());
-    log(fmt::format("  {} frames in {:.0f} s", captured->frames, captured->wallSeconds));
+    log(fmt::format("  {} frames in {:.0f} s{}", captured->frames, captured->wallSeconds,
+                    captured->framesOffClock > 0 ? fmt::format(" ({} frames off the fixed clock: need not be the seed's capture)", captured->framesOffClock)
+                                                 : ""));
     return {};
   });
 }
