@@ -25,7 +25,7 @@ Expected<void> runMapLights(const MapLightsCli& cli) {
   bar.reset();
   if (!lighting) return std::unexpected(lighting.error());
   const auto& r = lighting->report;
-  fmt::print("{}: {} lightmap texels ({} at 255 left out), gamma {}\n", cli.map, r.texels, r.clippedTexels, r.gamma);
+  fmt::print("{}: {} lightmap texels ({} clipped, at 254 or 255, left out), gamma {}\n", cli.map, r.texels, r.clippedTexels, r.gamma);
   fmt::print("  known emitters: {} light entities, {} suns, {} surface-light pieces; {} shaders with q3map_skylight (not modelled)\n",
              r.entityLights, r.suns, r.surfaceEmitters, r.skyLightShaders);
   fmt::print("  fit: {} texels, {} candidates ({} on a {}-unit lattice, {} at hot spots), {} lights fitted ({} moved off the lattice), constant {:.2f} {:.2f} {:.2f} (dropped)\n",

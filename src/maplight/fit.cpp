@@ -28,6 +28,11 @@ constexpr double kNudge = 1.0;  // units a sample is lifted off its surface befo
 // spot between them that the held-out texels show up (oa_bases3 at 16 units: variance explained
 // on held-out texels fell below 0).
 constexpr double kCandidateClearance = 32.0;
+// The byte from which a lightmap texel is clipped. ColorToBytes scales a colour whose brightest
+// channel passes 255 by 255 / max in float and truncates to a byte, which gives 254 as often as
+// 255 (254.99997). The lightmaps show it: on seven of the nine stock maps the brightest channel is
+// 254 on 5-30 times as many texels as on 250-253 (oa_dm2: 5,223 against about 180 each).
+constexpr std::uint8_t kClippedByte = 254;
 // Steps a fitted light may take at one scale of the refinement before the scale halves.
 constexpr int kRefineStepsPerScale = 8;
 
@@ -36,17 +41,19 @@ struct Sample {
   glm::dvec3 value{0.0};  // linear lightmap units
 };
 
-// The map's geometry as Embree sees it: node 0 the solid surfaces, node 1 the sky's.
+// The map's geometry as Embree sees it: `all` holds the solid surfaces (node 0) and the sky's
+// (node 1); `solid` the solid ones alone, as q3map2's light traces see the map (light_trace.c
+// ignores sky surfaces: light passes through them).
 struct Occluders {
-  std::unique_ptr<render::RayTracingScene> tracer;
+  std::unique_ptr<render::RayTracingScene> all, solid;
   bool visible(const glm::dvec3& from, const glm::dvec3& to) const {
     const glm::dvec3 d = to - from;
     const double length = glm::length(d);
-    return length <= 1e-6 || !tracer->occluded(from, d / length, length - 1e-3);
+    return length <= 1e-6 || !solid->occluded(from, d / length, length - 1e-3);
   }
   // Whether a ray from `from` towards `direction` reaches the sky (or leaves the map).
   bool seesSky(const glm::dvec3& from, const glm::dvec3& direction) const {
-    const render::SurfaceHit hit = tracer->intersect(render::Ray{from, direction});
+    const render::SurfaceHit hit = all->intersect(render::Ray{from, direction});
     return !hit.hit || hit.node == 1;
   }
 };
@@ -86,10 +93,21 @@ Expected<Occluders> buildOccluders(const Bsp& bsp, const ShaderScripts& scripts)
   // Embree's SSE4.2 kernels whatever the CPU: its AVX2 and AVX-512 kernels hit grazing edges
   // differently, and a different hit early in the greedy fit gives a different set of lights (seen
   // on oa_dm1). The fit is a property of the map, so every machine traces it the same way.
-  auto tracer = render::RayTracingScene::create(scene, {}, "max_isa=sse4.2");
-  if (!tracer) return std::unexpected(tracer.error());
-  if (auto updated = (*tracer)->update(0.0); !updated) return std::unexpected(updated.error());
-  return Occluders{std::move(*tracer)};
+  const auto tracerOf = [](const scene::Scene& s) -> Expected<std::unique_ptr<render::RayTracingScene>> {
+    auto tracer = render::RayTracingScene::create(s, {}, "max_isa=sse4.2");
+    if (!tracer) return std::unexpected(tracer.error());
+    if (auto updated = (*tracer)->update(0.0); !updated) return std::unexpected(updated.error());
+    return std::move(*tracer);
+  };
+  scene::Scene solidScene;
+  solidScene.meshes.push_back(scene.meshes[0]);
+  solidScene.nodes.push_back(scene.nodes[0]);
+  solidScene.roots.push_back(0);
+  auto all = tracerOf(scene);
+  if (!all) return std::unexpected(all.error());
+  auto solid = tracerOf(solidScene);
+  if (!solid) return std::unexpected(solid.error());
+  return Occluders{std::move(*all), std::move(*solid)};
 }
 
 double gammaOf(const Bsp& bsp) {
@@ -116,7 +134,7 @@ struct LightmapTexels {
 };
 
 // Every lightmap texel of the world's drawn, lightmapped surfaces, each once (the first triangle
-// over a texel's centre owns it); those at 255 (clipped) are only counted.
+// over a texel's centre owns it); those clipped (kClippedByte) are only counted.
 LightmapTexels lightmapTexels(const Bsp& bsp, const ShaderScripts& scripts, double gamma) {
   LightmapTexels out;
   std::vector<std::vector<char>> owned(bsp.lightmaps.size(), std::vector<char>(kLightmapSize * kLightmapSize, 0));
@@ -149,8 +167,9 @@ LightmapTexels lightmapTexels(const Bsp& bsp, const ShaderScripts& scripts, doub
           mark = 1;
           const std::uint8_t* rgb = &page[static_cast<std::size_t>((y * kLightmapSize + x) * 3)];
           ++out.texels;
-          // ColorToBytes normalises a colour whose brightest channel passes 255 to 255: its level is lost
-          if (std::max({rgb[0], rgb[1], rgb[2]}) >= 255) {
+          // ColorToBytes normalises a colour whose brightest channel passes 255 to 255 in float and
+          // truncates, so the clipped channel reads 254 or 255: its level is lost
+          if (std::max({rgb[0], rgb[1], rgb[2]}) >= kClippedByte) {
             ++out.clipped;
             continue;
           }
@@ -176,68 +195,82 @@ std::vector<Sample> texelSubset(const std::vector<Texel>& texels, int stride, in
   return samples;
 }
 
-double triangleArea(const std::array<glm::dvec3, 3>& t) { return 0.5 * glm::length(glm::cross(t[1] - t[0], t[2] - t[0])); }
+double polygonArea(const std::vector<glm::dvec3>& w) {
+  glm::dvec3 sum(0.0);
+  for (std::size_t i = 2; i < w.size(); ++i) sum += glm::cross(w[i - 1] - w[0], w[i] - w[0]);
+  return 0.5 * glm::length(sum);
+}
 
-// Splits a triangle at its longest edge until every edge is at most `size` (q3map2 subdivides a
-// surface light's windings likewise, RadSubdivideDiffuseLight).
-void subdivide(const std::array<glm::dvec3, 3>& t, double size, std::vector<std::array<glm::dvec3, 3>>& out, int depth = 0) {
-  int longest = 0;
-  double length = 0;
-  for (int k = 0; k < 3; ++k) {
-    const double l = glm::length(t[static_cast<std::size_t>((k + 1) % 3)] - t[static_cast<std::size_t>(k)]);
-    if (l > length) {
-      length = l;
-      longest = k;
-    }
+void subdivideInto(const std::vector<glm::dvec3>& w, double size, std::vector<std::vector<glm::dvec3>>& out, bool& split, int depth) {
+  glm::dvec3 lo(1e300), hi(-1e300);
+  for (const glm::dvec3& p : w) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
   }
-  if (length <= size || depth > 16) {
-    out.push_back(t);
+  for (int axis = 0; axis < 3 && depth < 24; ++axis) {
+    if (hi[axis] - lo[axis] <= size) continue;
+    const double mid = 0.5 * (hi[axis] + lo[axis]);
+    std::vector<glm::dvec3> front, back;
+    for (std::size_t i = 0; i < w.size(); ++i) {
+      const glm::dvec3& a = w[i];
+      const glm::dvec3& b = w[(i + 1) % w.size()];
+      const double da = a[axis] - mid, db = b[axis] - mid;
+      if (da >= 0) front.push_back(a);
+      if (da <= 0) back.push_back(a);
+      if ((da > 0 && db < 0) || (da < 0 && db > 0)) {
+        const glm::dvec3 m = a + (b - a) * (da / (da - db));
+        front.push_back(m);
+        back.push_back(m);
+      }
+    }
+    split = true;
+    if (front.size() >= 3) subdivideInto(front, size, out, split, depth + 1);
+    if (back.size() >= 3) subdivideInto(back, size, out, split, depth + 1);
     return;
   }
-  const auto a = static_cast<std::size_t>(longest), b = static_cast<std::size_t>((longest + 1) % 3), c = static_cast<std::size_t>((longest + 2) % 3);
-  const glm::dvec3 mid = 0.5 * (t[a] + t[b]);
-  subdivide({t[a], mid, t[c]}, size, out, depth + 1);
-  subdivide({mid, t[b], t[c]}, size, out, depth + 1);
+  out.push_back(w);
 }
 
 std::vector<SurfaceEmitter> surfaceEmitters(const Bsp& bsp, const ShaderScripts& scripts, const GameFiles& files) {
   std::vector<SurfaceEmitter> emitters;
   std::map<int, glm::dvec3> colors;
-  std::map<int, double> areas;
   const BspModel& world = bsp.models[0];
-  const auto emitting = [&](int i) -> const ShaderLighting* {
-    const BspSurface& s = bsp.surfaces[static_cast<std::size_t>(i)];
-    const ShaderLighting* script = scripts.find(bsp.shaders[static_cast<std::size_t>(s.shader)].name);
-    return script && script->surfaceLight > 0 ? script : nullptr;
-  };
-  for (int i = world.firstSurface; i < world.firstSurface + world.surfaceCount; ++i)
-    if (emitting(i))
-      for (const SurfaceTriangle& t : surfaceTriangles(bsp, i)) areas[bsp.surfaces[static_cast<std::size_t>(i)].shader] += triangleArea(t.position);
   for (int i = world.firstSurface; i < world.firstSurface + world.surfaceCount; ++i) {
     const BspSurface& s = bsp.surfaces[static_cast<std::size_t>(i)];
-    const ShaderLighting* script = emitting(i);
-    if (!script) continue;
+    const ShaderLighting* script = scripts.find(bsp.shaders[static_cast<std::size_t>(s.shader)].name);
+    if (!script || script->surfaceLight <= 0) continue;
     if (!colors.contains(s.shader)) colors[s.shader] = surfaceLightColor(*script, files);
-    // Pieces of at most 128 units, coarser where a shader covers so much (a sky box that emits)
-    // that it would make more than about 2000 of them.
-    const double pieceSize = std::max(128.0, std::sqrt(2.0 * areas[s.shader] / 2000.0));
+    const double subdivide = script->lightSubdivide > 0 ? script->lightSubdivide : kDefaultLightSubdivide;
+    // q3map2 makes area lights of each triangle (RadLightForTriangles; a patch's quads, here its
+    // triangles), as its light stage reads them
     for (const SurfaceTriangle& t : surfaceTriangles(bsp, i)) {
-      std::vector<std::array<glm::dvec3, 3>> pieces;
-      subdivide(t.position, pieceSize, pieces);
+      bool split = false;
+      std::vector<std::vector<glm::dvec3>> pieces = subdivideWinding({t.position.begin(), t.position.end()}, subdivide, &split);
       const glm::dvec3 facing = t.normal[0] + t.normal[1] + t.normal[2];  // the side the BSP's normals give it
-      for (const auto& piece : pieces) {
+      for (auto& piece : pieces) {
+        const double area = polygonArea(piece);
+        if (area < 1.0 || area > 20000000.0) continue;  // q3map2's bounds
         const glm::dvec3 cross = glm::cross(piece[1] - piece[0], piece[2] - piece[0]);
-        if (glm::length(cross) <= 1e-9) continue;
+        if (glm::length(cross) <= 1e-9 || glm::length(facing) <= 0) continue;
         SurfaceEmitter e;
-        e.triangle = piece;
-        e.normal = glm::normalize(cross) * (glm::dot(cross, facing) < 0 ? -1.0 : 1.0);
+        e.normal = glm::normalize(facing);
+        glm::dvec3 lo(1e300), hi(-1e300);
+        for (const glm::dvec3& p : piece) {
+          lo = glm::min(lo, p);
+          hi = glm::max(hi, p);
+        }
+        e.origin = 0.5 * (lo + hi) + e.normal;
+        e.winding = std::move(piece);
         e.color = colors[s.shader];
         e.value = script->surfaceLight;
-        e.backsplashFraction = script->backsplashFraction;
-        e.backsplashDistance = script->backsplashDistance;
+        e.twoSided = script->twoSided;
+        if (!split) {
+          e.backsplashFraction = script->backsplashFraction;
+          e.backsplashDistance = script->backsplashDistance;
+        }
         e.shader = s.shader;
         e.shaderName = bsp.shaders[static_cast<std::size_t>(s.shader)].name;
-        emitters.push_back(e);
+        emitters.push_back(std::move(e));
       }
     }
   }
@@ -265,11 +298,16 @@ struct Column {
 
 // A group of known emitters whose strength the fit confirms with one weight: one light entity, one
 // sun, or every piece of one shader's surface light. Its colour is shared.
+// A two-sided surface light's back is a group of its own: q3map2 lights both sides of a `cull none`
+// shader's surfaces (LIGHT_TWOSIDED) since some version, and the stock maps were compiled by
+// several; the lightmaps then say with the back's weight whether that map's compile did.
+enum class EmitterSide { kBoth, kFront, kBack };
 struct EmitterGroup {
   std::string name;
   glm::dvec3 color{1.0};
   std::vector<std::size_t> lights;    // indices into MapLighting::lights
   std::vector<std::size_t> surfaces;  // indices into MapLighting::surfaceLights
+  EmitterSide side = EmitterSide::kBoth;  // the surfaces' light from which side
 };
 
 // Every group's light at every sample (q3map2's model, lightmap units per unit colour, visibility
@@ -277,18 +315,15 @@ struct EmitterGroup {
 std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::vector<EmitterGroup>& groups, const std::vector<MapLight>& lights,
                                  const std::vector<SurfaceEmitter>& surfaces, const Occluders& occluders) {
   const std::size_t g = groups.size();
-  // per piece, once: the point traced to, its circumsphere's radius and its area
+  // per piece, once: the radius of its bounding sphere about the point traced to, and its area
   struct Piece {
-    glm::dvec3 centre{0.0};
     double radius = 0.0, area = 0.0;
   };
   std::vector<Piece> pieces(surfaces.size());
   for (std::size_t ei = 0; ei < surfaces.size(); ++ei) {
     const SurfaceEmitter& e = surfaces[ei];
-    Piece& p = pieces[ei];
-    p.centre = (e.triangle[0] + e.triangle[1] + e.triangle[2]) / 3.0 + e.normal;
-    p.radius = std::max({glm::length(e.triangle[0] - p.centre), glm::length(e.triangle[1] - p.centre), glm::length(e.triangle[2] - p.centre)});
-    p.area = triangleArea(e.triangle);
+    for (const glm::dvec3& p : e.winding) pieces[ei].radius = std::max(pieces[ei].radius, glm::length(p - e.origin));
+    pieces[ei].area = polygonArea(e.winding);
   }
   std::vector<float> dense(samples.size() * g, 0.0f);
   tbb::parallel_for(std::size_t(0), samples.size(), [&](std::size_t i) {
@@ -302,21 +337,23 @@ std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::
         const bool visible = l.kind == MapLightKind::kSun ? occluders.seesSky(s.position, l.towardsSun) : occluders.visible(s.position, l.position);
         if (visible) sum += add;
       }
+      const EmitterSide side = groups[k].side;
       for (std::size_t ei : groups[k].surfaces) {
         const SurfaceEmitter& e = surfaces[ei];
-        const glm::dvec3& centre = pieces[ei].centre;
         const double area = pieces[ei].area;
-        // a bound first: the form factor is at most area / (pi distance^2) from the piece's circumsphere
-        const double distance = glm::length(s.position - centre) - pieces[ei].radius;
+        // a bound first: the form factor is at most area / (pi distance^2) from the piece's bounding sphere
+        const double distance = glm::length(s.position - e.origin) - pieces[ei].radius;
         const bool negligible = distance > 0 && area / (std::numbers::pi * distance * distance) * e.value * kFormFactorValueScale * kAreaScale < 0.01;
         if (!negligible) {
-          const double add = surfaceContribution(e, s.position, s.normal);
-          if (add > 0 && occluders.visible(s.position, centre)) sum += add;
+          bool fromBack = false;
+          const double add = surfaceContribution(e, s.position, s.normal, &fromBack);
+          const bool counted = side == EmitterSide::kBoth || (side == EmitterSide::kBack) == fromBack;
+          if (add > 0 && counted && occluders.visible(s.position, fromBack ? e.origin - 2.0 * e.normal : e.origin)) sum += add;
         }
-        if (e.backsplashFraction > 0) {
-          // the point light q3map2 adds in front of every piece: photons V area areaScale fraction, no pointScale
+        if (e.backsplashFraction > 0 && side != EmitterSide::kBack) {
+          // the point light q3map2 puts in front of an undivided piece: photons V area areaScale fraction, no pointScale
           MapLight splash;
-          splash.position = centre + e.normal * (e.backsplashDistance - 1.0);
+          splash.position = e.origin + e.normal * e.backsplashDistance;
           splash.value = e.value * area * kAreaScale * e.backsplashFraction / kPointScale;
           const double b = lightContribution(splash, s.position, s.normal);
           if (b > 0.01 && occluders.visible(s.position, splash.position)) sum += b;
@@ -371,7 +408,7 @@ bool inOpenSpace(const glm::dvec3& p, const Occluders& occluders) {
     return d;
   }();
   for (const glm::dvec3& d : directions) {
-    const render::SurfaceHit hit = occluders.tracer->intersect(render::Ray{p, d});
+    const render::SurfaceHit hit = occluders.all->intersect(render::Ray{p, d});
     if (!hit.hit) return false;
     if (hit.node == 1) continue;  // the sky
     // the surface's own side: its vertex normals (the BSP's), not a winding convention
@@ -448,29 +485,39 @@ double dot(const Column& c, const std::vector<double>& dense) {
 
 }  // namespace
 
-double formFactor(const std::array<glm::dvec3, 3>& triangle, const glm::dvec3& point, const glm::dvec3& normal) {
+std::vector<std::vector<glm::dvec3>> subdivideWinding(const std::vector<glm::dvec3>& winding, double size, bool* split) {
+  std::vector<std::vector<glm::dvec3>> pieces;
+  bool halved = false;
+  subdivideInto(winding, size, pieces, halved, 0);
+  if (split) *split = halved;
+  return pieces;
+}
+
+double formFactor(const std::vector<glm::dvec3>& polygon, const glm::dvec3& point, const glm::dvec3& normal) {
   // Lambert: the projected solid angle is 1/2 sum_i gamma_i (n . u_i), with gamma_i the angle the
   // edge i subtends and u_i the unit normal of the plane through it and the point.
-  std::array<glm::dvec3, 3> dirs;
-  for (int i = 0; i < 3; ++i) {
-    const glm::dvec3 d = triangle[static_cast<std::size_t>(i)] - point;
+  const std::size_t n = polygon.size();
+  if (n < 3) return 0.0;
+  std::vector<glm::dvec3> dirs(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::dvec3 d = polygon[i] - point;
     const double l = glm::length(d);
     if (l <= 1e-12) return 0.0;
-    dirs[static_cast<std::size_t>(i)] = d / l;
+    dirs[i] = d / l;
   }
   double total = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    const glm::dvec3& a = dirs[static_cast<std::size_t>(i)];
-    const glm::dvec3& b = dirs[static_cast<std::size_t>((i + 1) % 3)];
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::dvec3& a = dirs[i];
+    const glm::dvec3& b = dirs[(i + 1) % n];
     const double angle = std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
     const glm::dvec3 cross = glm::cross(a, b);
     const double length = glm::length(cross);
     if (length < 1e-12) continue;
     total += glm::dot(normal, cross / length) * angle;
   }
-  // The sum's sign follows the winding: positive for a triangle wound clockwise seen from the
+  // The sum's sign follows the winding: positive for a polygon wound clockwise seen from the
   // point. Either winding gives the same form factor here.
-  const double side = glm::dot(glm::cross(triangle[1] - triangle[0], triangle[2] - triangle[0]), point - triangle[0]);
+  const double side = glm::dot(glm::cross(polygon[1] - polygon[0], polygon[2] - polygon[0]), point - polygon[0]);
   return (side > 0 ? -total : total) / (2.0 * std::numbers::pi);
 }
 
@@ -498,14 +545,26 @@ double lightContribution(const MapLight& light, const glm::dvec3& point, const g
   return std::max(0.0, add);
 }
 
-double surfaceContribution(const SurfaceEmitter& e, const glm::dvec3& point, const glm::dvec3& normal) {
-  const double d = glm::dot(point - e.triangle[0], e.normal);
-  if (d < -1.0) return 0.0;  // behind the emitter
-  if (d < 3.0 && glm::dot(normal, e.normal) > 0.9) return 0.0;  // coplanar with it
+double surfaceContribution(const SurfaceEmitter& e, const glm::dvec3& point, const glm::dvec3& normal, bool* fromBack) {
+  if (fromBack) *fromBack = false;
+  const double d = glm::dot(point - e.origin, e.normal);  // q3map2 measures from the plane through its origin
+  if (d < 3.0) {
+    if (!e.twoSided && d < -1.0) return 0.0;                        // behind the emitter
+    if (d > -3.0 && glm::dot(normal, e.normal) > 0.9) return 0.0;  // coplanar with it
+  }
   // q3map2 pushes a point close to the emitter's plane 8 units in front of it (no black edges)
   const glm::dvec3 pushed = d > -8.0 && d < 8.0 ? point + (8.0 - d) * e.normal : point;
-  const double factor = formFactor(e.triangle, pushed, normal);
-  return factor > 0 ? factor * e.value * kFormFactorValueScale * kAreaScale : 0.0;
+  // formFactor is positive where the point's surface faces the emitter. q3map2's signed form factor
+  // is positive where that agrees with the side of the emitter the point is on; where it does not,
+  // a one-sided emitter gives nothing and a two-sided one its magnitude, traced to its back.
+  const double factor = formFactor(e.winding, pushed, normal);
+  if (factor == 0.0) return 0.0;
+  const bool facing = factor > 0.0, inFront = glm::dot(pushed - e.origin, e.normal) >= 0.0;
+  if (facing != inFront) {
+    if (!e.twoSided) return 0.0;
+    if (fromBack) *fromBack = true;
+  }
+  return std::abs(factor) * e.value * kFormFactorValueScale * kAreaScale;
 }
 
 std::vector<MapLight> entityLights(const Bsp& bsp) {
@@ -612,12 +671,15 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   result.surfaceLights = surfaceEmitters(*bsp, *scripts, files);
   r.surfaceEmitters = result.surfaceLights.size();
   {
-    std::map<int, std::size_t> byShader;
+    std::map<std::pair<int, EmitterSide>, std::size_t> byShader;
     for (std::size_t i = 0; i < result.surfaceLights.size(); ++i) {
       const SurfaceEmitter& e = result.surfaceLights[i];
-      auto [it, fresh] = byShader.emplace(e.shader, groups.size());
-      if (fresh) groups.push_back({"surface light " + e.shaderName, e.color, {}, {}});
-      groups[it->second].surfaces.push_back(i);
+      for (const EmitterSide side : e.twoSided ? std::vector{EmitterSide::kFront, EmitterSide::kBack} : std::vector{EmitterSide::kBoth}) {
+        auto [it, fresh] = byShader.emplace(std::pair{e.shader, side}, groups.size());
+        if (fresh)
+          groups.push_back({"surface light " + e.shaderName + (side == EmitterSide::kBack ? " (its back)" : ""), e.color, {}, {}, side});
+        groups[it->second].surfaces.push_back(i);
+      }
     }
   }
   const std::size_t knownLights = result.lights.size(), groupCount = groups.size();
@@ -864,10 +926,15 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
     perChannel[static_cast<std::size_t>(c)] = solve(y, c);
     r.constant[c] = perChannel[static_cast<std::size_t>(c)].back();
   }
+  // q3map2's own strengths, for judging the fit on held-out texels below
+  const std::vector<MapLight> unweightedLights = result.lights;
+  const std::vector<SurfaceEmitter> unweightedSurfaces = result.surfaceLights;
   for (std::size_t k = 0; k < groupCount; ++k) {
     r.groupWeights.push_back({groups[k].name, weights[k]});
     for (std::size_t li : groups[k].lights) result.lights[li].value *= weights[k];
-    for (std::size_t ei : groups[k].surfaces) result.surfaceLights[ei].value *= weights[k];
+    // the dataset's emitter takes its front's weight; the back's is reported
+    if (groups[k].side != EmitterSide::kBack)
+      for (std::size_t ei : groups[k].surfaces) result.surfaceLights[ei].value *= weights[k];
   }
   for (std::size_t a = groupCount; a < chosen.size(); ++a) {
     const glm::dvec3 v(perChannel[0][a], perChannel[1][a], perChannel[2][a]);
@@ -907,16 +974,17 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
     all.push_back({"fitted", result.lights[i].color, {i}, {}});
     allWeights.push_back(1.0);
   }
-  const std::vector<Column> held = groupColumns(heldOut, all, result.lights, result.surfaceLights, *occluders);
+  std::vector<MapLight> heldLights = unweightedLights;
+  heldLights.insert(heldLights.end(), result.lights.begin() + static_cast<std::ptrdiff_t>(knownLights), result.lights.end());
+  const std::vector<Column> held = groupColumns(heldOut, all, heldLights, unweightedSurfaces, *occluders);
   std::vector<double> texel(heldOut.size()), knownLum(heldOut.size(), 0.0), allLum(heldOut.size(), 0.0);
   for (std::size_t i = 0; i < heldOut.size(); ++i) texel[i] = luminance(heldOut[i].value);
   for (std::size_t k = 0; k < all.size(); ++k) {
     const double lum = luminance(all[k].color);
     for (std::size_t q = 0; q < held[k].rows.size(); ++q) {
-      // the groups' columns were made with the weighted values: undo the weight for q3map2's own
-      const double v = held[k].values[q] * lum;
-      allLum[held[k].rows[q]] += v;
-      if (k < groupCount && weights[k] > 0) knownLum[held[k].rows[q]] += v / weights[k];
+      const double v = held[k].values[q] * lum;  // q3map2's strength (a fitted light's own)
+      allLum[held[k].rows[q]] += v * allWeights[k];
+      if (k < groupCount) knownLum[held[k].rows[q]] += v;
     }
   }
   r.heldOutCorrelation = pearson(texel, allLum);

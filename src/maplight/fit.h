@@ -37,6 +37,7 @@ inline constexpr double kLinearScale = 1.0 / 8000.0;
 inline constexpr double kAreaScale = 0.25, kFormFactorValueScale = 3.0;
 inline constexpr double kMinimumDistance = 16.0;  // q3map2 clamps a point light's distance to it
 inline constexpr double kFullLight = 63.75;       // lightmap units of the engine's full light
+inline constexpr double kDefaultLightSubdivide = 999.0;  // q3map2.h's defaultLightSubdivide, units
 inline constexpr double kRecoveryRadius = 64.0;   // units: a hidden light counts as found with a fitted light this near
 
 enum class MapLightKind { kPoint, kSpot, kSun };
@@ -56,12 +57,18 @@ struct MapLight {
   std::string source;             // "entity 12", "shader textures/sky/x", "fitted"
 };
 
-// One piece of a surface light's surface (a triangle, subdivided): an emitter of q3map2's value.
+// One of a surface light's area lights as q3map2 makes them (light_bounce.c,
+// RadSubdivideDiffuseLight): a triangle of the surface, halved at the mid-plane of its bounds along
+// the first axis they exceed the shader's q3map_lightSubdivide on (kDefaultLightSubdivide unless
+// set), until none does.
 struct SurfaceEmitter {
-  std::array<glm::dvec3, 3> triangle;
+  std::vector<glm::dvec3> winding;  // a convex polygon
   glm::dvec3 normal{0.0};  // unit, the side it lights
+  glm::dvec3 origin{0.0};  // its bounds' centre 1 unit in front: the one point q3map2 traces visibility to
   glm::dvec3 color{1.0};   // largest channel 1
   double value = 0.0;      // q3map_surfacelight
+  bool twoSided = false;   // the shader's cull none: it lights both sides (LIGHT_TWOSIDED)
+  // q3map2 puts a point light in front of a triangle that was not subdivided (none for the pieces)
   double backsplashFraction = 0.0, backsplashDistance = 0.0;
   int shader = -1;         // the BSP's shader index
   std::string shaderName;
@@ -80,7 +87,7 @@ struct MapLightFitOptions {
 };
 
 struct MapLightFitReport {
-  std::size_t texels = 0, clippedTexels = 0;  // lit lightmap texels of drawn surfaces; those at 255 (left out)
+  std::size_t texels = 0, clippedTexels = 0;  // lit lightmap texels of drawn surfaces; those clipped, at 254 or 255 (left out)
   std::size_t fitSamples = 0, heldOutSamples = 0;
   std::size_t candidates = 0, latticeCandidates = 0, latticeSpacing = 0;  // all candidates; those on the lattice
   std::size_t entityLights = 0, surfaceEmitters = 0, suns = 0, fittedLights = 0;
@@ -118,11 +125,17 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
 // (LightContributionToSample's `add`, before it is multiplied by the light's colour).
 double lightContribution(const MapLight& light, const glm::dvec3& point, const glm::dvec3& normal);
 // A surface emitter's light at a point (its exact point-to-polygon form factor times
-// formFactorValueScale areaScale V), without visibility.
-double surfaceContribution(const SurfaceEmitter& emitter, const glm::dvec3& point, const glm::dvec3& normal);
-// The projected solid angle of a triangle seen from `point` with normal `normal`, over pi (Lambert's
-// polygon formula; q3map2's PointToPolygonFormFactor): 1 for a triangle filling the hemisphere.
-double formFactor(const std::array<glm::dvec3, 3>& triangle, const glm::dvec3& point, const glm::dvec3& normal);
+// formFactorValueScale areaScale V), without visibility or its backsplash. A two-sided emitter
+// (LIGHT_TWOSIDED) gives the form factor's magnitude wherever q3map2's signed one is negative, and
+// `fromBack` (if given) then says so: q3map2 traces that light to its origin pushed 2 units behind.
+double surfaceContribution(const SurfaceEmitter& emitter, const glm::dvec3& point, const glm::dvec3& normal, bool* fromBack = nullptr);
+// A convex winding halved at the mid-plane of its bounds along the first axis on which they exceed
+// `size`, until none does (q3map2's RadSubdivideDiffuseLight); `split` says whether it was halved.
+std::vector<std::vector<glm::dvec3>> subdivideWinding(const std::vector<glm::dvec3>& winding, double size, bool* split = nullptr);
+// The projected solid angle of a convex polygon seen from `point` with normal `normal`, over pi
+// (Lambert's polygon formula; q3map2's PointToPolygonFormFactor): 1 for a polygon filling the
+// hemisphere. Either winding gives the same value.
+double formFactor(const std::vector<glm::dvec3>& polygon, const glm::dvec3& point, const glm::dvec3& normal);
 
 // The map's light entities (classname light*) as q3map2 reads them (light.c, CreateEntityLights):
 // spots aimed at their target, suns (_sun 1) made directional.

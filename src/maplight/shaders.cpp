@@ -113,6 +113,11 @@ Expected<void> ShaderScripts::add(const std::string& text, const std::string& fi
         } else if (key == "q3map_skylight" && args.size() >= 2) {
           shader.skyLight = number(args[0]);
           shader.skyLightIterations = static_cast<int>(number(args[1]));
+        } else if (key == "cull" && !args.empty()) {
+          const std::string mode = lower(args[0]);
+          shader.twoSided = mode == "none" || mode == "disable" || mode == "twosided";
+        } else if (key == "q3map_lightsubdivide" && !args.empty()) {
+          shader.lightSubdivide = number(args[0]);
         } else if (key == "q3map_backsplash" && args.size() >= 2) {
           shader.backsplashFraction = number(args[0]) * 0.01;
           shader.backsplashDistance = number(args[1]);

@@ -29,7 +29,9 @@ struct ShaderLighting {
   double skyLight = 0.0;                     // q3map_skylight value
   int skyLightIterations = 0;
   double backsplashFraction = 0.05, backsplashDistance = 23.0;  // q3map_backsplash (percent / 100, units)
+  double lightSubdivide = 0.0;  // q3map_lightSubdivide, units (0: q3map2's default, kDefaultLightSubdivide)
   bool sky = false, translucent = false, noDraw = false;         // surfaceparm sky, trans, nodraw
+  bool twoSided = false;  // cull none, disable or twosided: q3map2 makes its surface light emit from both sides
 };
 
 class ShaderScripts {
