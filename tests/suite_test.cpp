@@ -86,8 +86,8 @@ TEST(Suite, ValidityRanksEachMeasureAgainstEachMethodsError) {
     suite::DatasetResult d;
     d.name = fmt::format("d{}", k);
     d.measures = {{"direct_radiance", 10.0 * k}, {"frustum", 5.0 - k}};
-    d.errors["none"] = {{"flip", 0.2}, {"warped_error_change", 0.1}, {"flip_over_none", 0.0}};
-    d.errors["taa"] = {{"flip", 0.1 + 0.01 * k}, {"warped_error_change", 0.05}, {"flip_over_none", -0.1 + 0.01 * k}};
+    d.errors["none"] = {{"flip", 0.2}, {"warped_error_change", 0.1}, {"flip_over_none", 0.0}, {"flip_ratio_to_none", 1.0}};
+    d.errors["taa"] = {{"flip", 0.1 + 0.01 * k}, {"warped_error_change", 0.05}, {"flip_over_none", -0.1 + 0.01 * k}, {"flip_ratio_to_none", 0.5 + 0.05 * k}};
     datasets.push_back(d);
   }
   const auto cells = suite::validity(datasets);
@@ -101,7 +101,8 @@ TEST(Suite, ValidityRanksEachMeasureAgainstEachMethodsError) {
   EXPECT_DOUBLE_EQ(*cell("frustum", "taa", "flip_over_none").correlation.rho, -1.0);
   EXPECT_EQ(cell("direct_radiance", "taa", "flip_over_none").datasets, 3);
   EXPECT_FALSE(cell("direct_radiance", "none", "flip").correlation.rho);  // none's error is constant: no ranking
-  EXPECT_EQ(suite::rankingError("taa"), "flip_over_none");
+  EXPECT_DOUBLE_EQ(*cell("frustum", "taa", "flip_ratio_to_none").correlation.rho, -1.0);
+  EXPECT_EQ(suite::rankingError("taa"), "flip_ratio_to_none");
   EXPECT_EQ(suite::rankingError("none"), "flip");
 }
 
@@ -112,11 +113,12 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
   const auto r = dynbench(fmt::format("suite {} -o {}", kSmoke.string(), out.string()), dir);
   ASSERT_EQ(r.status, 0) << r.err << r.out;
   const auto doc = nlohmann::json::parse(test::slurp(out / "suite.json"));
-  EXPECT_EQ(doc["dynbench_suite_results"], 1);
+  EXPECT_EQ(doc["dynbench_suite_results"], 2);
   EXPECT_EQ(doc["manifest"], nlohmann::json::parse(test::slurp(kSmoke)));
   ASSERT_EQ(doc["datasets"].size(), 4u);
   // Each dataset's numbers are those its stages wrote: Table 6.7 from discard.json's mean, the
-  // methods' ꟻLIP from evaluate.json, flip_over_none their difference with none's.
+  // methods' ꟻLIP from evaluate.json, flip_over_none their difference with none's and
+  // flip_ratio_to_none their ratio.
   for (const auto& d : doc["datasets"]) {
     const fs::path run = out / d["run"].get<std::string>();
     const auto discard = nlohmann::json::parse(test::slurp(run / "discard.json"));
@@ -130,6 +132,7 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
       const std::string name = m["name"];
       EXPECT_NEAR(d["errors"][name]["flip"].get<double>(), m["mean"]["flip"]["mean"].get<double>(), 1e-12);
       EXPECT_NEAR(d["errors"][name]["flip_over_none"].get<double>(), m["mean"]["flip"]["mean"].get<double>() - noneFlip, 1e-12);
+      EXPECT_NEAR(d["errors"][name]["flip_ratio_to_none"].get<double>(), m["mean"]["flip"]["mean"].get<double>() / noneFlip, 1e-12);
     }
     // Every frame of the window is recorded with its checksum.
     EXPECT_TRUE(doc["files"].contains(d["dataset"].get<std::string>()));
@@ -177,7 +180,8 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
     const auto remade = dynbench(fmt::format("suite {} -o {} --part datasets", kSmoke.string(), again.string()), dir);
     EXPECT_EQ(remade.status, 0) << remade.err;
     EXPECT_NE(remade.out.find("fly-through: a smooth camera"), std::string::npos) << remade.out;
-    EXPECT_NE(remade.out.find("(as pinned), dataset 5cfce052"), std::string::npos) << remade.out;
+    const std::string lastPin = nlohmann::json::parse(test::slurp(kSmoke))["datasets"][3]["sha256"]["dataset"];
+    EXPECT_NE(remade.out.find("(as pinned), dataset " + lastPin), std::string::npos) << remade.out;
   }
 
   // The fly-throughs share their bot's capture: two captures for four datasets.

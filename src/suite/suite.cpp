@@ -194,7 +194,7 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
   nlohmann::json doc = {{"dynbench_suite_results", kResultsVersion},
                         {"tool_version", kVersion},
                         {"manifest", manifest->document},
-                        {"ranking_error", "flip_over_none (flip for none)"},
+                        {"ranking_error", "flip_ratio_to_none (flip for none)"},
                         {"datasets", nlohmann::json::array()},
                         {"files", nlohmann::json::object()}};
   auto prepared = prepareDatasets(*manifest, root, settings.fps, log);

@@ -17,7 +17,7 @@ const std::vector<std::string>& measureKeys() {
 }
 
 const std::vector<std::string>& errorKeys() {
-  static const std::vector<std::string> errors{"flip", "warped_error_change", "flip_over_none"};
+  static const std::vector<std::string> errors{"flip", "warped_error_change", "flip_over_none", "flip_ratio_to_none"};
   return errors;
 }
 
@@ -36,7 +36,7 @@ std::string measureLabel(const std::string& measure) {
 // Below this many datasets a bootstrap interval is not shown: resamples of a few points are
 // mostly ties and duplicates, and their rho takes only a handful of values.
 
-std::string rankingError(const std::string& method) { return method == "none" ? "flip" : "flip_over_none"; }
+std::string rankingError(const std::string& method) { return method == "none" ? "flip" : "flip_ratio_to_none"; }
 
 std::vector<ValidityCell> validity(const std::vector<DatasetResult>& datasets) {
   std::vector<ValidityCell> cells;
@@ -89,7 +89,11 @@ std::map<std::string, std::map<std::string, double>> errorsOf(const std::vector<
   for (const auto& m : methods) {
     e[m.name]["flip"] = m.flip.mean;
     e[m.name]["warped_error_change"] = m.warpedErrorChange.mean;
-    if (none != methods.end()) e[m.name]["flip_over_none"] = m.flip.mean - none->flip.mean;
+    if (none == methods.end()) continue;
+    e[m.name]["flip_over_none"] = m.flip.mean - none->flip.mean;
+    // a ratio of the window's means: where the input is noisier, none's error and a method's
+    // residual both grow, and the ratio keeps what history does apart from how noisy the input is
+    if (none->flip.mean > 0) e[m.name]["flip_ratio_to_none"] = m.flip.mean / none->flip.mean;
   }
   return e;
 }

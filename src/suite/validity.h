@@ -16,8 +16,9 @@ namespace dynbench::suite {
 // One dataset's numbers. Difficulty measures (docs/suite.md): Table 6.7's five columns over the
 // render window (percent) and the camera's motion over the same frames (Tables 6.4-6.6: position
 // in scene units and rotation, yaw and pitch in degrees per frame, cuts left out; cuts counted).
-// Method errors: "flip" (mean ꟻLIP), "warped_error_change" and "flip_over_none" (the method's
-// ꟻLIP minus `none`'s on the same frames: what history costs or gains).
+// Method errors: "flip" (mean ꟻLIP), "warped_error_change", "flip_over_none" (the method's
+// ꟻLIP minus `none`'s on the same frames: what history costs or gains) and "flip_ratio_to_none"
+// (the method's mean ꟻLIP over `none`'s on the same frames: below 1 where history helps).
 struct DatasetResult {
   std::string name;
   std::map<std::string, double> measures;
@@ -31,7 +32,7 @@ struct ValidityCell {
   int datasets = 0;
 };
 
-// The error each method is ranked by: flip_over_none, or flip for `none` itself.
+// The error each method is ranked by: flip_ratio_to_none, or flip for `none` itself.
 std::string rankingError(const std::string& method);
 // Every (measure, method, error) cell, over the datasets' numbers.
 std::vector<ValidityCell> validity(const std::vector<DatasetResult>& datasets);
