@@ -59,7 +59,20 @@ fi
 # game's Makefile, and -lenet then finds Debian's libenet.
 mkdir -p "$src/enet/include"
 printf 'all:\n\t@true\n' > "$src/enet/Makefile"
-make -C "$src" -j"$(nproc)" client \
+# The game's own flags, and no reciprocal estimates: under -ffast-math GCC computes x/y and
+# 1/sqrt(x) from RCPPS/RSQRTPS estimates (273 of them in the client, its collision code among
+# them), whose bits the x86 ISA leaves to the implementation, so Intel and AMD round them
+# differently: the same build and seed played another match on an Intel Xeon than on an AMD EPYC
+# (integrations/cube2/README.md). -mno-recip alone leaves 1/sqrtf to RSQRTSS (GCC's manual says so);
+# -fno-reciprocal-math as well leaves none. Objects and the precompiled header made with other
+# flags are dropped.
+cxxflags="-O3 -fomit-frame-pointer -ffast-math -mno-recip -fno-reciprocal-math"
+if [[ "$(cat "$src/.dynbench-cxxflags" 2>/dev/null)" != "$cxxflags" ]]; then
+  find "$src" \( -name '*.o' -o -name '*.gch' \) -delete
+  rm -f "$src/sauer_client"
+  echo "$cxxflags" >"$src/.dynbench-cxxflags"
+fi
+make -C "$src" -j"$(nproc)" client CXXFLAGS="$cxxflags" \
   DYNBENCH_INCLUDES="-I$repo/include" \
   DYNBENCH_LIBS="$dynbench_build/libdynbench_capture_engine.a -lfmt" \
   >"$build_dir/build.log" 2>&1 || { tail -20 "$build_dir/build.log" >&2; exit 1; }
