@@ -51,7 +51,18 @@ out="$src/build/release-linux-x86_64/baseq3"
 for dep in "$src/code/cgame/dynbench_oa.h" "$src/code/cgame/dynbench_oa_internal.h" "$sdk/lib/libdynbench_capture.so" "$here/build.sh"; do
   [[ -f "$out/cgamex86_64.so" && "$dep" -nt "$out/cgamex86_64.so" ]] && rm -f "$out/cgamex86_64.so" "$out"/cgame/*.o
 done
-make -C "$src" -j"$(nproc)" release BUILD_GAME_QVM=0 BUILD_MISSIONPACK=0 \
+# ioquake3's x86_64 release flags, and no reciprocal estimates: under -ffast-math GCC computes x/y
+# and 1/sqrt(x) from RCPPS/RSQRTPS estimates, whose bits differ between Intel and AMD (the x86 ISA
+# leaves them to the implementation); the client module had 9 (the adapter's normals and poses
+# among them). The same cause made Cube 2's matches differ between the two
+# (integrations/cube2/README.md). Modules built with other flags are rebuilt. Debian's engine
+# binary (ioquake3) keeps 8 RSQRTSS of its own: not ours to rebuild.
+optimize="-O3 -fomit-frame-pointer -ffast-math -funroll-loops -falign-loops=2 -falign-jumps=2 -falign-functions=2 -fstrength-reduce -mno-recip -fno-reciprocal-math"
+if [[ "$(cat "$src/.dynbench-optimize" 2>/dev/null)" != "$optimize" ]]; then
+  rm -rf "$src/build"
+  echo "$optimize" >"$src/.dynbench-optimize"
+fi
+make -C "$src" -j"$(nproc)" release BUILD_GAME_QVM=0 BUILD_MISSIONPACK=0 OPTIMIZE="$optimize" \
   DYNBENCH_CFLAGS="$cflags" DYNBENCH_LIBS="$libs" \
   >"$build_dir/build.log" 2>&1 || { tail -20 "$build_dir/build.log" >&2; exit 1; }
 for m in cgamex86_64.so qagamex86_64.so; do
