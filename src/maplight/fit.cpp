@@ -201,12 +201,18 @@ double polygonArea(const std::vector<glm::dvec3>& w) {
   return 0.5 * glm::length(sum);
 }
 
-void subdivideInto(const std::vector<glm::dvec3>& w, double size, std::vector<std::vector<glm::dvec3>>& out, bool& split, int depth) {
+// A winding's axis-aligned bounds: {lowest, highest} corner.
+std::pair<glm::dvec3, glm::dvec3> bounds(const std::vector<glm::dvec3>& w) {
   glm::dvec3 lo(1e300), hi(-1e300);
   for (const glm::dvec3& p : w) {
     lo = glm::min(lo, p);
     hi = glm::max(hi, p);
   }
+  return {lo, hi};
+}
+
+void subdivideInto(const std::vector<glm::dvec3>& w, double size, std::vector<std::vector<glm::dvec3>>& out, bool& split, int depth) {
+  const auto [lo, hi] = bounds(w);
   for (int axis = 0; axis < 3 && depth < 24; ++axis) {
     if (hi[axis] - lo[axis] <= size) continue;
     const double mid = 0.5 * (hi[axis] + lo[axis]);
@@ -247,18 +253,15 @@ std::vector<SurfaceEmitter> surfaceEmitters(const Bsp& bsp, const ShaderScripts&
       bool split = false;
       std::vector<std::vector<glm::dvec3>> pieces = subdivideWinding({t.position.begin(), t.position.end()}, subdivide, &split);
       const glm::dvec3 facing = t.normal[0] + t.normal[1] + t.normal[2];  // the side the BSP's normals give it
+      if (glm::length(facing) <= 0) continue;
       for (auto& piece : pieces) {
         const double area = polygonArea(piece);
         if (area < 1.0 || area > 20000000.0) continue;  // q3map2's bounds
         const glm::dvec3 cross = glm::cross(piece[1] - piece[0], piece[2] - piece[0]);
-        if (glm::length(cross) <= 1e-9 || glm::length(facing) <= 0) continue;
+        if (glm::length(cross) <= 1e-9) continue;
         SurfaceEmitter e;
         e.normal = glm::normalize(facing);
-        glm::dvec3 lo(1e300), hi(-1e300);
-        for (const glm::dvec3& p : piece) {
-          lo = glm::min(lo, p);
-          hi = glm::max(hi, p);
-        }
+        const auto [lo, hi] = bounds(piece);
         e.origin = 0.5 * (lo + hi) + e.normal;
         e.winding = std::move(piece);
         e.color = colors[s.shader];
@@ -308,6 +311,7 @@ struct EmitterGroup {
   std::vector<std::size_t> lights;    // indices into MapLighting::lights
   std::vector<std::size_t> surfaces;  // indices into MapLighting::surfaceLights
   EmitterSide side = EmitterSide::kBoth;  // the surfaces' light from which side
+  std::size_t backGroup = 0;              // a kFront group's kBack partner (same surfaces)
 };
 
 // Every group's light at every sample (q3map2's model, lightmap units per unit colour, visibility
@@ -337,7 +341,11 @@ std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::
         const bool visible = l.kind == MapLightKind::kSun ? occluders.seesSky(s.position, l.towardsSun) : occluders.visible(s.position, l.position);
         if (visible) sum += add;
       }
+      // a two-sided shader's pieces are evaluated once, by its front group, which credits its
+      // back group with the light from behind
       const EmitterSide side = groups[k].side;
+      if (side == EmitterSide::kBack) continue;
+      double backSum = 0.0;
       for (std::size_t ei : groups[k].surfaces) {
         const SurfaceEmitter& e = surfaces[ei];
         const double area = pieces[ei].area;
@@ -347,10 +355,12 @@ std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::
         if (!negligible) {
           bool fromBack = false;
           const double add = surfaceContribution(e, s.position, s.normal, &fromBack);
-          const bool counted = side == EmitterSide::kBoth || (side == EmitterSide::kBack) == fromBack;
-          if (add > 0 && counted && occluders.visible(s.position, fromBack ? e.origin - 2.0 * e.normal : e.origin)) sum += add;
+          if (add > 0 && occluders.visible(s.position, fromBack ? e.origin - 2.0 * e.normal : e.origin)) {
+            if (fromBack && side == EmitterSide::kFront) backSum += add;
+            else sum += add;
+          }
         }
-        if (e.backsplashFraction > 0 && side != EmitterSide::kBack) {
+        if (e.backsplashFraction > 0) {
           // the point light q3map2 puts in front of an undivided piece: photons V area areaScale fraction, no pointScale
           MapLight splash;
           splash.position = e.origin + e.normal * e.backsplashDistance;
@@ -360,6 +370,7 @@ std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::
         }
       }
       dense[i * g + k] = static_cast<float>(sum);
+      if (side == EmitterSide::kFront) dense[i * g + groups[k].backGroup] = static_cast<float>(backSum);
     }
   });
   std::vector<Column> columns(g);
@@ -676,8 +687,10 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
       const SurfaceEmitter& e = result.surfaceLights[i];
       for (const EmitterSide side : e.twoSided ? std::vector{EmitterSide::kFront, EmitterSide::kBack} : std::vector{EmitterSide::kBoth}) {
         auto [it, fresh] = byShader.emplace(std::pair{e.shader, side}, groups.size());
-        if (fresh)
+        if (fresh) {
           groups.push_back({"surface light " + e.shaderName + (side == EmitterSide::kBack ? " (its back)" : ""), e.color, {}, {}, side});
+          if (side == EmitterSide::kBack) groups[byShader.at({e.shader, EmitterSide::kFront})].backGroup = it->second;
+        }
         groups[it->second].surfaces.push_back(i);
       }
     }
