@@ -9,6 +9,7 @@
 #include "core/files.h"
 #include "frames/frame_io.h"
 #include "metrics/rank_correlation.h"
+#include "suite/score.h"
 #include "suite/suite.h"
 #include "external_tools.h"
 #include "gltf_builder.h"
@@ -104,6 +105,31 @@ TEST(Suite, ValidityRanksEachMeasureAgainstEachMethodsError) {
   EXPECT_DOUBLE_EQ(*cell("frustum", "taa", "flip_ratio_to_none").correlation.rho, -1.0);
   EXPECT_EQ(suite::rankingError("taa"), "flip_ratio_to_none");
   EXPECT_EQ(suite::rankingError("none"), "flip");
+}
+
+TEST(Suite, MethodsToScoreAreNamedAndTheirRatioUsesTheRecordedNone) {
+  auto external = suite::parseMethodToScore("mine=external:out/{dataset}/mine");
+  ASSERT_TRUE(external) << external.error().message;
+  EXPECT_EQ(external->name, "mine");
+  EXPECT_EQ(external->spec, "external:out/{dataset}/mine");
+  ASSERT_TRUE(suite::parseMethodToScore("svgf"));
+  for (const char* bad : {"taa2=taa", "x=bilateral", "a b=external:x", "x=external:", "../x=external:y"}) {
+    auto parsed = suite::parseMethodToScore(bad);
+    ASSERT_FALSE(parsed) << bad;
+    EXPECT_EQ(parsed.error().code, ErrorCode::kUsage) << bad;
+    EXPECT_NE(parsed.error().message.find(bad), std::string::npos) << parsed.error().message;
+  }
+  // Without none among the scores, the ratio and difference use the recorded none's ꟻLIP.
+  evaluate::MethodScores added;
+  added.name = "mine", added.flip.mean = 0.06, added.warpedErrorChange.mean = 0.01;
+  auto errors = suite::errorsOf({added}, 0.08);
+  EXPECT_DOUBLE_EQ(errors["mine"]["flip_ratio_to_none"], 0.75);
+  EXPECT_DOUBLE_EQ(errors["mine"]["flip_over_none"], 0.06 - 0.08);
+  EXPECT_FALSE(suite::errorsOf({added}).at("mine").count("flip_ratio_to_none"));
+  // none among the scores wins over a recorded one.
+  evaluate::MethodScores none;
+  none.name = "none", none.flip.mean = 0.12;
+  EXPECT_DOUBLE_EQ(suite::errorsOf({none, added}, 0.08)["mine"]["flip_ratio_to_none"], 0.5);
 }
 
 TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
@@ -211,6 +237,73 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
   const auto clean = dynbench(fmt::format("suite verify {}", out.string()), dir);
   EXPECT_EQ(clean.status, 0) << clean.err << clean.out;
   EXPECT_NE(clean.out.find(", 0 differ"), std::string::npos) << clean.out;
+
+  // A method that is not in the manifest, scored on the finished suite (issue 48): the worked
+  // example, examples/python/ema.py --suite, through dynbench.suite_score.
+  const fs::path python = fs::path(DYNBENCH_EXE).parent_path() / "python";
+  if (fs::exists(python / "dynbench" / "__init__.py")) {
+    const std::string env = fmt::format("PYTHONPATH='{}' /usr/bin/python3 ", python.string());
+    const std::string example = (fs::path(DYNBENCH_SOURCE_DIR) / "examples" / "python" / "ema.py").string();
+    std::string table;
+    ASSERT_EQ(runShell(env + fmt::format("'{}' --suite '{}' 2>&1", example, out.string()), table), 0) << table;
+    EXPECT_NE(table.find("fps-2-flythrough"), std::string::npos) << table;
+    // Its column is what `evaluate` gives for the same method on each dataset's stored frames.
+    std::string evaluated;
+    ASSERT_EQ(runShell(env + fmt::format("-c \"import importlib.util, json, dynbench; spec = importlib.util.spec_from_file_location('ema', '{}'); "
+                                         "ema = importlib.util.module_from_spec(spec); spec.loader.exec_module(ema); "
+                                         "suite = json.load(open('{}/suite.json')); "
+                                         "print(json.dumps({{d['name']: dynbench.evaluate('{}/' + d['run'] + '/input', '{}/' + d['run'] + '/frames', "
+                                         "methods=[ema.Ema()])['methods'][0]['mean']['flip']['mean'] for d in suite['datasets']}}))\" 2>&1",
+                                         example, out.string(), out.string(), out.string()),
+                       evaluated),
+              0)
+        << evaluated;
+    const auto byEvaluate = nlohmann::json::parse(evaluated);
+    const auto scored = nlohmann::json::parse(test::slurp(out / "suite.json"));
+    ASSERT_EQ(scored["scored_methods"].size(), 1u);
+    EXPECT_EQ(scored["scored_methods"][0]["name"], "ema");
+    EXPECT_EQ(scored["scored_methods"][0]["spec"], "python:__main__.Ema");
+    for (std::size_t i = 0; i < scored["datasets"].size(); ++i) {
+      const auto& d = scored["datasets"][i];
+      const double flip = d["errors"]["ema"]["flip"], none = d["errors"]["none"]["flip"];
+      EXPECT_DOUBLE_EQ(flip, byEvaluate[d["name"].get<std::string>()].get<double>()) << d["name"];
+      EXPECT_DOUBLE_EQ(d["errors"]["ema"]["flip_ratio_to_none"].get<double>(), flip / none) << d["name"];
+      // the manifest's methods' numbers are untouched
+      EXPECT_EQ(d["errors"]["taa"], doc["datasets"][i]["errors"]["taa"]);
+      EXPECT_TRUE(scored["files"].contains(fmt::format("scored/{}/ema/frame_{:05d}.exr", d["name"].get<std::string>(), d["window"]["first"].get<long>())));
+    }
+    EXPECT_NE(test::slurp(out / "suite.md").find("- `ema`: python:__main__.Ema"), std::string::npos);
+    EXPECT_NE(test::slurp(out / "suite.md").find("| ema (flip_ratio_to_none) |"), std::string::npos);
+
+    // The same outputs as another program's (the external: layout, {dataset} in the path): the same column.
+    const auto external = dynbench(fmt::format("suite score {} --method files=external:{}/scored/{{dataset}}/ema", out.string(), out.string()), dir);
+    ASSERT_EQ(external.status, 0) << external.err;
+    const auto both = nlohmann::json::parse(test::slurp(out / "suite.json"));
+    for (const auto& d : both["datasets"]) EXPECT_EQ(d["errors"]["files"], d["errors"]["ema"]) << d["name"];
+    // verify re-derives the added columns from their stored outputs.
+    const auto verified = dynbench(fmt::format("suite verify {}", out.string()), dir);
+    EXPECT_EQ(verified.status, 0) << verified.out;
+    EXPECT_NE(verified.out.find(", 0 differ"), std::string::npos) << verified.out;
+
+    // Bad requests: a manifest method's name (usage, status 2), a folder without the outputs
+    // (status 3, naming the file); suite.json is left as it was and nothing is left pending.
+    const std::string before = test::slurp(out / "suite.json");
+    const auto taken = dynbench(fmt::format("suite score {} --method taa", out.string()), dir);
+    EXPECT_EQ(taken.status, 2) << taken.err;
+    EXPECT_NE(taken.err.find("method 'taa' is one of the manifest's"), std::string::npos) << taken.err;
+    const auto missing = dynbench(fmt::format("suite score {} --method gone=external:{}", out.string(), (dir / "nowhere").string()), dir);
+    EXPECT_EQ(missing.status, 3) << missing.err;
+    EXPECT_NE(missing.err.find((dir / "nowhere" / "fps-1-bot").string()), std::string::npos) << missing.err;
+    const fs::path half = dir / "half";  // the first dataset's outputs only: fails at the second
+    fs::create_directories(half);
+    fs::copy(out / "scored" / "fps-1-bot" / "ema", half / "fps-1-bot");
+    const auto partial = dynbench(fmt::format("suite score {} --method half=external:{}", out.string(), half.string()), dir);
+    EXPECT_EQ(partial.status, 3) << partial.err;
+    EXPECT_NE(partial.err.find("dataset 'fps-1-flythrough'"), std::string::npos) << partial.err;
+    EXPECT_EQ(test::slurp(out / "suite.json"), before);
+    EXPECT_FALSE(fs::exists(out / "scored" / ".pending"));
+    EXPECT_FALSE(fs::exists(out / "scored" / "fps-1-bot" / "half"));
+  }
 
   // One input frame edited by hand (its direct radiance doubled): verify names the file and the
   // numbers that changed with it, and fails.

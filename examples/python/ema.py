@@ -3,6 +3,11 @@ with motion-vector reprojection (the nearest previous pixel), history kept only 
 with the same normal and clamped to the current 3x3 neighbourhood's range (as TAA does).
 
     python3 examples/python/ema.py dynbench-demo/runs/colos_bot/input dynbench-demo/runs/colos_bot/frames
+
+or scored on every dataset of a finished suite (`dynbench suite`), its column added to the suite's
+suite.json and suite.md (docs/suite.md, "Score your own method"):
+
+    python3 examples/python/ema.py --suite smoke
 """
 import sys
 
@@ -35,7 +40,18 @@ class Ema:
         return colour
 
 
+def score_suite(folder):
+    suite = dynbench.suite_score(folder, methods=[Ema()])
+    print(f"{'dataset':<20} {'none':>8} {'ema':>8} {'ema/none':>9}   (mean HDR-FLIP over the window)")
+    for d in suite["datasets"]:
+        e = d["errors"]
+        print(f"{d['name']:<20} {e['none']['flip']:8.4f} {e['ema']['flip']:8.4f} {e['ema']['flip_ratio_to_none']:9.3f}")
+
+
 if __name__ == "__main__":
+    if sys.argv[1] == "--suite":
+        score_suite(sys.argv[2])
+        sys.exit(0)
     scores = dynbench.evaluate(sys.argv[1], sys.argv[2], methods=["none", "accumulate", Ema()])
     print(f"{'method':<12} {'HDR-FLIP':>9} {'PSNR (dB)':>10} {'warped error change':>20}   (means over frames)")
     for method in scores["methods"]:

@@ -1,7 +1,9 @@
-// `dynbench suite MANIFEST -o DIR` and `dynbench suite verify DIR` (suite/suite.h, suite/verify.h).
+// `dynbench suite MANIFEST -o DIR`, `dynbench suite score DIR --method NAME=SPEC` and `dynbench suite
+// verify DIR` (suite/suite.h, suite/score.h, suite/verify.h).
 #include <cstdio>
 
 #include "cli/commands.h"
+#include "suite/score.h"
 #include "suite/suite.h"
 #include "suite/verify.h"
 
@@ -9,7 +11,8 @@ namespace dynbench::cli {
 namespace {
 
 struct SuiteCli {
-  std::string manifest, output, verifyDir;
+  std::string manifest, output, verifyDir, scoreDir;
+  std::vector<std::string> scoreMethods;
   int threads = 0;
   std::string part = "all";
   int renderTask = 0, framesPerTask = 8;
@@ -74,6 +77,20 @@ Expected<void> runVerify(const SuiteCli& cli) {
   return {};
 }
 
+Expected<void> runScore(const SuiteCli& cli) {
+  std::vector<suite::MethodToScore> methods;
+  for (const std::string& text : cli.scoreMethods) {
+    auto m = suite::parseMethodToScore(text);
+    if (!m) return std::unexpected(m.error());
+    methods.push_back(std::move(*m));
+  }
+  auto outcome = suite::scoreSuite(cli.scoreDir, methods, printLine);
+  if (!outcome) return std::unexpected(outcome.error());
+  fmt::print("suite score: {} scored on every dataset; {} and {}\n", fmt::join(outcome->methods, ", "), outcome->json.string(),
+             outcome->markdown.string());
+  return {};
+}
+
 }  // namespace
 
 void addSuiteCommand(CLI::App& app, CommandRun& run) {
@@ -98,9 +115,22 @@ void addSuiteCommand(CLI::App& app, CommandRun& run) {
                   false);
   auto* verify = cmd->add_subcommand("verify", "Recompute every number of DIR/suite.json from its files and report any that differ");
   verify->add_option("DIR", cli->verifyDir, "The suite's folder")->required();
-  cmd->callback([cmd, verify, cli, &run] {
+  auto* score = cmd->add_subcommand("score", "Score a method that is not in the manifest on every dataset of a finished suite, "
+                                             "from its stored frames (nothing captured or rendered), and add it to suite.json and suite.md");
+  score->add_option("DIR", cli->scoreDir, "The suite's folder (with suite.json)")->required();
+  score->add_option("--method", cli->scoreMethods,
+                    "NAME=external:PATH (PATH/DATASET/frame_NNNNN.exr for each dataset, or {dataset} in PATH) or a built-in "
+                    "method's name; repeat for several")
+      ->required();
+  score->footer("Example: dynbench suite score smoke --method mine=external:my-outputs   (my-outputs/fps-1-bot/frame_00034.exr, ...)\n"
+                "Outputs are kept in DIR/scored/DATASET/NAME, so `suite verify` re-derives the new column. docs/suite.md.");
+  cmd->callback([cmd, verify, score, cli, &run] {
     if (verify->parsed()) {
       run = [cli] { return runVerify(*cli); };
+      return;
+    }
+    if (score->parsed()) {
+      run = [cli] { return runScore(*cli); };
       return;
     }
     if (cli->manifest.empty() || cli->output.empty()) throw CLI::RequiredError("MANIFEST and --output");

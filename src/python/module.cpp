@@ -23,6 +23,7 @@
 #include "python/frame_objects.h"
 #include "python/python_method.h"
 #include "report/stats_output.h"
+#include "suite/score.h"
 
 namespace py = pybind11;
 namespace fs = std::filesystem;
@@ -205,6 +206,32 @@ py::object evaluateMethods(const fs::path& input, const fs::path& reference, con
   return document(evaluate::evaluateJson(result));
 }
 
+// dynbench.suite_score: suite/score.h's scoreSuite with Python methods beside the CLI's specs.
+py::object scoreSuite(const fs::path& dir, const py::list& methods) {
+  std::vector<suite::MethodToScore> toScore;
+  std::vector<std::shared_ptr<PythonMethod>> pythonMethods;
+  for (const py::handle& m : methods) {
+    if (py::isinstance<py::str>(m)) {
+      toScore.push_back(unwrap(suite::parseMethodToScore(m.cast<std::string>())));
+      continue;
+    }
+    pythonMethods.push_back(unwrap(PythonMethod::wrap(py::reinterpret_borrow<py::object>(m))));
+    const py::handle type = py::type::handle_of(m);
+    const std::string what = fmt::format("python:{}.{}", py::str(type.attr("__module__")).cast<std::string>(),
+                                         py::str(type.attr("__qualname__")).cast<std::string>());
+    toScore.push_back({pythonMethods.back()->name(), what, pythonMethods.back()});
+  }
+  Expected<suite::ScoreOutcome> outcome = std::unexpected(Error{});
+  {
+    py::gil_scoped_release release;
+    outcome = suite::scoreSuite(dir, toScore, [](const std::string&) {});  // quiet, as the other functions
+  }
+  for (const auto& m : pythonMethods)
+    if (m->pendingException()) throw *m->pendingException();
+  unwrap(std::move(outcome));
+  return document(unwrap(readJsonFile(dir / "suite.json")));
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_core, m) {
@@ -241,4 +268,7 @@ PYBIND11_MODULE(_core, m) {
         py::arg("methods") = py::list(py::cast(evaluate::builtInMethodNames())),
         py::arg("ppd") = evaluate::flip::defaultPixelsPerDegree(), py::arg("out_dir") = py::none(),
         "Temporal methods (built-in names or objects with reset() and process(frame)) scored as `dynbench evaluate --json` writes them");
+  m.def("suite_score", &scoreSuite, py::arg("dir"), py::kw_only(), py::arg("methods"),
+        "Methods (objects with reset() and process(frame), \"NAME=external:PATH\" or built-in names) scored on every dataset of the "
+        "finished suite in dir, added to its suite.json and suite.md as `dynbench suite score` adds them; returns suite.json");
 }

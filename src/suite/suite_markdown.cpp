@@ -42,13 +42,20 @@ nlohmann::json validityJson(const std::vector<ValidityCell>& cells) {
 // suite.md: the datasets' numbers, the validity table (each method's ranking error), and a
 // scatter plot per method of that error against its best-correlated measure.
 Expected<std::string> suiteMarkdown(const Manifest& manifest, const std::vector<DatasetResult>& datasets, const std::vector<ValidityCell>& cells,
-                                    const fs::path& root) {
+                                    const fs::path& root, const nlohmann::json& scoredMethods) {
   std::string md = fmt::format("# Suite {}\n\n{}\n\n", manifest.name, manifest.description);
   const auto& r = manifest.run;
   md += fmt::format("{} datasets; each a window of {} frames at {}x{}, references converged (tolerance {}, {}-{} spp, {} bounces), "
                     "input {} spp; dynbench {}.\n\n",
                     datasets.size(), r.renderFrames, r.width, r.height, r.tolerance, r.samplesPerPixel, r.maxSamplesPerPixel, r.bounces,
                     r.inputSamplesPerPixel, kVersion);
+  if (!scoredMethods.empty()) {
+    md += "Scored afterwards with `dynbench suite score`, on the same stored input and reference frames:\n\n";
+    for (const auto& s : scoredMethods)
+      md += fmt::format("- `{}`: {}{}\n", s.value("name", ""), s.value("spec", ""),
+                        s.contains("parameters") && !s["parameters"].empty() ? fmt::format(", parameters {}", s["parameters"].dump()) : std::string());
+    md += "\n";
+  }
   std::vector<std::string> methods;
   if (!datasets.empty())
     for (const auto& [method, errors] : datasets.front().errors) methods.push_back(method);
@@ -80,8 +87,8 @@ Expected<std::string> suiteMarkdown(const Manifest& manifest, const std::vector<
     }
     md += "## Validity\n\nSpearman's rank correlation of each difficulty measure with each method's error over the datasets, with its "
           "bootstrap 95 % interval (2000 resamples of the datasets); in bold where the interval excludes 0. Methods are ranked by "
-          "their ꟻLIP minus `none`'s on the same frames (what history costs or gains: the content's own difficulty, the same for "
-          "every method, cancels), `none` by its ꟻLIP. Every error's table is in suite.json." +
+          "their ꟻLIP over `none`'s on the same frames (below 1 where history helps: the content's own difficulty and the input's "
+          "noise, the same for every method, divide out), `none` by its ꟻLIP. Every error's table is in suite.json." +
           (datasets.size() < static_cast<std::size_t>(kMinDatasetsForInterval)
                ? fmt::format(" With fewer than {} datasets no interval is shown: a bootstrap of so few points says nothing.", kMinDatasetsForInterval)
                : std::string()) +
@@ -98,7 +105,7 @@ Expected<std::string> suiteMarkdown(const Manifest& manifest, const std::vector<
     if (!best) continue;
     std::vector<report::ScatterPoint> points;
     for (const DatasetResult& d : datasets) points.push_back({d.name, d.measures.at(best->measure), d.errors.at(m).at(rankingError(m))});
-    auto plot = report::writeScatterPlot(points, measureLabel(best->measure), fmt::format("{}: {}", m, m == "none" ? "mean ꟻLIP" : "mean ꟻLIP minus none's"),
+    auto plot = report::writeScatterPlot(points, measureLabel(best->measure), fmt::format("{}: {}", m, m == "none" ? "mean ꟻLIP" : "mean ꟻLIP over none's"),
                                          fmt::format("{}: rho {:+.2f}", m, *best->correlation.rho), root / "plots", "scatter_" + m);
     if (!plot) return std::unexpected(plot.error());
     md += fmt::format("![{} against {}](plots/scatter_{}.png)\n\n", m, best->measure, m);

@@ -83,17 +83,18 @@ std::map<std::string, double> measuresOf(const metrics::CameraMotion& motion, lo
   return m;
 }
 
-std::map<std::string, std::map<std::string, double>> errorsOf(const std::vector<evaluate::MethodScores>& methods) {
+std::map<std::string, std::map<std::string, double>> errorsOf(const std::vector<evaluate::MethodScores>& methods, std::optional<double> noneFlip) {
   std::map<std::string, std::map<std::string, double>> e;
   const auto none = std::find_if(methods.begin(), methods.end(), [](const auto& m) { return m.name == "none"; });
+  if (none != methods.end()) noneFlip = none->flip.mean;
   for (const auto& m : methods) {
     e[m.name]["flip"] = m.flip.mean;
     e[m.name]["warped_error_change"] = m.warpedErrorChange.mean;
-    if (none == methods.end()) continue;
-    e[m.name]["flip_over_none"] = m.flip.mean - none->flip.mean;
+    if (!noneFlip) continue;
+    e[m.name]["flip_over_none"] = m.flip.mean - *noneFlip;
     // a ratio of the window's means: where the input is noisier, none's error and a method's
     // residual both grow, and the ratio keeps what history does apart from how noisy the input is
-    if (none->flip.mean > 0) e[m.name]["flip_ratio_to_none"] = m.flip.mean / none->flip.mean;
+    if (*noneFlip > 0) e[m.name]["flip_ratio_to_none"] = m.flip.mean / *noneFlip;
   }
   return e;
 }

@@ -3,6 +3,7 @@
 // dataset's measures and errors, and the rank correlation of every (measure, method, error) over
 // the datasets (docs/suite.md, "Validity").
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,7 +48,9 @@ std::string measureLabel(const std::string& measure);
 // The difficulty measures of one dataset's window, frames first..last (DatasetResult::measures):
 // its discard mean and the camera's motion over the same frames, cuts left out and counted.
 std::map<std::string, double> measuresOf(const metrics::CameraMotion& motion, long first, long last, const discard::FramePercentages& discarded);
-// Each method's errors (DatasetResult::errors).
-std::map<std::string, std::map<std::string, double>> errorsOf(const std::vector<evaluate::MethodScores>& methods);
+// Each method's errors (DatasetResult::errors). The difference and ratio with `none` use its scores
+// among `methods`, or else `noneFlip` (none's mean ꟻLIP on the same frames, as a suite recorded it).
+std::map<std::string, std::map<std::string, double>> errorsOf(const std::vector<evaluate::MethodScores>& methods,
+                                                              std::optional<double> noneFlip = std::nullopt);
 
 }  // namespace dynbench::suite

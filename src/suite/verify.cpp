@@ -8,6 +8,7 @@
 #include "core/json_fields.h"
 #include "pipeline/stages.h"
 #include "suite/manifest.h"
+#include "suite/score.h"
 #include "suite/suite.h"
 #include "suite/validity.h"
 
@@ -17,18 +18,10 @@ namespace fs = std::filesystem;
 using pipeline::DatasetRunSettings;
 
 Expected<VerifyOutcome> verifySuite(const fs::path& root, const pipeline::RunLog& log) {
-  const fs::path path = root / "suite.json";
-  auto doc = readJsonFile(path);
-  if (!doc) return std::unexpected(doc.error());
-  const JsonFields f(*doc, path);
-  auto version = f.integer("/dynbench_suite_results");
-  if (!version) return std::unexpected(version.error());
-  if (*version != kResultsVersion) return fail(ErrorCode::kInvalidData, "{}: /dynbench_suite_results: expected {}, found {}", path.string(), kResultsVersion, *version);
-  // The manifest as recorded: the settings the numbers were made with.
-  auto recordedManifest = f.value("/manifest");
-  if (!recordedManifest) return std::unexpected(recordedManifest.error());
-  auto manifest = parseManifest(**recordedManifest, path.string() + " /manifest");
-  if (!manifest) return std::unexpected(manifest.error());
+  auto suite = readSuiteResults(root);
+  if (!suite) return std::unexpected(suite.error());
+  const fs::path& path = suite->path;
+  const JsonFields f(suite->document, path);
 
   VerifyOutcome out;
   // 1. Every file as recorded.
@@ -47,44 +40,40 @@ Expected<VerifyOutcome> verifySuite(const fs::path& root, const pipeline::RunLog
     if (!close(recorded, found)) out.differences.push_back(fmt::format("{}: recorded {:.10g}, recomputed {:.10g}", where, recorded, found));
   };
   std::vector<DatasetResult> recomputed;
-  auto datasets = f.value("/datasets");
-  if (!datasets || !(*datasets)->is_array()) return fail(ErrorCode::kInvalidData, "{}: /datasets: expected an array", path.string());
-  for (std::size_t i = 0; i < (*datasets)->size(); ++i) {
-    const std::string at = fmt::format("/datasets/{}", i);
-    auto name = f.string(at + "/name");
-    auto dataset = f.string(at + "/dataset");
-    auto run = f.string(at + "/run");
-    auto first = f.integer(at + "/window/first");
-    auto last = f.integer(at + "/window/last");
-    for (const auto* e : {&name, &dataset, &run})
-      if (!*e) return std::unexpected(e->error());
-    for (const auto* e : {&first, &last})
-      if (!*e) return std::unexpected(e->error());
-    log(fmt::format("[{}/{}] {}", i + 1, (*datasets)->size(), *name));
-    DatasetRunSettings s = manifest->run;
-    auto stats = pipeline::measureStats(root / *dataset, root / *run, s, false);
+  for (std::size_t i = 0; i < suite->datasets.size(); ++i) {
+    const RecordedDataset& d = suite->datasets[i];
+    const std::string& name = d.result.name;
+    log(fmt::format("[{}/{}] {}", i + 1, suite->datasets.size(), name));
+    DatasetRunSettings s = suite->manifest.run;
+    auto stats = pipeline::measureStats(root / d.dataset, root / d.run, s, false);
     if (!stats) return std::unexpected(stats.error());
     pipeline::DiscardStage discardStage;
-    discardStage.frames = root / *run / "frames";
+    discardStage.frames = root / d.run / "frames";
     auto discarded = pipeline::runDiscard(discardStage);
     if (!discarded) return std::unexpected(discarded.error());
     evaluate::EvaluateOptions evaluation;
-    evaluation.frames = root / *run / "input";
-    evaluation.reference = root / *run / "frames";
+    evaluation.frames = root / d.run / "input";
+    evaluation.reference = root / d.run / "frames";
     evaluation.methods = s.methods;
+    // The methods `suite score` added: built-in ones run again, the others from their stored outputs.
+    auto scored = storedScoredMethods(*suite, root, name);
+    if (!scored) return std::unexpected(scored.error());
+    evaluation.methods.insert(evaluation.methods.end(), scored->builtIn.begin(), scored->builtIn.end());
+    evaluation.callerMethods = scored->stored;
     auto evaluated = evaluate::runEvaluate(evaluation);
     if (!evaluated) return std::unexpected(evaluated.error());
-    DatasetResult result{*name, measuresOf(stats->rows.front().motion, *first, *last, discarded->run.mean), errorsOf(evaluated->methods)};
+    DatasetResult result{name, measuresOf(stats->rows.front().motion, d.first, d.last, discarded->run.mean), errorsOf(evaluated->methods)};
+    const std::string at = fmt::format("/datasets/{}", i);
     for (const auto& [measure, value] : result.measures) {
       auto recorded = f.number(at + "/measures/" + measure);
       if (!recorded) return std::unexpected(recorded.error());
-      check(fmt::format("{}: {}", *name, measure), *recorded, value);
+      check(fmt::format("{}: {}", name, measure), *recorded, value);
     }
     for (const auto& [method, errors] : result.errors)
       for (const auto& [error, value] : errors) {
         auto recorded = f.number(at + "/errors/" + method + "/" + error);
         if (!recorded) return std::unexpected(recorded.error());
-        check(fmt::format("{}: {} {}", *name, method, error), *recorded, value);
+        check(fmt::format("{}: {} {}", name, method, error), *recorded, value);
       }
     recomputed.push_back(result);
   }
