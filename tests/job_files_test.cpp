@@ -219,6 +219,7 @@ TEST(JobFiles, DemoJobRoundTripsEveryField) {
   o.maxPairs = 128;
   o.renderFrames = 12;
   o.inputSamplesPerPixel = 2;
+  o.floorFrames = 3;
   o.methods = {"none", "taa"};
   o.seed = 9;
   o.threads = 1;

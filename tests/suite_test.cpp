@@ -160,6 +160,24 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
       EXPECT_NEAR(d["errors"][name]["flip_over_none"].get<double>(), m["mean"]["flip"]["mean"].get<double>() - noneFlip, 1e-12);
       EXPECT_NEAR(d["errors"][name]["flip_ratio_to_none"].get<double>(), m["mean"]["flip"]["mean"].get<double>() / noneFlip, 1e-12);
     }
+    // The reference's noise floor: the window's first 4 frames (6 frames, a step of 1) rendered
+    // again with seed + 2; its ꟻLIP is what `dynbench compare` gives for each pair, averaged.
+    ASSERT_TRUE(d["reference_floor"].is_object()) << d["name"];
+    EXPECT_EQ(d["reference_floor"]["frames"], 4);
+    double floor = 0;
+    for (long f = d["window"]["first"].get<long>(), k = 0; k < 4; ++f, ++k) {
+      const fs::path compared = dir / fmt::format("floor_{}.json", f);
+      const auto c = dynbench(fmt::format("compare {} {} --json {}", (run / "frames" / fmt::format("frame_{:05d}.exr", f)).string(),
+                                          (run / "floor" / fmt::format("frame_{:05d}.exr", f)).string(), compared.string()),
+                              dir);
+      ASSERT_EQ(c.status, 0) << c.err;
+      floor += nlohmann::json::parse(test::slurp(compared))["images"][0]["flip"]["mean"].get<double>() / 4;
+      EXPECT_TRUE(doc["files"].contains(fmt::format("{}/floor/frame_{:05d}.exr", d["run"].get<std::string>(), f)));
+      const auto sidecar = nlohmann::json::parse(test::slurp(run / "floor" / fmt::format("frame_{:05d}.json", f)));
+      EXPECT_EQ(sidecar["render"]["seed"], nlohmann::json::parse(test::slurp(run / "frames" / fmt::format("frame_{:05d}.json", f)))["render"]["seed"].get<int>() + 2);
+    }
+    EXPECT_NEAR(d["reference_floor"]["flip"].get<double>(), floor, 1e-9) << d["name"];
+    EXPECT_GT(floor, 0.0);
     // Every frame of the window is recorded with its checksum.
     EXPECT_TRUE(doc["files"].contains(d["dataset"].get<std::string>()));
     const long window = d["window"]["last"].get<long>() - d["window"]["first"].get<long>() + 1;

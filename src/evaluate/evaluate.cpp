@@ -126,6 +126,28 @@ std::string methodFolder(const std::string& name) {
   return s;
 }
 
+Expected<MeanWithError> referenceNoiseFloor(const fs::path& reference, const fs::path& other, double pixelsPerDegree) {
+  auto others = frames::listFrames(other);
+  if (!others) return std::unexpected(others.error());
+  if (others->empty()) return fail(ErrorCode::kInvalidData, "{}: no frames (frame_NNNNN.exr + .json)", other.string());
+  std::vector<FrameScores> scores;
+  for (const frames::FrameEntry& entry : *others) {
+    const fs::path referenceImage = frames::frameImagePath(reference, entry.frame);
+    auto a = frames::readFrame(frames::FrameEntry{entry.frame, referenceImage, fs::path(referenceImage).replace_extension(".json")});
+    if (!a) return std::unexpected(a.error());
+    auto b = frames::readFrame(entry);
+    if (!b) return std::unexpected(b.error());
+    if (a->width != b->width || a->height != b->height)
+      return fail(ErrorCode::kInvalidData, "{}: {}x{} pixels, but {} is {}x{}", entry.image.string(), b->width, b->height, referenceImage.string(),
+                  a->width, a->height);
+    FrameScores s;
+    s.frame = entry.frame;
+    s.flip = scoreImage(frameRadiance(*a), frameRadiance(*b), /*hdr=*/true, pixelsPerDegree).scores.flip.mean;
+    scores.push_back(s);
+  }
+  return meanOf(scores, [](const FrameScores& s) { return std::optional(s.flip); });
+}
+
 Expected<EvaluateRun> runEvaluate(const EvaluateOptions& options, const EvaluateProgress& progress) {
   auto inputs = frames::listFrames(options.frames);
   if (!inputs) return std::unexpected(inputs.error());

@@ -76,6 +76,14 @@ struct EvaluateRun {
 using EvaluateProgress = std::function<void(std::size_t, std::size_t)>;
 Expected<EvaluateRun> runEvaluate(const EvaluateOptions& options, const EvaluateProgress& progress = {});
 
+// The reference's noise floor (issue 48): the mean HDR-ꟻLIP between two converged renders of the
+// same frames with other seeds, `reference` as the reference and `other` as the test, over every
+// frame of `other` (each must be in `reference`, the same size). A method whose ꟻLIP differs from
+// another's by less than this cannot be told apart from it by this reference: the reference's own
+// noise is as large (docs/suite.md, "The reference's noise floor").
+Expected<MeanWithError> referenceNoiseFloor(const std::filesystem::path& reference, const std::filesystem::path& other,
+                                            double pixelsPerDegree = flip::defaultPixelsPerDegree());
+
 // Method x metric table (means with standard errors).
 std::string evaluateMarkdown(const EvaluateRun& run);
 // The `evaluate --json` document (docs/cli.md); what `report` reads.

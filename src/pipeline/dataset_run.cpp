@@ -146,7 +146,22 @@ DatasetRenders datasetRenders(const fs::path& dataset, const fs::path& run, cons
   input.job.settings.seed = o.seed + 1;
   input.job.settings.jitter = true;
   input.job.settings.pixelFilter = {render::PixelFilterType::kCentre, 0.0};
-  return {render, input};
+  DatasetRenders renders{render, input, std::nullopt};
+  if (o.floorFrames > 0) {
+    // The same converged reference with another seed, on floorFrames frames spread over the window
+    // (every step-th from its first): two independent estimates of the same image. No pairs:
+    // only its radiance is compared.
+    RenderStage floor = render;
+    floor.job.output = run / "floor";
+    floor.job.settings.seed = o.seed + 2;
+    floor.job.settings.pairs = false;
+    const long window = render.job.frames.last - render.job.frames.first + 1;
+    const long count = std::min<long>(window, o.floorFrames);
+    floor.job.frames.step = window / count;
+    floor.job.frames.last = floor.job.frames.first + floor.job.frames.step * (count - 1);
+    renders.floor = floor;
+  }
+  return renders;
 }
 
 Expected<StatsOutcome> measureStats(const fs::path& dataset, const fs::path& run, const DatasetRunSettings& o, bool files) {
@@ -166,7 +181,7 @@ Expected<DatasetRunOutcome> measureDataset(const fs::path& dataset, const fs::pa
   DatasetRunOutcome outcome;
   outcome.motion = stats->rows.front().motion;
   const long frames = static_cast<long>(stats->rows.front().properties.animationFrames);
-  const auto [render, input] = datasetRenders(dataset, run, o, frames);
+  const auto [render, input, floor] = datasetRenders(dataset, run, o, frames);
   outcome.firstFrame = render.job.frames.first, outcome.lastFrame = render.job.frames.last;
   auto rendered = runRender(render);
   if (!rendered) return std::unexpected(rendered.error());
@@ -202,6 +217,14 @@ Expected<DatasetRunOutcome> measureDataset(const fs::path& dataset, const fs::pa
     log(fmt::format("  {} ({} spp input): FLIP {:.4f} ± {:.4f}, PSNR {:.2f} dB, history use {:.3f}", m.name, o.inputSamplesPerPixel, m.flip.mean,
                     m.flip.standardError, m.psnr.mean, m.historyUse.mean));
   outcome.methods = evaluated->methods;
+  if (floor) {
+    auto renderedFloor = runRender(*floor);
+    if (!renderedFloor) return std::unexpected(renderedFloor.error());
+    auto noise = evaluate::referenceNoiseFloor(render.job.output, floor->job.output);
+    if (!noise) return std::unexpected(noise.error());
+    outcome.referenceFloor = *noise;
+    log(fmt::format("  the reference's noise floor (seed {} against {}, {} frames): ꟻLIP {:.4f}", o.seed + 2, o.seed, noise->count, noise->mean));
+  }
   return outcome;
 }
 
@@ -212,8 +235,9 @@ Expected<void> renderTask(const std::vector<DatasetJob>& datasets, int task, int
     auto stats = measureStats(d.dataset, d.run, d.settings, false);
     if (!stats) return std::unexpected(stats.error());
     const auto renders = datasetRenders(d.dataset, d.run, d.settings, static_cast<long>(stats->rows.front().properties.animationFrames));
-    for (const RenderStage* stage : {&renders.reference, &renders.input})
-      for (long f = stage->job.frames.first; f <= stage->job.frames.last; ++f) items.emplace_back(*stage, f);
+    for (const RenderStage* stage : {&renders.reference, &renders.input, renders.floor ? &*renders.floor : nullptr})
+      if (stage)
+        for (long f = stage->job.frames.first; f <= stage->job.frames.last; f += stage->job.frames.step) items.emplace_back(*stage, f);
   }
   const std::size_t first = static_cast<std::size_t>(task) * static_cast<std::size_t>(perTask);
   const std::size_t last = std::min(items.size(), first + static_cast<std::size_t>(perTask));
@@ -236,7 +260,7 @@ Expected<void> renderTask(const std::vector<DatasetJob>& datasets, int task, int
 nlohmann::json datasetRunSettingsJson(const DatasetRunSettings& s, bool all) {
   nlohmann::json j = {{"width", s.width},   {"height", s.height},   {"frames", s.renderFrames},          {"spp", s.samplesPerPixel},
                       {"max_spp", s.maxSamplesPerPixel}, {"bounces", s.bounces}, {"input_spp", s.inputSamplesPerPixel}, {"tolerance", s.tolerance},
-                      {"fps", s.fps}};
+                      {"fps", s.fps}, {"floor_frames", s.floorFrames}};
   if (all) {
     j["max_pairs"] = s.maxPairs;
     j["methods"] = s.methods;
@@ -247,7 +271,8 @@ nlohmann::json datasetRunSettingsJson(const DatasetRunSettings& s, bool all) {
 }
 
 const std::vector<const char*>& datasetRunSettingsKeys(bool all) {
-  static const std::vector<const char*> manifest = {"width", "height", "frames", "spp", "max_spp", "bounces", "input_spp", "tolerance", "fps"};
+  static const std::vector<const char*> manifest = {"width", "height", "frames", "spp", "max_spp", "bounces", "input_spp", "tolerance", "fps",
+                                                    "floor_frames"};
   static const std::vector<const char*> every = [] {
     auto keys = manifest;
     keys.insert(keys.end(), {"max_pairs", "methods", "seed", "threads"});
@@ -261,7 +286,7 @@ Expected<void> readDatasetRunSettings(const JsonSettingsReader& r, const std::st
                   r.integer(prefix + "/frames", s.renderFrames, 2, 100000), r.integer(prefix + "/spp", s.samplesPerPixel, 1, 1 << 20),
                   r.integer(prefix + "/max_spp", s.maxSamplesPerPixel, 1, 1 << 20), r.integer(prefix + "/bounces", s.bounces, 0, 64),
                   r.integer(prefix + "/input_spp", s.inputSamplesPerPixel, 1, 1 << 20), r.number(prefix + "/tolerance", s.tolerance, 1e-4, 10.0),
-                  r.number(prefix + "/fps", s.fps, 1.0, 1000.0)})
+                  r.number(prefix + "/fps", s.fps, 1.0, 1000.0), r.integer(prefix + "/floor_frames", s.floorFrames, 0, 100000)})
     if (!ok) return ok;
   if (s.maxSamplesPerPixel < s.samplesPerPixel) return r.bad(prefix + "/max_spp", "at least " + prefix + "/spp");
   if (!all) return {};

@@ -4,7 +4,9 @@
 // as a real-time renderer's input, and evaluate (the temporal methods against the reference). The
 // files are those the commands write, in one RUN folder (docs/cli.md, `demo`).
 #include <filesystem>
+#include <algorithm>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,7 +43,11 @@ struct DatasetRunSettings {
   // the converged frames.
   int inputSamplesPerPixel = 4;
   std::vector<std::string> methods = evaluate::builtInMethodNames();
-  unsigned seed = 1;  // the reference's; the input's is seed + 1
+  // The reference's noise floor (evaluate::referenceNoiseFloor): this many frames of the window,
+  // evenly spaced, rendered again as the reference is but with seed + 2 (0: none; the demo's
+  // default, a suite manifest's is kDefaultFloorFrames).
+  int floorFrames = 0;
+  unsigned seed = 1;  // the reference's; the input's is seed + 1, the floor's seed + 2
   int threads = 0;    // render threads (0: all cores)
 };
 
@@ -72,13 +78,22 @@ Expected<void> captureAndConvert(const capture::OpenArenaOptions& options, const
 Expected<void> flyThroughUnlessNewer(const std::filesystem::path& bot, const std::filesystem::path& fly, const std::filesystem::path& csv,
                                      const camera::FlythroughOptions& options, const RunLog& log);
 
-// The two renders of a dataset: converged reference frames (RUN/frames) and the temporal methods'
-// input (RUN/input), of the same window of frames around the middle of the dataset.
+// The renders of a dataset: converged reference frames (RUN/frames) and the temporal methods'
+// input (RUN/input), of the same window of frames around the middle of the dataset, and with
+// floorFrames > 0 the reference again with another seed (RUN/floor) on a few of its frames.
 struct DatasetRenders {
   RenderStage reference, input;
+  std::optional<RenderStage> floor;
 };
 DatasetRenders datasetRenders(const std::filesystem::path& dataset, const std::filesystem::path& run, const DatasetRunSettings& settings,
                               long animationFrames);
+
+// The most frame renders one dataset needs (a window shorter than the dataset's animation needs
+// fewer): the reference and input windows and the floor's frames. What --slurm divides among tasks.
+inline int datasetFrameRenders(const DatasetRunSettings& s) {
+  const int window = std::max(2, s.renderFrames);
+  return 2 * window + std::min(window, s.floorFrames);
+}
 
 // The dataset's stats at settings.fps; with `files`, RUN/stats.json and the camera series too.
 Expected<StatsOutcome> measureStats(const std::filesystem::path& dataset, const std::filesystem::path& run, const DatasetRunSettings& settings,
@@ -89,6 +104,7 @@ struct DatasetRunOutcome {
   long firstFrame = 0, lastFrame = 0;  // the rendered window
   discard::FramePercentages discard;  // Table 6.7 (the window's mean)
   std::vector<evaluate::MethodScores> methods;
+  std::optional<evaluate::MeanWithError> referenceFloor;  // with floorFrames > 0
 };
 // stats, render, discard, input render and evaluate of one dataset into RUN; renders already
 // complete with the same settings are reused.

@@ -38,7 +38,7 @@ struct DemoOptions : pipeline::DatasetRunSettings {
 
 // The number of frame renders the demo makes (two datasets, reference and input, renderFrames
 // each at most): what `demo --slurm` divides among its render tasks.
-inline int demoFrameRenders(const DemoOptions& o) { return 2 * 2 * std::max(2, o.renderFrames); }
+inline int demoFrameRenders(const DemoOptions& o) { return 2 * pipeline::datasetFrameRenders(o); }
 
 // The map the demo plays: --map, or the engine's default (colos for Cube 2, oa_dm1 for OpenArena).
 std::string demoMap(const DemoOptions& options);

@@ -50,7 +50,9 @@ Expected<Manifest> parseManifest(const nlohmann::json& document, const fs::path&
     if (!d) return std::unexpected(d.error());
     m.description = *d;
   }
-  // The render window: every field optional, defaulting to DatasetRunSettings'.
+  // The render window: every field optional, defaulting to DatasetRunSettings' (but for the
+  // noise floor, which a suite reports for every dataset).
+  m.run.floorFrames = kDefaultFloorFrames;
   if (auto ok = readDatasetRunSettings(JsonSettingsReader(m.document, path), "/render", m.run, false); !ok) return std::unexpected(ok.error());
   DatasetRunSettings& r = m.run;
   if (f.has("/methods")) {

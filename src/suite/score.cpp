@@ -111,6 +111,13 @@ Expected<SuiteResults> readSuiteResults(const fs::path& dir) {
         d.result.errors[method][error] = *v;
       }
     }
+    if (f.has(at + "/reference_floor") && !(*f.value(at + "/reference_floor"))->is_null()) {
+      auto floor = f.number(at + "/reference_floor/flip");
+      auto frames = f.integer(at + "/reference_floor/frames");
+      if (!floor) return std::unexpected(floor.error());
+      if (!frames) return std::unexpected(frames.error());
+      d.result.referenceFloor = *floor, d.result.floorFrames = static_cast<int>(*frames);
+    }
     out.datasets.push_back(std::move(d));
   }
   return out;

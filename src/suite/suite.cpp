@@ -142,14 +142,11 @@ Expected<std::vector<std::pair<fs::path, Digests>>> prepareDatasets(const Manife
   return prepared;
 }
 
-// The files a dataset's numbers come from, relative to DIR: the dataset's .gltf and .bin, and the
-
 }  // namespace
 
-// run's reference and input frames with their sidecars.
 std::vector<fs::path> recordedFiles(const fs::path& root, const fs::path& dataset, const fs::path& run) {
   std::vector<fs::path> files{fs::relative(dataset, root), fs::relative(fs::path(dataset).replace_extension(".bin"), root)};
-  for (const char* folder : {"frames", "input"}) {
+  for (const char* folder : {"frames", "input", "floor"}) {
     std::vector<fs::path> frames;
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator(run / folder, ec))
@@ -162,7 +159,7 @@ std::vector<fs::path> recordedFiles(const fs::path& root, const fs::path& datase
 }
 
 int suiteFrameRenders(const Manifest& manifest) {
-  return static_cast<int>(manifest.datasets.size()) * 2 * std::max(2, manifest.run.renderFrames);
+  return static_cast<int>(manifest.datasets.size()) * pipeline::datasetFrameRenders(manifest.run);
 }
 
 Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::RunLog& log) {
@@ -214,7 +211,8 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
     s.seed = spec.seed;
     auto measured = pipeline::measureDataset(dataset, run, s, log);
     if (!measured) return std::unexpected(measured.error());
-    DatasetResult result{spec.name, measuresOf(measured->motion, measured->firstFrame, measured->lastFrame, measured->discard), errorsOf(measured->methods)};
+    DatasetResult result{spec.name, measuresOf(measured->motion, measured->firstFrame, measured->lastFrame, measured->discard), errorsOf(measured->methods), {}, 0};
+    if (measured->referenceFloor) result.referenceFloor = measured->referenceFloor->mean, result.floorFrames = static_cast<int>(measured->referenceFloor->count);
     outcome.datasets.push_back(result);
     doc["datasets"].push_back({{"name", spec.name},
                                {"dataset", fs::relative(dataset, root).string()},
@@ -222,7 +220,8 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
                                {"sha256", {{"capture", digests.capture}, {"dataset", digests.dataset}}},
                                {"window", {{"first", measured->firstFrame}, {"last", measured->lastFrame}}},
                                {"measures", result.measures},
-                               {"errors", result.errors}});
+                               {"errors", result.errors},
+                               {"reference_floor", referenceFloorJson(result)}});
     for (const fs::path& file : recordedFiles(root, dataset, run)) {
       auto sum = sha256File(root / file);
       if (!sum) return std::unexpected(sum.error());

@@ -51,7 +51,7 @@ struct SuiteOutcome {
 Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::RunLog& log);
 
 // The files a dataset's numbers come from, relative to DIR: the dataset's .gltf and .bin, and the
-// run's reference and input frames with their sidecars (suite.json's /files).
+// run's reference, input and noise-floor frames with their sidecars (suite.json's /files).
 std::vector<std::filesystem::path> recordedFiles(const std::filesystem::path& root, const std::filesystem::path& dataset,
                                                  const std::filesystem::path& run);
 

@@ -29,6 +29,11 @@ std::string cellText(const ValidityCell& c) {
 
 }  // namespace
 
+nlohmann::json referenceFloorJson(const DatasetResult& d) {
+  if (!d.referenceFloor) return nullptr;
+  return {{"flip", *d.referenceFloor}, {"frames", d.floorFrames}};
+}
+
 nlohmann::json validityJson(const std::vector<ValidityCell>& cells) {
   nlohmann::json out = nlohmann::json::array();
   for (const ValidityCell& c : cells) {
@@ -62,16 +67,30 @@ Expected<std::string> suiteMarkdown(const Manifest& manifest, const std::vector<
   {
     std::vector<std::string> header{"dataset"};
     for (const auto& m : measureKeys()) header.push_back(m);
+    header.push_back("reference floor");
     for (const auto& m : methods) header.push_back(m + " ꟻLIP");
     std::vector<std::vector<std::string>> rows;
+    std::vector<std::string> undecided;  // "dataset: method" within the floor
     for (const DatasetResult& d : datasets) {
       std::vector<std::string> row{d.name};
       for (const auto& m : measureKeys()) row.push_back(fmt::format("{:.3f}", d.measures.at(m)));
-      for (const auto& m : methods) row.push_back(fmt::format("{:.4f}", d.errors.at(m).at("flip")));
+      row.push_back(d.referenceFloor ? fmt::format("{:.4f}", *d.referenceFloor) : "—");
+      for (const auto& m : methods) {
+        const bool within = withinNoiseFloor(d, m);
+        row.push_back(fmt::format("{}{:.4f}", within ? "≈ " : "", d.errors.at(m).at("flip")));
+        if (within) undecided.push_back(fmt::format("{}: {}", d.name, m));
+      }
       rows.push_back(row);
     }
+    const bool anyFloor = std::any_of(datasets.begin(), datasets.end(), [](const DatasetResult& d) { return d.referenceFloor.has_value(); });
     md += "## Datasets\n\nTable 6.7's columns over the window (%), the camera over the same frames (units or degrees per frame, cuts counted), "
-          "each method's mean ꟻLIP.\n\n" + report::markdownTable(header, rows) + "\n";
+          "the reference's noise floor (mean ꟻLIP between the reference and its render with another seed, on a few of the window's "
+          "frames) and each method's mean ꟻLIP; ≈ marks a method whose ꟻLIP differs from `none`'s by less than the floor: the "
+          "reference cannot tell them apart there, and the dataset does not rank them.\n\n" +
+          report::markdownTable(header, rows) + "\n";
+    if (anyFloor)
+      md += undecided.empty() ? std::string("Every method's difference with `none` is larger than its dataset's noise floor.\n\n")
+                              : fmt::format("Within the noise floor (not ranked against `none`): {}.\n\n", fmt::join(undecided, "; "));
   }
   {
     std::vector<std::string> header{"measure"};

@@ -1,6 +1,7 @@
 #include "suite/validity.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include <fmt/format.h>
 
@@ -35,6 +36,13 @@ std::string measureLabel(const std::string& measure) {
 }
 // Below this many datasets a bootstrap interval is not shown: resamples of a few points are
 // mostly ties and duplicates, and their rho takes only a handful of values.
+
+bool withinNoiseFloor(const DatasetResult& d, const std::string& method) {
+  if (method == "none" || !d.referenceFloor) return false;
+  const auto m = d.errors.find(method), none = d.errors.find("none");
+  if (m == d.errors.end() || none == d.errors.end() || !m->second.count("flip") || !none->second.count("flip")) return false;
+  return std::abs(m->second.at("flip") - none->second.at("flip")) < *d.referenceFloor;
+}
 
 std::string rankingError(const std::string& method) { return method == "none" ? "flip" : "flip_ratio_to_none"; }
 

@@ -24,7 +24,15 @@ struct DatasetResult {
   std::string name;
   std::map<std::string, double> measures;
   std::map<std::string, std::map<std::string, double>> errors;  // method -> error name -> value
+  // The reference's noise floor (evaluate::referenceNoiseFloor): mean ꟻLIP between the reference
+  // and its re-render with another seed, over floorFrames frames; absent when not rendered.
+  std::optional<double> referenceFloor;
+  int floorFrames = 0;
 };
+
+// True when the method's ꟻLIP differs from `none`'s on the dataset by less than the reference's
+// noise floor: the reference cannot tell the two apart, so the dataset does not rank them.
+bool withinNoiseFloor(const DatasetResult& dataset, const std::string& method);
 
 // The rank correlation of one measure with one method's error over the suite's datasets.
 struct ValidityCell {

@@ -62,7 +62,16 @@ Expected<VerifyOutcome> verifySuite(const fs::path& root, const pipeline::RunLog
     evaluation.callerMethods = scored->stored;
     auto evaluated = evaluate::runEvaluate(evaluation);
     if (!evaluated) return std::unexpected(evaluated.error());
-    DatasetResult result{name, measuresOf(stats->rows.front().motion, d.first, d.last, discarded->run.mean), errorsOf(evaluated->methods)};
+    DatasetResult result{name, measuresOf(stats->rows.front().motion, d.first, d.last, discarded->run.mean), errorsOf(evaluated->methods), {}, 0};
+    if (d.result.referenceFloor) {
+      auto floor = evaluate::referenceNoiseFloor(root / d.run / "frames", root / d.run / "floor");
+      if (!floor) return std::unexpected(floor.error());
+      result.referenceFloor = floor->mean, result.floorFrames = static_cast<int>(floor->count);
+      check(fmt::format("{}: reference noise floor", name), *d.result.referenceFloor, floor->mean);
+      check(fmt::format("{}: reference noise floor frames", name), d.result.floorFrames, floor->count);
+    } else if (s.floorFrames > 0) {
+      out.differences.push_back(fmt::format("{}: no reference noise floor recorded, but the manifest asks for {} frames", name, s.floorFrames));
+    }
     const std::string at = fmt::format("/datasets/{}", i);
     for (const auto& [measure, value] : result.measures) {
       auto recorded = f.number(at + "/measures/" + measure);
