@@ -1,6 +1,8 @@
 // `dynbench suite` and `suite verify` (pipeline/suite.h): the manifest's errors, and the smoke suite
 // run for real (Cube 2, the renderer, discard, evaluate), resumed, verified, and caught when a frame
 // is edited by hand.
+#include <set>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -55,7 +57,21 @@ TEST(Suite, ManifestErrorsNameTheFileAndPointer) {
       {"/datasets/0/sha256", "05aa", "/datasets/0/sha256: expected an object"},
       {"/datasets/0/sha256/capture", "05AA494F", "/datasets/0/sha256/capture: expected a SHA-256 as 64 lower-case hex digits"},
       {"/datasets/0/sha256/bin", "00", "/datasets/0/sha256/bin: expected no other key"},
+      {"/method_inputs", "still", "/method_inputs: expected an object"},
+      {"/method_inputs/taa", "wobbly", "/method_inputs/taa: expected \"jittered\" or \"still\", found \"wobbly\""},
+      {"/method_inputs/dlss", "still", "/method_inputs/dlss: expected one of /methods (none, accumulate, taa, svgf)"},
+      {"/render/floor_frames", -1, "/render/floor_frames: expected a whole number in [0, 100000]"},
   };
+  // Each method's input: its own unless the manifest says otherwise.
+  {
+    nlohmann::json doc = good;
+    doc["method_inputs"] = {{"svgf", "jittered"}};
+    ASSERT_TRUE(writeFileAtomic(dir / "inputs.json", doc.dump()));
+    auto m = suite::readManifest(dir / "inputs.json");
+    ASSERT_TRUE(m) << m.error().message;
+    EXPECT_EQ(m->run.methodInputs, (std::map<std::string, std::string>{{"none", "jittered"}, {"accumulate", "still"}, {"taa", "jittered"}, {"svgf", "jittered"}}));
+    EXPECT_EQ(m->run.floorFrames, suite::kDefaultFloorFrames);
+  }
   for (const Case& c : cases) {
     nlohmann::json doc = good;
     const nlohmann::json::json_pointer p(c.pointer);
@@ -150,16 +166,33 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
     const auto discard = nlohmann::json::parse(test::slurp(run / "discard.json"));
     EXPECT_NEAR(d["measures"]["direct_radiance"].get<double>(), discard["mean"]["direct_radiance"].get<double>(), 1e-9) << d["name"];
     EXPECT_NEAR(d["measures"]["frustum"].get<double>(), discard["mean"]["frustum"].get<double>(), 1e-9) << d["name"];
-    const auto evaluation = nlohmann::json::parse(test::slurp(run / "evaluate.json"));
-    double noneFlip = -1;
-    for (const auto& m : evaluation["methods"])
-      if (m["name"] == "none") noneFlip = m["mean"]["flip"]["mean"].get<double>();
-    for (const auto& m : evaluation["methods"]) {
-      const std::string name = m["name"];
-      EXPECT_NEAR(d["errors"][name]["flip"].get<double>(), m["mean"]["flip"]["mean"].get<double>(), 1e-12);
-      EXPECT_NEAR(d["errors"][name]["flip_over_none"].get<double>(), m["mean"]["flip"]["mean"].get<double>() - noneFlip, 1e-12);
-      EXPECT_NEAR(d["errors"][name]["flip_ratio_to_none"].get<double>(), m["mean"]["flip"]["mean"].get<double>() / noneFlip, 1e-12);
+    // Each method on its own input (issue 48): TAA on the jittered one (evaluate.json), accumulate
+    // and SVGF on the still one (evaluate-still.json), each with that input's `none` as its base.
+    EXPECT_EQ(doc["method_inputs"], nlohmann::json({{"none", "jittered"}, {"accumulate", "still"}, {"taa", "jittered"}, {"svgf", "still"}}));
+    for (const auto& [file, methods] : {std::pair{"evaluate.json", std::set<std::string>{"none", "taa"}},
+                                        std::pair{"evaluate-still.json", std::set<std::string>{"none", "accumulate", "svgf"}}}) {
+      const auto evaluation = nlohmann::json::parse(test::slurp(run / file));
+      double noneFlip = -1;
+      std::set<std::string> names;
+      for (const auto& m : evaluation["methods"]) {
+        names.insert(m["name"].get<std::string>());
+        if (m["name"] == "none") noneFlip = m["mean"]["flip"]["mean"].get<double>();
+      }
+      EXPECT_EQ(names, methods) << file;
+      for (const auto& m : evaluation["methods"]) {
+        const std::string name = m["name"] == "none" && std::string(file) == "evaluate-still.json" ? "none-still" : m["name"].get<std::string>();
+        EXPECT_NEAR(d["errors"][name]["flip"].get<double>(), m["mean"]["flip"]["mean"].get<double>(), 1e-12);
+        EXPECT_NEAR(d["errors"][name]["flip_over_none"].get<double>(), m["mean"]["flip"]["mean"].get<double>() - noneFlip, 1e-12);
+        EXPECT_NEAR(d["errors"][name]["flip_ratio_to_none"].get<double>(), m["mean"]["flip"]["mean"].get<double>() / noneFlip, 1e-12);
+      }
     }
+    // The still input is the jittered one's render without the jitter: the same seed, no jitter.
+    const long firstFrame = d["window"]["first"];
+    const auto jitteredSidecar = nlohmann::json::parse(test::slurp(run / "input" / fmt::format("frame_{:05d}.json", firstFrame + 1)));
+    const auto stillSidecar = nlohmann::json::parse(test::slurp(run / "input-still" / fmt::format("frame_{:05d}.json", firstFrame + 1)));
+    EXPECT_EQ(stillSidecar["render"]["seed"], jitteredSidecar["render"]["seed"]);
+    EXPECT_NE(jitteredSidecar["camera"]["jitter"], nlohmann::json::array({0.0, 0.0}));
+    EXPECT_EQ(stillSidecar["camera"]["jitter"], nlohmann::json::array({0.0, 0.0}));
     // The reference's noise floor: the window's first 4 frames (6 frames, a step of 1) rendered
     // again with seed + 2; its ꟻLIP is what `dynbench compare` gives for each pair, averaged.
     ASSERT_TRUE(d["reference_floor"].is_object()) << d["name"];

@@ -32,10 +32,12 @@ const std::vector<MethodInfo>& builtInMethods() {
       {"none", "the input as it is, reusing nothing: the floor the others must beat",
        [](const MethodContext&) { return makeNoneMethod(); }},
       {"accumulate", "reprojected history blended in, rejected by the discard stage's tests",
-       [](const MethodContext& context) { return makeAccumulateMethod(context); }},
+       [](const MethodContext& context) { return makeAccumulateMethod(context); }, kStillInput},
       {"taa", "temporal anti-aliasing (Karis 2014, Salvi 2016): Catmull-Rom history, variance clipping",
        [](const MethodContext&) { return makeTaaMethod(); }},
-      {"svgf", "spatiotemporal variance-guided filtering (Schied et al. 2017)", [](const MethodContext&) { return makeSvgfMethod(); }},
+      // [S17] §3 filters "1 sample per pixel path traced" frames at the pixel centre; its temporal
+      // reprojection has no jitter to undo.
+      {"svgf", "spatiotemporal variance-guided filtering (Schied et al. 2017)", [](const MethodContext&) { return makeSvgfMethod(); }, kStillInput},
   };
   return methods;
 }
@@ -44,6 +46,12 @@ std::vector<std::string> builtInMethodNames() {
   std::vector<std::string> names;
   for (const auto& m : builtInMethods()) names.emplace_back(m.name);
   return names;
+}
+
+std::string_view builtForInput(const std::string& spec) {
+  for (const auto& m : builtInMethods())
+    if (spec == m.name) return m.input;
+  return kJitteredInput;
 }
 
 std::string methodSpecHelp() {

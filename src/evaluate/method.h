@@ -46,15 +46,22 @@ struct MethodContext {
 // A built-in method: its name as the CLI, manifests and Python spell it, a line for help texts,
 // and its factory. Adding a method is one file (its class and factory) and one entry in
 // builtInMethods() (CONTRIBUTING.md, "Adding a temporal method").
+// The input a method is built for (issue 48): "jittered", the projection jittered from frame to
+// frame (render --jitter, the Halton sequence TAA turns into anti-aliasing), or "still", the pixel
+// centres every frame, as accumulation and SVGF's paper feed them path-traced frames.
+inline constexpr std::string_view kJitteredInput = "jittered", kStillInput = "still";
 struct MethodInfo {
   std::string_view name;
   std::string_view description;
   std::function<std::unique_ptr<TemporalMethod>(const MethodContext&)> make;
+  std::string_view input = kJitteredInput;  // the input it is built for
 };
 // Every built-in method, in the order tables list them (none first: the floor the others must beat).
 const std::vector<MethodInfo>& builtInMethods();
 // Their names: the default of `evaluate --methods`, the demo, suites and Python.
 std::vector<std::string> builtInMethodNames();
+// The input a method spec is built for: a built-in method's own, "jittered" for any other.
+std::string_view builtForInput(const std::string& spec);
 // "none, accumulate, taa, svgf, external:DIR": the methods a spec may name, for help texts.
 std::string methodSpecHelp();
 

@@ -110,6 +110,42 @@ Expected<void> flyThroughUnlessNewer(const fs::path& bot, const fs::path& fly, c
   return {};
 }
 
+bool needsStillInput(const DatasetRunSettings& settings) {
+  return std::any_of(settings.methodInputs.begin(), settings.methodInputs.end(),
+                     [](const auto& m) { return m.second == evaluate::kStillInput; });
+}
+
+Expected<MethodsOnTheirInputs> evaluateOnTheirInputs(const fs::path& run, const DatasetRunSettings& o,
+                                                     const std::vector<std::shared_ptr<evaluate::TemporalMethod>>& extra, bool writeFiles) {
+  MethodsOnTheirInputs out;
+  for (const bool still : {false, true}) {
+    evaluate::EvaluateOptions evaluation;
+    evaluation.frames = run / (still ? "input-still" : "input");
+    evaluation.reference = run / "frames";
+    // The jittered input's methods as listed; the still input's after its own `none` (each
+    // method's ratio is to `none` on the input it had).
+    evaluation.methods.clear();
+    if (still) evaluation.methods.push_back("none");
+    for (const std::string& m : o.methods) {
+      const auto input = o.methodInputs.find(m);
+      const bool wantsStill = input != o.methodInputs.end() && input->second == evaluate::kStillInput;
+      if (wantsStill == still && !(still && m == "none")) evaluation.methods.push_back(m);
+    }
+    if (still && evaluation.methods.size() == 1) break;  // no method asked for it
+    if (!still) evaluation.callerMethods = extra;
+    if (writeFiles) {
+      const std::string suffix = still ? "-still" : "";
+      evaluation.json = run / ("evaluate" + suffix + ".json");
+      evaluation.csv = run / ("evaluate" + suffix + ".csv");
+      evaluation.outDir = run / ("evaluate" + suffix);
+    }
+    auto evaluated = evaluate::runEvaluate(evaluation);
+    if (!evaluated) return std::unexpected(evaluated.error());
+    (still ? out.still : out.jittered) = std::move(evaluated->methods);
+  }
+  return out;
+}
+
 DatasetRenders datasetRenders(const fs::path& dataset, const fs::path& run, const DatasetRunSettings& o, long animationFrames) {
   RenderStage render;
   render.job.dataset = dataset;
@@ -146,7 +182,15 @@ DatasetRenders datasetRenders(const fs::path& dataset, const fs::path& run, cons
   input.job.settings.seed = o.seed + 1;
   input.job.settings.jitter = true;
   input.job.settings.pixelFilter = {render::PixelFilterType::kCentre, 0.0};
-  DatasetRenders renders{render, input, std::nullopt};
+  DatasetRenders renders{render, input, std::nullopt, std::nullopt};
+  if (needsStillInput(o)) {
+    // The same input without the jitter: the pixel centres every frame, what accumulation and
+    // SVGF are fed in their papers.
+    RenderStage still = input;
+    still.job.output = run / "input-still";
+    still.job.settings.jitter = false;
+    renders.stillInput = still;
+  }
   if (o.floorFrames > 0) {
     // The same converged reference with another seed, on floorFrames frames spread over the window
     // (every step-th from its first): two independent estimates of the same image. No pairs:
@@ -181,7 +225,7 @@ Expected<DatasetRunOutcome> measureDataset(const fs::path& dataset, const fs::pa
   DatasetRunOutcome outcome;
   outcome.motion = stats->rows.front().motion;
   const long frames = static_cast<long>(stats->rows.front().properties.animationFrames);
-  const auto [render, input, floor] = datasetRenders(dataset, run, o, frames);
+  const auto [render, input, stillInput, floor] = datasetRenders(dataset, run, o, frames);
   outcome.firstFrame = render.job.frames.first, outcome.lastFrame = render.job.frames.last;
   auto rendered = runRender(render);
   if (!rendered) return std::unexpected(rendered.error());
@@ -202,21 +246,17 @@ Expected<DatasetRunOutcome> measureDataset(const fs::path& dataset, const fs::pa
                   mean.indirect, mean.indirectInterval ? mean.indirectInterval->halfWidth() : 0.0));
 
   // Temporal methods: each run over the input window and scored against the converged frames above.
-  auto renderedInput = runRender(input);
-  if (!renderedInput) return std::unexpected(renderedInput.error());
-  evaluate::EvaluateOptions evaluation;
-  evaluation.frames = input.job.output;
-  evaluation.reference = render.job.output;
-  evaluation.methods = o.methods;
-  evaluation.json = run / "evaluate.json";
-  evaluation.csv = run / "evaluate.csv";
-  evaluation.outDir = run / "evaluate";
-  auto evaluated = evaluate::runEvaluate(evaluation);
+  for (const auto& stage : {std::optional(input), stillInput})
+    if (stage)
+      if (auto rendered = runRender(*stage); !rendered) return std::unexpected(rendered.error());
+  auto evaluated = evaluateOnTheirInputs(run, o, {}, true);
   if (!evaluated) return std::unexpected(evaluated.error());
-  for (const auto& m : evaluated->methods)
-    log(fmt::format("  {} ({} spp input): FLIP {:.4f} ± {:.4f}, PSNR {:.2f} dB, history use {:.3f}", m.name, o.inputSamplesPerPixel, m.flip.mean,
-                    m.flip.standardError, m.psnr.mean, m.historyUse.mean));
-  outcome.methods = evaluated->methods;
+  for (const auto* group : {&evaluated->jittered, &evaluated->still})
+    for (const auto& m : *group)
+      log(fmt::format("  {} ({} spp {} input): FLIP {:.4f} ± {:.4f}, PSNR {:.2f} dB, history use {:.3f}", m.name, o.inputSamplesPerPixel,
+                      group == &evaluated->still ? evaluate::kStillInput : evaluate::kJitteredInput, m.flip.mean, m.flip.standardError,
+                      m.psnr.mean, m.historyUse.mean));
+  outcome.methods = std::move(*evaluated);
   if (floor) {
     auto renderedFloor = runRender(*floor);
     if (!renderedFloor) return std::unexpected(renderedFloor.error());
@@ -235,7 +275,8 @@ Expected<void> renderTask(const std::vector<DatasetJob>& datasets, int task, int
     auto stats = measureStats(d.dataset, d.run, d.settings, false);
     if (!stats) return std::unexpected(stats.error());
     const auto renders = datasetRenders(d.dataset, d.run, d.settings, static_cast<long>(stats->rows.front().properties.animationFrames));
-    for (const RenderStage* stage : {&renders.reference, &renders.input, renders.floor ? &*renders.floor : nullptr})
+    for (const RenderStage* stage : {&renders.reference, &renders.input, renders.stillInput ? &*renders.stillInput : nullptr,
+                                     renders.floor ? &*renders.floor : nullptr})
       if (stage)
         for (long f = stage->job.frames.first; f <= stage->job.frames.last; f += stage->job.frames.step) items.emplace_back(*stage, f);
   }

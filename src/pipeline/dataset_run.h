@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <algorithm>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,6 +44,12 @@ struct DatasetRunSettings {
   // the converged frames.
   int inputSamplesPerPixel = 4;
   std::vector<std::string> methods = evaluate::builtInMethodNames();
+  // The input each method gets (evaluate::kJitteredInput or kStillInput); a method not named here
+  // gets the jittered one. With any "still", the window is also rendered unjittered (RUN/input-still)
+  // and `none` is scored on both inputs, so each method's ratio to `none` is on its own input. Empty
+  // (the demo's): every method on the jittered input. A suite manifest's default: each method's
+  // own (evaluate::builtForInput).
+  std::map<std::string, std::string> methodInputs;
   // The reference's noise floor (evaluate::referenceNoiseFloor): this many frames of the window,
   // evenly spaced, rendered again as the reference is but with seed + 2 (0: none; the demo's
   // default, a suite manifest's is kDefaultFloorFrames).
@@ -83,6 +90,7 @@ Expected<void> flyThroughUnlessNewer(const std::filesystem::path& bot, const std
 // floorFrames > 0 the reference again with another seed (RUN/floor) on a few of its frames.
 struct DatasetRenders {
   RenderStage reference, input;
+  std::optional<RenderStage> stillInput;  // the input unjittered, when a method asks for it
   std::optional<RenderStage> floor;
 };
 DatasetRenders datasetRenders(const std::filesystem::path& dataset, const std::filesystem::path& run, const DatasetRunSettings& settings,
@@ -90,20 +98,32 @@ DatasetRenders datasetRenders(const std::filesystem::path& dataset, const std::f
 
 // The most frame renders one dataset needs (a window shorter than the dataset's animation needs
 // fewer): the reference and input windows and the floor's frames. What --slurm divides among tasks.
+bool needsStillInput(const DatasetRunSettings& settings);
 inline int datasetFrameRenders(const DatasetRunSettings& s) {
   const int window = std::max(2, s.renderFrames);
-  return 2 * window + std::min(window, s.floorFrames);
+  return (needsStillInput(s) ? 3 : 2) * window + std::min(window, s.floorFrames);
 }
 
 // The dataset's stats at settings.fps; with `files`, RUN/stats.json and the camera series too.
 Expected<StatsOutcome> measureStats(const std::filesystem::path& dataset, const std::filesystem::path& run, const DatasetRunSettings& settings,
                                     bool files);
 
+// The methods scored on each input: `jittered` on RUN/input (with `none`), `still` on
+// RUN/input-still (with its own `none`; empty when no method asked for it).
+struct MethodsOnTheirInputs {
+  std::vector<evaluate::MethodScores> jittered, still;
+};
+// Each of settings.methods evaluated on its input (settings.methodInputs) against RUN/frames, with
+// `none` on every input used; `extra` are scored on the jittered input beside them. With
+// `writeFiles`, RUN/evaluate.json, .csv and evaluate/ (and evaluate-still.*) as the demo writes them.
+Expected<MethodsOnTheirInputs> evaluateOnTheirInputs(const std::filesystem::path& run, const DatasetRunSettings& settings,
+                                                     const std::vector<std::shared_ptr<evaluate::TemporalMethod>>& extra, bool writeFiles);
+
 struct DatasetRunOutcome {
   metrics::CameraMotion motion;   // Tables 6.4-6.6 (every frame of the dataset at settings.fps)
   long firstFrame = 0, lastFrame = 0;  // the rendered window
   discard::FramePercentages discard;  // Table 6.7 (the window's mean)
-  std::vector<evaluate::MethodScores> methods;
+  MethodsOnTheirInputs methods;
   std::optional<evaluate::MeanWithError> referenceFloor;  // with floorFrames > 0
 };
 // stats, render, discard, input render and evaluate of one dataset into RUN; renders already

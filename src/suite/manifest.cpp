@@ -8,6 +8,7 @@
 #include "core/checksum.h"
 #include "core/files.h"
 #include "core/json_fields.h"
+#include "suite/validity.h"
 
 namespace dynbench::suite {
 
@@ -65,6 +66,22 @@ Expected<Manifest> parseManifest(const nlohmann::json& document, const fs::path&
       r.methods.push_back(*method);
     }
   }
+  // Each method's input: its own unless /method_inputs says otherwise (issue 48).
+  for (const std::string& method : r.methods) r.methodInputs[method] = std::string(evaluate::builtForInput(method));
+  if (f.has("/method_inputs")) {
+    auto inputs = f.value("/method_inputs");
+    if (!(*inputs)->is_object()) return bad("/method_inputs", "an object: method name -> \"jittered\" or \"still\"");
+    for (const auto& [method, value] : (*inputs)->items()) {
+      const std::string at = "/method_inputs/" + method;
+      if (!r.methodInputs.count(method)) return bad(at, fmt::format("one of /methods ({})", fmt::join(r.methods, ", ")));
+      auto input = f.string(at);
+      if (!input) return std::unexpected(input.error());
+      if (*input != evaluate::kJitteredInput && *input != evaluate::kStillInput)
+        return bad(at, fmt::format("\"jittered\" or \"still\", found \"{}\"", *input));
+      r.methodInputs[method] = *input;
+    }
+  }
+  if (r.methodInputs.count(kStillNone)) return bad("/methods", fmt::format("no method named \"{}\" (suite.json's name for none on the still input)", kStillNone));
   auto datasets = f.value("/datasets");
   if (!datasets) return std::unexpected(datasets.error());
   if (!(*datasets)->is_array() || (*datasets)->empty()) return bad("/datasets", "a non-empty array of datasets");

@@ -193,6 +193,7 @@ Expected<ScoreOutcome> scoreSuite(const fs::path& dir, const std::vector<MethodT
     if (std::find(manifestMethods.begin(), manifestMethods.end(), m.name) != manifestMethods.end())
       return fail(ErrorCode::kUsage, "{}: method '{}' is one of the manifest's ({}); give the new method another name", suite->path.string(), m.name,
                   fmt::join(manifestMethods, ", "));
+    if (m.name == kStillNone) return fail(ErrorCode::kUsage, "suite score: '{}' is suite.json's name for none on the still input", m.name);
     if (!names.insert(m.name).second) return fail(ErrorCode::kUsage, "suite score: method '{}' twice", m.name);
   }
 

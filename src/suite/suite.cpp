@@ -146,7 +146,7 @@ Expected<std::vector<std::pair<fs::path, Digests>>> prepareDatasets(const Manife
 
 std::vector<fs::path> recordedFiles(const fs::path& root, const fs::path& dataset, const fs::path& run) {
   std::vector<fs::path> files{fs::relative(dataset, root), fs::relative(fs::path(dataset).replace_extension(".bin"), root)};
-  for (const char* folder : {"frames", "input", "floor"}) {
+  for (const char* folder : {"frames", "input", "input-still", "floor"}) {
     std::vector<fs::path> frames;
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator(run / folder, ec))
@@ -192,6 +192,7 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
                         {"tool_version", kVersion},
                         {"manifest", manifest->document},
                         {"ranking_error", "flip_ratio_to_none (flip for none)"},
+                        {"method_inputs", manifest->run.methodInputs},
                         {"datasets", nlohmann::json::array()},
                         {"files", nlohmann::json::object()}};
   auto prepared = prepareDatasets(*manifest, root, settings.fps, log);

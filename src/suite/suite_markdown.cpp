@@ -54,6 +54,14 @@ Expected<std::string> suiteMarkdown(const Manifest& manifest, const std::vector<
                     "input {} spp; dynbench {}.\n\n",
                     datasets.size(), r.renderFrames, r.width, r.height, r.tolerance, r.samplesPerPixel, r.maxSamplesPerPixel, r.bounces,
                     r.inputSamplesPerPixel, kVersion);
+  {
+    std::vector<std::string> inputs;
+    for (const auto& [method, input] : r.methodInputs) inputs.push_back(fmt::format("{} {}", method, input));
+    if (!inputs.empty())
+      md += fmt::format("Each method's input: {} (jittered: the projection jittered frame to frame; still: the pixel centres; `{}` is "
+                        "`none` on the still input, the ratio's base for the methods there).\n\n",
+                        fmt::join(inputs, ", "), kStillNone);
+  }
   if (!scoredMethods.empty()) {
     md += "Scored afterwards with `dynbench suite score`, on the same stored input and reference frames:\n\n";
     for (const auto& s : scoredMethods)

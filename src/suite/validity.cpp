@@ -37,14 +37,21 @@ std::string measureLabel(const std::string& measure) {
 // Below this many datasets a bootstrap interval is not shown: resamples of a few points are
 // mostly ties and duplicates, and their rho takes only a handful of values.
 
-bool withinNoiseFloor(const DatasetResult& d, const std::string& method) {
-  if (method == "none" || !d.referenceFloor) return false;
-  const auto m = d.errors.find(method), none = d.errors.find("none");
-  if (m == d.errors.end() || none == d.errors.end() || !m->second.count("flip") || !none->second.count("flip")) return false;
-  return std::abs(m->second.at("flip") - none->second.at("flip")) < *d.referenceFloor;
+std::map<std::string, std::map<std::string, double>> errorsOf(const pipeline::MethodsOnTheirInputs& methods) {
+  auto e = errorsOf(methods.jittered);
+  for (auto& [method, errors] : errorsOf(methods.still)) e[method == "none" ? kStillNone : method] = errors;
+  return e;
 }
 
-std::string rankingError(const std::string& method) { return method == "none" ? "flip" : "flip_ratio_to_none"; }
+bool withinNoiseFloor(const DatasetResult& d, const std::string& method) {
+  if (method == "none" || method == kStillNone || !d.referenceFloor) return false;
+  // flip_over_none is against `none` on the method's own input.
+  const auto m = d.errors.find(method);
+  if (m == d.errors.end() || !m->second.count("flip_over_none")) return false;
+  return std::abs(m->second.at("flip_over_none")) < *d.referenceFloor;
+}
+
+std::string rankingError(const std::string& method) { return method == "none" || method == kStillNone ? "flip" : "flip_ratio_to_none"; }
 
 std::vector<ValidityCell> validity(const std::vector<DatasetResult>& datasets) {
   std::vector<ValidityCell> cells;

@@ -11,6 +11,7 @@
 #include "evaluate/evaluate.h"
 #include "metrics/camera_motion.h"
 #include "metrics/rank_correlation.h"
+#include "pipeline/dataset_run.h"
 
 namespace dynbench::suite {
 
@@ -30,8 +31,9 @@ struct DatasetResult {
   int floorFrames = 0;
 };
 
-// True when the method's ꟻLIP differs from `none`'s on the dataset by less than the reference's
-// noise floor: the reference cannot tell the two apart, so the dataset does not rank them.
+// True when the method's ꟻLIP differs from `none`'s (on the method's input: its flip_over_none) by
+// less than the reference's noise floor: the reference cannot tell the two apart, so the dataset
+// does not rank them.
 bool withinNoiseFloor(const DatasetResult& dataset, const std::string& method);
 
 // The rank correlation of one measure with one method's error over the suite's datasets.
@@ -56,6 +58,11 @@ std::string measureLabel(const std::string& measure);
 // The difficulty measures of one dataset's window, frames first..last (DatasetResult::measures):
 // its discard mean and the camera's motion over the same frames, cuts left out and counted.
 std::map<std::string, double> measuresOf(const metrics::CameraMotion& motion, long first, long last, const discard::FramePercentages& discarded);
+// `none` on the still input, as suite.json names it beside `none` on the jittered one.
+inline constexpr const char* kStillNone = "none-still";
+// Each method's errors on the input it had: the jittered input's as errorsOf gives them, the still
+// input's against that input's own `none`, which is kept as kStillNone.
+std::map<std::string, std::map<std::string, double>> errorsOf(const pipeline::MethodsOnTheirInputs& methods);
 // Each method's errors (DatasetResult::errors). The difference and ratio with `none` use its scores
 // among `methods`, or else `noneFlip` (none's mean ꟻLIP on the same frames, as a suite recorded it).
 std::map<std::string, std::map<std::string, double>> errorsOf(const std::vector<evaluate::MethodScores>& methods,

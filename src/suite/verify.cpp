@@ -51,18 +51,14 @@ Expected<VerifyOutcome> verifySuite(const fs::path& root, const pipeline::RunLog
     discardStage.frames = root / d.run / "frames";
     auto discarded = pipeline::runDiscard(discardStage);
     if (!discarded) return std::unexpected(discarded.error());
-    evaluate::EvaluateOptions evaluation;
-    evaluation.frames = root / d.run / "input";
-    evaluation.reference = root / d.run / "frames";
-    evaluation.methods = s.methods;
-    // The methods `suite score` added: built-in ones run again, the others from their stored outputs.
+    // The methods `suite score` added: built-in ones run again (on the jittered input, as score
+    // ran them), the others from their stored outputs.
     auto scored = storedScoredMethods(*suite, root, name);
     if (!scored) return std::unexpected(scored.error());
-    evaluation.methods.insert(evaluation.methods.end(), scored->builtIn.begin(), scored->builtIn.end());
-    evaluation.callerMethods = scored->stored;
-    auto evaluated = evaluate::runEvaluate(evaluation);
+    s.methods.insert(s.methods.end(), scored->builtIn.begin(), scored->builtIn.end());
+    auto evaluated = pipeline::evaluateOnTheirInputs(root / d.run, s, scored->stored, false);
     if (!evaluated) return std::unexpected(evaluated.error());
-    DatasetResult result{name, measuresOf(stats->rows.front().motion, d.first, d.last, discarded->run.mean), errorsOf(evaluated->methods), {}, 0};
+    DatasetResult result{name, measuresOf(stats->rows.front().motion, d.first, d.last, discarded->run.mean), errorsOf(*evaluated), {}, 0};
     if (d.result.referenceFloor) {
       auto floor = evaluate::referenceNoiseFloor(root / d.run / "frames", root / d.run / "floor");
       if (!floor) return std::unexpected(floor.error());
