@@ -79,5 +79,15 @@ TEST(RankCorrelation, BootstrapIntervalHasTheExpectedWidthAndIsSeeded) {
   EXPECT_GT(*strong.low, 0.85);
 }
 
+// Known answers: the binomial tail at p = 1/2 by hand (suite v1's within-match counts, docs/suite.md).
+TEST(SignTest, OneSidedTailOfAFairCoin) {
+  EXPECT_NEAR(signTestOneSided(8, 9), 10.0 / 512.0, 1e-12);   // C(9,8) + C(9,9) over 2^9: 0.0195
+  EXPECT_NEAR(signTestOneSided(7, 9), 46.0 / 512.0, 1e-12);   // 36 + 9 + 1: 0.0898
+  EXPECT_NEAR(signTestOneSided(9, 9), 1.0 / 512.0, 1e-12);
+  EXPECT_NEAR(signTestOneSided(10, 20), 616666.0 / 1048576.0, 1e-12);  // half of 20 flips or more: (2^20 + C(20,10)) / 2^21
+  EXPECT_DOUBLE_EQ(signTestOneSided(0, 5), 1.0);
+  EXPECT_DOUBLE_EQ(signTestOneSided(6, 5), 0.0);
+}
+
 }  // namespace
 }  // namespace dynbench::metrics

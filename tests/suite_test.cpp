@@ -123,6 +123,49 @@ TEST(Suite, ValidityRanksEachMeasureAgainstEachMethodsError) {
   EXPECT_EQ(suite::rankingError("none"), "flip");
 }
 
+// Within matches: each match's bot dataset against its fly-through, by hand.
+TEST(Suite, WithinMatchDifferencesCountSignsAndRankTheDifferences) {
+  std::vector<suite::DatasetResult> datasets;
+  // Three matches with both cameras; a fourth with the bot's camera alone (left out of the pairs).
+  const double frustumDifference[] = {1, 2, 3}, errorDifference[] = {0.1, -0.2, 0.3};
+  for (int m = 0; m < 3; ++m)
+    for (const char* camera : {"bot", "flythrough"}) {
+      suite::DatasetResult d;
+      const bool bot = std::string(camera) == "bot";
+      d.name = fmt::format("m{}-{}", m, camera), d.match = fmt::format("m{}", m), d.camera = camera;
+      for (const auto& key : suite::measureKeys()) d.measures[key] = 1.0;
+      d.measures["frustum"] = 5.0 + (bot ? frustumDifference[m] : 0.0);
+      d.errors["none"]["flip"] = 0.2;
+      d.errors["taa"]["flip_ratio_to_none"] = 0.7 + (bot ? errorDifference[m] : 0.0);
+      datasets.push_back(d);
+    }
+  suite::DatasetResult alone = datasets.front();
+  alone.match = "m3", alone.measures["frustum"] = 100.0;
+  datasets.push_back(alone);
+  const auto cells = suite::withinMatches(datasets);
+  auto cell = [&](const std::string& measure, const std::string& method) {
+    for (const auto& c : cells)
+      if (c.measure == measure && c.method == method) return c;
+    ADD_FAILURE() << measure << " " << method;
+    return suite::WithinMatchCell{};
+  };
+  const auto frustumTaa = cell("frustum", "taa");
+  EXPECT_EQ(frustumTaa.cameraA, "bot");
+  EXPECT_EQ(frustumTaa.cameraB, "flythrough");
+  EXPECT_EQ(frustumTaa.error, "flip_ratio_to_none");
+  EXPECT_EQ(frustumTaa.matches, 3);
+  EXPECT_EQ(frustumTaa.measureHigher, 3);
+  EXPECT_EQ(frustumTaa.errorHigher, 2);
+  EXPECT_NEAR(frustumTaa.errorSignTestP, 0.5, 1e-12);  // 2 or 3 of 3: (3 + 1) / 8
+  // Differences (1, 2, 3) against (0.1, -0.2, 0.3): ranks (1, 2, 3) and (2, 1, 3), rho = 1 - 6 * 2 / 24.
+  ASSERT_TRUE(frustumTaa.correlation.rho);
+  EXPECT_NEAR(*frustumTaa.correlation.rho, 0.5, 1e-12);
+  // A measure equal on both cameras everywhere: never higher, rho undefined.
+  EXPECT_EQ(cell("camera_yaw", "taa").measureHigher, 0);
+  EXPECT_FALSE(cell("camera_yaw", "taa").correlation.rho);
+  EXPECT_EQ(cell("frustum", "none").error, "flip");
+}
+
 TEST(Suite, MethodsToScoreAreNamedAndTheirRatioUsesTheRecordedNone) {
   auto external = suite::parseMethodToScore("mine=external:out/{dataset}/mine");
   ASSERT_TRUE(external) << external.error().message;
@@ -155,7 +198,7 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
   const auto r = dynbench(fmt::format("suite {} -o {}", kSmoke.string(), out.string()), dir);
   ASSERT_EQ(r.status, 0) << r.err << r.out;
   const auto doc = nlohmann::json::parse(test::slurp(out / "suite.json"));
-  EXPECT_EQ(doc["dynbench_suite_results"], 2);
+  EXPECT_EQ(doc["dynbench_suite_results"], 3);
   EXPECT_EQ(doc["manifest"], nlohmann::json::parse(test::slurp(kSmoke)));
   ASSERT_EQ(doc["datasets"].size(), 4u);
   // Each dataset's numbers are those its stages wrote: Table 6.7 from discard.json's mean, the
@@ -271,8 +314,28 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
     for (const auto& d : doc["datasets"]) x.push_back(d["measures"]["direct_radiance"]), y.push_back(d["errors"]["taa"]["flip_over_none"]);
     EXPECT_NEAR(c["rho"].get<double>(), *metrics::spearman(x, y), 1e-12);
   }
+  // Within matches: the two matches' bot dataset against their fly-through, each cell from the
+  // recorded numbers.
+  ASSERT_FALSE(doc["within_matches"].empty());
+  for (const auto& c : doc["within_matches"]) {
+    EXPECT_EQ(c["camera_a"], "bot");
+    EXPECT_EQ(c["camera_b"], "flythrough");
+    EXPECT_EQ(c["matches"], 2);
+    if (c["measure"] != "frustum" || c["method"] != "taa") continue;
+    int higher = 0;
+    for (int seed : {1, 2}) {
+      const auto pick = [&](const std::string& camera) {
+        for (const auto& d : doc["datasets"])
+          if (d["name"] == fmt::format("fps-{}-{}", seed, camera)) return d;
+        return nlohmann::json();
+      };
+      higher += pick("bot")["measures"]["frustum"].get<double>() > pick("flythrough")["measures"]["frustum"].get<double>();
+    }
+    EXPECT_EQ(c["measure_higher"], higher);
+  }
   const std::string md = test::slurp(out / "suite.md");
   EXPECT_NE(md.find("## Validity"), std::string::npos);
+  EXPECT_NE(md.find("### bot (A) against flythrough (B), 2 matches"), std::string::npos);
   EXPECT_NE(md.find("| fps-2-flythrough "), std::string::npos);
   for (const char* method : {"none", "accumulate", "taa", "svgf"}) EXPECT_TRUE(fs::exists(out / "plots" / fmt::format("scatter_{}.png", method)));
 

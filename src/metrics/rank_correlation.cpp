@@ -68,4 +68,14 @@ RankCorrelation rankCorrelation(const std::vector<double>& x, const std::vector<
   return result;
 }
 
+double signTestOneSided(int successes, int trials) {
+  if (trials <= 0 || successes <= 0) return 1.0;
+  if (successes > trials) return 0.0;
+  // In logs: C(n, k) / 2^n underflows nothing for n <= 1000.
+  double p = 0.0;
+  for (int k = successes; k <= trials; ++k)
+    p += std::exp(std::lgamma(trials + 1.0) - std::lgamma(k + 1.0) - std::lgamma(trials - k + 1.0) - trials * std::log(2.0));
+  return std::min(1.0, p);
+}
+
 }  // namespace dynbench::metrics

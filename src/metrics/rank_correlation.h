@@ -30,4 +30,9 @@ struct RankCorrelation {
 RankCorrelation rankCorrelation(const std::vector<double>& x, const std::vector<double>& y, int resamples = 2000, double level = 0.95,
                                 std::uint64_t seed = 1);
 
+// The one-sided sign test: the probability of at least `successes` of `trials` fair coin flips,
+// P(X >= k) for X ~ Binomial(n, 1/2) (Conover 1999, §3.4). Exact: a sum of binomial coefficients
+// over 2^n (n <= 1000). Written here for the same reason as the rest of this file.
+double signTestOneSided(int successes, int trials);
+
 }  // namespace dynbench::metrics

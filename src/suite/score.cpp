@@ -93,6 +93,12 @@ Expected<SuiteResults> readSuiteResults(const fs::path& dir) {
     for (const auto* e : {&first, &last})
       if (!*e) return std::unexpected(e->error());
     d.result.name = *name, d.dataset = *dataset, d.run = *run, d.first = *first, d.last = *last;
+    for (const auto& [key, target] : {std::pair{"/match", &d.result.match}, std::pair{"/camera", &d.result.camera}})
+      if (f.has(at + key)) {
+        auto v = f.string(at + key);
+        if (!v) return std::unexpected(v.error());
+        *target = *v;
+      }
     for (const char* group : {"/measures", "/errors"}) {
       auto object = f.value(at + group);
       if (!object) return std::unexpected(object.error());
@@ -245,6 +251,7 @@ Expected<ScoreOutcome> scoreSuite(const fs::path& dir, const std::vector<MethodT
 
   const std::vector<ValidityCell> cells = validity(results);
   doc["validity"] = validityJson(cells);
+  doc["within_matches"] = withinMatchesJson(withinMatches(results));
   ScoreOutcome outcome;
   outcome.json = dir / "suite.json";
   outcome.markdown = dir / "suite.md";

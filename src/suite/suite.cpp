@@ -212,7 +212,13 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
     s.seed = spec.seed;
     auto measured = pipeline::measureDataset(dataset, run, s, log);
     if (!measured) return std::unexpected(measured.error());
-    DatasetResult result{spec.name, measuresOf(measured->motion, measured->firstFrame, measured->lastFrame, measured->discard), errorsOf(measured->methods), {}, 0};
+    DatasetResult result;
+    result.name = spec.name;
+    result.measures = measuresOf(measured->motion, measured->firstFrame, measured->lastFrame, measured->discard);
+    result.errors = errorsOf(measured->methods);
+    auto plan = capturePlan(spec, root);
+    if (!plan) return std::unexpected(plan.error());
+    result.match = plan->key, result.camera = spec.camera;
     if (measured->referenceFloor) result.referenceFloor = measured->referenceFloor->mean, result.floorFrames = static_cast<int>(measured->referenceFloor->count);
     outcome.datasets.push_back(result);
     doc["datasets"].push_back({{"name", spec.name},
@@ -222,6 +228,8 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
                                {"window", {{"first", measured->firstFrame}, {"last", measured->lastFrame}}},
                                {"measures", result.measures},
                                {"errors", result.errors},
+                               {"match", result.match},
+                               {"camera", result.camera},
                                {"reference_floor", referenceFloorJson(result)}});
     for (const fs::path& file : recordedFiles(root, dataset, run)) {
       auto sum = sha256File(root / file);
@@ -231,6 +239,7 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
   }
   outcome.validity = validity(outcome.datasets);
   doc["validity"] = validityJson(outcome.validity);
+  doc["within_matches"] = withinMatchesJson(withinMatches(outcome.datasets));
   outcome.json = root / "suite.json";
   outcome.markdown = root / "suite.md";
   auto md = suiteMarkdown(*manifest, outcome.datasets, outcome.validity, root);

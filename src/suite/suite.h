@@ -21,7 +21,9 @@
 
 namespace dynbench::suite {
 
-inline constexpr int kResultsVersion = 2;   // "dynbench_suite_results" in suite.json (2: flip_ratio_to_none, the ranking error)
+// "dynbench_suite_results" in suite.json (2: flip_ratio_to_none, the ranking error; 3: each method on
+// its own input, the reference's noise floor, the within-match comparisons)
+inline constexpr int kResultsVersion = 3;
 
 // What one run of `suite` does: all of it, or one part of `suite --slurm`'s chain (each part reuses
 // what the parts before it made), as the demo's parts.

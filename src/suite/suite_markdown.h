@@ -15,6 +15,8 @@ namespace dynbench::suite {
 
 // suite.json's /datasets/N/reference_floor: {"flip", "frames"}, or null when it was not rendered.
 nlohmann::json referenceFloorJson(const DatasetResult& dataset);
+// suite.json's /within_matches: one object per cell.
+nlohmann::json withinMatchesJson(const std::vector<WithinMatchCell>& cells);
 // suite.json's /validity: one object per cell.
 nlohmann::json validityJson(const std::vector<ValidityCell>& cells);
 // suite.md, with its scatter plots written into root/plots; `scoredMethods` is suite.json's

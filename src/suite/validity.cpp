@@ -76,6 +76,55 @@ std::vector<ValidityCell> validity(const std::vector<DatasetResult>& datasets) {
   return cells;
 }
 
+std::vector<WithinMatchCell> withinMatches(const std::vector<DatasetResult>& datasets) {
+  // Camera policies in a fixed order: the bot's own first, the fly-through last, others between.
+  std::vector<std::string> cameras;
+  for (const DatasetResult& d : datasets)
+    if (!d.camera.empty() && std::find(cameras.begin(), cameras.end(), d.camera) == cameras.end()) cameras.push_back(d.camera);
+  auto order = [](const std::string& c) { return c == "bot" ? 0 : c == "flythrough" ? 2 : 1; };
+  std::stable_sort(cameras.begin(), cameras.end(), [&](const std::string& a, const std::string& b) {
+    return order(a) != order(b) ? order(a) < order(b) : a < b;
+  });
+  std::map<std::pair<std::string, std::string>, const DatasetResult*> byMatch;  // (match, camera) -> dataset
+  for (const DatasetResult& d : datasets)
+    if (!d.match.empty()) byMatch[{d.match, d.camera}] = &d;
+  std::vector<std::string> matches;
+  for (const auto& [key, d] : byMatch)
+    if (matches.empty() || matches.back() != key.first) matches.push_back(key.first);
+  std::vector<WithinMatchCell> cells;
+  if (datasets.empty()) return cells;
+  std::vector<std::string> methods;
+  for (const auto& [method, errors] : datasets.front().errors) methods.push_back(method);
+  for (std::size_t i = 0; i < cameras.size(); ++i)
+    for (std::size_t j = i + 1; j < cameras.size(); ++j)
+      for (const std::string& measure : measureKeys())
+        for (const std::string& method : methods) {
+          WithinMatchCell c{cameras[i], cameras[j], measure, method, rankingError(method)};
+          std::vector<double> dm, de;
+          for (const std::string& match : matches) {
+            const auto a = byMatch.find({match, cameras[i]}), b = byMatch.find({match, cameras[j]});
+            if (a == byMatch.end() || b == byMatch.end()) continue;
+            const auto value = [&](const DatasetResult* d, bool error) -> std::optional<double> {
+              if (!error) return d->measures.count(measure) ? std::optional(d->measures.at(measure)) : std::nullopt;
+              const auto e = d->errors.find(method);
+              if (e == d->errors.end() || !e->second.count(c.error)) return std::nullopt;
+              return e->second.at(c.error);
+            };
+            const auto ma = value(a->second, false), mb = value(b->second, false), ea = value(a->second, true), eb = value(b->second, true);
+            if (!ma || !mb || !ea || !eb) continue;
+            dm.push_back(*ma - *mb), de.push_back(*ea - *eb);
+            c.measureHigher += *ma > *mb;
+            c.errorHigher += *ea > *eb;
+          }
+          if (dm.empty()) continue;
+          c.matches = static_cast<int>(dm.size());
+          c.errorSignTestP = metrics::signTestOneSided(c.errorHigher, c.matches);
+          c.correlation = metrics::rankCorrelation(dm, de);
+          cells.push_back(c);
+        }
+  return cells;
+}
+
 // The difficulty measures of one dataset's window (DatasetResult).
 std::map<std::string, double> measuresOf(const metrics::CameraMotion& motion, long first, long last, const discard::FramePercentages& d) {
   std::map<std::string, double> m;

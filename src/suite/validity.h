@@ -29,6 +29,9 @@ struct DatasetResult {
   // and its re-render with another seed, over floorFrames frames; absent when not rendered.
   std::optional<double> referenceFloor;
   int floorFrames = 0;
+  // The match it shows (its capture's folder key: the same for every camera over one match) and
+  // its camera policy ("bot", "flythrough"): the pairs of the within-match comparison.
+  std::string match, camera;
 };
 
 // True when the method's ꟻLIP differs from `none`'s (on the method's input: its flip_over_none) by
@@ -42,6 +45,22 @@ struct ValidityCell {
   metrics::RankCorrelation correlation;
   int datasets = 0;
 };
+
+// One measure against one method's ranking error within matches (issue 48's paired design): for
+// each match with a dataset of camera `a` and one of camera `b` (the same capture: the same
+// players, map and moments, seen by two cameras), the difference a - b of the measure and of the
+// error. Content is held fixed in each difference, so it cannot stand in for difficulty.
+struct WithinMatchCell {
+  std::string cameraA, cameraB, measure, method, error;
+  int matches = 0;
+  int measureHigher = 0;       // matches where a's measure is the higher
+  int errorHigher = 0;         // matches where a's error is the higher
+  double errorSignTestP = 1.0; // one-sided sign test of errorHigher of matches (metrics::signTestOneSided)
+  metrics::RankCorrelation correlation;  // Spearman's rho of the differences over the matches, bootstrap over matches
+};
+// Every camera pair present (in the order bot, then any other, flythrough last), every measure,
+// every method's ranking error.
+std::vector<WithinMatchCell> withinMatches(const std::vector<DatasetResult>& datasets);
 
 // The error each method is ranked by: flip_ratio_to_none, or flip for `none` itself.
 std::string rankingError(const std::string& method);

@@ -10,6 +10,7 @@
 #include "suite/manifest.h"
 #include "suite/score.h"
 #include "suite/suite.h"
+#include "suite/suite_markdown.h"
 #include "suite/validity.h"
 
 namespace dynbench::suite {
@@ -58,7 +59,10 @@ Expected<VerifyOutcome> verifySuite(const fs::path& root, const pipeline::RunLog
     s.methods.insert(s.methods.end(), scored->builtIn.begin(), scored->builtIn.end());
     auto evaluated = pipeline::evaluateOnTheirInputs(root / d.run, s, scored->stored, false);
     if (!evaluated) return std::unexpected(evaluated.error());
-    DatasetResult result{name, measuresOf(stats->rows.front().motion, d.first, d.last, discarded->run.mean), errorsOf(*evaluated), {}, 0};
+    DatasetResult result = d.result;  // its name, match and camera as recorded; its numbers recomputed below
+    result.measures = measuresOf(stats->rows.front().motion, d.first, d.last, discarded->run.mean);
+    result.errors = errorsOf(*evaluated);
+    result.referenceFloor.reset(), result.floorFrames = 0;
     if (d.result.referenceFloor) {
       auto floor = evaluate::referenceNoiseFloor(root / d.run / "frames", root / d.run / "floor");
       if (!floor) return std::unexpected(floor.error());
@@ -97,6 +101,26 @@ Expected<VerifyOutcome> verifySuite(const fs::path& root, const pipeline::RunLog
           continue;
         }
         if (value) check(fmt::format("{}: {}", where, key), c[key].get<double>(), *value);
+      }
+    }
+  // 4. The within-match comparisons, from the recomputed numbers.
+  const auto paired = withinMatchesJson(withinMatches(recomputed));
+  auto recordedPaired = f.value("/within_matches");
+  if (!recordedPaired || !(*recordedPaired)->is_array() || (*recordedPaired)->size() != paired.size())
+    out.differences.push_back(fmt::format("/within_matches: recorded {} cells, recomputed {}",
+                                          recordedPaired && (*recordedPaired)->is_array() ? (*recordedPaired)->size() : 0, paired.size()));
+  else
+    for (std::size_t k = 0; k < paired.size(); ++k) {
+      const nlohmann::json &c = (**recordedPaired)[k], &p = paired[k];
+      const std::string where = fmt::format("within matches {} / {} / {} / {}", p["camera_a"].get<std::string>(), p["camera_b"].get<std::string>(),
+                                            p["measure"].get<std::string>(), p["method"].get<std::string>());
+      for (const auto& [key, value] : p.items()) {
+        if (!c.contains(key) || c[key].is_null() != value.is_null() || c[key].is_number() != value.is_number()) {
+          out.differences.push_back(fmt::format("{}: {} differs: recorded {}, recomputed {}", where, key, c.value(key, nlohmann::json()).dump(), value.dump()));
+          continue;
+        }
+        if (value.is_number()) check(fmt::format("{}: {}", where, key), c[key].get<double>(), value.get<double>());
+        else if (c[key] != value) out.differences.push_back(fmt::format("{}: {}: recorded {}, recomputed {}", where, key, c[key].dump(), value.dump()));
       }
     }
   return out;
