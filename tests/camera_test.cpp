@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "camera/merge_camera.h"
+#include "camera/slowed.h"
 #include "capture_fixture.h"
 #include "core/files.h"
 #include "gltf_builder.h"
@@ -191,6 +192,73 @@ TEST(MergeCamera, BadRunsAndPaths) {
   r = mergeCamera(options);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("nobody"), std::string::npos);
+}
+
+// The third camera policy (issue 48): the bot's positions and cuts, its heading averaged over a
+// window. A heading turning at a constant rate (the fixture's 3 degrees a frame) is left as it is.
+TEST(SlowedTurns, PositionsAndCutsAreTheBotsAndAConstantTurnIsKept) {
+  const Converted c = convertFixture("slowed_constant");
+  SlowedTurnsOptions options;
+  options.window = 0.1;  // 6 frames at 60 fps
+  const fs::path out = c.dataset.parent_path() / "slowed.gltf";
+  auto report = makeSlowedTurnsDataset(c.dataset, out, c.dataset.parent_path() / "slowed.csv", options);
+  ASSERT_TRUE(report) << report.error().message;
+  EXPECT_EQ(report->stretches, 2u);  // the cut at frame 7 splits it
+  int status = -1;
+  const std::string validation = test::validateGltf(out, status);
+  EXPECT_EQ(status, 0) << validation;
+  auto original = scene::loadScene(c.dataset);
+  auto slowed = scene::loadScene(out);
+  ASSERT_TRUE(original && slowed);
+  const int camera = nodeNamed(*original, "camera_1");
+  const auto& cuts = slowed->nodes[static_cast<std::size_t>(camera)].cuts;
+  ASSERT_EQ(cuts.size(), original->nodes[static_cast<std::size_t>(camera)].cuts.size());
+  ASSERT_EQ(cuts.size(), 1u);
+  EXPECT_NEAR(cuts[0].time, original->nodes[static_cast<std::size_t>(camera)].cuts[0].time, 1e-6);
+  const scene::Evaluator a(*original), b(*slowed);
+  for (int frame = 0; frame < 10; ++frame) {
+    const double t = static_cast<float>(frame / 60.0);
+    const RigidPose was = decomposeRigid(a.worldMatrix(camera, t)), is = decomposeRigid(b.worldMatrix(camera, t));
+    expectClose(is.position, was.position, fmt::format("frame {}", frame));
+    EXPECT_NEAR(wrapDegrees(degrees(eulerYawPitchRoll(is.rotation).yaw - eulerYawPitchRoll(was.rotation).yaw)), 0.0, 1e-3) << frame;
+  }
+}
+
+// A heading that zig-zags +-10 degrees every key (+10 at even keys): the window's mean. At key 4
+// the window of 0.1 s (keys 1-7) holds four -10 and three +10: -10/7 degrees; at key 5 (keys 2-8)
+// four +10 and three -10: +10/7.
+TEST(SlowedTurns, AZigZagIsAveragedOverTheWindow) {
+  const Converted c = convertFixture("slowed_zigzag");
+  const fs::path csv = c.dataset.parent_path() / "zigzag.csv";
+  {
+    std::ofstream run(csv);
+    run << "time,x,y,z,qx,qy,qz,qw\n";
+    for (int k = 0; k < 10; ++k) {
+      const glm::dquat q = quatFromYawPitchRoll(radians(k % 2 ? -10.0 : 10.0), 0.0, 0.0);
+      run << fmt::format("{},{},{},{},{},{},{},{}\n", k / 60.0, k, 2, 0, q.x, q.y, q.z, q.w);
+    }
+  }
+  MergeCameraOptions merge;
+  merge.dataset = c.dataset, merge.run = csv, merge.output = c.dataset.parent_path() / "zigzag.gltf";
+  ASSERT_TRUE(mergeCamera(merge));
+  SlowedTurnsOptions options;
+  options.window = 0.1;
+  const fs::path out = c.dataset.parent_path() / "slowed.gltf";
+  ASSERT_TRUE(makeSlowedTurnsDataset(merge.output, out, c.dataset.parent_path() / "slowed.csv", options));
+  auto slowed = scene::loadScene(out);
+  ASSERT_TRUE(slowed);
+  const int camera = nodeNamed(*slowed, "camera_1");
+  const scene::Evaluator e(*slowed);
+  auto yawAt = [&](int key) { return degrees(eulerYawPitchRoll(decomposeRigid(e.worldMatrix(camera, static_cast<float>(key / 60.0))).rotation).yaw); };
+  EXPECT_NEAR(yawAt(4), -10.0 / 7.0, 1e-3);
+  EXPECT_NEAR(yawAt(5), 10.0 / 7.0, 1e-3);
+  EXPECT_NEAR(yawAt(0), 10.0, 1e-3);  // a stretch keeps its ends
+  // Bad options: an error, nothing written.
+  options.window = -1;
+  const auto bad = makeSlowedTurnsDataset(merge.output, c.dataset.parent_path() / "bad.gltf", c.dataset.parent_path() / "bad.csv", options);
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().code, ErrorCode::kUsage);
+  EXPECT_FALSE(fs::exists(c.dataset.parent_path() / "bad.gltf"));
 }
 
 }  // namespace

@@ -193,7 +193,7 @@ Expected<MergeCameraReport> mergeCamera(const MergeCameraOptions& options) {
     }
     // The old camera's cuts were jumps of its motion, which the run replaces: they go with it.
     auto& cameraNode = doc["nodes"][static_cast<std::size_t>(*node)];
-    if (cameraNode.contains("extras") && cameraNode["extras"].is_object()) {
+    if (!options.keepCuts && cameraNode.contains("extras") && cameraNode["extras"].is_object()) {
       cameraNode["extras"].erase("dynbench_camera_cuts");
       if (cameraNode["extras"].empty()) cameraNode.erase("extras");
     }

@@ -30,6 +30,9 @@ struct MergeCameraOptions {
   std::filesystem::path output;   // .gltf, in the dataset's folder (textures stay reachable)
   std::optional<std::string> camera;  // camera node: index or name (default: the first animated camera)
   double offsetSeconds = 0.0;     // added after aligning the run's first key to the dataset's start
+  // Keep the dataset camera's cuts (extras.dynbench_camera_cuts): for a run whose keys jump where
+  // the old camera's did (the bot's positions with another rotation). Otherwise they go with it.
+  bool keepCuts = false;
 };
 
 struct MergeCameraReport {

@@ -129,7 +129,8 @@ Expected<Manifest> parseManifest(const nlohmann::json& document, const fs::path&
     d.seconds = *seconds;
     auto camera = f.string(at + "/camera");
     if (!camera) return std::unexpected(camera.error());
-    if (*camera != "bot" && *camera != "flythrough") return bad(at + "/camera", fmt::format("\"bot\" or \"flythrough\", found \"{}\"", *camera));
+    if (*camera != "bot" && *camera != "slowed" && *camera != "flythrough")
+      return bad(at + "/camera", fmt::format("\"bot\", \"slowed\" or \"flythrough\", found \"{}\"", *camera));
     d.camera = *camera;
     if (f.has(at + "/sha256")) {
       auto pins = f.value(at + "/sha256");

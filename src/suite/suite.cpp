@@ -14,6 +14,7 @@
 #include "core/json_fields.h"
 #include "dynbench/version.h"
 #include "camera/flythrough.h"
+#include "camera/slowed.h"
 #include "report/plots.h"
 #include "report/stats_output.h"
 #include "scene/load.h"
@@ -62,11 +63,11 @@ Expected<CapturePlan> capturePlan(const DatasetSpec& d, const fs::path& root) {
   return plan;
 }
 
-// Where a spec's dataset lives: its capture's folder, bot.gltf or flythrough.gltf.
+// Where a spec's dataset lives: its capture's folder, bot.gltf, slowed.gltf or flythrough.gltf.
 Expected<fs::path> datasetPath(const DatasetSpec& d, const fs::path& root) {
   auto plan = capturePlan(d, root);
   if (!plan) return std::unexpected(plan.error());
-  return root / "captures" / plan->key / (d.camera == "bot" ? "bot.gltf" : "flythrough.gltf");
+  return root / "captures" / plan->key / (d.camera + ".gltf");
 }
 
 // The dataset (bot or fly-through) for one spec, captured, converted and flown as needed.
@@ -79,6 +80,18 @@ Expected<fs::path> prepareDataset(const DatasetSpec& d, const fs::path& root, do
                               : pipeline::captureAndConvert(plan->options, folder / "capture-options.json", bot, indented);
   if (!made) return std::unexpected(made.error());
   if (d.camera == "bot") return bot;
+  if (d.camera == "slowed") {
+    const fs::path slowed = folder / "slowed.gltf";
+    if (isNewerThan(slowed, bot)) {
+      indented("slowed turns: " + slowed.string() + " is newer than its source, reused");
+      return slowed;
+    }
+    indented("slowed turns: the bot's camera, its turns slowed -> " + slowed.string());
+    auto made = camera::makeSlowedTurnsDataset(bot, slowed, folder / "slowed.csv");
+    if (!made) return std::unexpected(made.error());
+    indented("  " + camera::describe(*made));
+    return slowed;
+  }
   camera::FlythroughOptions o;
   o.frameRate = fps;  // the rate the suite renders and measures at
   const fs::path fly = folder / "flythrough.gltf";
@@ -117,7 +130,7 @@ Expected<Digests> checkPins(const Manifest& manifest, std::size_t index, const f
     return fail(ErrorCode::kInvalidData,
                 "{}: /datasets/{}/sha256/dataset: dataset '{}': the {} stage made {} with SHA-256 {}, not the pinned {} (the capture "
                 "{}; docs/suite.md)",
-                manifestName, index, d.name, d.camera == "bot" ? "convert" : "convert or fly-through", dataset.string(), *made,
+                manifestName, index, d.name, d.camera == "bot" ? "convert" : d.camera == "slowed" ? "convert or slowed-turns" : "convert or fly-through", dataset.string(), *made,
                 d.datasetSha256, d.captureSha256.empty() ? "is not pinned" : "matches its pin: convert or flythrough made another dataset");
   return Digests{capture, *made};
 }
