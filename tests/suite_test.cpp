@@ -29,10 +29,10 @@ const fs::path kSmoke = fs::path(DYNBENCH_SOURCE_DIR) / "suites" / "smoke.json";
 TEST(Suite, ManifestErrorsNameTheFileAndPointer) {
   const fs::path dir = test::freshDir("suite_manifest");
   // The repository's manifests read.
-  for (const char* name : {"smoke.json", "v1.json"}) {
+  for (const char* name : {"smoke.json", "v1.json", "engines.json", "slurm-1080p.json"}) {
     auto m = suite::readManifest(fs::path(DYNBENCH_SOURCE_DIR) / "suites" / name);
     ASSERT_TRUE(m) << m.error().message;
-    EXPECT_GE(m->datasets.size(), 4u);
+    EXPECT_GE(m->datasets.size(), 1u) << name;
   }
   const auto good = nlohmann::json::parse(test::slurp(kSmoke));
   struct Case {
