@@ -329,10 +329,10 @@ TEST_F(Slurm, SuiteAsAChainOfJobsGivesTheLocalSuitesNumbers) {
   DYNBENCH_NEEDS(test::missingCube2());
   const auto dir = test::freshDir("slurm_suite");
   const fs::path smoke = fs::path(DYNBENCH_SOURCE_DIR) / "suites" / "smoke.json";
-  auto r = dynbench(fmt::format("suite {} -o {} --slurm --frames-per-task 22", smoke.string(), (dir / "cluster").string()), dir);
+  auto r = dynbench(fmt::format("suite {} -o {} --slurm --frames-per-task 33", smoke.string(), (dir / "cluster").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err << r.out;
-  // Three jobs chained: the datasets, an array of 4 render tasks (4 datasets x (3 renders x 6
-  // frames: reference, jittered and still input; + 4 noise-floor frames) = 88 frame renders, 22 a
+  // Three jobs chained: the datasets, an array of 4 render tasks (6 datasets x (3 renders x 6
+  // frames: reference, jittered and still input; + 4 noise-floor frames) = 132 frame renders, 33 a
   // task), the whole suite.
   std::smatch m;
   ASSERT_TRUE(std::regex_search(r.out, m, std::regex("Slurm jobs: datasets (\\d+) .*render (\\d+) \\(4 tasks.*suite (\\d+) "))) << r.out;
@@ -351,7 +351,7 @@ TEST_F(Slurm, SuiteAsAChainOfJobsGivesTheLocalSuitesNumbers) {
     ++frames;
     EXPECT_EQ(sum, cluster["files"][file]) << file;
   }
-  EXPECT_EQ(frames, 4u * (3 * 6 + 4));  // reference, both inputs and noise-floor frames
+  EXPECT_EQ(frames, 6u * (3 * 6 + 4));  // reference, both inputs and noise-floor frames
   // The cluster's suite verifies.
   EXPECT_EQ(dynbench(fmt::format("suite verify {}", (dir / "cluster").string()), dir).status, 0);
 }

@@ -200,7 +200,7 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
   const auto doc = nlohmann::json::parse(test::slurp(out / "suite.json"));
   EXPECT_EQ(doc["dynbench_suite_results"], 3);
   EXPECT_EQ(doc["manifest"], nlohmann::json::parse(test::slurp(kSmoke)));
-  ASSERT_EQ(doc["datasets"].size(), 4u);
+  ASSERT_EQ(doc["datasets"].size(), 6u);
   // Each dataset's numbers are those its stages wrote: Table 6.7 from discard.json's mean, the
   // methods' ꟻLIP from evaluate.json, flip_over_none their difference with none's and
   // flip_ratio_to_none their ratio.
@@ -262,7 +262,7 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
   }
   // The smoke manifest's pins (issue 45) held, and suite.json records each dataset's digests.
   const auto manifest = nlohmann::json::parse(test::slurp(kSmoke));
-  for (std::size_t i = 0; i < 4; ++i) {
+  for (std::size_t i = 0; i < 6; ++i) {
     EXPECT_EQ(doc["datasets"][i]["sha256"], manifest["datasets"][i]["sha256"]) << i;
     EXPECT_EQ(doc["datasets"][i]["sha256"]["dataset"],
               *scene::datasetDigest(out / doc["datasets"][i]["dataset"].get<std::string>()));
@@ -295,16 +295,18 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
     fs::create_directories(again);
     fs::copy(out / "captures", again / "captures", fs::copy_options::recursive);
     for (const auto& entry : fs::recursive_directory_iterator(again / "captures"))
-      if (entry.path().stem() == "flythrough" || entry.path().stem() == "bot") fs::remove(entry.path());
+      if (entry.path().stem() == "flythrough" || entry.path().stem() == "bot" || entry.path().stem() == "slowed") fs::remove(entry.path());
     test::OtherMachine other;
     const auto remade = dynbench(fmt::format("suite {} -o {} --part datasets", kSmoke.string(), again.string()), dir);
     EXPECT_EQ(remade.status, 0) << remade.err;
     EXPECT_NE(remade.out.find("fly-through: a smooth camera"), std::string::npos) << remade.out;
-    const std::string lastPin = nlohmann::json::parse(test::slurp(kSmoke))["datasets"][3]["sha256"]["dataset"];
-    EXPECT_NE(remade.out.find("(as pinned), dataset " + lastPin), std::string::npos) << remade.out;
+    EXPECT_NE(remade.out.find("slowed turns: the bot's camera"), std::string::npos) << remade.out;
+    for (const auto& d : nlohmann::json::parse(test::slurp(kSmoke))["datasets"])
+      EXPECT_NE(remade.out.find("(as pinned), dataset " + d["sha256"]["dataset"].get<std::string>() + " (as pinned)"), std::string::npos)
+          << d["name"] << remade.out;
   }
 
-  // The fly-throughs share their bot's capture: two captures for four datasets.
+  // The fly-throughs and slowed cameras share their bot's capture: two captures for six datasets.
   EXPECT_EQ(std::distance(fs::directory_iterator(out / "captures"), fs::directory_iterator()), 2);
   // The validity table: a cell per measure, method and error, rho from the recorded numbers.
   ASSERT_FALSE(doc["validity"].empty());
@@ -314,14 +316,14 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
     for (const auto& d : doc["datasets"]) x.push_back(d["measures"]["direct_radiance"]), y.push_back(d["errors"]["taa"]["flip_over_none"]);
     EXPECT_NEAR(c["rho"].get<double>(), *metrics::spearman(x, y), 1e-12);
   }
-  // Within matches: the two matches' bot dataset against their fly-through, each cell from the
-  // recorded numbers.
+  // Within matches: each match's three cameras in pairs (bot against slowed and against the
+  // fly-through, slowed against the fly-through), each cell from the recorded numbers.
   ASSERT_FALSE(doc["within_matches"].empty());
+  std::set<std::pair<std::string, std::string>> pairs;
   for (const auto& c : doc["within_matches"]) {
-    EXPECT_EQ(c["camera_a"], "bot");
-    EXPECT_EQ(c["camera_b"], "flythrough");
+    pairs.emplace(c["camera_a"], c["camera_b"]);
     EXPECT_EQ(c["matches"], 2);
-    if (c["measure"] != "frustum" || c["method"] != "taa") continue;
+    if (c["camera_a"] != "bot" || c["camera_b"] != "flythrough" || c["measure"] != "frustum" || c["method"] != "taa") continue;
     int higher = 0;
     for (int seed : {1, 2}) {
       const auto pick = [&](const std::string& camera) {
@@ -332,6 +334,24 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
       higher += pick("bot")["measures"]["frustum"].get<double>() > pick("flythrough")["measures"]["frustum"].get<double>();
     }
     EXPECT_EQ(c["measure_higher"], higher);
+  }
+  EXPECT_EQ(pairs, (std::set<std::pair<std::string, std::string>>{{"bot", "slowed"}, {"bot", "flythrough"}, {"slowed", "flythrough"}}));
+  // The slowed camera keeps the bot's positions and cuts and turns less over the whole match
+  // (RUN/stats.json); within a short window it may turn more, a turn's rotation spread over the
+  // 2 s around it (docs/suite.md, "Camera policies").
+  for (int seed : {1, 2}) {
+    const auto pick = [&](const std::string& camera) {
+      for (const auto& d : doc["datasets"])
+        if (d["name"] == fmt::format("fps-{}-{}", seed, camera)) return d;
+      return nlohmann::json();
+    };
+    const auto motion = [&](const std::string& camera) {
+      return nlohmann::json::parse(test::slurp(out / pick(camera)["run"].get<std::string>() / "stats.json"))["datasets"][0]["camera_motion"];
+    };
+    EXPECT_LT(motion("slowed")["rotation_degrees"]["mean"].get<double>(), motion("bot")["rotation_degrees"]["mean"].get<double>()) << seed;
+    EXPECT_EQ(motion("slowed")["cuts"], motion("bot")["cuts"]) << seed;
+    EXPECT_DOUBLE_EQ(motion("slowed")["position"]["mean"].get<double>(), motion("bot")["position"]["mean"].get<double>()) << seed;
+    EXPECT_DOUBLE_EQ(pick("slowed")["measures"]["camera_position"].get<double>(), pick("bot")["measures"]["camera_position"].get<double>()) << seed;
   }
   const std::string md = test::slurp(out / "suite.md");
   EXPECT_NE(md.find("## Validity"), std::string::npos);
