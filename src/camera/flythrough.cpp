@@ -304,13 +304,9 @@ Expected<FlythroughReport> writeFlythroughCsv(const fs::path& dataset, const fs:
     return fail(ErrorCode::kInvalidData, "{}: the bot's own path crosses static geometry on each of the {} longest stretches; no fly-through made",
                 dataset.string(), compared);
   best->report.stretchesCompared = compared;
-  std::string out = "time,x,y,z,qx,qy,qz,qw\n";
-  for (std::size_t n = 0; n < samples; ++n) {
-    const glm::dquat q = orientation(best->yaw[n], best->pitch[n]);
-    const glm::dvec3& p = best->positions[n];
-    out += fmt::format("{},{},{},{},{},{},{},{}\n", flyer.poseTime(n), p.x, p.y, p.z, q.x, q.y, q.z, q.w);
-  }
-  if (auto ok = writeFileAtomic(csv, out); !ok) return std::unexpected(ok.error());
+  std::vector<CameraPoseKey> keys;
+  for (std::size_t n = 0; n < samples; ++n) keys.push_back({flyer.poseTime(n), best->positions[n], orientation(best->yaw[n], best->pitch[n])});
+  if (auto ok = writeCameraRunCsv(csv, keys); !ok) return std::unexpected(ok.error());
   return best->report;
 }
 

@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "capture/reader.h"
@@ -93,6 +94,14 @@ Expected<std::vector<CameraPoseKey>> readCameraRun(const fs::path& run) {
   std::error_code ec;
   if (fs::is_directory(run, ec)) return readCaptureRun(run);
   return readCsvRun(run);
+}
+
+Expected<void> writeCameraRunCsv(const fs::path& csv, const std::vector<CameraPoseKey>& keys) {
+  std::string out = "time,x,y,z,qx,qy,qz,qw\n";
+  for (const CameraPoseKey& k : keys)
+    out += fmt::format("{},{},{},{},{},{},{},{}\n", k.time, k.position.x, k.position.y, k.position.z, k.rotation.x, k.rotation.y, k.rotation.z,
+                       k.rotation.w);
+  return writeFileAtomic(csv, out);
 }
 
 Expected<MergeCameraReport> mergeCamera(const MergeCameraOptions& options) {

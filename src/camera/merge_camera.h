@@ -23,6 +23,9 @@ struct CameraPoseKey {
 // with lines `time,x,y,z,qx,qy,qz,qw` (a header line is allowed) such as a head-mounted display
 // records. Errors name file:line.
 Expected<std::vector<CameraPoseKey>> readCameraRun(const std::filesystem::path& run);
+// Writes a CSV pose log readCameraRun reads (header line, one key a line, shortest round-trip
+// decimals), from a temporary file.
+Expected<void> writeCameraRunCsv(const std::filesystem::path& csv, const std::vector<CameraPoseKey>& keys);
 
 struct MergeCameraOptions {
   std::filesystem::path dataset;  // .gltf with its .bin (as `convert` writes)

@@ -9,6 +9,7 @@
 
 #include "camera/merge_camera.h"
 #include "core/files.h"
+#include "core/math.h"
 #include "scene/evaluate.h"
 #include "scene/load.h"
 #include "scene/queries.h"
@@ -18,19 +19,6 @@ namespace dynbench::camera {
 namespace fs = std::filesystem;
 
 namespace {
-
-// A camera's heading and pitch (radians) from its world matrix: glTF cameras look down -Z with +Y
-// up, so the view direction f is -column 2, yaw = atan2(-f.x, -f.z), pitch = asin(f.y); the
-// inverse of orientation() below.
-std::pair<double, double> headingAndPitch(const glm::dmat4& world) {
-  const glm::dvec3 f = -glm::normalize(glm::dvec3(world[2]));
-  return {std::atan2(-f.x, -f.z), std::asin(std::clamp(f.y, -1.0, 1.0))};
-}
-
-// Yaw about +Y after pitch about +X: no roll (as the fly-through's).
-glm::dquat orientation(double yaw, double pitch) {
-  return glm::angleAxis(yaw, glm::dvec3(0, 1, 0)) * glm::angleAxis(pitch, glm::dvec3(1, 0, 0));
-}
 
 // The centred moving average over time: each value the mean of those within +-h seconds, h the
 // half width, shrunk symmetrically near a stretch's ends (h = min(half, time to either end)) so a
@@ -80,11 +68,12 @@ Expected<SlowedTurnsReport> makeSlowedTurnsDataset(const fs::path& dataset, cons
   for (double t : times) {
     const glm::dmat4 world = evaluator.worldMatrix(*cameraNode, t);
     positions.emplace_back(world[3]);
-    const auto [y, p] = headingAndPitch(world);
+    const EulerYawPitchRoll angles = eulerYawPitchRoll(decomposeRigid(world).rotation);
+    const double y = angles.yaw, p = angles.pitch;
     // unwrapped: the average of 179° and -179° is 180°, not 0°
     yaw.push_back(yaw.empty() || scene::cameraCutBetween(node, times[yaw.size() - 1], t)
                       ? y
-                      : yaw.back() + std::remainder(y - yaw.back(), 2.0 * glm::pi<double>()));
+                      : yaw.back() + std::remainder(y - yaw.back(), 2.0 * kPi));
     pitch.push_back(p);
   }
   // Each cut-free stretch smoothed on its own.
@@ -102,13 +91,10 @@ Expected<SlowedTurnsReport> makeSlowedTurnsDataset(const fs::path& dataset, cons
     ++report.stretches;
     begin = end;
   }
-  std::string out = "time,x,y,z,qx,qy,qz,qw\n";
-  for (std::size_t k = 0; k < times.size(); ++k) {
-    const glm::dquat q = orientation(smoothYaw[k], smoothPitch[k]);
-    const glm::dvec3& p = positions[k];
-    out += fmt::format("{},{},{},{},{},{},{},{}\n", times[k] - range.start, p.x, p.y, p.z, q.x, q.y, q.z, q.w);
-  }
-  if (auto ok = writeFileAtomic(csv, out); !ok) return std::unexpected(ok.error());
+  std::vector<CameraPoseKey> keys;
+  for (std::size_t k = 0; k < times.size(); ++k)  // no roll, as the fly-through's
+    keys.push_back({times[k] - range.start, positions[k], quatFromYawPitchRoll(smoothYaw[k], smoothPitch[k], 0.0)});
+  if (auto ok = writeCameraRunCsv(csv, keys); !ok) return std::unexpected(ok.error());
   report.poses = times.size();
   MergeCameraOptions merge;
   merge.dataset = dataset;
