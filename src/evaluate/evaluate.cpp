@@ -133,7 +133,9 @@ Expected<MeanWithError> referenceNoiseFloor(const fs::path& reference, const fs:
   std::vector<FrameScores> scores;
   for (const frames::FrameEntry& entry : *others) {
     const fs::path referenceImage = frames::frameImagePath(reference, entry.frame);
-    auto a = frames::readFrame(frames::FrameEntry{entry.frame, referenceImage, fs::path(referenceImage).replace_extension(".json")});
+    auto referenceEntry = frames::frameEntry(referenceImage);
+    if (!referenceEntry) return std::unexpected(referenceEntry.error());
+    auto a = frames::readFrame(*referenceEntry);
     if (!a) return std::unexpected(a.error());
     auto b = frames::readFrame(entry);
     if (!b) return std::unexpected(b.error());

@@ -251,12 +251,13 @@ Expected<ScoreOutcome> scoreSuite(const fs::path& dir, const std::vector<MethodT
 
   const std::vector<ValidityCell> cells = validity(results);
   doc["validity"] = validityJson(cells);
-  doc["within_matches"] = withinMatchesJson(withinMatches(results));
+  const std::vector<WithinMatchCell> paired = withinMatches(results);
+  doc["within_matches"] = withinMatchesJson(paired);
   ScoreOutcome outcome;
   outcome.json = dir / "suite.json";
   outcome.markdown = dir / "suite.md";
   for (const MethodToScore& m : methods) outcome.methods.push_back(m.name);
-  auto md = suiteMarkdown(suite->manifest, results, cells, dir, scored);
+  auto md = suiteMarkdown(suite->manifest, results, cells, paired, dir, scored);
   if (!md) return std::unexpected(md.error());
   if (auto ok = writeFileAtomic(outcome.markdown, *md); !ok) return std::unexpected(ok.error());
   if (auto ok = writeFileAtomic(outcome.json, jsonFileText(doc)); !ok) return std::unexpected(ok.error());

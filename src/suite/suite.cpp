@@ -252,10 +252,11 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
   }
   outcome.validity = validity(outcome.datasets);
   doc["validity"] = validityJson(outcome.validity);
-  doc["within_matches"] = withinMatchesJson(withinMatches(outcome.datasets));
+  const std::vector<WithinMatchCell> paired = withinMatches(outcome.datasets);
+  doc["within_matches"] = withinMatchesJson(paired);
   outcome.json = root / "suite.json";
   outcome.markdown = root / "suite.md";
-  auto md = suiteMarkdown(*manifest, outcome.datasets, outcome.validity, root);
+  auto md = suiteMarkdown(*manifest, outcome.datasets, outcome.validity, paired, root);
   if (!md) return std::unexpected(md.error());
   if (auto ok = writeFileAtomic(outcome.markdown, *md); !ok) return std::unexpected(ok.error());
   // suite.json last: its presence says the run is complete.

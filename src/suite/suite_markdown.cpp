@@ -58,7 +58,7 @@ nlohmann::json validityJson(const std::vector<ValidityCell>& cells) {
 // suite.md: the datasets' numbers, the validity table (each method's ranking error), and a
 // scatter plot per method of that error against its best-correlated measure.
 Expected<std::string> suiteMarkdown(const Manifest& manifest, const std::vector<DatasetResult>& datasets, const std::vector<ValidityCell>& cells,
-                                    const fs::path& root, const nlohmann::json& scoredMethods) {
+                                    const std::vector<WithinMatchCell>& paired, const fs::path& root, const nlohmann::json& scoredMethods) {
   std::string md = fmt::format("# Suite {}\n\n{}\n\n", manifest.name, manifest.description);
   const auto& r = manifest.run;
   md += fmt::format("{} datasets; each a window of {} frames at {}x{}, references converged (tolerance {}, {}-{} spp, {} bounces), "
@@ -134,7 +134,7 @@ Expected<std::string> suiteMarkdown(const Manifest& manifest, const std::vector<
           report::markdownTable(header, rows) + "\n";
   }
   // Within matches: each camera pair's differences over the matches that have both.
-  if (const auto paired = withinMatches(datasets); !paired.empty()) {
+  if (!paired.empty()) {
     md += "## Within matches\n\nThe same match seen by two cameras: each difference is camera A's dataset minus camera B's over one "
           "match, so the content (map, players, moments) is the same on both sides and cannot stand in for difficulty. For each "
           "measure: in how many matches it is higher on A; for each method: Spearman's rho between the matches' differences of the "

@@ -19,9 +19,11 @@ nlohmann::json referenceFloorJson(const DatasetResult& dataset);
 nlohmann::json withinMatchesJson(const std::vector<WithinMatchCell>& cells);
 // suite.json's /validity: one object per cell.
 nlohmann::json validityJson(const std::vector<ValidityCell>& cells);
-// suite.md, with its scatter plots written into root/plots; `scoredMethods` is suite.json's
-// /scored_methods (the methods `suite score` added afterwards), listed with what they were.
+// suite.md, with its scatter plots written into root/plots: the validity table from `cells`, the
+// within-match comparisons from `paired`; `scoredMethods` is suite.json's /scored_methods (the
+// methods `suite score` added afterwards), listed with what they were.
 Expected<std::string> suiteMarkdown(const Manifest& manifest, const std::vector<DatasetResult>& datasets, const std::vector<ValidityCell>& cells,
-                                    const std::filesystem::path& root, const nlohmann::json& scoredMethods = nlohmann::json::array());
+                                    const std::vector<WithinMatchCell>& paired, const std::filesystem::path& root,
+                                    const nlohmann::json& scoredMethods = nlohmann::json::array());
 
 }  // namespace dynbench::suite
