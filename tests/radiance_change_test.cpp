@@ -52,7 +52,8 @@ struct Room {
   double ballRadius = 0.5, ballSpeed = 0.0;
 };
 
-Room room(const std::string& name, bool glossy, double ballSpeed, bool secondLight = false, double hideFrom = 1.0, double ballStart = 0.0) {
+Room room(const std::string& name, bool glossy, double ballSpeed, bool secondLight = false, double hideFrom = 1.0, double ballStart = 0.0,
+          int unchangedLights = 0) {
   Room r;
   r.ballSpeed = ballSpeed;
   r.ball.x = ballStart;
@@ -86,6 +87,15 @@ Room room(const std::string& name, bool glossy, double ballSpeed, bool secondLig
         {{"sampler", b.doc["animations"][0]["samplers"].size() - 1},
          {"target", {{"path", "pointer"},
                      {"extensions", {{"KHR_animation_pointer", {{"pointer", fmt::format("/nodes/{}/extensions/KHR_node_visibility/visible", lamp)}}}}}}}});
+  }
+  // Dim point lights without a range on a grid under the ceiling, the same in every frame.
+  if (unchangedLights > 0) {
+    b.doc["extensions"]["KHR_lights_punctual"]["lights"].push_back({{"type", "point"}, {"intensity", 1.0}});
+    const int side = static_cast<int>(std::ceil(std::sqrt(unchangedLights)));
+    for (int i = 0; i < unchangedLights; ++i) {
+      const double x = -3.0 + 6.0 * (i % side + 0.5) / side, z = -1.8 + 4.0 * (i / side + 0.5) / side;
+      b.node({{"name", fmt::format("dim{}", i)}, {"translation", {x, 2.9, z}}, {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
+    }
   }
   r.scene = load(b, name);
   return r;
@@ -238,6 +248,35 @@ TEST(RadianceChange, OneOfTwoCoincidentLightsSwitchedOffChangesExactlyThePixelsI
   EXPECT_GT(d.indirect, 20.0);
   EXPECT_NEAR(d.indirect, bruteForce.indirect, 2.0) << "brute force " << bruteForce.indirect << " interval ["
                                                      << bruteForce.indirectInterval->low << ", " << bruteForce.indirectInterval->high << "]";
+}
+
+TEST(RadianceChange, ManyUnchangedLightsCancelInThePairsAsIfEveryLightWereEvaluated) {
+  // 48 unchanged lights without a range, more than the 32 a pair's half evaluates at a point, and
+  // the second lamp switched off. The unchanged lights are chosen from one tree with the same
+  // number in both halves (PairLights), so at the pixel centre their light cancels and D is the
+  // lamp's light alone, without noise, as with every light evaluated (lightsPerPoint 0). Each
+  // frame's own tree would choose differently in the two halves: D would be noisy.
+  const double fps = 24.0, t = 1.0 + 0.5 / fps;
+  const Room r = room("many_lights", false, 0.0, true, 1.0, 0.0, 48);
+  const RenderCamera cam = lookCamera({0.3, 1.6, 3.5}, {-0.1, -0.35, -1}, 50.0, 48, 36);
+  RenderSettings settings = smallSettings(5);
+  settings.constantEnvironment.reset();
+  settings.useEnvironment = false;
+  settings.pixelFilter = {PixelFilterType::kCentre, 0.0};
+  settings.bounces = 0;  // direct light only: every pair's D is the same number
+  const Pair chosen = renderPair(r.scene, settings, t, 1.0 / fps, cam, cam);
+  settings.lightsPerPoint = 0;
+  const Pair every = renderPair(r.scene, settings, t, 1.0 / fps, cam, cam);
+  ASSERT_TRUE(chosen.current.hasChanges() && every.current.hasChanges());
+  std::size_t lit = 0;
+  for (std::size_t i = 0; i < chosen.current.pixelCount(); ++i) {
+    if (chosen.current.hit[i] <= 0) continue;
+    const double exact = every.current.directChange[3 * i], y = luminance(rgb(every.current.direct, i));
+    EXPECT_NEAR(chosen.current.directChange[3 * i], exact, 1e-5 * std::max(1.0, y)) << "pixel " << i;
+    EXPECT_LE(chosen.current.directChange[3 * i + 1], 1e-5 * std::max(1.0, y)) << "pixel " << i;
+    if (exact < -1e-3 * y) ++lit;  // the lamp lit it: its light is a share of the pixel's, not rounding
+  }
+  EXPECT_GT(lit, chosen.current.pixelCount() / 4);  // the test means something
 }
 
 // Whether the segment from floor point p to the light passes through the ball at centre c.

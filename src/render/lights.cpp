@@ -231,15 +231,76 @@ void LightSet::selectPunctual(const glm::dvec3& point, const glm::dvec3& normal,
     // Every light that can reach the point, each with probability 1, found without the tree:
     // a light whose range ends before the point, or that is behind the surface, gives nothing.
     selected.clear();
-    for (const std::uint32_t l : treeLight_) {
-      const Punctual& p = punctual_[l];
-      const glm::dvec3 toLight = p.position - point;
-      if (glm::dot(toLight, normal) <= 0) continue;
-      if (p.range > 0 && std::isfinite(p.range) && glm::dot(toLight, toLight) >= p.range * p.range) continue;
-      selected.push_back({l, 1.0});
-    }
+    for (const std::uint32_t l : treeLight_)
+      if (reaches(l, point, normal)) selected.push_back({l, 1.0});
   }
   for (const std::uint32_t l : directional_) selected.push_back({l, 1.0});
+}
+
+bool LightSet::reaches(std::uint32_t light, const glm::dvec3& point, const glm::dvec3& normal) const {
+  const Punctual& p = punctual_[light];
+  const glm::dvec3 toLight = p.position - point;
+  if (glm::dot(toLight, normal) <= 0) return false;
+  return !(p.range > 0 && std::isfinite(p.range) && glm::dot(toLight, toLight) >= p.range * p.range);
+}
+
+void PairLights::build(const LightSet& now, const LightSet& before) {
+  halves_ = {&now, &before};
+  for (auto& v : sharedLight_) v.clear();
+  for (auto& v : changed_) v.clear();
+  // Each half's point and spot lights in one order of every parameter, then merged: equal
+  // parameters are the same light in both frames (two coincident equal lights pair up one to one).
+  auto key = [](const LightSet::Punctual& p) {
+    return std::array<double, 13>{static_cast<double>(p.type), p.position.x,  p.position.y,  p.position.z, p.direction.x,
+                                  p.direction.y,               p.direction.z, p.intensity.x, p.intensity.y, p.intensity.z,
+                                  p.range,                     p.cosOuter,    p.cosInner};
+  };
+  std::array<std::vector<std::uint32_t>, 2> sorted;
+  for (std::size_t h = 0; h < 2; ++h) {
+    sorted[h] = halves_[h]->treeLight_;
+    const auto& lights = halves_[h]->punctual_;
+    std::stable_sort(sorted[h].begin(), sorted[h].end(), [&](std::uint32_t a, std::uint32_t b) { return key(lights[a]) < key(lights[b]); });
+  }
+  std::size_t i = 0, j = 0;
+  while (i < sorted[0].size() || j < sorted[1].size()) {
+    if (j == sorted[1].size()) {
+      changed_[0].push_back(sorted[0][i++]);
+    } else if (i == sorted[0].size()) {
+      changed_[1].push_back(sorted[1][j++]);
+    } else {
+      const auto a = key(now.punctual_[sorted[0][i]]), b = key(before.punctual_[sorted[1][j]]);
+      if (a < b) changed_[0].push_back(sorted[0][i++]);
+      else if (b < a) changed_[1].push_back(sorted[1][j++]);
+      else {
+        sharedLight_[0].push_back(sorted[0][i++]);
+        sharedLight_[1].push_back(sorted[1][j++]);
+      }
+    }
+  }
+  std::vector<LightTree::Light> treeLights;
+  treeLights.reserve(sharedLight_[0].size());
+  for (const std::uint32_t l : sharedLight_[0]) {
+    const LightSet::Punctual& p = now.punctual_[l];
+    treeLights.push_back({p.position, std::max(luminance(p.intensity), 1e-30), p.range});
+  }
+  shared_.build(treeLights);
+}
+
+void PairLights::select(int half, const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights,
+                        std::vector<LightTree::Selected>& selected) const {
+  const LightSet& lights = *halves_[static_cast<std::size_t>(half)];
+  const auto& sharedLight = sharedLight_[static_cast<std::size_t>(half)];
+  selected.clear();
+  if (maxLights > 0 && !shared_.empty()) {
+    shared_.select(point, normal, u, maxLights, selected);
+    for (auto& s : selected) s.light = sharedLight[s.light];
+  } else {
+    for (const std::uint32_t l : sharedLight)
+      if (lights.reaches(l, point, normal)) selected.push_back({l, 1.0});
+  }
+  for (const std::uint32_t l : changed_[static_cast<std::size_t>(half)])
+    if (lights.reaches(l, point, normal)) selected.push_back({l, 1.0});
+  for (const std::uint32_t l : lights.directional_) selected.push_back({l, 1.0});
 }
 
 bool LightSet::samplePunctual(std::size_t light, const glm::dvec3& point, LightSample& s) const {

@@ -7,6 +7,7 @@
 // light gives E c cos(theta) (lux); the environment image holds radiance (cd/m2) times its
 // intensity; an emissive surface emits emissiveFactor (times emissiveStrength and the emissive
 // texture) as radiance. docs/feature-buffers.md repeats this.
+#include <array>
 #include <functional>
 #include <span>
 #include <vector>
@@ -157,6 +158,7 @@ class LightSet {
   static double emissiveWeight(const glm::dvec3& emissiveFactor) { return luminance(emissiveFactor); }
 
  private:
+  friend class PairLights;
   struct Punctual {
     scene::Light::Type type;
     glm::dvec3 position{0.0}, direction{0.0, 0.0, -1.0};  // direction the light shines along
@@ -168,6 +170,9 @@ class LightSet {
     int node, primitive;
     unsigned index;
   };
+  // Whether point or spot light `light` can light `point` on a surface facing `normal`: in front
+  // of the surface and inside its range.
+  bool reaches(std::uint32_t light, const glm::dvec3& point, const glm::dvec3& normal) const;
   std::vector<Punctual> punctual_;
   std::vector<std::uint32_t> directional_;  // evaluated everywhere
   std::vector<std::uint32_t> treeLight_;    // light k of the tree -> punctual light
@@ -178,6 +183,31 @@ class LightSet {
   EmissionFunction emission_;
   Distribution1D choice_;  // the environment (0) or the emissive triangles (1)
   double environmentChoice_ = 0.0, emissiveChoice_ = 0.0;
+};
+
+// The punctual lights of a radiance-change pair's two halves (PathTracer::renderChanges). A point
+// or spot light identical in both frames goes into one light tree that both halves select from with
+// the same random number, so where the shading point did not move they pick the same lights and the
+// lights' share of D = Y_t - Y_{t-1} cancels exactly, as it does with every light evaluated (common
+// random numbers). A light that moved, changed or is in one frame only is evaluated wherever it
+// reaches, in its own frame's half. Each half stays unbiased (LightTree::select over the shared
+// lights, the others exactly). Why not every light in reach, as before: a map lit by hundreds of
+// lights without a range (OpenArena's fitted lights) then cost hundreds of shadow rays a vertex,
+// two thirds of a reference frame's time on oa_dm1.
+class PairLights {
+ public:
+  void build(const LightSet& now, const LightSet& before);
+  // As LightSet::selectPunctual, for half 0 (`now`) or 1 (`before`): indices into that half's
+  // lights. maxLights 0: every light in reach, shared or not.
+  void select(int half, const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights,
+              std::vector<LightTree::Selected>& selected) const;
+  std::size_t sharedCount() const { return shared_.size(); }
+
+ private:
+  std::array<const LightSet*, 2> halves_{nullptr, nullptr};
+  LightTree shared_;
+  std::array<std::vector<std::uint32_t>, 2> sharedLight_;  // shared tree light k -> each half's punctual light
+  std::array<std::vector<std::uint32_t>, 2> changed_;      // each half's point and spot lights not shared
 };
 
 }  // namespace dynbench::render

@@ -169,10 +169,16 @@ bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const S
     const double uTree = p.keyed ? p.rng.uniform() : 0.0;
     if (scratch.lights->punctualCount() > 0) {
       const double uLight = p.keyed ? uTree : scratch.lights->hasPunctualTree() ? p.rng.uniform() : 0.0;
-      // A pair's halves evaluate every light that reaches the point (lightsPerPoint 0): each frame's
-      // light tree is built from its own lights, and once they differ (a muzzle flash, a moving
-      // player's light) the same number picks different lights in the two halves everywhere.
-      scratch.lights->selectPunctual(hit.position, s.geometricNormal, uLight, p.keyed ? 0 : settings_.lightsPerPoint, scratch.selected);
+      // A pair's halves select from the lights both frames share with one tree and the same number
+      // (PairLights): each frame's own tree is built from its own lights, and once they differ (a
+      // muzzle flash, a moving player's light) the same number picks different lights everywhere.
+      // They select more lights than an image sample: a glossy surface seen from a moving camera
+      // changes under every light, and D's estimate of that change gets the selection's noise.
+      if (p.keyed && scratch.pairLights)
+        scratch.pairLights->select(scratch.pairHalf, hit.position, s.geometricNormal, uLight, pairLightsPerPoint(settings_.lightsPerPoint),
+                                   scratch.selected);
+      else
+        scratch.lights->selectPunctual(hit.position, s.geometricNormal, uLight, settings_.lightsPerPoint, scratch.selected);
       scratch.punctualEvaluated += scratch.selected.size();
       if (!scratch.selected.empty()) {
         const Bsdf bsdf(s.material, Frame(s.shadingNormal), s.geometricNormal);

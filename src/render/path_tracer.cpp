@@ -261,7 +261,9 @@ Expected<void> PathTracer::setTime(double time, double previousTime) {
     if (auto ok = previousLights_.build(scene_, *previousRayTracing_, environment_ ? &*environment_ : nullptr, *sceneRadius_, emissionAt); !ok)
       return ok;
   }
-  return lights_.build(scene_, *rayTracing_, environment_ ? &*environment_ : nullptr, *sceneRadius_, emissionAt);
+  if (auto ok = lights_.build(scene_, *rayTracing_, environment_ ? &*environment_ : nullptr, *sceneRadius_, emissionAt); !ok) return ok;
+  if (previousRayTracing_) pairLights_.build(lights_, previousLights_);
+  return {};
 }
 
 

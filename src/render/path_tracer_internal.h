@@ -95,6 +95,10 @@ struct PathTracer::PathScratch {
   // previous half of a radiance-change pair the previous frame's (renderChanges).
   const RayTracingScene* scene = nullptr;
   const LightSet* lights = nullptr;
+  // For a radiance-change pair's halves: both frames' punctual lights, and which half (0: this
+  // frame, 1: the previous) is traced.
+  const PairLights* pairLights = nullptr;
+  int pairHalf = 0;
   // What advance computes at a path vertex, written in place (returned by value, GCC zeroed and
   // copied them, with loads that waited on the stores just made).
   Shading shading;

@@ -172,11 +172,14 @@ void PathTracer::renderChanges(std::uint64_t frameIndex, const RenderCamera& cam
       b.traced.push_back(k);
     }
     if (b.traced.empty()) return;
+    b.scratch.pairLights = &pairLights_;
     b.scratch.scene = rayTracing_.get();
     b.scratch.lights = &lights_;
+    b.scratch.pairHalf = 0;
     tracePaths(b.pathsNow, b.scratch, true);
     b.scratch.scene = previousRayTracing_.get();
     b.scratch.lights = &previousLights_;
+    b.scratch.pairHalf = 1;
     tracePaths(b.pathsBefore, b.scratch, true);
     for (std::size_t j = 0; j < b.traced.size(); ++j) {
       const std::size_t k = b.traced[j];

@@ -108,8 +108,11 @@ nlohmann::json renderRecord(const RenderJob& job) {
   if (s.converge) r["converge"] = {{"tolerance", s.tolerance}, {"max_spp", s.maxSamplesPerPixel},
                                    {"direct_threshold", s.directThresholdFraction}, {"indirect_threshold", s.indirectThresholdFraction}};
   // Radiance-change pairs (frames without them are not complete for a job that wants them).
+  // Their lights (PairLights): the frames' shared lights through one tree, pairLightsPerPoint a
+  // point; pairs that evaluated every light in reach are not reused.
   if (s.pairs) r["pairs"] = {{"max_pairs", s.maxPairs}, {"first_pairs", frames::kFirstPairs}, {"z", frames::kChangeZ},
-                             {"direct_threshold", s.directThresholdFraction}, {"indirect_threshold", s.indirectThresholdFraction}};
+                             {"direct_threshold", s.directThresholdFraction}, {"indirect_threshold", s.indirectThresholdFraction},
+                             {"lights", {{"sampler", "shared_tree"}, {"per_point", pairLightsPerPoint(s.lightsPerPoint)}}}};
   // Point and spot lights through the light tree (frames of the earlier cut-off are not reused).
   r["lights"] = {{"sampler", "tree"}, {"per_point", s.lightsPerPoint}};
   if (s.jitter) r["jitter"] = "halton23x8";

@@ -99,7 +99,12 @@ std::vector<WithinMatchCell> withinMatches(const std::vector<DatasetResult>& dat
     for (std::size_t j = i + 1; j < cameras.size(); ++j)
       for (const std::string& measure : measureKeys())
         for (const std::string& method : methods) {
-          WithinMatchCell c{cameras[i], cameras[j], measure, method, rankingError(method)};
+          WithinMatchCell c;
+          c.cameraA = cameras[i];
+          c.cameraB = cameras[j];
+          c.measure = measure;
+          c.method = method;
+          c.error = rankingError(method);
           std::vector<double> dm, de;
           for (const std::string& match : matches) {
             const auto a = byMatch.find({match, cameras[i]}), b = byMatch.find({match, cameras[j]});
