@@ -251,11 +251,12 @@ TEST(RadianceChange, OneOfTwoCoincidentLightsSwitchedOffChangesExactlyThePixelsI
 }
 
 TEST(RadianceChange, ManyUnchangedLightsCancelInThePairsAsIfEveryLightWereEvaluated) {
-  // 48 unchanged lights without a range, more than the 32 a pair's half evaluates at a point, and
-  // the second lamp switched off. The unchanged lights are chosen from one tree with the same
-  // number in both halves (PairLights), so at the pixel centre their light cancels and D is the
-  // lamp's light alone, without noise, as with every light evaluated (lightsPerPoint 0). Each
-  // frame's own tree would choose differently in the two halves: D would be noisy.
+  // 48 unchanged lights without a range, more than the 32 a pair's half evaluates at its first
+  // vertex (and the 4 at the next), and the second lamp switched off. The unchanged lights are
+  // chosen from one tree with the same number in both halves (PairLights), so on every path their
+  // light cancels and D is the lamp's light alone, as with every light evaluated (lightsPerPoint
+  // 0): at the pixel centre the same direct D for every pair, and the same indirect D pair by pair
+  // (4 pairs a pixel, both ways). Each frame's own tree would choose differently in the two halves.
   const double fps = 24.0, t = 1.0 + 0.5 / fps;
   const Room r = room("many_lights", false, 0.0, true, 1.0, 0.0, 48);
   const RenderCamera cam = lookCamera({0.3, 1.6, 3.5}, {-0.1, -0.35, -1}, 50.0, 48, 36);
@@ -263,7 +264,8 @@ TEST(RadianceChange, ManyUnchangedLightsCancelInThePairsAsIfEveryLightWereEvalua
   settings.constantEnvironment.reset();
   settings.useEnvironment = false;
   settings.pixelFilter = {PixelFilterType::kCentre, 0.0};
-  settings.bounces = 0;  // direct light only: every pair's D is the same number
+  settings.bounces = 1;
+  settings.maxPairs = frames::kFirstPairs;
   const Pair chosen = renderPair(r.scene, settings, t, 1.0 / fps, cam, cam);
   settings.lightsPerPoint = 0;
   const Pair every = renderPair(r.scene, settings, t, 1.0 / fps, cam, cam);
@@ -274,9 +276,16 @@ TEST(RadianceChange, ManyUnchangedLightsCancelInThePairsAsIfEveryLightWereEvalua
     const double exact = every.current.directChange[3 * i], y = luminance(rgb(every.current.direct, i));
     EXPECT_NEAR(chosen.current.directChange[3 * i], exact, 1e-5 * std::max(1.0, y)) << "pixel " << i;
     EXPECT_LE(chosen.current.directChange[3 * i + 1], 1e-5 * std::max(1.0, y)) << "pixel " << i;
+    const double yIndirect = luminance(rgb(every.current.indirect, i));
+    EXPECT_NEAR(chosen.current.indirectChange[3 * i], every.current.indirectChange[3 * i], 1e-5 * std::max(1.0, yIndirect)) << "pixel " << i;
+    EXPECT_EQ(chosen.current.changePairs[i], every.current.changePairs[i]) << "pixel " << i;
     if (exact < -1e-3 * y) ++lit;  // the lamp lit it: its light is a share of the pixel's, not rounding
   }
   EXPECT_GT(lit, chosen.current.pixelCount() / 4);  // the test means something
+  // ... and the lamp's indirect light changed too, by more than rounding.
+  double indirectChange = 0.0;
+  for (std::size_t i = 0; i < every.current.pixelCount(); ++i) indirectChange += std::abs(every.current.indirectChange[3 * i]);
+  EXPECT_GT(indirectChange, 1e-2 * static_cast<double>(every.current.pixelCount()) * frames::meanLuminance(every.current.indirect));
 }
 
 // Whether the segment from floor point p to the light passes through the ball at centre c.

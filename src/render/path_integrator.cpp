@@ -172,11 +172,13 @@ bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const S
       // A pair's halves select from the lights both frames share with one tree and the same number
       // (PairLights): each frame's own tree is built from its own lights, and once they differ (a
       // muzzle flash, a moving player's light) the same number picks different lights everywhere.
-      // They select more lights than an image sample: a glossy surface seen from a moving camera
-      // changes under every light, and D's estimate of that change gets the selection's noise.
+      // At the first vertex they select more lights than an image sample: a glossy surface seen
+      // from a moving camera changes under every light, and D's estimate of that change gets the
+      // selection's noise. Further vertices are reached along the same directions in both halves,
+      // so there an unchanged light at an unmoved point gives both the same light, whichever.
       if (p.keyed && scratch.pairLights)
-        scratch.pairLights->select(scratch.pairHalf, hit.position, s.geometricNormal, uLight, pairLightsPerPoint(settings_.lightsPerPoint),
-                                   scratch.selected);
+        scratch.pairLights->select(scratch.pairHalf, hit.position, s.geometricNormal, uLight,
+                                   depth == 0 ? pairLightsPerPoint(settings_.lightsPerPoint) : settings_.lightsPerPoint, scratch.selected);
       else
         scratch.lights->selectPunctual(hit.position, s.geometricNormal, uLight, settings_.lightsPerPoint, scratch.selected);
       scratch.punctualEvaluated += scratch.selected.size();

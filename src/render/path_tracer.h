@@ -83,11 +83,12 @@ struct RenderSettings {
   int maxPairs = 4096;
 };
 
-// Point and spot lights a radiance-change pair's half evaluates at a shading point at most
-// (PairLights::select): at least 32, or every light in reach with lightsPerPoint 0. On oa_dm1
-// (169 lights without a range; frame 108 at 96x54, 128 samples, pairs up to 64) 4 lights a point
-// left 1219 pixels undecided against 586 with every light, 16 left 647 and 32 left 589, at 2.5,
-// 3.1 and 4.0 s of the frame's 8.3 s of pairs with every light.
+// Point and spot lights a radiance-change pair's half evaluates at its first vertex at most
+// (PairLights::select; lightsPerPoint at the vertices after it): at least 32, or every light in
+// reach with lightsPerPoint 0. On oa_dm1 (169 lights without a range; frame 108 at 96x54, 128
+// samples, pairs up to 64) 4 lights at every vertex left 1219 pixels undecided against 586 with
+// every light, 16 at the first vertex 647, 32 about 580; pairs took 8.3 s of the frame with every
+// light, 2.5 s with 4 (docs/feature-buffers.md).
 constexpr int kPairLightsPerPoint = 32;
 inline int pairLightsPerPoint(int lightsPerPoint) { return lightsPerPoint == 0 ? 0 : std::max(lightsPerPoint, kPairLightsPerPoint); }
 
