@@ -1,6 +1,7 @@
 // `dynbench suite` and `suite verify` (pipeline/suite.h): the manifest's errors, and the smoke suite
 // run for real (Cube 2, the renderer, discard, evaluate), resumed, verified, and caught when a frame
 // is edited by hand.
+#include <map>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -26,10 +27,44 @@ namespace fs = std::filesystem;
 
 const fs::path kSmoke = fs::path(DYNBENCH_SOURCE_DIR) / "suites" / "smoke.json";
 
+TEST(Suite, V2IsPairedAcrossBothEnginesPinnedAndAtItsSize) {
+  // Issue 48's design as the manifest states it: both engines (Cube 2's three presets, two
+  // OpenArena maps), every match (capture) seen by the bot's, the slowed and the fly-through camera,
+  // several seeds, 320x180 or more, windows of at least 48 frames, a noise floor, every dataset
+  // pinned (a capture's pin the same for its three cameras).
+  auto m = suite::readManifest(fs::path(DYNBENCH_SOURCE_DIR) / "suites" / "v2.json");
+  ASSERT_TRUE(m) << m.error().message;
+  EXPECT_GE(m->run.width, 320);
+  EXPECT_GE(m->run.height, 180);
+  EXPECT_GE(m->run.renderFrames, 48);
+  EXPECT_GT(m->run.floorFrames, 0);
+  std::map<std::string, std::set<std::string>> camerasByMatch;
+  std::map<std::string, std::set<std::string>> capturePinsByMatch;
+  std::set<std::string> presets, openArenaMaps;
+  std::set<unsigned> seeds;
+  for (const auto& d : m->datasets) {
+    const std::string match = d.engine + "/" + (d.preset.empty() ? d.map : d.preset) + "/" + std::to_string(d.seed);
+    camerasByMatch[match].insert(d.camera);
+    capturePinsByMatch[match].insert(d.captureSha256);
+    EXPECT_EQ(d.captureSha256.size(), 64u) << d.name;
+    EXPECT_EQ(d.datasetSha256.size(), 64u) << d.name;
+    if (d.engine == "cube2") presets.insert(d.preset);
+    else openArenaMaps.insert(d.map);
+    seeds.insert(d.seed);
+  }
+  EXPECT_EQ(presets, (std::set<std::string>{"calm", "fps", "hard"}));
+  EXPECT_GE(openArenaMaps.size(), 2u);
+  EXPECT_GE(seeds.size(), 2u);
+  for (const auto& [match, cameras] : camerasByMatch) {
+    EXPECT_EQ(cameras, (std::set<std::string>{"bot", "slowed", "flythrough"})) << match;
+    EXPECT_EQ(capturePinsByMatch[match].size(), 1u) << match;
+  }
+}
+
 TEST(Suite, ManifestErrorsNameTheFileAndPointer) {
   const fs::path dir = test::freshDir("suite_manifest");
   // The repository's manifests read.
-  for (const char* name : {"smoke.json", "v1.json", "engines.json", "slurm-1080p.json"}) {
+  for (const char* name : {"smoke.json", "v1.json", "v2.json", "engines.json", "slurm-1080p.json"}) {
     auto m = suite::readManifest(fs::path(DYNBENCH_SOURCE_DIR) / "suites" / name);
     ASSERT_TRUE(m) << m.error().message;
     EXPECT_GE(m->datasets.size(), 1u) << name;
