@@ -449,6 +449,32 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
     ASSERT_EQ(external.status, 0) << external.err;
     const auto both = nlohmann::json::parse(test::slurp(out / "suite.json"));
     for (const auto& d : both["datasets"]) EXPECT_EQ(d["errors"]["files"], d["errors"]["ema"]) << d["name"];
+    // ... and on the still input: the same ꟻLIP (the same outputs against the same reference), its
+    // ratio to `none` on the still input; recorded as such, so verify re-derives it as such.
+    const auto still = dynbench(fmt::format("suite score {} --method files-still=external:{}/scored/{{dataset}}/ema --input still", out.string(),
+                                            out.string()),
+                                dir);
+    ASSERT_EQ(still.status, 0) << still.err;
+    const auto withStill = nlohmann::json::parse(test::slurp(out / "suite.json"));
+    EXPECT_EQ(withStill["scored_methods"].back()["input"], "still");
+    EXPECT_EQ(withStill["scored_methods"][0]["input"], "jittered");
+    for (const auto& d : withStill["datasets"]) {
+      const auto& e = d["errors"]["files-still"];
+      EXPECT_DOUBLE_EQ(e["flip"].get<double>(), d["errors"]["ema"]["flip"].get<double>()) << d["name"];
+      EXPECT_DOUBLE_EQ(e["flip_ratio_to_none"].get<double>(), e["flip"].get<double>() / d["errors"]["none-still"]["flip"].get<double>()) << d["name"];
+      EXPECT_NE(e["flip_ratio_to_none"], d["errors"]["ema"]["flip_ratio_to_none"]) << d["name"];
+    }
+    // A dataset without the still input: status 3, naming it; nothing changes.
+    const std::string withStillText = test::slurp(out / "suite.json");
+    const fs::path stillInput = out / withStill["datasets"][1]["run"].get<std::string>() / "input-still";
+    fs::rename(stillInput, dir / "input-still-aside");
+    const auto noStill = dynbench(fmt::format("suite score {} --method gone-still=external:{}/scored/{{dataset}}/ema --input still", out.string(),
+                                              out.string()),
+                                  dir);
+    fs::rename(dir / "input-still-aside", stillInput);
+    EXPECT_EQ(noStill.status, 3) << noStill.err;
+    EXPECT_NE(noStill.err.find("no still input"), std::string::npos) << noStill.err;
+    EXPECT_EQ(test::slurp(out / "suite.json"), withStillText);
     // verify re-derives the added columns from their stored outputs.
     const auto verified = dynbench(fmt::format("suite verify {}", out.string()), dir);
     EXPECT_EQ(verified.status, 0) << verified.out;

@@ -13,6 +13,7 @@ namespace {
 struct SuiteCli {
   std::string manifest, output, verifyDir, scoreDir;
   std::vector<std::string> scoreMethods;
+  std::string scoreInput{evaluate::kJitteredInput};
   int threads = 0;
   std::string part = "all";
   int renderTask = 0, framesPerTask = 8;
@@ -82,6 +83,7 @@ Expected<void> runScore(const SuiteCli& cli) {
   for (const std::string& text : cli.scoreMethods) {
     auto m = suite::parseMethodToScore(text);
     if (!m) return std::unexpected(m.error());
+    m->input = cli.scoreInput;
     methods.push_back(std::move(*m));
   }
   auto outcome = suite::scoreSuite(cli.scoreDir, methods, printLine);
@@ -122,6 +124,10 @@ void addSuiteCommand(CLI::App& app, CommandRun& run) {
                     "NAME=external:PATH (PATH/DATASET/frame_NNNNN.exr for each dataset, or {dataset} in PATH) or a built-in "
                     "method's name; repeat for several")
       ->required();
+  score->add_option("--input", cli->scoreInput,
+                    "The input every --method is scored on: jittered (RUN/input, TAA's) or still (RUN/input-still, the same render "
+                    "without the jitter, accumulate's and SVGF's); its ratio is to none on the same input")
+      ->check(CLI::IsMember({"jittered", "still"}));
   score->footer("Example: dynbench suite score smoke --method mine=external:my-outputs   (my-outputs/fps-1-bot/frame_00034.exr, ...)\n"
                 "Outputs are kept in DIR/scored/DATASET/NAME, so `suite verify` re-derives the new column. docs/suite.md.");
   cmd->callback([cmd, verify, score, cli, &run] {

@@ -116,7 +116,8 @@ bool needsStillInput(const DatasetRunSettings& settings) {
 }
 
 Expected<MethodsOnTheirInputs> evaluateOnTheirInputs(const fs::path& run, const DatasetRunSettings& o,
-                                                     const std::vector<std::shared_ptr<evaluate::TemporalMethod>>& extra, bool writeFiles) {
+                                                     const std::vector<std::shared_ptr<evaluate::TemporalMethod>>& extra, bool writeFiles,
+                                                     const std::vector<std::shared_ptr<evaluate::TemporalMethod>>& extraStill) {
   MethodsOnTheirInputs out;
   for (const bool still : {false, true}) {
     evaluate::EvaluateOptions evaluation;
@@ -131,8 +132,8 @@ Expected<MethodsOnTheirInputs> evaluateOnTheirInputs(const fs::path& run, const 
       const bool wantsStill = input != o.methodInputs.end() && input->second == evaluate::kStillInput;
       if (wantsStill == still && !(still && m == "none")) evaluation.methods.push_back(m);
     }
-    if (still && evaluation.methods.size() == 1) break;  // no method asked for it
-    if (!still) evaluation.callerMethods = extra;
+    if (still && evaluation.methods.size() == 1 && extraStill.empty()) break;  // no method asked for it
+    evaluation.callerMethods = still ? extraStill : extra;
     if (writeFiles) {
       const std::string suffix = still ? "-still" : "";
       evaluation.json = run / ("evaluate" + suffix + ".json");

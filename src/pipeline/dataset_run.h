@@ -114,10 +114,12 @@ struct MethodsOnTheirInputs {
   std::vector<evaluate::MethodScores> jittered, still;
 };
 // Each of settings.methods evaluated on its input (settings.methodInputs) against RUN/frames, with
-// `none` on every input used; `extra` are scored on the jittered input beside them. With
-// `writeFiles`, RUN/evaluate.json, .csv and evaluate/ (and evaluate-still.*) as the demo writes them.
+// `none` on every input used; `extra` are scored on the jittered input beside them, `extraStill` on
+// the still one. With `writeFiles`, RUN/evaluate.json, .csv and evaluate/ (and evaluate-still.*) as
+// the demo writes them.
 Expected<MethodsOnTheirInputs> evaluateOnTheirInputs(const std::filesystem::path& run, const DatasetRunSettings& settings,
-                                                     const std::vector<std::shared_ptr<evaluate::TemporalMethod>>& extra, bool writeFiles);
+                                                     const std::vector<std::shared_ptr<evaluate::TemporalMethod>>& extra, bool writeFiles,
+                                                     const std::vector<std::shared_ptr<evaluate::TemporalMethod>>& extraStill = {});
 
 struct DatasetRunOutcome {
   metrics::CameraMotion motion;   // Tables 6.4-6.6 (every frame of the dataset at settings.fps)

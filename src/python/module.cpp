@@ -207,7 +207,7 @@ py::object evaluateMethods(const fs::path& input, const fs::path& reference, con
 }
 
 // dynbench.suite_score: suite/score.h's scoreSuite with Python methods beside the CLI's specs.
-py::object scoreSuite(const fs::path& dir, const py::list& methods) {
+py::object scoreSuite(const fs::path& dir, const py::list& methods, const std::string& input) {
   std::vector<suite::MethodToScore> toScore;
   std::vector<std::shared_ptr<PythonMethod>> pythonMethods;
   for (const py::handle& m : methods) {
@@ -221,6 +221,7 @@ py::object scoreSuite(const fs::path& dir, const py::list& methods) {
                                          py::str(type.attr("__qualname__")).cast<std::string>());
     toScore.push_back({pythonMethods.back()->name(), what, pythonMethods.back()});
   }
+  for (suite::MethodToScore& m : toScore) m.input = input;
   Expected<suite::ScoreOutcome> outcome = std::unexpected(Error{});
   {
     py::gil_scoped_release release;
@@ -268,7 +269,8 @@ PYBIND11_MODULE(_core, m) {
         py::arg("methods") = py::list(py::cast(evaluate::builtInMethodNames())),
         py::arg("ppd") = evaluate::flip::defaultPixelsPerDegree(), py::arg("out_dir") = py::none(),
         "Temporal methods (built-in names or objects with reset() and process(frame)) scored as `dynbench evaluate --json` writes them");
-  m.def("suite_score", &scoreSuite, py::arg("dir"), py::kw_only(), py::arg("methods"),
+  m.def("suite_score", &scoreSuite, py::arg("dir"), py::kw_only(), py::arg("methods"), py::arg("input") = std::string(evaluate::kJitteredInput),
         "Methods (objects with reset() and process(frame), \"NAME=external:PATH\" or built-in names) scored on every dataset of the "
-        "finished suite in dir, added to its suite.json and suite.md as `dynbench suite score` adds them; returns suite.json");
+        "finished suite in dir, on its jittered or still input, added to its suite.json and suite.md as `dynbench suite score` adds "
+        "them; returns suite.json");
 }

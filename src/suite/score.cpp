@@ -157,12 +157,20 @@ Expected<std::vector<DatasetResult>> scoreEveryDataset(const SuiteResults& suite
   for (std::size_t i = 0; i < suite.datasets.size(); ++i) {
     const RecordedDataset& d = suite.datasets[i];
     log(fmt::format("[{}/{}] {}", i + 1, suite.datasets.size(), d.result.name));
+    DatasetResult result = d.result;
+    for (const std::string_view input : {evaluate::kJitteredInput, evaluate::kStillInput}) {
+    const bool still = input == evaluate::kStillInput;
+    if (std::none_of(methods.begin(), methods.end(), [&](const MethodToScore& m) { return m.input == input; })) continue;
     evaluate::EvaluateOptions options;
-    options.frames = dir / d.run / "input";
+    options.frames = dir / d.run / (still ? "input-still" : "input");
+    if (still && !fs::is_directory(options.frames))
+      return fail(ErrorCode::kIo, "{}: dataset '{}': no still input ({}): no method of the manifest was scored on it, so the suite did not render it",
+                  suite.path.string(), d.result.name, options.frames.string());
     options.reference = dir / d.run / "frames";
     options.methods.clear();
     options.outDir = pending / d.result.name;
     for (const MethodToScore& m : methods) {
+      if (m.input != input) continue;
       if (m.method) {
         options.callerMethods.push_back(m.method);
       } else if (m.spec.starts_with("external:")) {
@@ -175,11 +183,12 @@ Expected<std::vector<DatasetResult>> scoreEveryDataset(const SuiteResults& suite
     }
     auto run = evaluate::runEvaluate(options);
     if (!run) return fail(run.error().code, "{}: dataset '{}': {}", suite.path.string(), d.result.name, run.error().message);
-    // The ratio and difference against `none` as the suite recorded it on the same frames.
+    // The ratio and difference against `none` as the suite recorded it on the same input's frames.
     std::optional<double> noneFlip;
-    if (auto none = d.result.errors.find("none"); none != d.result.errors.end() && none->second.count("flip")) noneFlip = none->second.at("flip");
-    DatasetResult result = d.result;
+    if (auto none = d.result.errors.find(still ? kStillNone : "none"); none != d.result.errors.end() && none->second.count("flip"))
+      noneFlip = none->second.at("flip");
     for (const auto& [method, errors] : errorsOf(run->methods, noneFlip)) result.errors[method] = errors;
+    }
     results.push_back(std::move(result));
   }
   return results;
@@ -201,6 +210,8 @@ Expected<ScoreOutcome> scoreSuite(const fs::path& dir, const std::vector<MethodT
                   fmt::join(manifestMethods, ", "));
     if (m.name == kStillNone) return fail(ErrorCode::kUsage, "suite score: '{}' is suite.json's name for none on the still input", m.name);
     if (!names.insert(m.name).second) return fail(ErrorCode::kUsage, "suite score: method '{}' twice", m.name);
+    if (m.input != evaluate::kJitteredInput && m.input != evaluate::kStillInput)
+      return fail(ErrorCode::kUsage, "suite score: method '{}': input '{}': expected \"jittered\" or \"still\"", m.name, m.input);
   }
 
   // Every dataset's outputs go to DIR/scored/.pending first and move into place only when every
@@ -221,7 +232,7 @@ Expected<ScoreOutcome> scoreSuite(const fs::path& dir, const std::vector<MethodT
                scored.end());
   for (const MethodToScore& m : methods)
     scored.push_back({{"name", m.name}, {"spec", m.spec}, {"parameters", m.method ? m.method->parameters() : nlohmann::json::object()},
-                      {"outputs", fmt::format("scored/{{dataset}}/{}", m.name)}});
+                      {"input", m.input}, {"outputs", fmt::format("scored/{{dataset}}/{}", m.name)}});
   doc["scored_methods"] = scored;
   for (std::size_t i = 0; i < results.size(); ++i) {
     const std::string& dataset = results[i].name;
@@ -275,13 +286,23 @@ Expected<StoredMethods> storedScoredMethods(const SuiteResults& suite, const fs:
     auto spec = f.string(fmt::format("/scored_methods/{}/spec", i));
     for (const auto* e : {&name, &spec})
       if (!*e) return std::unexpected(e->error());
+    // Suites scored before the input was recorded scored every added method on the jittered input.
+    std::string input{evaluate::kJitteredInput};
+    if (const std::string at = fmt::format("/scored_methods/{}/input", i); scored[i].contains("input")) {
+      auto recorded = f.string(at);
+      if (!recorded) return std::unexpected(recorded.error());
+      if (*recorded != evaluate::kJitteredInput && *recorded != evaluate::kStillInput)
+        return fail(ErrorCode::kInvalidData, "{}: {}: expected \"jittered\" or \"still\"", suite.path.string(), at);
+      input = *recorded;
+    }
     if (isBuiltIn(*spec)) {
       out.builtIn.push_back(*spec);
+      out.inputs[*spec] = input;
       continue;
     }
     auto external = evaluate::makeExternalMethod(storedFolder(dir, dataset, *name));
     if (!external) return std::unexpected(external.error());
-    out.stored.push_back(std::make_shared<NamedMethod>(*name, std::move(*external)));
+    (input == evaluate::kStillInput ? out.storedStill : out.stored).push_back(std::make_shared<NamedMethod>(*name, std::move(*external)));
   }
   return out;
 }

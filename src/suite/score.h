@@ -6,6 +6,7 @@
 // frames are kept in DIR/scored/DATASET/NAME (recorded with their SHA-256) so that `suite verify`
 // re-derives its numbers from the files as it does the manifest's methods'.
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -43,6 +44,10 @@ struct MethodToScore {
   std::string name;  // suite.json's key and DIR/scored/DATASET/NAME: letters, digits, '-', '_'
   std::string spec;
   std::shared_ptr<evaluate::TemporalMethod> method;
+  // The input it is scored on: evaluate::kJitteredInput (RUN/input) or kStillInput (RUN/input-still,
+  // the same render without the jitter; there only when a manifest method was scored on it). Its
+  // ratio and difference are against `none` on the same input.
+  std::string input{evaluate::kJitteredInput};
 };
 // "NAME=SPEC" or a built-in method's name alone (the CLI's --method).
 Expected<MethodToScore> parseMethodToScore(const std::string& text);
@@ -62,7 +67,8 @@ Expected<ScoreOutcome> scoreSuite(const std::filesystem::path& dir, const std::v
 // DIR/scored/DATASET/NAME.
 struct StoredMethods {
   std::vector<std::string> builtIn;
-  std::vector<std::shared_ptr<evaluate::TemporalMethod>> stored;
+  std::map<std::string, std::string> inputs;  // each built-in one's input (DatasetRunSettings::methodInputs)
+  std::vector<std::shared_ptr<evaluate::TemporalMethod>> stored, storedStill;  // by the input they were scored on
 };
 Expected<StoredMethods> storedScoredMethods(const SuiteResults& suite, const std::filesystem::path& dir, const std::string& dataset);
 

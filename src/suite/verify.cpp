@@ -52,12 +52,13 @@ Expected<VerifyOutcome> verifySuite(const fs::path& root, const pipeline::RunLog
     discardStage.frames = root / d.run / "frames";
     auto discarded = pipeline::runDiscard(discardStage);
     if (!discarded) return std::unexpected(discarded.error());
-    // The methods `suite score` added: built-in ones run again (on the jittered input, as score
-    // ran them), the others from their stored outputs.
+    // The methods `suite score` added: built-in ones run again (on the input score ran them on),
+    // the others from their stored outputs.
     auto scored = storedScoredMethods(*suite, root, name);
     if (!scored) return std::unexpected(scored.error());
     s.methods.insert(s.methods.end(), scored->builtIn.begin(), scored->builtIn.end());
-    auto evaluated = pipeline::evaluateOnTheirInputs(root / d.run, s, scored->stored, false);
+    for (const auto& [method, input] : scored->inputs) s.methodInputs[method] = input;
+    auto evaluated = pipeline::evaluateOnTheirInputs(root / d.run, s, scored->stored, false, scored->storedStill);
     if (!evaluated) return std::unexpected(evaluated.error());
     DatasetResult result = d.result;  // its name, match and camera as recorded; its numbers recomputed below
     result.measures = measuresOf(stats->rows.front().motion, d.first, d.last, discarded->run.mean);
