@@ -149,8 +149,44 @@ Expected<MethodToScore> parseMethodToScore(const std::string& text) {
 
 namespace {
 
-// Each method on every dataset of the suite, its outputs into pending/DATASET/NAME; the datasets'
-// recorded numbers with the methods' errors added.
+// The methods scored on `input` (evaluate::kJitteredInput or kStillInput) for one dataset, their
+// outputs into pending/DATASET/NAME, their errors added to `result`.
+Expected<void> scoreOnInput(const SuiteResults& suite, const fs::path& dir, const RecordedDataset& d, const std::vector<MethodToScore>& methods,
+                            std::string_view input, const fs::path& pending, DatasetResult& result) {
+  if (std::none_of(methods.begin(), methods.end(), [&](const MethodToScore& m) { return m.input == input; })) return {};
+  const bool still = input == evaluate::kStillInput;
+  evaluate::EvaluateOptions options;
+  options.frames = dir / d.run / (still ? "input-still" : "input");
+  if (still && !fs::is_directory(options.frames))
+    return fail(ErrorCode::kIo, "{}: dataset '{}': no still input ({}): no method of the manifest was scored on it, so the suite did not render it",
+                suite.path.string(), d.result.name, options.frames.string());
+  options.reference = dir / d.run / "frames";
+  options.methods.clear();
+  options.outDir = pending / d.result.name;
+  for (const MethodToScore& m : methods) {
+    if (m.input != input) continue;
+    if (m.method) {
+      options.callerMethods.push_back(m.method);
+    } else if (m.spec.starts_with("external:")) {
+      auto external = evaluate::makeExternalMethod(externalFolder(m.spec, d.result.name));
+      if (!external) return fail(external.error().code, "{}: dataset '{}': {}", suite.path.string(), d.result.name, external.error().message);
+      options.callerMethods.push_back(std::make_shared<NamedMethod>(m.name, std::move(*external)));
+    } else {
+      options.methods.push_back(m.spec);
+    }
+  }
+  auto run = evaluate::runEvaluate(options);
+  if (!run) return fail(run.error().code, "{}: dataset '{}': {}", suite.path.string(), d.result.name, run.error().message);
+  // The ratio and difference against `none` as the suite recorded it on the same input's frames.
+  std::optional<double> noneFlip;
+  if (auto none = d.result.errors.find(still ? kStillNone : "none"); none != d.result.errors.end() && none->second.count("flip"))
+    noneFlip = none->second.at("flip");
+  for (const auto& [method, errors] : errorsOf(run->methods, noneFlip)) result.errors[method] = errors;
+  return {};
+}
+
+// Each method on every dataset of the suite, on its input, its outputs into pending/DATASET/NAME;
+// the datasets' recorded numbers with the methods' errors added.
 Expected<std::vector<DatasetResult>> scoreEveryDataset(const SuiteResults& suite, const fs::path& dir, const std::vector<MethodToScore>& methods,
                                                        const fs::path& pending, const pipeline::RunLog& log) {
   std::vector<DatasetResult> results;
@@ -158,37 +194,8 @@ Expected<std::vector<DatasetResult>> scoreEveryDataset(const SuiteResults& suite
     const RecordedDataset& d = suite.datasets[i];
     log(fmt::format("[{}/{}] {}", i + 1, suite.datasets.size(), d.result.name));
     DatasetResult result = d.result;
-    for (const std::string_view input : {evaluate::kJitteredInput, evaluate::kStillInput}) {
-    const bool still = input == evaluate::kStillInput;
-    if (std::none_of(methods.begin(), methods.end(), [&](const MethodToScore& m) { return m.input == input; })) continue;
-    evaluate::EvaluateOptions options;
-    options.frames = dir / d.run / (still ? "input-still" : "input");
-    if (still && !fs::is_directory(options.frames))
-      return fail(ErrorCode::kIo, "{}: dataset '{}': no still input ({}): no method of the manifest was scored on it, so the suite did not render it",
-                  suite.path.string(), d.result.name, options.frames.string());
-    options.reference = dir / d.run / "frames";
-    options.methods.clear();
-    options.outDir = pending / d.result.name;
-    for (const MethodToScore& m : methods) {
-      if (m.input != input) continue;
-      if (m.method) {
-        options.callerMethods.push_back(m.method);
-      } else if (m.spec.starts_with("external:")) {
-        auto external = evaluate::makeExternalMethod(externalFolder(m.spec, d.result.name));
-        if (!external) return fail(external.error().code, "{}: dataset '{}': {}", suite.path.string(), d.result.name, external.error().message);
-        options.callerMethods.push_back(std::make_shared<NamedMethod>(m.name, std::move(*external)));
-      } else {
-        options.methods.push_back(m.spec);
-      }
-    }
-    auto run = evaluate::runEvaluate(options);
-    if (!run) return fail(run.error().code, "{}: dataset '{}': {}", suite.path.string(), d.result.name, run.error().message);
-    // The ratio and difference against `none` as the suite recorded it on the same input's frames.
-    std::optional<double> noneFlip;
-    if (auto none = d.result.errors.find(still ? kStillNone : "none"); none != d.result.errors.end() && none->second.count("flip"))
-      noneFlip = none->second.at("flip");
-    for (const auto& [method, errors] : errorsOf(run->methods, noneFlip)) result.errors[method] = errors;
-    }
+    for (const std::string_view input : {evaluate::kJitteredInput, evaluate::kStillInput})
+      if (auto ok = scoreOnInput(suite, dir, d, methods, input, pending, result); !ok) return std::unexpected(ok.error());
     results.push_back(std::move(result));
   }
   return results;
