@@ -182,7 +182,7 @@ Expected<void> LightSet::build(const scene::Scene& scene, const RayTracingScene&
       directional_.push_back(static_cast<std::uint32_t>(i));
       continue;
     }
-    treeLights.push_back({p.position, std::max(luminance(p.intensity), 1e-30), p.range});
+    treeLights.push_back(treeLightOf(p));
     treeLight_.push_back(static_cast<std::uint32_t>(i));
   }
   tree_.build(treeLights);
@@ -237,6 +237,8 @@ void LightSet::selectPunctual(const glm::dvec3& point, const glm::dvec3& normal,
   for (const std::uint32_t l : directional_) selected.push_back({l, 1.0});
 }
 
+LightTree::Light LightSet::treeLightOf(const Punctual& p) { return {p.position, std::max(luminance(p.intensity), 1e-30), p.range}; }
+
 bool LightSet::reaches(std::uint32_t light, const glm::dvec3& point, const glm::dvec3& normal) const {
   const Punctual& p = punctual_[light];
   const glm::dvec3 toLight = p.position - point;
@@ -279,10 +281,7 @@ void PairLights::build(const LightSet& now, const LightSet& before) {
   }
   std::vector<LightTree::Light> treeLights;
   treeLights.reserve(sharedLight_[0].size());
-  for (const std::uint32_t l : sharedLight_[0]) {
-    const LightSet::Punctual& p = now.punctual_[l];
-    treeLights.push_back({p.position, std::max(luminance(p.intensity), 1e-30), p.range});
-  }
+  for (const std::uint32_t l : sharedLight_[0]) treeLights.push_back(LightSet::treeLightOf(now.punctual_[l]));
   shared_.build(treeLights);
 }
 

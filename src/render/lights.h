@@ -173,6 +173,8 @@ class LightSet {
   // Whether point or spot light `light` can light `point` on a surface facing `normal`: in front
   // of the surface and inside its range.
   bool reaches(std::uint32_t light, const glm::dvec3& point, const glm::dvec3& normal) const;
+  // A point or spot light as the light tree sees it (its position, luminous power and range).
+  static LightTree::Light treeLightOf(const Punctual& p);
   std::vector<Punctual> punctual_;
   std::vector<std::uint32_t> directional_;  // evaluated everywhere
   std::vector<std::uint32_t> treeLight_;    // light k of the tree -> punctual light
