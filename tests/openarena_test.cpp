@@ -122,27 +122,31 @@ TEST(OpenArena, MatchConvertsWithMorphTargetsWhereTheGamePutThem) {
   DYNBENCH_NEEDS(test::missingOpenArena());
   DYNBENCH_NEEDS(test::missingGltfValidator());
   const auto dir = test::freshDir("openarena_dataset");
-  auto r = dynbench(fmt::format("capture openarena -o {} --map oa_dm1 --bots 4 --seconds 6 --seed 3 --game-frames 100,250", (dir / "cap").string()), dir);
+  // A window other than the default, whose size the game's frames must have.
+  constexpr unsigned kWidth = 480, kHeight = 270;
+  auto r = dynbench(fmt::format("capture openarena -o {} --map oa_dm1 --bots 4 --seconds 6 --seed 3 --game-frames 100,250 --width {} --height {}",
+                                (dir / "cap").string(), kWidth, kHeight),
+                    dir);
   ASSERT_EQ(r.status, 0) << r.err;
   // The game's own image of frames 100 and 250: the window's size, and a lit room, not a black
   // buffer; and its depth buffer, read before the swap from the classic renderer (read after it
   // from Debian's default renderer, these two frames' depth read back as zeros on every run).
   for (const char* frame : {"00100", "00250"}) {
     const std::string ppm = test::slurp(dir / "cap" / "game" / fmt::format("frame_{}.ppm", frame));
-    const std::string header = "P6\n640 360\n255\n";
+    const std::string header = fmt::format("P6\n{} {}\n255\n", kWidth, kHeight);
     ASSERT_EQ(ppm.substr(0, header.size()), header);
-    ASSERT_EQ(ppm.size(), header.size() + 640u * 360u * 3u);
+    ASSERT_EQ(ppm.size(), header.size() + kWidth * kHeight * 3u);
     double mean = 0;
     for (std::size_t i = header.size(); i < ppm.size(); ++i) mean += static_cast<unsigned char>(ppm[i]);
-    mean /= 640.0 * 360.0 * 3.0 * 255.0;
+    mean /= kWidth * kHeight * 3.0 * 255.0;
     EXPECT_GT(mean, 0.05) << "the game's frame " << frame << " is black";
     const fs::path depthPath = dir / "cap" / "game" / fmt::format("frame_{}_window_depth.pfm", frame);
     ASSERT_TRUE(fs::exists(depthPath)) << "frame " << frame << " kept no depth";
     const std::string pfm = test::slurp(depthPath);
-    const std::string pfmHeader = "Pf\n640 360\n-1.0\n";
+    const std::string pfmHeader = fmt::format("Pf\n{} {}\n-1.0\n", kWidth, kHeight);
     ASSERT_EQ(pfm.substr(0, pfmHeader.size()), pfmHeader);
-    ASSERT_EQ(pfm.size(), pfmHeader.size() + 640u * 360u * sizeof(float));
-    std::vector<float> depth(640u * 360u);
+    ASSERT_EQ(pfm.size(), pfmHeader.size() + kWidth * kHeight * sizeof(float));
+    std::vector<float> depth(kWidth * kHeight);
     std::memcpy(depth.data(), pfm.data() + pfmHeader.size(), depth.size() * sizeof(float));
     // window depth: in [0, 1], 1 on the sky; a room in view covers most of the frame nearer than that
     const auto [lowest, highest] = std::minmax_element(depth.begin(), depth.end());

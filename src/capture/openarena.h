@@ -34,7 +34,9 @@ struct OpenArenaOptions {
   // Recorded frames (0-based) whose own image the game keeps in game/frame_NNNNN.ppm (8-bit sRGB,
   // the HUD hidden), to put beside the dataset's render of them.
   std::vector<long> gameFrames;
-  int width = 640, height = 360;
+  // As Cube 2's (capture/cube2.h): the window records nothing but its aspect, and a smaller one is
+  // drawn faster (a 3 s capture of oa_dm1: 4.9 s at 384x216, 6.8 s at 640x360, byte-identical).
+  int width = 384, height = 216;
   bool window = false;           // on the user's display instead of Xvfb
   std::filesystem::path modules;  // folder with cgamex86_64.so and qagamex86_64.so; empty: the build's
   std::filesystem::path engine = "/usr/lib/ioquake3/ioquake3";  // Debian's ioquake3
