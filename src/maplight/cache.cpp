@@ -23,7 +23,9 @@ Expected<std::filesystem::path> cachedAdapterLights(const std::filesystem::path&
   const auto file = cacheFolder / fmt::format("{}-{}-v{}.txt", map, sha256Text(*bytes).substr(0, 16), kFitVersion);
   std::error_code ec;
   if (std::filesystem::is_regular_file(file, ec)) return file;
-  auto lighting = fitMapLighting(*files, map, {}, progress);
+  MapLightFitOptions options;
+  options.judgeOnHeldOut = false;  // the file holds the lights alone
+  auto lighting = fitMapLighting(*files, map, options, progress);
   if (!lighting) return std::unexpected(lighting.error());
   std::filesystem::create_directories(cacheFolder, ec);
   if (ec) return fail(ErrorCode::kIo, "{}: cannot create the map-light cache folder: {}", cacheFolder.string(), ec.message());

@@ -977,6 +977,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
     r.recoveredShare = total > 0 ? found / total : 0.0;
   }
 
+  if (!options.judgeOnHeldOut) return result;
   // Judged on the held-out texels: the known emitters as q3map2 gives them, and the dataset's
   // lights (the known ones weighted, the fitted ones).
   report("held-out texels", 0, 1);
