@@ -290,14 +290,17 @@ TEST(Convert, MaterialFactorsEmissionAndVertexColours) {
   EXPECT_TRUE(sawColours);
 }
 
-// OpenArena's light-emitting shaders (record m): the capture's emission is the surface's mean and
-// the texture only shapes it, so the converter divides by the texture's linear mean. A texture of
-// a white and a black texel (sRGB 1 and 0: linear mean 0.5) doubles the emission; a channel the
-// texture lacks (blue 0) carries none. The same mesh with record E keeps its emission as it is.
+// OpenArena's light-emitting shaders (record m): the capture's emission is the surface's mean, in
+// the light's colour, and the texture only shapes its level: the converter writes the texture's
+// linear luminance as a grey emission map and divides the emission by that map's mean. A texture
+// of a yellow and a black texel (sRGB (1, 1, 0) and 0: level Y = 0.9278 and 0, mean 0.4639) scales
+// the emission by 1 / 0.4639 in every channel, blue included, so its hue is the light's; the old
+// division channel by channel gave (3, 1.5, 0): no blue, another hue. The same mesh with record E
+// keeps its emission and the texture itself.
 TEST(Convert, AnEmissionMapThatOnlyShapesTheEmissionKeepsItsMean) {
   const fs::path dir = freshDir("convert_emission_mean");
   fs::create_directories(dir / "data");
-  ASSERT_TRUE(writeImage(dir / "data/glow.png", FloatImage{2, 1, 3, {1, 1, 0, 0, 0, 0}, {}, {}, {}}));
+  ASSERT_TRUE(writeImage(dir / "data/glow.png", FloatImage{2, 1, 3, {1, 1, 0, 0, 0, 0}, {}, {}, {}}));  // yellow, black
   const float positions[] = {0, 0, 0, 1, 0, 0, 1, 0, 1, 0, 0, 1}, uvs[] = {0, 0, 1, 0, 1, 1, 0, 1};
   const float normals[] = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0}, emission[] = {1.5f, 0.75f, 0.5f};
   const uint32_t quad[] = {0, 1, 2, 0, 2, 3};
@@ -332,14 +335,30 @@ TEST(Convert, AnEmissionMapThatOnlyShapesTheEmissionKeepsItsMean) {
   ASSERT_EQ(j["materials"].size(), 2u);
   const auto& a = j["materials"][0];
   EXPECT_EQ(a["name"], "glow");
-  EXPECT_TRUE(a.contains("emissiveTexture"));
-  // mean (0.5, 0.5, 0): emission (3, 1.5, 0), strength E_u 3 / pi
+  ASSERT_TRUE(a.contains("emissiveTexture"));
+  const auto uriOf = [&](const nlohmann::json& material) {
+    return j["images"][j["textures"][material["emissiveTexture"]["index"].get<int>()]["source"].get<int>()]["uri"].get<std::string>();
+  };
+  // The level map: grey, the texels' luminance sRGB-encoded (Y 0.9278 -> 0.9688 -> byte 247; 0).
+  const std::string levelUri = uriOf(a);
+  EXPECT_TRUE(levelUri.ends_with("glow_emission_level.png")) << levelUri;
+  auto level = readImage(options.output.parent_path() / levelUri);
+  ASSERT_TRUE(level) << level.error().message;
+  ASSERT_EQ(level->width, 2);
+  const auto texel = [&](int x, int c) { return level->pixels[static_cast<std::size_t>(x * level->channels + c)]; };
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(texel(0, c), 247.0f / 255.0f, 1e-6) << c;
+    EXPECT_EQ(texel(1, c), 0.0f) << c;
+  }
+  // mean level: byte 247 decoded over two texels; the emission keeps its hue (1.5, 0.75, 0.5)
+  const double meanLevel = srgbToLinear(247.0 / 255.0) / 2.0;
   ASSERT_EQ(a["emissiveFactor"].size(), 3u);
   EXPECT_NEAR(a["emissiveFactor"][0].get<double>(), 1.0, 1e-6);
   EXPECT_NEAR(a["emissiveFactor"][1].get<double>(), 0.5, 1e-6);
-  EXPECT_EQ(a["emissiveFactor"][2].get<double>(), 0.0);
-  EXPECT_NEAR(a["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"].get<double>(), 20000.0 * 3.0 / kPi, 1e-3);
+  EXPECT_NEAR(a["emissiveFactor"][2].get<double>(), 0.5 / 1.5, 1e-6);
+  EXPECT_NEAR(a["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"].get<double>(), 20000.0 * 1.5 / meanLevel / kPi, 1e-2);
   const auto& b = j["materials"][1];
+  EXPECT_EQ(uriOf(b), "emission_textures/glow.png");
   EXPECT_NEAR(b["emissiveFactor"][2].get<double>(), 0.5 / 1.5, 1e-6);
   EXPECT_NEAR(b["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"].get<double>(), 20000.0 * 1.5 / kPi, 1e-3);
   int status = -1;

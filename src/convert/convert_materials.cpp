@@ -110,17 +110,46 @@ bool blended(const CapturedMesh& mesh) {
 }
 }  // namespace
 
-std::optional<glm::dvec3> Converter::linearMean(const std::string& texture) {
-  const fs::path source = textureSource(texture);
-  if (source.empty()) return std::nullopt;
-  auto pixels = readImage(source);
-  if (!pixels || pixels->channels < 1 || pixels->pixels.empty()) return std::nullopt;
-  glm::dvec3 sum(0.0);
-  const std::size_t n = static_cast<std::size_t>(pixels->width) * static_cast<std::size_t>(pixels->height);
-  for (std::size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c)
-      sum[c] += srgbToLinear<double>(pixels->pixels[i * static_cast<std::size_t>(pixels->channels) + static_cast<std::size_t>(std::min(c, pixels->channels - 1))]);
-  return sum / static_cast<double>(n);
+// Why a grey map: q3map2 gives a light-emitting shader one colour (its light image's mean, or
+// q3map_lightRGB), often of another image than the one the game draws. Dividing the drawn map by its
+// mean channel by channel kept the mean but not the hue: oa_ctf2's red flame, whose light image is
+// orange, rendered magenta where its texels have a little green and blue. The level map keeps the
+// map's pattern and the light's colour.
+std::optional<Converter::EmissionLevelMap> Converter::emissionLevelMap(const std::string& texture) {
+  if (auto it = emissionLevelMaps_.find(texture); it != emissionLevelMaps_.end()) return it->second;
+  std::optional<EmissionLevelMap> result;
+  if (const fs::path source = textureSource(texture); !source.empty()) {
+    auto pixels = readImage(source);
+    if (pixels && pixels->channels >= 1 && !pixels->pixels.empty()) {
+      const std::size_t n = static_cast<std::size_t>(pixels->width) * static_cast<std::size_t>(pixels->height);
+      const auto channels = static_cast<std::size_t>(pixels->channels);
+      FloatImage level{pixels->width, pixels->height, 3, {}, {}, {}, {}};
+      level.pixels.resize(n * 3);
+      for (std::size_t i = 0; i < n; ++i) {
+        glm::dvec3 rgb;
+        for (std::size_t c = 0; c < 3; ++c) rgb[static_cast<int>(c)] = srgbToLinear<double>(pixels->pixels[i * channels + std::min(c, channels - 1)]);
+        const double y = std::clamp(luminance(rgb), 0.0, 1.0);
+        // sRGB-encoded, as glTF stores emissive textures (IEC 61966-2-1)
+        const auto encoded = static_cast<float>(y <= 0.0031308 ? 12.92 * y : 1.055 * std::pow(y, 1.0 / 2.4) - 0.055);
+        for (std::size_t c = 0; c < 3; ++c) level.pixels[i * 3 + c] = encoded;
+      }
+      const std::string relative = (fs::path(texture).parent_path() / (fs::path(texture).stem().string() + "_emission_level.png")).generic_string();
+      const fs::path target = outDir_ / (stem_ + "_textures") / relative;
+      std::error_code ec;
+      fs::create_directories(target.parent_path(), ec);
+      if (auto ok = writeImage(target, level); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
+      report_.written.push_back(target);
+      // the mean of the bytes written, decoded as the renderer decodes them
+      auto written = readImage(target);
+      if (!written) throw Failure{Error{written.error().code, written.error().message}};
+      double sum = 0.0;
+      for (std::size_t i = 0; i < n; ++i) sum += srgbToLinear<double>(written->pixels[i * static_cast<std::size_t>(written->channels)]);
+      result = EmissionLevelMap{addTexture(relative, "image/png"), sum / static_cast<double>(n)};
+    }
+  }
+  if (!result) report_.warnings.push_back(fmt::format("emission map '{}' cannot be read; its surface gives off its mean emission evenly", texture));
+  emissionLevelMaps_[texture] = result;
+  return result;
 }
 
 // Material per distinct set of maps and factors (docs/dataset.md): base colour from the texture
@@ -150,22 +179,23 @@ int Converter::material(const CapturedMesh& mesh) {
   // engine's full light, E_u lux: radiance E_u e / pi cd/m2. glTF keeps emissiveFactor within
   // [0, 1]; KHR_materials_emissive_strength carries the rest.
   glm::vec3 emission = mesh.emission;
+  int emissionTexture = -1;
   if (mesh.emissionTextureMeanOne && !mesh.emissionTexture.empty() && glm::any(glm::greaterThan(emission, glm::vec3(0.0f)))) {
-    // The capture's emission is the surface's mean (record m): divided by the map's mean, the map
-    // times it averages to it again, so the surface gives off the light the capture says. A channel
-    // the map lacks (mean 0) cannot carry light and is left out.
-    if (const auto mean = linearMean(mesh.emissionTexture)) {
-      for (int k = 0; k < 3; ++k) emission[k] = (*mean)[k] > 1e-6 ? static_cast<float>(emission[k] / (*mean)[k]) : 0.0f;
-    } else {
-      report_.warnings.push_back(fmt::format("emission map '{}' cannot be read; its surface gives off its mean emission evenly", mesh.emissionTexture));
+    // The capture's emission is the surface's mean (record m): in the light's colour, times the
+    // map's level over its mean, the surface gives off the light the capture says. A map without
+    // light (mean 0) leaves the surface dark.
+    if (const auto level = emissionLevelMap(mesh.emissionTexture)) {
+      emission = level->mean > 1e-6 ? emission / static_cast<float>(level->mean) : glm::vec3(0.0f);
+      emissionTexture = level->texture;
     }
   }
   if (const float peak = std::max({emission.r, emission.g, emission.b}); peak > 0) {
+    if (!mesh.emissionTextureMeanOne) emissionTexture = image(mesh.emissionTexture);
     const glm::vec3 factor = emission / peak;
     m["emissiveFactor"] = {factor.r, factor.g, factor.b};
     m["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", luxPerUnit_ * peak / kPi}};
     usesEmissiveStrength_ = true;
-    if (int t = image(mesh.emissionTexture); t >= 0) m["emissiveTexture"] = {{"index", t}};
+    if (emissionTexture >= 0) m["emissiveTexture"] = {{"index", emissionTexture}};
   }
   if (blend) m["alphaMode"] = "BLEND";
   doc_["materials"].push_back(m);

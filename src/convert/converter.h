@@ -156,9 +156,14 @@ class Converter {
 
   // A texture's file under the data root, or empty (with a warning) when it cannot be used.
   fs::path textureSource(const std::string& texture);
-  // A texture's mean linear RGB (its sRGB bytes decoded), for emission maps that only shape a mean
-  // emission (record m); nullopt when it cannot be read.
-  std::optional<glm::dvec3> linearMean(const std::string& texture);
+  // An emission map that only shapes a mean emission (record m) as the map of its level: each
+  // texel's linear luminance, written sRGB-encoded in grey (TEXTURE_emission_level.png), and that
+  // map's mean as the renderer reads it back. nullopt (with a warning) when it cannot be read.
+  struct EmissionLevelMap {
+    int texture = -1;  // glTF texture index
+    double mean = 0.0; // mean linear level
+  };
+  std::optional<EmissionLevelMap> emissionLevelMap(const std::string& texture);
 
   int addTexture(const std::string& relativeUri, const std::string& mime);
 
@@ -234,6 +239,7 @@ class Converter {
   std::vector<int> meshOfModel_;
   std::map<int, int> ibmOfModel_;
   std::map<std::string, int> imageByTexture_, maskTextures_;
+  std::map<std::string, std::optional<EmissionLevelMap>> emissionLevelMaps_;
   std::map<std::string, int> materialByMaps_;  // by maps and factors (material())
   std::map<std::uint64_t, int> visInputs_;
   int timesView_ = -1;
