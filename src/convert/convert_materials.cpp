@@ -66,6 +66,16 @@ int Converter::addTexture(const std::string& relativeUri, const std::string& mim
   return static_cast<int>(doc_["textures"].size()) - 1;
 }
 
+Converter::DerivedTexture Converter::derivedTexture(const std::string& texture, const std::string& suffix, const FloatImage& image) {
+  const std::string relative = (fs::path(texture).parent_path() / (fs::path(texture).stem().string() + suffix + ".png")).generic_string();
+  const fs::path target = outDir_ / (stem_ + "_textures") / relative;
+  std::error_code ec;
+  fs::create_directories(target.parent_path(), ec);
+  if (auto ok = writeImage(target, image); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
+  report_.written.push_back(target);
+  return {addTexture(relative, "image/png"), target};
+}
+
 // The mask map turned into a glTF metallic-roughness texture (docs/dataset.md): Cube 2 masks hold
 // specular intensity in R and the environment-map (chrome) mask in B, so roughness (G) = 1 - 0.8 R
 // and metallic (B) = B. Returns -1 when the mask cannot be read.
@@ -88,13 +98,7 @@ int Converter::metallicRoughnessFromMask(const std::string& mask) {
         mr.pixels[p * 3 + 1] = 1.0f - 0.8f * specular;  // G: roughness
         mr.pixels[p * 3 + 2] = chrome;                  // B: metallic
       }
-      const std::string relative = (fs::path(mask).parent_path() / (fs::path(mask).stem().string() + "_metallic_roughness.png")).generic_string();
-      const fs::path target = outDir_ / (stem_ + "_textures") / relative;
-      std::error_code ec;
-      fs::create_directories(target.parent_path(), ec);
-      if (auto ok = writeImage(target, mr); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
-      report_.written.push_back(target);
-      index = addTexture(relative, "image/png");
+      index = derivedTexture(mask, "_metallic_roughness", mr).texture;
     }
   }
   maskTextures_[mask] = index;
@@ -133,18 +137,13 @@ std::optional<Converter::EmissionLevelMap> Converter::emissionLevelMap(const std
         const auto encoded = static_cast<float>(y <= 0.0031308 ? 12.92 * y : 1.055 * std::pow(y, 1.0 / 2.4) - 0.055);
         for (std::size_t c = 0; c < 3; ++c) level.pixels[i * 3 + c] = encoded;
       }
-      const std::string relative = (fs::path(texture).parent_path() / (fs::path(texture).stem().string() + "_emission_level.png")).generic_string();
-      const fs::path target = outDir_ / (stem_ + "_textures") / relative;
-      std::error_code ec;
-      fs::create_directories(target.parent_path(), ec);
-      if (auto ok = writeImage(target, level); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
-      report_.written.push_back(target);
+      const DerivedTexture derived = derivedTexture(texture, "_emission_level", level);
       // the mean of the bytes written, decoded as the renderer decodes them
-      auto written = readImage(target);
+      auto written = readImage(derived.file);
       if (!written) throw Failure{Error{written.error().code, written.error().message}};
       double sum = 0.0;
       for (std::size_t i = 0; i < n; ++i) sum += srgbToLinear<double>(written->pixels[i * static_cast<std::size_t>(written->channels)]);
-      result = EmissionLevelMap{addTexture(relative, "image/png"), sum / static_cast<double>(n)};
+      result = EmissionLevelMap{derived.texture, sum / static_cast<double>(n)};
     }
   }
   if (!result) report_.warnings.push_back(fmt::format("emission map '{}' cannot be read; its surface gives off its mean emission evenly", texture));

@@ -166,6 +166,13 @@ class Converter {
   std::optional<EmissionLevelMap> emissionLevelMap(const std::string& texture);
 
   int addTexture(const std::string& relativeUri, const std::string& mime);
+  // An image made from a capture texture, written beside the dataset's copies as
+  // TEXTURE_textures/<texture's folder>/<its stem><suffix>.png and added as a texture.
+  struct DerivedTexture {
+    int texture = -1;
+    fs::path file;
+  };
+  DerivedTexture derivedTexture(const std::string& texture, const std::string& suffix, const FloatImage& image);
 
   // The mask map turned into a glTF metallic-roughness texture (docs/dataset.md): Cube 2 masks hold
   // specular intensity in R and the environment-map (chrome) mask in B, so roughness (G) = 1 - 0.8 R
