@@ -133,8 +133,7 @@ std::optional<Converter::EmissionLevelMap> Converter::emissionLevelMap(const std
         glm::dvec3 rgb;
         for (std::size_t c = 0; c < 3; ++c) rgb[static_cast<int>(c)] = srgbToLinear<double>(pixels->pixels[i * channels + std::min(c, channels - 1)]);
         const double y = std::clamp(luminance(rgb), 0.0, 1.0);
-        // sRGB-encoded, as glTF stores emissive textures (IEC 61966-2-1)
-        const auto encoded = static_cast<float>(y <= 0.0031308 ? 12.92 * y : 1.055 * std::pow(y, 1.0 / 2.4) - 0.055);
+        const auto encoded = static_cast<float>(linearToSrgb(y));  // sRGB-encoded, as glTF stores emissive textures
         for (std::size_t c = 0; c < 3; ++c) level.pixels[i * 3 + c] = encoded;
       }
       const DerivedTexture derived = derivedTexture(texture, "_emission_level", level);

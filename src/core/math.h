@@ -78,6 +78,11 @@ template <typename T>
 inline T srgbToLinear(T c) {
   return c <= T(0.04045) ? c / T(12.92) : std::pow((c + T(0.055)) / T(1.055), T(2.4));
 }
+// Its inverse: a linear channel in [0, 1] to sRGB-encoded.
+template <typename T>
+inline T linearToSrgb(T c) {
+  return c <= T(0.0031308) ? T(12.92) * c : T(1.055) * std::pow(c, T(1) / T(2.4)) - T(0.055);
+}
 
 // sin and cos of an angle, computed in single precision and widened. For Monte Carlo sampling
 // only: a sampled direction is off by at most ~3e-7 rad (the float rounding of the angle), far

@@ -288,10 +288,7 @@ FeatureKernels featureKernels(double ppd) {
 double defaultPixelsPerDegree() { return 0.7 * (3840.0 / 0.7) * (pi / 180.0); }
 
 glm::dvec3 srgbToLinear(glm::dvec3 s) { return {dynbench::srgbToLinear(s.x), dynbench::srgbToLinear(s.y), dynbench::srgbToLinear(s.z)}; }
-glm::dvec3 linearToSrgb(glm::dvec3 l) {
-  auto f = [](double c) { return c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055; };
-  return {f(l.x), f(l.y), f(l.z)};
-}
+glm::dvec3 linearToSrgb(glm::dvec3 l) { return {dynbench::linearToSrgb(l.x), dynbench::linearToSrgb(l.y), dynbench::linearToSrgb(l.z)}; }
 glm::dvec3 linearRgbToXyz(glm::dvec3 rgb) { return kColour.linearRgbToXyz(rgb); }
 glm::dvec3 xyzToLinearRgb(glm::dvec3 xyz) { return kColour.xyzToLinearRgb(xyz); }
 glm::dvec3 xyzToYcxcz(glm::dvec3 xyz) { return kColour.xyzToYcxcz(xyz); }
