@@ -24,7 +24,7 @@ GameImages corridor(int w = 96, int h = 54) {
   m.renderRadiance.resize(3 * n);
   m.renderDepth.resize(n);
   m.renderHit.resize(n);
-  m.renderDirect.resize(3 * n);
+  m.renderLightReach.resize(n);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const std::size_t i = static_cast<std::size_t>(y * w + x);
@@ -37,8 +37,8 @@ GameImages corridor(int w = 96, int h = 54) {
       for (int c = 0; c < 3; ++c) {
         m.gameColour[3 * i + c] = static_cast<float>(std::pow(lit, 1 / 2.2));  // sRGB-ish
         m.renderRadiance[3 * i + c] = static_cast<float>(1000.0 * lit);      // a different exposure
-        m.renderDirect[3 * i + c] = static_cast<float>(800.0 * lit);
       }
+      m.renderLightReach[i] = sky ? 0.0f : 1.0f;
     }
   return m;
 }
@@ -66,7 +66,7 @@ TEST(Fidelity, ADepthOffByMoreThanItsToleranceFails) {
 TEST(Fidelity, ABlackOrSpeckledRenderFails) {
   GameImages black = corridor();
   for (auto& v : black.renderRadiance) v = 0.0f;
-  for (auto& v : black.renderDirect) v = 0.0f;
+  for (auto& v : black.renderLightReach) v = 0.0f;
   GameAgreement f = compareWithGame(black);
   EXPECT_EQ(f.depthAgreement, 1.0);  // the geometry is right
   EXPECT_EQ(f.unlitShare, 1.0);

@@ -204,6 +204,63 @@ TEST(Render, ALightSwitchedOffByNodeVisibilityContributesNothing) {
   EXPECT_GT(litSum, 0.0);  // the same light, visible, does light the plane
 }
 
+// PathTracer::lightReach (fidelity's pixels without direct light, without sampling) against the
+// geometry of a shadow: a 1 x 1 plate at y = 1 over the floor y = 0, lit from y = 2. The segment
+// from a floor point (a, 0, b) to a light point (q, 2, r) crosses y = 1 at ((a + q) / 2, (b + r) / 2),
+// so a point light over the centre shadows |a|, |b| < 1 exactly, and a 0.2 x 0.2 emissive square
+// there hides all of itself from |a|, |b| < 0.9 (umbra) and none of itself beyond 1.1. The camera
+// above sees the floor beyond 2/3 (the plate hides the rest).
+TEST(Render, LightReachIsTheShadowsGeometry) {
+  enum class Light { kPoint, kEmissiveSquare, kEnvironment, kNone };
+  for (const Light light : {Light::kPoint, Light::kEmissiveSquare, Light::kEnvironment, Light::kNone}) {
+    SCOPED_TRACE(static_cast<int>(light));
+    test::GltfBuilder b;
+    const int grey = addMaterial(b, glm::dvec3(0.5), 0.0, 1.0, true);
+    b.node({{"mesh", addPlane(b, 3.0, 0.0, grey)}});
+    b.node({{"mesh", addPlane(b, 0.5, 1.0, grey)}});
+    b.doc["extensionsUsed"] = {"KHR_lights_punctual", "KHR_materials_specular"};
+    if (light == Light::kPoint) {
+      b.doc["extensions"]["KHR_lights_punctual"]["lights"] = json::array({{{"type", "point"}, {"intensity", 10.0}}});
+      b.node({{"translation", {0, 2, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    }
+    if (light == Light::kEmissiveSquare) b.node({{"mesh", addPlane(b, 0.1, 2.0, addMaterial(b, glm::dvec3(0.0), 0.0, 1.0, true, glm::dvec3(1.0)))}});
+    const scene::Scene s = load(b, "light_reach");
+    RenderSettings settings;
+    settings.samplesPerPixel = 1;
+    settings.useEnvironment = light == Light::kEnvironment;
+    if (light == Light::kEnvironment) settings.constantEnvironment = glm::dvec3(1.0);
+    auto tracer = tracerFor(s, settings);
+    ASSERT_TRUE(tracer);
+    ASSERT_TRUE(tracer->setTime(0.0, 0.0));
+    const RenderCamera cam = lookCamera({0, 4, 0}, {0, -1, 0}, 90.0, 101, 101);
+    const FrameBuffers f = tracer->render(0, cam, cam);  // the pixel centres' hits, to judge by
+    const std::vector<std::uint8_t> reach = tracer->lightReach(cam);
+    ASSERT_EQ(reach.size(), f.hit.size());
+    int shadowed = 0, lit = 0;
+    for (std::size_t i = 0; i < reach.size(); ++i) {
+      if (f.hit[i] == 0.0f) {
+        EXPECT_EQ(reach[i], 0) << "pixel " << i << " sees nothing";
+        continue;
+      }
+      const glm::dvec3 x = rgb(f.position, i);
+      const double edge = std::max(std::abs(x.x), std::abs(x.z));
+      bool expected = light != Light::kNone;  // the plate and the square, seen from above, and open floor
+      if (light == Light::kPoint && x.y < 0.5) {
+        if (std::abs(edge - 1.0) < 0.02) continue;  // the shadow's edge, within float precision
+        expected = edge > 1.0;
+      }
+      if (light == Light::kEmissiveSquare && x.y < 0.5) {
+        if (edge > 0.85 && edge < 1.15) continue;  // the penumbra: four points of the square judge it
+        expected = edge >= 1.15;
+      }
+      EXPECT_EQ(reach[i], expected ? 1 : 0) << "pixel " << i << " at " << x.x << ", " << x.y << ", " << x.z;
+      (reach[i] ? lit : shadowed) += 1;
+    }
+    if (light == Light::kPoint || light == Light::kEmissiveSquare) EXPECT_GT(shadowed, 100);  // the test has a shadow to judge
+    EXPECT_EQ(lit > 0, light != Light::kNone);
+  }
+}
+
 // A closed room (inward-facing walls, floor and ceiling of half size `half`, centred on the origin).
 void addRoom(test::GltfBuilder& b, double half, int material) {
   const auto h = static_cast<float>(half);

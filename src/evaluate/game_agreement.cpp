@@ -90,7 +90,7 @@ GameAgreement compareWithGame(const GameImages& m) {
     sameKind += game == render;
     if (render) {
       ++geometry;
-      unlit += luminance(glm::dvec3(m.renderDirect[3 * i], m.renderDirect[3 * i + 1], m.renderDirect[3 * i + 2])) <= 0;
+      unlit += !(m.renderLightReach[i] > 0);
     }
     if (!game && !render) continue;
     ++either;

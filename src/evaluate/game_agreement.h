@@ -22,10 +22,11 @@ inline constexpr double kFidelityMinCorrelation = 0.30;
 
 // The comparison of one frame's images (exposed for tests): game colour (sRGB, 3 channels),
 // game view depth (0: sky), render radiance (linear, 3 channels), render view depth, render hit
-// flags, render direct radiance (for unlitShare); near and far of the game's projection.
+// flags, the render's light reach (render::PathTracer::lightReach: 1 where some light reaches the
+// surface seen through the pixel's centre, for unlitShare); near and far of the game's projection.
 struct GameImages {
   int width = 0, height = 0;
-  std::vector<float> gameColour, gameDepth, renderRadiance, renderDepth, renderHit, renderDirect;
+  std::vector<float> gameColour, gameDepth, renderRadiance, renderDepth, renderHit, renderLightReach;
   double near = 0.0, far = 0.0;
   // false: the game kept no depth for this frame (id Tech 3's buffer read back empty); depth and
   // sky agreement are NaN and gameDepth is only the mask of pixels compared
@@ -37,7 +38,7 @@ struct GameAgreement {
   double depthAgreement = 0.0;   // share, see above; NaN when the game kept no depth for the frame
   double skyAgreement = 0.0;     // share of pixels where both see sky or both see geometry; NaN likewise
   double correlation = 0.0;      // of the tone-mapped, blurred luminance over geometry
-  double unlitShare = 0.0;       // share of the render's geometry pixels with no direct light
+  double unlitShare = 0.0;       // share of the render's geometry pixels that no light reaches
   bool passed = false;
 };
 GameAgreement compareWithGame(const GameImages& images);

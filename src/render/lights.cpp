@@ -246,6 +246,44 @@ bool LightSet::reaches(std::uint32_t light, const glm::dvec3& point, const glm::
   return !(p.range > 0 && std::isfinite(p.range) && glm::dot(toLight, toLight) >= p.range * p.range);
 }
 
+bool LightSet::anyLightReaches(const glm::dvec3& point, const glm::dvec3& normal, const Visibility& visible) const {
+  LightSample s;
+  for (std::size_t light = 0; light < punctual_.size(); ++light) {
+    if (punctual_[light].type != scene::Light::Type::kDirectional && !reaches(static_cast<std::uint32_t>(light), point, normal)) continue;
+    if (!samplePunctual(light, point, s) || !(luminance(s.radiance) > 0) || glm::dot(s.direction, normal) <= 0) continue;
+    if (visible(s.direction, s.distance)) return true;
+  }
+  // Barycentric points of a triangle: the centroid, then halfway from it to each corner.
+  static constexpr std::array<glm::dvec2, 4> kPoints{glm::dvec2(1.0 / 3, 1.0 / 3), glm::dvec2(1.0 / 6, 1.0 / 6), glm::dvec2(2.0 / 3, 1.0 / 6),
+                                                      glm::dvec2(1.0 / 6, 2.0 / 3)};
+  for (const Triangle& tri : triangles_) {
+    const glm::dvec3 facing = glm::cross(tri.p1 - tri.p0, tri.p2 - tri.p0);
+    for (const glm::dvec2 b : kPoints) {
+      const glm::dvec3 toLight = (1.0 - b.x - b.y) * tri.p0 + b.x * tri.p1 + b.y * tri.p2 - point;
+      const double distance = glm::length(toLight);
+      if (!(distance > 0)) continue;
+      const glm::dvec3 direction = toLight / distance;
+      // Emissive surfaces emit from both faces (sample()'s |cos| at the light).
+      if (glm::dot(direction, normal) <= 0 || glm::dot(facing, direction) == 0) continue;
+      if (!(luminance(emission_(tri.node, tri.primitive, tri.index, b)) > 0)) continue;
+      if (visible(direction, distance)) return true;
+    }
+  }
+  if (environment_) {
+    // A spherical Fibonacci set (golden-angle spiral, equal areas): directions i = 0..N-1 at
+    // z = 1 - (2i + 1) / N, azimuth 2 pi i / phi^2.
+    constexpr int kDirections = 256;
+    const double goldenAngle = kPi * (3.0 - std::sqrt(5.0));
+    for (int i = 0; i < kDirections; ++i) {
+      const double z = 1.0 - (2.0 * i + 1.0) / kDirections, r = std::sqrt(std::max(0.0, 1.0 - z * z));
+      const glm::dvec3 direction(r * std::cos(goldenAngle * i), r * std::sin(goldenAngle * i), z);
+      if (glm::dot(direction, normal) <= 0 || !(luminance(environment_->radiance(direction)) > 0)) continue;
+      if (visible(direction, std::numeric_limits<double>::infinity())) return true;
+    }
+  }
+  return false;
+}
+
 void PairLights::build(const LightSet& now, const LightSet& before) {
   halves_ = {&now, &before};
   for (auto& v : sharedLight_) v.clear();

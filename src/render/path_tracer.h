@@ -136,6 +136,10 @@ class PathTracer {
   void renderChanges(std::uint64_t frameIndex, const RenderCamera& camera, const RenderCamera& previousCamera, FrameBuffers& frame,
                      RenderStatistics* statistics = nullptr) const;
 
+  // For each pixel of `camera`'s image, whether any light of the frame at the current time reaches
+  // the surface the ray through the pixel's centre hits (1; LightSet::anyLightReaches, no sampling),
+  // or the surface emits itself; 0 where no light reaches it or the ray hits nothing.
+  std::vector<std::uint8_t> lightReach(const RenderCamera& camera) const;
   const RayTracingScene& rayTracing() const { return *rayTracing_; }
   const RenderSettings& settings() const { return settings_; }
 

@@ -265,4 +265,31 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
   return out;
 }
 
+std::vector<std::uint8_t> PathTracer::lightReach(const RenderCamera& camera) const {
+  const int width = camera.width(), height = camera.height();
+  std::vector<std::uint8_t> reach(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, height, 1), [&](const tbb::blocked_range<int>& rows) {
+    for (int py = rows.begin(); py < rows.end(); ++py)
+      for (int px = 0; px < width; ++px) {
+        const Ray ray = camera.ray(px + 0.5, py + 0.5);
+        const SurfaceHit hit = trace(ray);
+        if (!hit.hit) continue;
+        const std::size_t pixel = static_cast<std::size_t>(py) * static_cast<std::size_t>(width) + static_cast<std::size_t>(px);
+        if (luminance(emission(hit.node, hit.primitive, hit.triangle, hit.barycentric)) > 0) {
+          reach[pixel] = 1;
+          continue;
+        }
+        // The side of the surface the camera sees (Shading's geometric normal faces the viewer).
+        const glm::dvec3 normal = glm::dot(hit.geometricNormal, ray.direction) < 0 ? hit.geometricNormal : -hit.geometricNormal;
+        const glm::dvec3 origin = offsetOrigin(hit.position, normal);
+        reach[pixel] = lights_.anyLightReaches(hit.position, normal, [&](const glm::dvec3& direction, double distance) {
+          // As addLight's shadow ray, which stops short of the light.
+          const double tMax = std::isinf(distance) ? 1e30 : distance * (1.0 - 1e-4) - 3e-5;
+          return !rayTracing_->occluded(origin, direction, tMax);
+        });
+      }
+  });
+  return reach;
+}
+
 }  // namespace dynbench::render
