@@ -1,6 +1,8 @@
 // maplight: q3map2's light model (known answers), the NNLS solver (its optimality conditions), the
 // BSP and shader readers (their refusals), and the fit on Debian's OpenArena maps: a map's
 // lightmaps reproduced, real lights recovered when hidden, the same lights every run.
+#include <sstream>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -207,6 +209,26 @@ TEST(Bsp, EntitiesAndLightsAsQ3map2ReadsThem) {
   EXPECT_EQ(lights[2].value, 200.0);
 }
 
+TEST(Bsp, TheLightmapFloorAsQ3map2StoresIt) {
+  // _minlight times _color (white when unset), through ColorToBytes: the -gamma curve, a brightest
+  // channel above 255 scaled down to 255, truncated.
+  const auto floorOf = [](const std::string& worldspawn, double gamma) {
+    Bsp bsp;
+    bsp.entities.push_back({{"classname", "worldspawn"}});
+    std::istringstream in(worldspawn);
+    std::string key, value;
+    while (in >> key >> value) bsp.entities[0][key] = value;
+    return minimumLightBytes(bsp, gamma);
+  };
+  EXPECT_EQ(floorOf("", 1.0), glm::dvec3(0.0));
+  EXPECT_EQ(floorOf("_minlight 64", 1.0), glm::dvec3(64.0));
+  EXPECT_EQ(floorOf("_minlight 64", 2.0), glm::dvec3(127.0));  // 255 (64/255)^(1/2) = 127.75
+  Bsp coloured;
+  coloured.entities.push_back({{"_minlight", "200"}, {"_color", "2 1 1"}});
+  // (400, 200, 200) x (255 / 400), truncated: 254.99999... gives 254, as q3map2's clipped bytes do
+  EXPECT_EQ(minimumLightBytes(coloured, 1.0), glm::dvec3(254.0, 127.0, 127.0));
+}
+
 TEST(Bsp, BrokenFilesAreRefusedNamingTheMapAndLump) {
   auto shortFile = parseBsp("IBSP", "maps/a.bsp");
   ASSERT_FALSE(shortFile);
@@ -290,6 +312,12 @@ TEST(OpenArena, StrippedLightsAreFittedToTheLightmaps) {
   EXPECT_EQ(recovered->report.hiddenLightValue, 48 * 60.0);
   EXPECT_GT(recovered->report.candidates, recovered->report.latticeCandidates) << "candidates at the residual's hot spots";
   EXPECT_GE(recovered->report.recoveredShare, 0.70);
+  // oa_ctf2's _minlight 64: most texels read the floor, and some of its dim lights light none above it
+  EXPECT_EQ(recovered->report.floorBytes, glm::dvec3(64.0));
+  EXPECT_GT(recovered->report.flooredTexels, recovered->report.texels / 2);
+  EXPECT_LT(recovered->report.shownLightValue, recovered->report.hiddenLightValue);
+  EXPECT_GT(recovered->report.shownLightValue, 0.5 * recovered->report.hiddenLightValue);
+  EXPECT_GT(recovered->report.recoveredShownShare, recovered->report.recoveredShare);
 
   MapLightFitOptions small = hidden;
   small.fitSamples = 6000;

@@ -26,6 +26,9 @@ Expected<void> runMapLights(const MapLightsCli& cli) {
   if (!lighting) return std::unexpected(lighting.error());
   const auto& r = lighting->report;
   fmt::print("{}: {} lightmap texels ({} clipped, at 254 or 255, left out), gamma {}\n", cli.map, r.texels, r.clippedTexels, r.gamma);
+  if (r.floorBytes != glm::dvec3(0.0))
+    fmt::print("  {} texels at the map's _minlight floor (bytes {} {} {}), fitted as they read\n", r.flooredTexels, r.floorBytes.r,
+               r.floorBytes.g, r.floorBytes.b);
   fmt::print("  known emitters: {} light entities, {} suns, {} surface-light pieces; {} shaders with q3map_skylight (not modelled)\n",
              r.entityLights, r.suns, r.surfaceEmitters, r.skyLightShaders);
   fmt::print("  fit: {} texels, {} candidates ({} on a {}-unit lattice, {} at hot spots), {} lights fitted ({} moved off the lattice), constant {:.2f} {:.2f} {:.2f} (dropped)\n",
@@ -33,8 +36,10 @@ Expected<void> runMapLights(const MapLightsCli& cli) {
   fmt::print("  held-out texels ({}): correlation {:.3f} (known emitters alone {:.3f}); variance explained {:.3f} (known alone {:.3f})\n",
              r.heldOutSamples, r.heldOutCorrelation, r.knownCorrelation, r.totalExplained, r.knownExplained);
   if (cli.hideEntityLights)
-    fmt::print("  hidden entity lights: {:.0f} of light value, {:.1f} % of it with a fitted light within {} units\n", r.hiddenLightValue,
-               100.0 * r.recoveredShare, maplight::kRecoveryRadius);
+    fmt::print("  hidden entity lights: {:.0f} of light value, {:.1f} % of it with a fitted light within {} units; the lightmaps show {:.0f} of it "
+               "(at least {} unit on a texel neither clipped nor at the floor), {:.1f} % of that recovered\n",
+               r.hiddenLightValue, 100.0 * r.recoveredShare, maplight::kRecoveryRadius, r.shownLightValue, maplight::kShownLightmapUnits,
+               100.0 * r.recoveredShownShare);
   for (const auto& [name, weight] : r.groupWeights) fmt::print("  {}: weight {:.3f}\n", name, weight);
   if (!cli.adapterLights.empty())
     if (auto written = maplight::writeAdapterLights(cli.adapterLights, *lighting); !written) return written;

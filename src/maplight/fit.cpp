@@ -39,6 +39,10 @@ constexpr int kRefineStepsPerScale = 8;
 struct Sample {
   glm::dvec3 position{0.0}, normal{0.0};
   glm::dvec3 value{0.0};  // linear lightmap units
+  // Some channel at the map's lightmap floor (minimumLightBytes): the light there reads as the
+  // floor whatever it is below it. The fit takes the value as it reads (a censored fit measured
+  // worse: integrations/openarena/README.md); the recovery report asks which lights show above it.
+  bool floored = false;
 };
 
 // The map's geometry as Embree sees it: `all` holds the solid surfaces (node 0) and the sky's
@@ -122,6 +126,31 @@ double gammaOf(const Bsp& bsp) {
   return 1.0;
 }
 
+}  // namespace
+
+// The map's lightmap floor in bytes, per channel: q3map2 raises every texel's colour to at least
+// worldspawn's `_minlight` times its `_color` (white when unset; light.c), then stores it with
+// ColorToBytes (the -gamma curve, a brightest channel above 255 scaled down to it, truncated;
+// lightmaps_ydnar.c, StoreSurfaceLightmaps). 0 where the map sets no floor. oa_ctf2's
+// `_minlight 64` floors 80 % of its lit texels.
+glm::dvec3 minimumLightBytes(const Bsp& bsp, double gamma) {
+  if (bsp.entities.empty()) return glm::dvec3(0.0);
+  const std::string value = entityValue(bsp.entities[0], "_minlight");
+  const double f = value.empty() ? 0.0 : std::atof(value.c_str());
+  if (!(f > 0)) return glm::dvec3(0.0);
+  glm::dvec3 color(0.0);
+  std::istringstream in(entityValue(bsp.entities[0], "_color"));
+  in >> color.x >> color.y >> color.z;
+  if (!in || glm::length(color) == 0.0) color = glm::dvec3(1.0);
+  glm::dvec3 bytes = color * f;
+  for (int k = 0; k < 3; ++k) bytes[k] = bytes[k] > 0 ? 255.0 * std::pow(bytes[k] / 255.0, 1.0 / gamma) : 0.0;
+  const double brightest = std::max({bytes.x, bytes.y, bytes.z});
+  if (brightest > 255.0) bytes *= 255.0 / brightest;
+  return glm::floor(bytes);
+}
+
+namespace {
+
 // A lightmap texel of a drawn, lightmapped world surface: where it lies on its page, and its sample.
 struct Texel {
   int x = 0, y = 0;
@@ -130,12 +159,12 @@ struct Texel {
 
 struct LightmapTexels {
   std::vector<Texel> unclipped;  // in surface, triangle and row order
-  std::size_t texels = 0, clipped = 0;
+  std::size_t texels = 0, clipped = 0, floored = 0;
 };
 
 // Every lightmap texel of the world's drawn, lightmapped surfaces, each once (the first triangle
 // over a texel's centre owns it); those clipped (kClippedByte) are only counted.
-LightmapTexels lightmapTexels(const Bsp& bsp, const ShaderScripts& scripts, double gamma) {
+LightmapTexels lightmapTexels(const Bsp& bsp, const ShaderScripts& scripts, double gamma, const glm::dvec3& floorBytes) {
   LightmapTexels out;
   std::vector<std::vector<char>> owned(bsp.lightmaps.size(), std::vector<char>(kLightmapSize * kLightmapSize, 0));
   const BspModel& world = bsp.models[0];
@@ -180,6 +209,8 @@ LightmapTexels lightmapTexels(const Bsp& bsp, const ShaderScripts& scripts, doub
           texel.sample.normal = n;
           texel.sample.position = w0 * t.position[0] + w1 * t.position[1] + w2 * t.position[2] + kNudge * n;
           for (int k = 0; k < 3; ++k) texel.sample.value[k] = 255.0 * std::pow(rgb[k] / 255.0, gamma);  // undo -gamma (ColorToBytes)
+          for (int k = 0; k < 3; ++k) texel.sample.floored = texel.sample.floored || (floorBytes[k] > 0 && rgb[k] <= floorBytes[k]);
+          out.floored += texel.sample.floored;
           out.unclipped.push_back(texel);
         }
     }
@@ -698,9 +729,11 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   const std::size_t knownLights = result.lights.size(), groupCount = groups.size();
 
   // Samples: a regular subset of the texels to fit, a disjoint one to judge the fit on.
-  const LightmapTexels texels = lightmapTexels(*bsp, *scripts, r.gamma);
+  r.floorBytes = minimumLightBytes(*bsp, r.gamma);
+  const LightmapTexels texels = lightmapTexels(*bsp, *scripts, r.gamma, r.floorBytes);
   r.texels = texels.texels;
   r.clippedTexels = texels.clipped;
+  r.flooredTexels = texels.floored;
   const int stride =
       std::max(2, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(texels.texels) / std::max(options.fitSamples, 1)))));
   const std::vector<Sample> fit = texelSubset(texels.unclipped, stride, 0);
@@ -963,18 +996,32 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   r.fittedLights = result.lights.size() - knownLights;
   if (options.hideEntityLights) {
     // How much of the hidden lights' value has a fitted light near it.
-    double total = 0.0, found = 0.0;
-    for (const MapLight& hidden : entityLights(*bsp)) {
-      if (hidden.kind == MapLightKind::kSun) continue;
-      total += hidden.value;
-      for (std::size_t i = knownLights; i < result.lights.size(); ++i)
-        if (glm::length(result.lights[i].position - hidden.position) <= kRecoveryRadius) {
-          found += hidden.value;
-          break;
-        }
+    // Whether the lightmaps show a hidden light at all: q3map2's model of it gives at least one
+    // lightmap unit (a byte at -gamma 1) on some fitted texel that is neither clipped nor at the
+    // map's floor. Elsewhere the texels read the same with it or without it.
+    const std::vector<MapLight> hidden = entityLights(*bsp);
+    std::vector<EmitterGroup> hiddenGroups;
+    for (std::size_t i = 0; i < hidden.size(); ++i) hiddenGroups.push_back({hidden[i].source, hidden[i].color, {i}, {}});
+    const std::vector<Column> hiddenColumns = groupColumns(fit, hiddenGroups, hidden, {}, *occluders);
+    double total = 0.0, found = 0.0, shown = 0.0, shownFound = 0.0;
+    for (std::size_t h = 0; h < hidden.size(); ++h) {
+      if (hidden[h].kind == MapLightKind::kSun) continue;
+      total += hidden[h].value;
+      bool inLightmaps = false;
+      const Column& c = hiddenColumns[h];
+      for (std::size_t k = 0; k < c.rows.size() && !inLightmaps; ++k)
+        inLightmaps = !fit[c.rows[k]].floored && c.values[k] * luminance(hidden[h].color) >= kShownLightmapUnits;
+      bool near = false;
+      for (std::size_t i = knownLights; i < result.lights.size() && !near; ++i)
+        near = glm::length(result.lights[i].position - hidden[h].position) <= kRecoveryRadius;
+      found += near ? hidden[h].value : 0.0;
+      shown += inLightmaps ? hidden[h].value : 0.0;
+      shownFound += inLightmaps && near ? hidden[h].value : 0.0;
     }
     r.hiddenLightValue = total;
     r.recoveredShare = total > 0 ? found / total : 0.0;
+    r.shownLightValue = shown;
+    r.recoveredShownShare = shown > 0 ? shownFound / shown : 0.0;
   }
 
   if (!options.judgeOnHeldOut) return result;

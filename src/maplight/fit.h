@@ -38,6 +38,7 @@ inline constexpr double kAreaScale = 0.25, kFormFactorValueScale = 3.0;
 inline constexpr double kMinimumDistance = 16.0;  // q3map2 clamps a point light's distance to it
 inline constexpr double kFullLight = 63.75;       // lightmap units of the engine's full light
 inline constexpr double kDefaultLightSubdivide = 999.0;  // q3map2.h's defaultLightSubdivide, units
+inline constexpr double kShownLightmapUnits = 1.0;  // a hidden light shows in the lightmaps where its model gives a texel this much
 inline constexpr double kRecoveryRadius = 64.0;   // units: a hidden light counts as found with a fitted light this near
 
 enum class MapLightKind { kPoint, kSpot, kSun };
@@ -91,6 +92,10 @@ struct MapLightFitOptions {
 
 struct MapLightFitReport {
   std::size_t texels = 0, clippedTexels = 0;  // lit lightmap texels of drawn surfaces; those clipped, at 254 or 255 (left out)
+  // Those at the map's floor (worldspawn _minlight: q3map2 raises every texel to it; fitted as they
+  // read), and the floor in lightmap bytes per channel (0: none).
+  std::size_t flooredTexels = 0;
+  glm::dvec3 floorBytes{0.0};
   std::size_t fitSamples = 0, heldOutSamples = 0;
   std::size_t candidates = 0, latticeCandidates = 0, latticeSpacing = 0;  // all candidates; those on the lattice
   std::size_t entityLights = 0, surfaceEmitters = 0, suns = 0, fittedLights = 0;
@@ -108,6 +113,10 @@ struct MapLightFitReport {
   // With the entity lights hidden: their total value (suns left out), and the share of it whose
   // light has a fitted light within kRecoveryRadius.
   double hiddenLightValue = 0.0, recoveredShare = 0.0;
+  // The same for the hidden lights the lightmaps show (q3map2's model of the light gives at least
+  // kShownLightmapUnits on a fitted texel neither clipped nor at the floor): a light whose every
+  // texel reads the floor or the clip leaves nothing to recover it from.
+  double shownLightValue = 0.0, recoveredShownShare = 0.0;
   // Each known group's weight (a light entity, a sun, a surface-light shader): 1 where the
   // lightmaps agree with q3map2's model of it; the dataset's emitter is the model times it.
   std::vector<std::pair<std::string, double>> groupWeights;
@@ -121,6 +130,10 @@ struct MapLighting {
 };
 
 using MapLightProgress = std::function<void(const std::string& step, std::size_t done, std::size_t total)>;
+
+// The map's lightmap floor in bytes per channel (worldspawn `_minlight` times `_color`, through
+// q3map2's ColorToBytes with the map's -gamma); 0 where it sets none.
+glm::dvec3 minimumLightBytes(const Bsp& bsp, double gamma);
 
 Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& map, const MapLightFitOptions& options = {},
                                      const MapLightProgress& progress = {});
