@@ -109,9 +109,9 @@ class LightSet {
   // it gives none.
   bool samplePunctual(std::size_t light, const glm::dvec3& point, LightSample& sample) const;
   // Whether any light of the frame lights a surface at `point` whose side facing the viewer has the
-  // normal `normal`, with no Monte Carlo sampling: the limit of "a path found direct light here" as
-  // paths grow (`dynbench fidelity`'s share of pixels without direct light, which at a finite path
-  // count fell with more paths: 10.0 % at 16 and 7.2 % at 64 on one OpenArena frame). A directional
+  // normal `normal`, with no Monte Carlo sampling: the limit of "a path from here found direct
+  // light" as paths grow (`dynbench fidelity`'s share of pixels without direct light, which counted
+  // paths and fell with their number: 10.0 % at 16 and 7.2 % at 64 on one OpenArena frame). A directional
   // or punctual light counts where it gives light there (range, spot cone) along an unoccluded
   // line; an emissive triangle where one of a fixed set of its points that emits is seen (its
   // centroid, then points towards its corners); the environment where one of 256 fixed directions
