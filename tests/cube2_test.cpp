@@ -20,6 +20,7 @@
 
 #include "capture/cube2.h"
 #include "core/files.h"
+#include "core/image_io.h"
 #include "scene/evaluate.h"
 #include "scene/load.h"
 #include "gltf_builder.h"
@@ -251,6 +252,22 @@ TEST(Cube2, TheGamesOwnFramesAgreeWithTheDatasetsRenderOfThem) {
     EXPECT_GE(f["depth_agreement"].get<double>(), 0.95) << f;
     EXPECT_GE(f["correlation"].get<double>(), 0.4) << f;
     EXPECT_LE(f["unlit_share"].get<double>(), 0.15) << f;
+    // The side-by-side's fourth panel shows the same light reach: white where a light reaches the
+    // render's surface, black where none does, dark blue on its sky.
+    auto side = readImage(dir / "fid" / fmt::format("fidelity_{:05d}.png", f["frame"].get<int>()));
+    ASSERT_TRUE(side) << side.error().message;
+    ASSERT_EQ(side->width, 4 * 320);
+    std::size_t reached = 0, unreached = 0, sky = 0;
+    for (int y = 0; y < side->height; ++y)
+      for (int x = 3 * 320; x < 4 * 320; ++x) {
+        const float* p = &side->pixels[(static_cast<std::size_t>(y) * side->width + x) * side->channels];
+        if (p[0] > 0.5f && p[1] > 0.5f && p[2] > 0.5f) ++reached;
+        else if (p[0] < 0.01f && p[1] < 0.01f && p[2] > 0.1f) ++sky;
+        else if (p[0] < 0.01f && p[1] < 0.01f && p[2] < 0.01f) ++unreached;
+      }
+    EXPECT_EQ(reached + unreached + sky, 320u * static_cast<std::size_t>(side->height)) << "every pixel one of the three colours";
+    EXPECT_GT(reached, unreached);
+    EXPECT_NEAR(static_cast<double>(unreached) / static_cast<double>(reached + unreached), f["unlit_share"].get<double>(), 1e-12) << f;
   }
 
   auto dataset = scene::loadScene(dir / "ds" / "two_towers.gltf");
