@@ -138,7 +138,8 @@ Expected<Cube2Report> captureCube2(const Cube2Options& o, const Cube2Progress& p
     display.emplace(std::move(*started));
     game.environment.emplace_back("DISPLAY", display->name());
   }
-  game.argv = {"timeout", fmt::format("{}", timeout), "./" + client->filename().string(), "-q" + fs::absolute(home).string(),
+  // -k 10: SIGKILL if the client outlives the SIGTERM by 10 s (as capture/openarena.cpp, whose engine once hung in its handler)
+  game.argv = {"timeout", "-k", "10", fmt::format("{}", timeout), "./" + client->filename().string(), "-q" + fs::absolute(home).string(),
                "-k" + fs::absolute(o.data).string(), "-r", "-t0", fmt::format("-w{}", o.width), fmt::format("-h{}", o.height),
                "-x" + *script};
   std::size_t frames = 0;

@@ -212,7 +212,11 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
     display.emplace(std::move(*started));
     game.environment.emplace_back("DISPLAY", display->name());
   }
-  game.argv = {"timeout", std::to_string(timeout), o.engine.string()};
+  // -k: SIGKILL 10 s after the SIGTERM (the timeout's, or ours when the engine cannot load the map)
+  // if the engine is still there. ioquake3's SIGTERM handler shuts the engine down from inside the
+  // handler and can deadlock there: once, under load, a `--map no_such_map` capture hung with the
+  // signal blocked in its handler and the main thread waiting on a lock, past both signals.
+  game.argv = {"timeout", "-k", "10", std::to_string(timeout), o.engine.string()};
   game.argv.insert(game.argv.end(), arguments->begin(), arguments->end());
   std::size_t frames = 0;
   unsigned long windowMs = 0, offClock = 0;
