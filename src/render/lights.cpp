@@ -249,7 +249,7 @@ bool LightSet::reaches(std::uint32_t light, const glm::dvec3& point, const glm::
 bool LightSet::anyLightReaches(const glm::dvec3& point, const glm::dvec3& normal, const Visibility& visible) const {
   LightSample s;
   for (std::size_t light = 0; light < punctual_.size(); ++light) {
-    if (punctual_[light].type != scene::Light::Type::kDirectional && !reaches(static_cast<std::uint32_t>(light), point, normal)) continue;
+    // samplePunctual gives no light beyond a range or outside a cone
     if (!samplePunctual(light, point, s) || !(luminance(s.radiance) > 0) || glm::dot(s.direction, normal) <= 0) continue;
     if (visible(s.direction, s.distance)) return true;
   }

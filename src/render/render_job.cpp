@@ -128,19 +128,24 @@ nlohmann::json renderRecord(const RenderJob& job) {
   return r;
 }
 
-Expected<std::vector<std::uint8_t>> frameLightReach(const scene::Scene& scene, const RenderJob& job, long frame) {
+Expected<std::map<long, std::vector<std::uint8_t>>> frameLightReach(const scene::Scene& scene, const RenderJob& job,
+                                                                    const std::vector<long>& frames) {
   auto cameraNode = scene::selectCameraNode(scene, job.camera);
   if (!cameraNode) return std::unexpected(cameraNode.error());
   const scene::Evaluator evaluator(scene);
-  auto cameras = frameCameras(evaluator, *cameraNode, job, frame);
-  if (!cameras) return std::unexpected(cameras.error());
   std::optional<tbb::global_control> limit;
   if (job.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(job.threads));
   std::vector<std::string> warnings;
   auto tracer = PathTracer::create(scene, job.settings, warnings);
   if (!tracer) return std::unexpected(tracer.error());
-  if (auto ok = (*tracer)->setTime(cameras->time, cameras->previousTime); !ok) return std::unexpected(ok.error());
-  return (*tracer)->lightReach(cameras->camera);
+  std::map<long, std::vector<std::uint8_t>> reach;
+  for (const long frame : frames) {
+    auto cameras = frameCameras(evaluator, *cameraNode, job, frame);
+    if (!cameras) return std::unexpected(cameras.error());
+    if (auto ok = (*tracer)->setTime(cameras->time, cameras->previousTime); !ok) return std::unexpected(ok.error());
+    reach[frame] = (*tracer)->lightReach(cameras->camera);
+  }
+  return reach;
 }
 
 Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob& job, const RenderProgress& progress) {

@@ -4,6 +4,7 @@
 // to a temporary name and renamed.
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -69,10 +70,12 @@ struct FrameCameras {
 };
 Expected<FrameCameras> frameCameras(const scene::Evaluator& evaluator, int cameraNode, const RenderJob& job, long frame);
 
-// The frame's light reach (PathTracer::lightReach) at the job's size, camera and the frame's time:
-// per pixel, 1 where some light reaches the surface seen through the pixel's centre. No sampling, so
-// no seed or sample count changes it (`dynbench fidelity`'s share without direct light).
-Expected<std::vector<std::uint8_t>> frameLightReach(const scene::Scene& scene, const RenderJob& job, long frame);
+// The frames' light reach (PathTracer::lightReach) at the job's size and camera and each frame's
+// time, from one path tracer: per pixel, 1 where some light reaches the surface seen through the
+// pixel's centre. No sampling, so no seed or sample count changes it (`dynbench fidelity`'s share
+// without direct light).
+Expected<std::map<long, std::vector<std::uint8_t>>> frameLightReach(const scene::Scene& scene, const RenderJob& job,
+                                                                    const std::vector<long>& frames);
 
 // The settings a frame's sidecar records (`render` object), compared when resuming.
 nlohmann::json renderRecord(const RenderJob& job);
