@@ -229,6 +229,64 @@ TEST(Bsp, TheLightmapFloorAsQ3map2StoresIt) {
   EXPECT_EQ(minimumLightBytes(coloured, 1.0), glm::dvec3(254.0, 127.0, 127.0));
 }
 
+TEST(Bsp, TheLightGridLiesWhereSetupGridLaysIt) {
+  // The world's bounds (-100, -10, 0)-(130, 70, 256) with gridsize 32 32 100.7 (floored to 100):
+  // x from 32 ceil(-100/32) = -96 to 32 floor(130/32) = 128, 8 points; y from 0 to 64, 3; z from 0
+  // to 200, 3: 72 points of 8 bytes.
+  const std::string entities = "{ \"classname\" \"worldspawn\" \"gridsize\" \"32 32 100.7\" }\n";
+  const auto mapWithGrid = [&](int gridBytes) {
+    const int models = 144 + static_cast<int>(entities.size()), grid = models + 40;
+    std::vector<std::pair<int, int>> lumps(17, {144, 0});
+    lumps[0] = {144, static_cast<int>(entities.size())};
+    lumps[7] = {models, 40};
+    lumps[15] = {grid, gridBytes};
+    std::string bytes = header(lumps) + entities;
+    const float bounds[6] = {-100, -10, 0, 130, 70, 256};
+    bytes.append(reinterpret_cast<const char*>(bounds), sizeof(bounds));
+    bytes.append(16, '\0');  // no surfaces or brushes
+    for (int i = 0; i < gridBytes; ++i) bytes += static_cast<char>(i % 251);
+    return parseBsp(bytes, "maps/grid.bsp");
+  };
+  auto bsp = mapWithGrid(72 * 8);
+  ASSERT_TRUE(bsp) << bsp.error().message;
+  const LightGrid& g = bsp->lightGrid;
+  EXPECT_EQ(g.counts, glm::ivec3(8, 3, 3));
+  EXPECT_EQ(g.spacing, glm::dvec3(32, 32, 100));
+  EXPECT_EQ(g.origin, glm::dvec3(-96, 0, 0));
+  ASSERT_EQ(g.points.size(), 72u);
+  EXPECT_EQ(g.position(45), glm::dvec3(-96 + 5 * 32, 2 * 32, 100));  // 45 = 5 + 8 (2 + 3 * 1)
+  EXPECT_EQ(g.points[45].ambient, (std::array<std::uint8_t, 3>{45 * 8 % 251, 45 * 8 % 251 + 1, 45 * 8 % 251 + 2}));
+  EXPECT_EQ(g.points[45].direction[1], 45 * 8 % 251 + 7);
+  // a lump of another size is left out, as the engine leaves it out ("light grid mismatch")
+  auto mismatched = mapWithGrid(71 * 8);
+  ASSERT_TRUE(mismatched) << mismatched.error().message;
+  EXPECT_TRUE(mismatched->lightGrid.points.empty());
+}
+
+TEST(MapLight, AGridPointsLightIsTheSumOfItsLights) {
+  // TraceGrid by hand for two lights at a point: 100 units from +x and 40 from +y. The main
+  // direction is (100, 40) normalised, d = (0.928, 0.371); directed = sum d c, ambient =
+  // sum 0.25 (1 - d) c + directed / 8, stored truncated to bytes (gamma 1). The light from every
+  // direction read back is the sum, 140, within the truncation (half a byte of directed, four of ambient).
+  const glm::dvec2 main = glm::normalize(glm::dvec2(100, 40));
+  const double d1 = main.x, d2 = main.y;
+  const double directed = d1 * 100 + d2 * 40, ambient = 0.25 * (1 - d1) * 100 + 0.25 * (1 - d2) * 40 + directed / 8;
+  LightGridPoint p;
+  for (std::size_t k = 0; k < 3; ++k) {
+    p.directed[k] = static_cast<std::uint8_t>(directed);
+    p.ambient[k] = static_cast<std::uint8_t>(ambient);
+  }
+  EXPECT_EQ(p.directed[0], 107);
+  EXPECT_EQ(p.ambient[0], 21);
+  const glm::dvec3 light = gridPointLight(p, 1.0);
+  EXPECT_NEAR(light.r, 140.0, 0.5 + 4.0);
+  EXPECT_DOUBLE_EQ(light.r, 0.5 * 107 + 4 * 21);
+  // -gamma 2 stores 255 (x / 255)^(1/2): undone before the sum
+  LightGridPoint g2;
+  g2.ambient = {128, 128, 128};
+  EXPECT_NEAR(gridPointLight(g2, 2.0).g, 4.0 * 255.0 * std::pow(128.0 / 255.0, 2.0), 1e-9);
+}
+
 TEST(Bsp, BrokenFilesAreRefusedNamingTheMapAndLump) {
   auto shortFile = parseBsp("IBSP", "maps/a.bsp");
   ASSERT_FALSE(shortFile);
@@ -304,6 +362,11 @@ TEST(OpenArena, StrippedLightsAreFittedToTheLightmaps) {
   const auto back = std::find_if(dm2->report.groupWeights.begin(), dm2->report.groupWeights.end(),
                                  [](const auto& g) { return g.first == "surface light textures/liquids/lavahell_xdm1 (its back)"; });
   EXPECT_NE(back, dm2->report.groupWeights.end()) << "the lava (cull none) lights from its back too";
+  // The light grid, never fitted, agrees with the fitted lights (0.781 on 1,454 points, 2026-11-28)
+  // far better than with the known emitters alone (0.371)
+  EXPECT_GT(dm2->report.gridPoints, 1000u);
+  EXPECT_GE(dm2->report.gridCorrelation, 0.70);
+  EXPECT_GT(dm2->report.gridCorrelation, dm2->report.gridKnownCorrelation + 0.2);
 
   MapLightFitOptions hidden;
   hidden.hideEntityLights = true;
@@ -318,6 +381,7 @@ TEST(OpenArena, StrippedLightsAreFittedToTheLightmaps) {
   EXPECT_LT(recovered->report.shownLightValue, recovered->report.hiddenLightValue);
   EXPECT_GT(recovered->report.shownLightValue, 0.5 * recovered->report.hiddenLightValue);
   EXPECT_GT(recovered->report.recoveredShownShare, recovered->report.recoveredShare);
+  EXPECT_EQ(recovered->report.gridPoints, 0u) << "the floor raises every grid point's ambient too";
 
   MapLightFitOptions small = hidden;
   small.fitSamples = 6000;

@@ -35,6 +35,11 @@ Expected<void> runMapLights(const MapLightsCli& cli) {
              r.fitSamples, r.candidates, r.latticeCandidates, r.latticeSpacing, r.candidates - r.latticeCandidates, r.fittedLights, r.refinedLights, r.constant.r, r.constant.g, r.constant.b);
   fmt::print("  held-out texels ({}): correlation {:.3f} (known emitters alone {:.3f}); variance explained {:.3f} (known alone {:.3f})\n",
              r.heldOutSamples, r.heldOutCorrelation, r.knownCorrelation, r.totalExplained, r.knownExplained);
+  if (r.gridPoints > 0)
+    fmt::print("  light grid ({} points, never fitted): correlation {:.3f} (known emitters alone {:.3f})\n", r.gridPoints, r.gridCorrelation,
+               r.gridKnownCorrelation);
+  else
+    fmt::print("  light grid: no usable points (none, or every one clipped or at the floor)\n");
   if (cli.hideEntityLights)
     fmt::print("  hidden entity lights: {:.0f} of light value, {:.1f} % of it with a fitted light within {} units; the lightmaps show {:.0f} of it "
                "(at least {} unit on a texel neither clipped nor at the floor), {:.1f} % of that recovered\n",
@@ -72,6 +77,7 @@ void addMapLightsCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--hot-spot-peaks", cli->options.hotSpotPeaks, "Peaks of the lightmaps' residual that add candidates along their normals (0: the lattice alone)")
       ->capture_default_str()
       ->check(CLI::Range(0, 100000));
+  cmd->add_option("--grid-samples", cli->options.gridSamples, "Light grid points the lights are judged on at most")->capture_default_str()->check(CLI::Range(16, 1000000));
   cmd->add_option("--adapter-lights", cli->adapterLights, "Write the lights file the OpenArena capture adapter reads");
   cmd->callback([cli, &run] { run = [cli] { return runMapLights(*cli); }; });
 }

@@ -1,6 +1,7 @@
 #include "maplight/bsp.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cctype>
 #include <cstring>
 #include <optional>
@@ -10,7 +11,7 @@ namespace dynbench::maplight {
 
 namespace {
 constexpr int kLumpEntities = 0, kLumpShaders = 1, kLumpModels = 7, kLumpVertices = 10, kLumpIndices = 11, kLumpSurfaces = 13,
-              kLumpLightmaps = 14, kLumpCount = 17;
+              kLumpLightmaps = 14, kLumpLightGrid = 15, kLumpCount = 17;
 constexpr std::size_t kShaderBytes = 72, kModelBytes = 40, kVertexBytes = 44, kSurfaceBytes = 104;
 
 template <typename T>
@@ -161,7 +162,43 @@ Expected<Bsp> parseBsp(const std::string& bytes, const std::string& name) {
   if (bsp.models.empty()) return fail(ErrorCode::kInvalidData, "{}: no models (expected the world as model 0)", name);
   bsp.lightmaps.resize(*lightmaps);
   if (*lightmaps > 0) std::memcpy(bsp.lightmaps.data(), lumps[kLumpLightmaps].data, *lightmaps * sizeof(Bsp::lightmaps[0]));
+  if (const Lump& grid = lumps[kLumpLightGrid]; grid.size > 0) {
+    // The lattice as SetupGrid lays it (and ioquake3's R_LoadLightGrid reads it): worldspawn's
+    // gridsize (64 64 128 unless set; q3map2 stores the size it enlarged to), the world's bounds
+    // rounded inwards to multiples of it.
+    LightGrid& g = bsp.lightGrid;
+    g.spacing = glm::dvec3(64.0, 64.0, 128.0);
+    if (!bsp.entities.empty() && !entityValue(bsp.entities[0], "gridsize").empty()) {
+      const glm::dvec3 size = entityVector(bsp.entities[0], "gridsize");
+      for (int k = 0; k < 3; ++k) g.spacing[k] = size[k] >= 8.0 ? std::floor(size[k]) : 8.0;
+    }
+    const BspModel& world = bsp.models[0];
+    std::size_t expected = 1;
+    for (int k = 0; k < 3; ++k) {
+      g.origin[k] = g.spacing[k] * std::ceil(world.mins[k] / g.spacing[k]);
+      const double top = g.spacing[k] * std::floor(world.maxs[k] / g.spacing[k]);
+      g.counts[k] = std::max(0, static_cast<int>((top - g.origin[k]) / g.spacing[k]) + 1);
+      expected *= static_cast<std::size_t>(g.counts[k]);
+    }
+    // A lump of another size is left out, as the engine leaves it out ("light grid mismatch"): the
+    // map still plays, lit by its lightmaps; only the grid's check of the lights is lost.
+    if (grid.size != expected * 8) {
+      g.points.clear();
+      g.counts = glm::ivec3(0);
+    } else {
+      g.points.resize(expected);
+    }
+    for (std::size_t i = 0; i < g.points.size(); ++i) {
+      const auto* p = reinterpret_cast<const std::uint8_t*>(grid.data + i * 8);
+      g.points[i] = {{p[0], p[1], p[2]}, {p[3], p[4], p[5]}, {p[6], p[7]}};
+    }
+  }
   return bsp;
+}
+
+glm::dvec3 LightGrid::position(std::size_t index) const {
+  const auto nx = static_cast<std::size_t>(counts.x), ny = static_cast<std::size_t>(counts.y);
+  return origin + spacing * glm::dvec3(static_cast<double>(index % nx), static_cast<double>(index / nx % ny), static_cast<double>(index / (nx * ny)));
 }
 
 std::vector<SurfaceTriangle> surfaceTriangles(const Bsp& bsp, int index, int patchLevel) {

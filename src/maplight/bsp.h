@@ -46,6 +46,22 @@ struct BspModel {
   int firstSurface = 0, surfaceCount = 0;
 };
 
+// The light grid (lump 15): q3map2's light at points of a regular lattice over the world's bounds,
+// for lighting moving models (light.c, SetupGrid and TraceGrid). Point (x, y, z) is
+// points[x + counts.x (y + counts.y z)] at origin + spacing (x, y, z). Bytes as ColorToBytes stores
+// them (the map's -gamma, a brightest channel above 255 scaled down to it); a point q3map2 could
+// not place in the map's open space (every byte 0) holds nothing.
+struct LightGridPoint {
+  std::array<std::uint8_t, 3> ambient{}, directed{};
+  std::array<std::uint8_t, 2> direction{};  // q3map2's NormalToLatLong: polar angle, then azimuth, 255 / 360 per degree
+};
+struct LightGrid {
+  glm::dvec3 origin{0.0}, spacing{0.0};
+  glm::ivec3 counts{0};
+  std::vector<LightGridPoint> points;
+  glm::dvec3 position(std::size_t index) const;
+};
+
 using BspEntity = std::map<std::string, std::string>;  // keys as written (q3map2 compares without case)
 
 struct Bsp {
@@ -57,6 +73,7 @@ struct Bsp {
   std::vector<int> indices;
   std::vector<BspSurface> surfaces;
   std::vector<std::array<std::uint8_t, kLightmapSize * kLightmapSize * 3>> lightmaps;  // RGB bytes, rows of texels
+  LightGrid lightGrid;  // empty when the lump is (a map compiled without -light)
 };
 
 Expected<Bsp> parseBsp(const std::string& bytes, const std::string& name);

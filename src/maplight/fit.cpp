@@ -50,14 +50,17 @@ struct Sample {
 // ignores sky surfaces: light passes through them).
 struct Occluders {
   std::unique_ptr<render::RayTracingScene> all, solid;
-  bool visible(const glm::dvec3& from, const glm::dvec3& to) const {
+  // Surfaces nearer `from` than `inhibit` are passed through (q3map2's inhibitRadius: a grid
+  // point's traces ignore what lies within half a grid step of it).
+  bool visible(const glm::dvec3& from, const glm::dvec3& to, double inhibit = 0.0) const {
     const glm::dvec3 d = to - from;
     const double length = glm::length(d);
-    return length <= 1e-6 || !solid->occluded(from, d / length, length - 1e-3);
+    if (length <= inhibit + 1e-6) return true;
+    return !solid->occluded(from + inhibit * (d / length), d / length, length - inhibit - 1e-3);
   }
   // Whether a ray from `from` towards `direction` reaches the sky (or leaves the map).
-  bool seesSky(const glm::dvec3& from, const glm::dvec3& direction) const {
-    const render::SurfaceHit hit = all->intersect(render::Ray{from, direction});
+  bool seesSky(const glm::dvec3& from, const glm::dvec3& direction, double inhibit = 0.0) const {
+    const render::SurfaceHit hit = all->intersect(render::Ray{from + inhibit * direction, direction});
     return !hit.hit || hit.node == 1;
   }
 };
@@ -345,10 +348,26 @@ struct EmitterGroup {
   std::size_t backGroup = 0;              // a kFront group's kBack partner (same surfaces)
 };
 
+// How a sample receives light: as a lightmap texel (a surface facing its normal:
+// LightContributionToSample) or as a light grid point (light from every direction, each emitter
+// seen head on: LightContributionToPoint; the sample's normal is not used, and its traces pass
+// through what lies within `inhibitRadius` of it).
+enum class Receiver { kSurface, kPoint };
+
+// The normal a sample receives light from `towards` with.
+glm::dvec3 receivingNormal(const glm::dvec3& normal, Receiver receiver, const glm::dvec3& position, const glm::dvec3& towards) {
+  if (receiver == Receiver::kSurface) return normal;
+  const glm::dvec3 d = towards - position;
+  const double length = glm::length(d);
+  return length > 0 ? d / length : glm::dvec3(0.0, 0.0, 1.0);
+}
+
 // Every group's light at every sample (q3map2's model, lightmap units per unit colour, visibility
 // included) as sparse columns.
 std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::vector<EmitterGroup>& groups, const std::vector<MapLight>& lights,
-                                 const std::vector<SurfaceEmitter>& surfaces, const Occluders& occluders) {
+                                 const std::vector<SurfaceEmitter>& surfaces, const Occluders& occluders, Receiver receiver = Receiver::kSurface,
+                                 double inhibitRadius = 0.0) {
+  const double inhibit = receiver == Receiver::kPoint ? inhibitRadius : 0.0;
   const std::size_t g = groups.size();
   // per piece, once: the radius of its bounding sphere about the point traced to, and its area
   struct Piece {
@@ -367,9 +386,12 @@ std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::
       double sum = 0.0;
       for (std::size_t li : groups[k].lights) {
         const MapLight& l = lights[li];
-        const double add = lightContribution(l, s.position, s.normal);
+        const glm::dvec3 normal = l.kind == MapLightKind::kSun ? receivingNormal(s.normal, receiver, glm::dvec3(0.0), l.towardsSun)
+                                                               : receivingNormal(s.normal, receiver, s.position, l.position);
+        const double add = lightContribution(l, s.position, normal);
         if (add <= 0) continue;
-        const bool visible = l.kind == MapLightKind::kSun ? occluders.seesSky(s.position, l.towardsSun) : occluders.visible(s.position, l.position);
+        const bool visible = l.kind == MapLightKind::kSun ? occluders.seesSky(s.position, l.towardsSun, inhibit)
+                                                           : occluders.visible(s.position, l.position, inhibit);
         if (visible) sum += add;
       }
       // a two-sided shader's pieces are evaluated once, by its front group, which credits its
@@ -385,8 +407,8 @@ std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::
         const bool negligible = distance > 0 && area / (std::numbers::pi * distance * distance) * e.value * kFormFactorValueScale * kAreaScale < 0.01;
         if (!negligible) {
           bool fromBack = false;
-          const double add = surfaceContribution(e, s.position, s.normal, &fromBack);
-          if (add > 0 && occluders.visible(s.position, fromBack ? e.origin - 2.0 * e.normal : e.origin)) {
+          const double add = surfaceContribution(e, s.position, receivingNormal(s.normal, receiver, s.position, e.origin), &fromBack);
+          if (add > 0 && occluders.visible(s.position, fromBack ? e.origin - 2.0 * e.normal : e.origin, inhibit)) {
             if (fromBack && side == EmitterSide::kFront) backSum += add;
             else sum += add;
           }
@@ -396,8 +418,8 @@ std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::
           MapLight splash;
           splash.position = e.origin + e.normal * e.backsplashDistance;
           splash.value = e.value * area * kAreaScale * e.backsplashFraction / kPointScale;
-          const double b = lightContribution(splash, s.position, s.normal);
-          if (b > 0.01 && occluders.visible(s.position, splash.position)) sum += b;
+          const double b = lightContribution(splash, s.position, receivingNormal(s.normal, receiver, s.position, splash.position));
+          if (b > 0.01 && occluders.visible(s.position, splash.position, inhibit)) sum += b;
         }
       }
       dense[i * g + k] = static_cast<float>(sum);
@@ -561,6 +583,17 @@ double formFactor(const std::vector<glm::dvec3>& polygon, const glm::dvec3& poin
   // point. Either winding gives the same form factor here.
   const double side = glm::dot(glm::cross(polygon[1] - polygon[0], polygon[2] - polygon[0]), point - polygon[0]);
   return (side > 0 ? -total : total) / (2.0 * std::numbers::pi);
+}
+
+// TraceGrid splits each light c_i reaching a point into directed d_i c_i and ambient
+// 0.25 (1 - d_i) c_i (d_i its cosine to the point's main direction, at least 0), then adds an
+// eighth of the directed to the ambient: 0.5 directed + 4 ambient = sum of c_i. Exact without
+// -bounce; the bounces' light (added without the eighth) counts half its directed part twice.
+glm::dvec3 gridPointLight(const LightGridPoint& point, double gamma) {
+  glm::dvec3 light(0.0);
+  const auto linear = [&](std::uint8_t b) { return 255.0 * std::pow(b / 255.0, gamma); };  // undo -gamma (ColorToBytes)
+  for (int k = 0; k < 3; ++k) light[k] = 0.5 * linear(point.directed[static_cast<std::size_t>(k)]) + 4.0 * linear(point.ambient[static_cast<std::size_t>(k)]);
+  return light;
 }
 
 double lightContribution(const MapLight& light, const glm::dvec3& point, const glm::dvec3& normal) {
@@ -1037,17 +1070,25 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   }
   std::vector<MapLight> heldLights = unweightedLights;
   heldLights.insert(heldLights.end(), result.lights.begin() + static_cast<std::ptrdiff_t>(knownLights), result.lights.end());
-  const std::vector<Column> held = groupColumns(heldOut, all, heldLights, unweightedSurfaces, *occluders);
-  std::vector<double> texel(heldOut.size()), knownLum(heldOut.size(), 0.0), allLum(heldOut.size(), 0.0);
-  for (std::size_t i = 0; i < heldOut.size(); ++i) texel[i] = luminance(heldOut[i].value);
-  for (std::size_t k = 0; k < all.size(); ++k) {
-    const double lum = luminance(all[k].color);
-    for (std::size_t q = 0; q < held[k].rows.size(); ++q) {
-      const double v = held[k].values[q] * lum;  // q3map2's strength (a fitted light's own)
-      allLum[held[k].rows[q]] += v * allWeights[k];
-      if (k < groupCount) knownLum[held[k].rows[q]] += v;
+  // The luminance q3map2's model gives each sample: of the known emitters alone (their strength as
+  // q3map2 gives it), and of the dataset's lights (weighted, with the fitted ones).
+  const auto modelLuminance = [&](const std::vector<Sample>& samples, Receiver receiver, double inhibitRadius, std::vector<double>& knownLum,
+                                  std::vector<double>& allLum) {
+    const std::vector<Column> columnsHere = groupColumns(samples, all, heldLights, unweightedSurfaces, *occluders, receiver, inhibitRadius);
+    knownLum.assign(samples.size(), 0.0);
+    allLum.assign(samples.size(), 0.0);
+    for (std::size_t k = 0; k < all.size(); ++k) {
+      const double lum = luminance(all[k].color);
+      for (std::size_t q = 0; q < columnsHere[k].rows.size(); ++q) {
+        const double v = columnsHere[k].values[q] * lum;  // q3map2's strength (a fitted light's own)
+        allLum[columnsHere[k].rows[q]] += v * allWeights[k];
+        if (k < groupCount) knownLum[columnsHere[k].rows[q]] += v;
+      }
     }
-  }
+  };
+  std::vector<double> texel(heldOut.size()), knownLum, allLum;
+  for (std::size_t i = 0; i < heldOut.size(); ++i) texel[i] = luminance(heldOut[i].value);
+  modelLuminance(heldOut, Receiver::kSurface, 0.0, knownLum, allLum);
   r.heldOutCorrelation = pearson(texel, allLum);
   r.knownCorrelation = pearson(texel, knownLum);
   const auto explained = [&](const std::vector<double>& model, double offset) {
@@ -1062,6 +1103,45 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   r.knownExplained = explained(knownLum, 0.0);
   r.totalExplained = explained(allLum, weights.back());
   report("held-out texels", 1, 1);
+
+  // Judged on the light grid, which the fit never sees: q3map2's record of the same lights at
+  // points of the map's open space, where players move (gridPointLight). Left out: points with
+  // nothing (outside the map), a byte clipped, or the ambient at the map's floor (_minlight raises
+  // the grid's ambient too).
+  const LightGrid& grid = bsp->lightGrid;
+  std::vector<std::size_t> usable;
+  for (std::size_t i = 0; i < grid.points.size(); ++i) {
+    const LightGridPoint& g = grid.points[i];
+    bool empty = true, clipped = false, floored = false;
+    for (std::size_t k = 0; k < 3; ++k) {
+      empty = empty && g.ambient[k] == 0 && g.directed[k] == 0;
+      clipped = clipped || g.ambient[k] >= kClippedByte || g.directed[k] >= kClippedByte;
+      floored = floored || (r.floorBytes[static_cast<int>(k)] > 0 && g.ambient[k] <= r.floorBytes[static_cast<int>(k)]);
+    }
+    if (!empty && !clipped && !floored) usable.push_back(i);
+  }
+  const std::size_t gridStride = std::max<std::size_t>(1, (usable.size() + options.gridSamples - 1) / std::max(options.gridSamples, 1));
+  std::vector<Sample> gridSamples;
+  std::vector<double> gridLum;
+  for (std::size_t u = 0; u < usable.size(); u += gridStride) {
+    const LightGridPoint& g = grid.points[usable[u]];
+    Sample s;
+    s.position = grid.position(usable[u]);
+    s.value = gridPointLight(g, r.gamma);
+    gridSamples.push_back(s);
+    gridLum.push_back(luminance(s.value));
+  }
+  r.gridPoints = gridSamples.size();
+  if (gridSamples.size() >= 16) {
+    report("light grid", 0, 1);
+    // TraceGrid's inhibit radius: half the grid's largest step (z's unless x or y is strictly the largest)
+    const glm::dvec3 step = grid.spacing;
+    const double inhibit = 0.5 * (step.x > step.y && step.x > step.z ? step.x : step.y > step.x && step.y > step.z ? step.y : step.z);
+    modelLuminance(gridSamples, Receiver::kPoint, inhibit, knownLum, allLum);
+    r.gridCorrelation = pearson(gridLum, allLum);
+    r.gridKnownCorrelation = pearson(gridLum, knownLum);
+    report("light grid", 1, 1);
+  }
   return result;
 }
 

@@ -11,7 +11,8 @@
 //   3. fits what is left with non-negative point lights: candidates on a lattice in open space and
 //      along the normals of the residual's hot spots, chosen greedily, weighted by non-negative
 //      least squares, plus a constant term that absorbs bounced light and ambient and is then
-//      dropped (the path tracer makes its own indirect light).
+//      dropped (the path tracer makes its own indirect light),
+//   4. judges the lights on held-out texels and on the map's light grid, which the fit never sees.
 // The result is deterministic: the same map gives the same lights, byte for byte.
 #include <array>
 #include <filesystem>
@@ -88,6 +89,7 @@ struct MapLightFitOptions {
   // Judge the lights on the held-out texels (the report's held-out figures; about a fifth of the
   // fit's time). The lights do not depend on it: a capture's cached fit leaves it out.
   bool judgeOnHeldOut = true;
+  int gridSamples = 8000;  // light grid points the lights are judged on at most (a regular subset)
 };
 
 struct MapLightFitReport {
@@ -109,6 +111,12 @@ struct MapLightFitReport {
   // The share of the texels' luminance variance explained (1 - residual / total), known emitters
   // alone as q3map2 gives them (no constant), and the dataset's lights with the constant, on held-out texels.
   double knownExplained = 0.0, totalExplained = 0.0;
+  // The same correlation on the map's light grid (Bsp::lightGrid), an independent record of the
+  // lights that the fit never sees: q3map2's light from every direction at points of open space,
+  // against its model of the dataset's lights and of the known emitters alone there. 0 where the
+  // map has no usable grid points (gridPoints: those judged).
+  std::size_t gridPoints = 0;
+  double gridCorrelation = 0.0, gridKnownCorrelation = 0.0;
   std::size_t skyLightShaders = 0;  // shaders with q3map_skylight (not modelled)
   // With the entity lights hidden: their total value (suns left out), and the share of it whose
   // light has a fitted light within kRecoveryRadius.
@@ -137,6 +145,10 @@ glm::dvec3 minimumLightBytes(const Bsp& bsp, double gamma);
 
 Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& map, const MapLightFitOptions& options = {},
                                      const MapLightProgress& progress = {});
+
+// A light grid point's light from every direction (the sum of what each light gives it, q3map2's
+// LightContributionToPoint), linear lightmap units per channel, from its directed and ambient bytes.
+glm::dvec3 gridPointLight(const LightGridPoint& point, double gamma);
 
 // q3map2's light at a point without visibility: lightmap units of luminance per unit colour
 // (LightContributionToSample's `add`, before it is multiplied by the light's colour).
