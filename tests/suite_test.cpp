@@ -414,8 +414,9 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
     const std::string env = fmt::format("PYTHONPATH='{}' /usr/bin/python3 ", python.string());
     const std::string example = (fs::path(DYNBENCH_SOURCE_DIR) / "examples" / "python" / "ema.py").string();
     std::string table;
-    ASSERT_EQ(runShell(env + fmt::format("'{}' --suite '{}' 2>&1", example, out.string()), table), 0) << table;
+    ASSERT_EQ(runShell(env + fmt::format("'{}' --suite '{}' --check 2>&1", example, out.string()), table), 0) << table;
     EXPECT_NE(table.find("fps-2-flythrough"), std::string::npos) << table;
+    EXPECT_NE(table.find(" datasets, 0 differ from evaluate"), std::string::npos) << table;
     // Its column is what `evaluate` gives for the same method on each dataset's stored frames.
     std::string evaluated;
     ASSERT_EQ(runShell(env + fmt::format("-c \"import importlib.util, json, dynbench; spec = importlib.util.spec_from_file_location('ema', '{}'); "

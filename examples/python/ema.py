@@ -8,6 +8,10 @@ or scored on every dataset of a finished suite (`dynbench suite`), its column ad
 suite.json and suite.md (docs/suite.md, "Score your own method"):
 
     python3 examples/python/ema.py --suite smoke
+    python3 examples/python/ema.py --suite smoke --check   # and each dataset's column against `evaluate`
+
+`--check` runs `dynbench.evaluate` again on each dataset's stored input and reference and exits 1
+unless its mean HDR-FLIP equals the suite's column exactly.
 """
 import sys
 
@@ -40,18 +44,28 @@ class Ema:
         return colour
 
 
-def score_suite(folder):
+def score_suite(folder, check=False):
     suite = dynbench.suite_score(folder, methods=[Ema()])
-    print(f"{'dataset':<20} {'none':>8} {'ema':>8} {'ema/none':>9}   (mean HDR-FLIP over the window)")
+    print(f"{'dataset':<20} {'none':>8} {'ema':>8} {'ema/none':>9}" + (f" {'evaluate':>9}" if check else "") + "   (mean HDR-FLIP over the window)")
+    differs = 0
     for d in suite["datasets"]:
         e = d["errors"]
-        print(f"{d['name']:<20} {e['none']['flip']:8.4f} {e['ema']['flip']:8.4f} {e['ema']['flip_ratio_to_none']:9.3f}")
+        line = f"{d['name']:<20} {e['none']['flip']:8.4f} {e['ema']['flip']:8.4f} {e['ema']['flip_ratio_to_none']:9.3f}"
+        if check:
+            run = f"{folder}/{d['run']}"
+            again = dynbench.evaluate(f"{run}/input", f"{run}/frames", methods=[Ema()])["methods"][0]["mean"]["flip"]["mean"]
+            same = again == e["ema"]["flip"]
+            differs += not same
+            line += f" {again:9.4f}" + ("" if same else f"  differs by {again - e['ema']['flip']:.3g}")
+        print(line)
+    if check:
+        print(f"{len(suite['datasets'])} datasets, {differs} differ from evaluate")
+    return differs == 0
 
 
 if __name__ == "__main__":
     if sys.argv[1] == "--suite":
-        score_suite(sys.argv[2])
-        sys.exit(0)
+        sys.exit(0 if score_suite(sys.argv[2], check="--check" in sys.argv[3:]) else 1)
     scores = dynbench.evaluate(sys.argv[1], sys.argv[2], methods=["none", "accumulate", Ema()])
     print(f"{'method':<12} {'HDR-FLIP':>9} {'PSNR (dB)':>10} {'warped error change':>20}   (means over frames)")
     for method in scores["methods"]:
