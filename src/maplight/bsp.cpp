@@ -196,6 +196,11 @@ Expected<Bsp> parseBsp(const std::string& bytes, const std::string& name) {
   return bsp;
 }
 
+double LightGrid::inhibitRadius() const {
+  const glm::dvec3& s = spacing;
+  return 0.5 * (s.x > s.y && s.x > s.z ? s.x : s.y > s.x && s.y > s.z ? s.y : s.z);
+}
+
 glm::dvec3 LightGrid::position(std::size_t index) const {
   const auto nx = static_cast<std::size_t>(counts.x), ny = static_cast<std::size_t>(counts.y);
   return origin + spacing * glm::dvec3(static_cast<double>(index % nx), static_cast<double>(index / nx % ny), static_cast<double>(index / (nx * ny)));

@@ -60,6 +60,9 @@ struct LightGrid {
   glm::ivec3 counts{0};
   std::vector<LightGridPoint> points;
   glm::dvec3 position(std::size_t index) const;
+  // TraceGrid's inhibitRadius: half the largest step (z's unless x's or y's is strictly the
+  // largest); a point's traces pass through what lies nearer.
+  double inhibitRadius() const;
 };
 
 using BspEntity = std::map<std::string, std::string>;  // keys as written (q3map2 compares without case)

@@ -33,6 +33,17 @@ constexpr double kCandidateClearance = 32.0;
 // 255 (254.99997). The lightmaps show it: on seven of the nine stock maps the brightest channel is
 // 254 on 5-30 times as many texels as on 250-253 (oa_dm2: 5,223 against about 180 each).
 constexpr std::uint8_t kClippedByte = 254;
+
+// A lightmap or light grid byte as linear lightmap units: q3map2's ColorToBytes applied the map's
+// -gamma (255 (x / 255)^(1 / gamma)), undone here.
+double linearFromByte(std::uint8_t b, double gamma) { return 255.0 * std::pow(b / 255.0, gamma); }
+
+// Whether some channel of a stored colour reads the map's floor (minimumLightBytes; 0: none).
+bool atFloor(const std::uint8_t* rgb, const glm::dvec3& floorBytes) {
+  for (int k = 0; k < 3; ++k)
+    if (floorBytes[k] > 0 && rgb[k] <= floorBytes[k]) return true;
+  return false;
+}
 // Steps a fitted light may take at one scale of the refinement before the scale halves.
 constexpr int kRefineStepsPerScale = 8;
 
@@ -211,8 +222,8 @@ LightmapTexels lightmapTexels(const Bsp& bsp, const ShaderScripts& scripts, doub
           Texel texel{x, y, {}};
           texel.sample.normal = n;
           texel.sample.position = w0 * t.position[0] + w1 * t.position[1] + w2 * t.position[2] + kNudge * n;
-          for (int k = 0; k < 3; ++k) texel.sample.value[k] = 255.0 * std::pow(rgb[k] / 255.0, gamma);  // undo -gamma (ColorToBytes)
-          for (int k = 0; k < 3; ++k) texel.sample.floored = texel.sample.floored || (floorBytes[k] > 0 && rgb[k] <= floorBytes[k]);
+          for (int k = 0; k < 3; ++k) texel.sample.value[k] = linearFromByte(rgb[k], gamma);
+          texel.sample.floored = atFloor(rgb, floorBytes);
           out.floored += texel.sample.floored;
           out.unclipped.push_back(texel);
         }
@@ -386,8 +397,9 @@ std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::
       double sum = 0.0;
       for (std::size_t li : groups[k].lights) {
         const MapLight& l = lights[li];
-        const glm::dvec3 normal = l.kind == MapLightKind::kSun ? receivingNormal(s.normal, receiver, glm::dvec3(0.0), l.towardsSun)
-                                                               : receivingNormal(s.normal, receiver, s.position, l.position);
+        const glm::dvec3 normal = l.kind != MapLightKind::kSun ? receivingNormal(s.normal, receiver, s.position, l.position)
+                                  : receiver == Receiver::kPoint ? l.towardsSun
+                                                                 : s.normal;
         const double add = lightContribution(l, s.position, normal);
         if (add <= 0) continue;
         const bool visible = l.kind == MapLightKind::kSun ? occluders.seesSky(s.position, l.towardsSun, inhibit)
@@ -591,8 +603,7 @@ double formFactor(const std::vector<glm::dvec3>& polygon, const glm::dvec3& poin
 // -bounce; the bounces' light (added without the eighth) counts half its directed part twice.
 glm::dvec3 gridPointLight(const LightGridPoint& point, double gamma) {
   glm::dvec3 light(0.0);
-  const auto linear = [&](std::uint8_t b) { return 255.0 * std::pow(b / 255.0, gamma); };  // undo -gamma (ColorToBytes)
-  for (int k = 0; k < 3; ++k) light[k] = 0.5 * linear(point.directed[static_cast<std::size_t>(k)]) + 4.0 * linear(point.ambient[static_cast<std::size_t>(k)]);
+  for (std::size_t k = 0; k < 3; ++k) light[static_cast<int>(k)] = 0.5 * linearFromByte(point.directed[k], gamma) + 4.0 * linearFromByte(point.ambient[k], gamma);
   return light;
 }
 
@@ -1112,13 +1123,10 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   std::vector<std::size_t> usable;
   for (std::size_t i = 0; i < grid.points.size(); ++i) {
     const LightGridPoint& g = grid.points[i];
-    bool empty = true, clipped = false, floored = false;
-    for (std::size_t k = 0; k < 3; ++k) {
-      empty = empty && g.ambient[k] == 0 && g.directed[k] == 0;
-      clipped = clipped || g.ambient[k] >= kClippedByte || g.directed[k] >= kClippedByte;
-      floored = floored || (r.floorBytes[static_cast<int>(k)] > 0 && g.ambient[k] <= r.floorBytes[static_cast<int>(k)]);
-    }
-    if (!empty && !clipped && !floored) usable.push_back(i);
+    constexpr std::array<std::uint8_t, 3> kNone{};
+    const bool empty = g.ambient == kNone && g.directed == kNone;
+    const bool clipped = std::max({g.ambient[0], g.ambient[1], g.ambient[2], g.directed[0], g.directed[1], g.directed[2]}) >= kClippedByte;
+    if (!empty && !clipped && !atFloor(g.ambient.data(), r.floorBytes)) usable.push_back(i);
   }
   const std::size_t gridStride = std::max<std::size_t>(1, (usable.size() + options.gridSamples - 1) / std::max(options.gridSamples, 1));
   std::vector<Sample> gridSamples;
@@ -1134,10 +1142,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   r.gridPoints = gridSamples.size();
   if (gridSamples.size() >= 16) {
     report("light grid", 0, 1);
-    // TraceGrid's inhibit radius: half the grid's largest step (z's unless x or y is strictly the largest)
-    const glm::dvec3 step = grid.spacing;
-    const double inhibit = 0.5 * (step.x > step.y && step.x > step.z ? step.x : step.y > step.x && step.y > step.z ? step.y : step.z);
-    modelLuminance(gridSamples, Receiver::kPoint, inhibit, knownLum, allLum);
+    modelLuminance(gridSamples, Receiver::kPoint, grid.inhibitRadius(), knownLum, allLum);
     r.gridCorrelation = pearson(gridLum, allLum);
     r.gridKnownCorrelation = pearson(gridLum, knownLum);
     report("light grid", 1, 1);
