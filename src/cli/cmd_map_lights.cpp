@@ -10,7 +10,7 @@ namespace dynbench::cli {
 namespace {
 
 struct MapLightsCli {
-  std::string map, data = "/usr/lib/openarena/baseoa", adapterLights;
+  std::string map, data = "/usr/lib/openarena/baseoa", adapterLights, gridFit = "where-floored";
   bool hideEntityLights = false;
   maplight::MapLightFitOptions options;
 };
@@ -20,6 +20,7 @@ Expected<void> runMapLights(const MapLightsCli& cli) {
   if (!files) return std::unexpected(files.error());
   maplight::MapLightFitOptions options = cli.options;
   options.hideEntityLights = cli.hideEntityLights;
+  options.gridFit = cli.gridFit == "always" ? maplight::GridFit::kAlways : cli.gridFit == "never" ? maplight::GridFit::kNever : maplight::GridFit::kWhereFloored;
   std::unique_ptr<Progress> bar;
   auto lighting = maplight::fitMapLighting(*files, cli.map, options, stepProgress("map-lights", bar));
   bar.reset();
@@ -35,9 +36,12 @@ Expected<void> runMapLights(const MapLightsCli& cli) {
              r.fitSamples, r.candidates, r.latticeCandidates, r.latticeSpacing, r.candidates - r.latticeCandidates, r.fittedLights, r.refinedLights, r.constant.r, r.constant.g, r.constant.b);
   fmt::print("  held-out texels ({}): correlation {:.3f} (known emitters alone {:.3f}); variance explained {:.3f} (known alone {:.3f})\n",
              r.heldOutSamples, r.heldOutCorrelation, r.knownCorrelation, r.totalExplained, r.knownExplained);
+  if (r.gridFitted)
+    fmt::print("  light grid: {} points (the lattice's even half) fitted beside the texels, the directed light alone where the ambient is clipped or at the floor\n",
+               r.gridFitPoints);
   if (r.gridPoints > 0)
-    fmt::print("  light grid ({} points, never fitted): correlation {:.3f} (known emitters alone {:.3f})\n", r.gridPoints, r.gridCorrelation,
-               r.gridKnownCorrelation);
+    fmt::print("  light grid ({} points{}): correlation {:.3f} (known emitters alone {:.3f})\n", r.gridPoints,
+               r.gridFitPoints > 0 ? ", the lattice's other half, not fitted" : ", never fitted", r.gridCorrelation, r.gridKnownCorrelation);
   else
     fmt::print("  light grid: no usable points (none, or every one clipped or at the floor)\n");
   if (cli.hideEntityLights)
@@ -78,6 +82,9 @@ void addMapLightsCommand(CLI::App& app, CommandRun& run) {
       ->capture_default_str()
       ->check(CLI::Range(0, 100000));
   cmd->add_option("--grid-samples", cli->options.gridSamples, "Light grid points the lights are judged on at most")->capture_default_str()->check(CLI::Range(16, 1000000));
+  cmd->add_option("--grid-fit", cli->gridFit, "When the light grid is fit data beside the lightmaps: where the map's lightmap floor hides most texels, never, always")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"where-floored", "never", "always"}));
   cmd->add_option("--adapter-lights", cli->adapterLights, "Write the lights file the OpenArena capture adapter reads");
   cmd->callback([cli, &run] { run = [cli] { return runMapLights(*cli); }; });
 }

@@ -196,6 +196,17 @@ Expected<Bsp> parseBsp(const std::string& bytes, const std::string& name) {
   return bsp;
 }
 
+glm::dvec3 LightGridPoint::mainDirection() const {
+  constexpr double kPerByte = 2.0 * 3.14159265358979323846 / 255.0;  // NormalToLatLong's 255 / 360 per degree
+  const double polar = direction[0] * kPerByte, azimuth = direction[1] * kPerByte;
+  return {std::cos(azimuth) * std::sin(polar), std::sin(azimuth) * std::sin(polar), std::cos(polar)};
+}
+
+bool LightGrid::even(std::size_t index) const {
+  const auto nx = static_cast<std::size_t>(counts.x), ny = static_cast<std::size_t>(counts.y);
+  return (index % nx + index / nx % ny + index / (nx * ny)) % 2 == 0;
+}
+
 double LightGrid::inhibitRadius() const {
   const glm::dvec3& s = spacing;
   return 0.5 * (s.x > s.y && s.x > s.z ? s.x : s.y > s.x && s.y > s.z ? s.y : s.z);

@@ -54,14 +54,17 @@ struct BspModel {
 struct LightGridPoint {
   std::array<std::uint8_t, 3> ambient{}, directed{};
   std::array<std::uint8_t, 2> direction{};  // q3map2's NormalToLatLong: polar angle, then azimuth, 255 / 360 per degree
+  // The unit direction its light mainly comes from (towards the lights), decoded from `direction`.
+  glm::dvec3 mainDirection() const;
 };
 struct LightGrid {
   glm::dvec3 origin{0.0}, spacing{0.0};
   glm::ivec3 counts{0};
   std::vector<LightGridPoint> points;
   glm::dvec3 position(std::size_t index) const;
-  // TraceGrid's inhibitRadius: half the largest step (z's unless x's or y's is strictly the
-  // largest); a point's traces pass through what lies nearer.
+  bool even(std::size_t index) const;  // whether x + y + z is even: a checkerboard that halves the lattice
+  // TraceGrid's inhibitRadius: half the largest step (z's unless x's or y's is strictly the largest);
+  // a point's traces pass through what lies nearer.
   double inhibitRadius() const;
 };
 

@@ -10,7 +10,7 @@
 namespace dynbench::maplight {
 
 // Bumped whenever the fit or the file's meaning changes, so that older cached files are not used.
-inline constexpr int kFitVersion = 6;
+inline constexpr int kFitVersion = 7;
 
 // $XDG_CACHE_HOME/dynbench/map-lights, else $HOME/.cache/dynbench/map-lights.
 std::filesystem::path defaultCacheFolder();

@@ -54,6 +54,14 @@ struct Sample {
   // floor whatever it is below it. The fit takes the value as it reads (a censored fit measured
   // worse: integrations/openarena/README.md); the recovery report asks which lights show above it.
   bool floored = false;
+  // A light grid point (LightContributionToPoint) rather than a texel: it receives light from
+  // every direction, its traces pass through what lies within `inhibit` of it, and, where
+  // `mainDirection` is set, it is the point's directed light: each light's times its cosine to
+  // that direction (TraceGrid). `normal` is then the main direction too (the residual's hot
+  // spots put candidates along it).
+  bool point = false;
+  double inhibit = 0.0;
+  glm::dvec3 mainDirection{0.0};
 };
 
 // The map's geometry as Embree sees it: `all` holds the solid surfaces (node 0) and the sky's
@@ -359,26 +367,26 @@ struct EmitterGroup {
   std::size_t backGroup = 0;              // a kFront group's kBack partner (same surfaces)
 };
 
-// How a sample receives light: as a lightmap texel (a surface facing its normal:
-// LightContributionToSample) or as a light grid point (light from every direction, each emitter
-// seen head on: LightContributionToPoint; the sample's normal is not used, and its traces pass
-// through what lies within `inhibitRadius` of it).
-enum class Receiver { kSurface, kPoint };
-
-// The normal a sample receives light from `towards` with.
-glm::dvec3 receivingNormal(const glm::dvec3& normal, Receiver receiver, const glm::dvec3& position, const glm::dvec3& towards) {
-  if (receiver == Receiver::kSurface) return normal;
-  const glm::dvec3 d = towards - position;
+// The normal a sample receives light from `towards` with: a texel's own, or for a grid point
+// the direction to the light (each emitter seen head on).
+glm::dvec3 receivingNormal(const Sample& s, const glm::dvec3& towards) {
+  if (!s.point) return s.normal;
+  const glm::dvec3 d = towards - s.position;
   const double length = glm::length(d);
   return length > 0 ? d / length : glm::dvec3(0.0, 0.0, 1.0);
+}
+
+// The share of a light from direction `direction` a sample counts: all of it, or at a grid point
+// read for its directed light, its cosine to the point's main direction (at least 0).
+double directedShare(const Sample& s, const glm::dvec3& direction) {
+  if (!s.point || s.mainDirection == glm::dvec3(0.0)) return 1.0;
+  return std::max(0.0, glm::dot(direction, s.mainDirection));
 }
 
 // Every group's light at every sample (q3map2's model, lightmap units per unit colour, visibility
 // included) as sparse columns.
 std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::vector<EmitterGroup>& groups, const std::vector<MapLight>& lights,
-                                 const std::vector<SurfaceEmitter>& surfaces, const Occluders& occluders, Receiver receiver = Receiver::kSurface,
-                                 double inhibitRadius = 0.0) {
-  const double inhibit = receiver == Receiver::kPoint ? inhibitRadius : 0.0;
+                                 const std::vector<SurfaceEmitter>& surfaces, const Occluders& occluders) {
   const std::size_t g = groups.size();
   // per piece, once: the radius of its bounding sphere about the point traced to, and its area
   struct Piece {
@@ -393,14 +401,13 @@ std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::
   std::vector<float> dense(samples.size() * g, 0.0f);
   tbb::parallel_for(std::size_t(0), samples.size(), [&](std::size_t i) {
     const Sample& s = samples[i];
+    const double inhibit = s.inhibit;
     for (std::size_t k = 0; k < g; ++k) {
       double sum = 0.0;
       for (std::size_t li : groups[k].lights) {
         const MapLight& l = lights[li];
-        const glm::dvec3 normal = l.kind != MapLightKind::kSun ? receivingNormal(s.normal, receiver, s.position, l.position)
-                                  : receiver == Receiver::kPoint ? l.towardsSun
-                                                                 : s.normal;
-        const double add = lightContribution(l, s.position, normal);
+        const glm::dvec3 normal = l.kind == MapLightKind::kSun ? (s.point ? l.towardsSun : s.normal) : receivingNormal(s, l.position);
+        const double add = lightContribution(l, s.position, normal) * directedShare(s, normal);
         if (add <= 0) continue;
         const bool visible = l.kind == MapLightKind::kSun ? occluders.seesSky(s.position, l.towardsSun, inhibit)
                                                            : occluders.visible(s.position, l.position, inhibit);
@@ -419,7 +426,8 @@ std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::
         const bool negligible = distance > 0 && area / (std::numbers::pi * distance * distance) * e.value * kFormFactorValueScale * kAreaScale < 0.01;
         if (!negligible) {
           bool fromBack = false;
-          const double add = surfaceContribution(e, s.position, receivingNormal(s.normal, receiver, s.position, e.origin), &fromBack);
+          const glm::dvec3 normal = receivingNormal(s, e.origin);
+          const double add = surfaceContribution(e, s.position, normal, &fromBack) * directedShare(s, normal);
           if (add > 0 && occluders.visible(s.position, fromBack ? e.origin - 2.0 * e.normal : e.origin, inhibit)) {
             if (fromBack && side == EmitterSide::kFront) backSum += add;
             else sum += add;
@@ -430,7 +438,8 @@ std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::
           MapLight splash;
           splash.position = e.origin + e.normal * e.backsplashDistance;
           splash.value = e.value * area * kAreaScale * e.backsplashFraction / kPointScale;
-          const double b = lightContribution(splash, s.position, receivingNormal(s.normal, receiver, s.position, splash.position));
+          const glm::dvec3 normal = receivingNormal(s, splash.position);
+          const double b = lightContribution(splash, s.position, normal) * directedShare(s, normal);
           if (b > 0.01 && occluders.visible(s.position, splash.position, inhibit)) sum += b;
         }
       }
@@ -456,10 +465,12 @@ Column candidateColumn(const glm::dvec3& position, const std::vector<Sample>& sa
   light.position = position;
   light.value = 1.0;
   for (std::size_t i = 0; i < samples.size(); ++i) {
-    const double add = lightContribution(light, samples[i].position, samples[i].normal);
+    const Sample& s = samples[i];
+    const glm::dvec3 normal = receivingNormal(s, position);
+    const double add = lightContribution(light, s.position, normal) * directedShare(s, normal);
     // below 1/4 of a byte for the brightest entity lights q3map2 maps use (V ~ 1000): nothing
     if (add * 1000.0 < 0.25) continue;
-    if (!occluders.visible(samples[i].position, position)) continue;
+    if (!occluders.visible(s.position, position, s.inhibit)) continue;
     c.rows.push_back(static_cast<std::uint32_t>(i));
     c.values.push_back(static_cast<float>(add));
     c.norm2 += add * add;
@@ -606,6 +617,29 @@ glm::dvec3 gridPointLight(const LightGridPoint& point, double gamma) {
   for (std::size_t k = 0; k < 3; ++k) light[static_cast<int>(k)] = 0.5 * linearFromByte(point.directed[k], gamma) + 4.0 * linearFromByte(point.ambient[k], gamma);
   return light;
 }
+
+namespace {
+// A light grid point as a sample (LightContributionToPoint): it receives light from every
+// direction, and its traces pass through what lies within the grid's inhibit radius.
+Sample gridPointSample(const LightGrid& grid, std::size_t index) {
+  Sample s;
+  s.point = true;
+  s.inhibit = grid.inhibitRadius();
+  s.position = grid.position(index);
+  return s;
+}
+
+bool emptyGridPoint(const LightGridPoint& g) {
+  constexpr std::array<std::uint8_t, 3> kNone{};
+  return g.ambient == kNone && g.directed == kNone;  // outside the map
+}
+
+// The step of a regular subset of at most `atMost` of `count` items.
+std::size_t subsetStride(std::size_t count, int atMost) {
+  const auto most = static_cast<std::size_t>(std::max(atMost, 1));
+  return std::max<std::size_t>(1, (count + most - 1) / most);
+}
+}  // namespace
 
 double lightContribution(const MapLight& light, const glm::dvec3& point, const glm::dvec3& normal) {
   if (light.kind == MapLightKind::kSun) {
@@ -770,24 +804,78 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
       }
     }
   }
-  const std::size_t knownLights = result.lights.size(), groupCount = groups.size();
-
-  // Samples: a regular subset of the texels to fit, a disjoint one to judge the fit on.
+  // The lightmap texels (the fit's and the judge's samples are regular subsets of them, below).
   r.floorBytes = minimumLightBytes(*bsp, r.gamma);
   const LightmapTexels texels = lightmapTexels(*bsp, *scripts, r.gamma, r.floorBytes);
   r.texels = texels.texels;
   r.clippedTexels = texels.clipped;
   r.flooredTexels = texels.floored;
+
+  // The light grid as fit data, on the lattice's even points (the odd ones judge the lights below).
+  // Its directed light has no floor and each point says where its light mainly comes from, so it
+  // shows lights a lightmap floor hides. Where the lightmaps are not floored they are the better
+  // data: fitted on every map, the grid cost oa_dm3 (0.914 -> 0.878 held out, 256 lights, 3 min)
+  // and oa_bases3's recovery (96 -> 87 %); integrations/openarena/README.md has the figures.
+  const LightGrid& grid = bsp->lightGrid;
+  const bool floorHidesMost = 2 * texels.floored > texels.texels;
+  r.gridFitted = options.gridFit == GridFit::kAlways || (options.gridFit == GridFit::kWhereFloored && floorHidesMost);
+  std::vector<Sample> gridRows;
+  if (r.gridFitted) {
+    std::vector<std::size_t> usable;
+    for (std::size_t i = 0; i < grid.points.size(); ++i) {
+      const LightGridPoint& g = grid.points[i];
+      if (!emptyGridPoint(g) && grid.even(i) && std::max({g.directed[0], g.directed[1], g.directed[2]}) < kClippedByte) usable.push_back(i);
+    }
+    const std::size_t stride = subsetStride(usable.size(), options.gridFitSamples);
+    for (std::size_t u = 0; u < usable.size(); u += stride) {
+      const LightGridPoint& g = grid.points[usable[u]];
+      Sample s = gridPointSample(grid, usable[u]);
+      s.normal = g.mainDirection();
+      // The light from every direction where the ambient is neither clipped nor floored (what the
+      // grid's judge compares, gridPointLight); else the directed light alone, each light's times
+      // its cosine to the main direction (TraceGrid), with no floor in it.
+      const bool whole = std::max({g.ambient[0], g.ambient[1], g.ambient[2]}) < kClippedByte && !atFloor(g.ambient.data(), r.floorBytes);
+      if (whole) s.value = gridPointLight(g, r.gamma);
+      else {
+        s.mainDirection = s.normal;
+        for (std::size_t k = 0; k < 3; ++k) s.value[static_cast<int>(k)] = linearFromByte(g.directed[k], r.gamma);
+      }
+      gridRows.push_back(s);
+    }
+  }
+  // The grid's bounced light takes a constant of its own: a group with no emitters, its column set below.
+  const std::size_t gridConstant = groups.size();
+  if (!gridRows.empty()) groups.push_back({"the light grid's bounced light (a constant)", glm::dvec3(1.0), {}, {}});
+  const std::size_t knownLights = result.lights.size(), groupCount = groups.size();
+
   const int stride =
       std::max(2, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(texels.texels) / std::max(options.fitSamples, 1)))));
-  const std::vector<Sample> fit = texelSubset(texels.unclipped, stride, 0);
+  std::vector<Sample> fit = texelSubset(texels.unclipped, stride, 0);
   const std::vector<Sample> heldOut = texelSubset(texels.unclipped, stride, stride / 2);
   r.fitSamples = fit.size();
+  const std::size_t texelRows = fit.size();  // the texels come first, then the grid's points
+  fit.insert(fit.end(), gridRows.begin(), gridRows.end());
+  r.gridFitPoints = gridRows.size();
   r.heldOutSamples = heldOut.size();
-  if (fit.size() < 16) return fail(ErrorCode::kUnsupported, "{}: {} lightmap texels to fit; the map has no lightmaps to recover lights from", path, fit.size());
+  if (texelRows < 16) return fail(ErrorCode::kUnsupported, "{}: {} lightmap texels to fit; the map has no lightmaps to recover lights from", path, texelRows);
   report("known emitters", 0, 1);
   std::vector<Column> columns = groupColumns(fit, groups, result.lights, result.surfaceLights, *occluders);
+  if (!gridRows.empty()) {
+    Column& c = columns[gridConstant];
+    for (std::size_t i = texelRows; i < fit.size(); ++i) {
+      c.rows.push_back(static_cast<std::uint32_t>(i));
+      c.values.push_back(1.0f);
+    }
+    c.norm2 = static_cast<double>(gridRows.size());
+  }
   report("known emitters", 1, 1);
+  // The fit's own constant (bounced light and ambient in the lightmaps) is over the texels alone.
+  const auto texelSum = [&](const Column& c) {
+    double sum = 0.0;
+    for (std::size_t k = 0; k < c.rows.size(); ++k)
+      if (c.rows[k] < texelRows) sum += c.values[k];
+    return sum;
+  };
 
   // A column's colour: its group's, white for a candidate. `channel` 3 is luminance.
   const auto colorOf = [&](std::size_t column, int channel) {
@@ -815,7 +903,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
     row[chosen.size()] = cj.norm2;
     for (std::uint32_t i : cj.rows) dense[i] = 0.0;
     gramRows.push_back(std::move(row));
-    columnSums.push_back(std::accumulate(cj.values.begin(), cj.values.end(), 0.0));
+    columnSums.push_back(texelSum(cj));
     chosen.push_back(j);
   };
   const auto removeColumns = [&](const std::vector<char>& drop) {
@@ -845,13 +933,13 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
       gram[a * m + m - 1] = gram[(m - 1) * m + a] = columnSums[a] * ca;
       atb[a] = dot(columns[chosen[a]], y) * ca;
     }
-    gram[(m - 1) * m + m - 1] = static_cast<double>(n);
-    atb[m - 1] = std::accumulate(y.begin(), y.end(), 0.0);
+    gram[(m - 1) * m + m - 1] = static_cast<double>(texelRows);
+    atb[m - 1] = std::accumulate(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(texelRows), 0.0);
     return nnls(gram, atb).x;
   };
   const auto residualOf = [&](const std::vector<double>& y, const std::vector<double>& x, int channel, std::vector<double>& out) {
     out.assign(n, 0.0);
-    for (std::size_t i = 0; i < n; ++i) out[i] = y[i] - x.back();
+    for (std::size_t i = 0; i < n; ++i) out[i] = i < texelRows ? y[i] - x.back() : y[i];
     for (std::size_t a = 0; a < chosen.size(); ++a) {
       const Column& c = columns[chosen[a]];
       const double w = x[a] * colorOf(chosen[a], channel);
@@ -863,10 +951,12 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   };
   std::vector<double> target(n), residual;
   for (std::size_t i = 0; i < n; ++i) target[i] = luminance(fit[i].value);
+  // The lightmaps' signal (the texels' variance) sets when the greedy fit stops, the grid's rows or not.
   double signal = 0.0;
   {
-    const double mean = std::accumulate(target.begin(), target.end(), 0.0) / static_cast<double>(n);
-    for (double t : target) signal += (t - mean) * (t - mean);
+    const auto texelsEnd = target.begin() + static_cast<std::ptrdiff_t>(texelRows);
+    const double mean = std::accumulate(target.begin(), texelsEnd, 0.0) / static_cast<double>(texelRows);
+    for (auto t = target.begin(); t != texelsEnd; ++t) signal += (*t - mean) * (*t - mean);
   }
   for (std::size_t k = 0; k < groupCount; ++k) addColumn(k);
   double error = residualOf(target, solve(target, 3), 3, residual);
@@ -996,7 +1086,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
         if (b != a) gramRows[a][b] = gramRows[b][a] = dot(columns[chosen[b]], dense);
       for (std::uint32_t i : cj.rows) dense[i] = 0.0;
       gramRows[a][a] = cj.norm2;
-      columnSums[a] = std::accumulate(cj.values.begin(), cj.values.end(), 0.0);
+      columnSums[a] = texelSum(cj);
       chosen[a] = j;
       residual = std::move(without);
       for (std::size_t k = 0; k < cj.rows.size(); ++k) residual[cj.rows[k]] -= currentWeight * cj.values[k];
@@ -1054,7 +1144,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
       bool inLightmaps = false;
       const Column& c = hiddenColumns[h];
       for (std::size_t k = 0; k < c.rows.size() && !inLightmaps; ++k)
-        inLightmaps = !fit[c.rows[k]].floored && c.values[k] * luminance(hidden[h].color) >= kShownLightmapUnits;
+        inLightmaps = !fit[c.rows[k]].floored && !fit[c.rows[k]].point && c.values[k] * luminance(hidden[h].color) >= kShownLightmapUnits;
       bool near = false;
       for (std::size_t i = knownLights; i < result.lights.size() && !near; ++i)
         near = glm::length(result.lights[i].position - hidden[h].position) <= kRecoveryRadius;
@@ -1083,9 +1173,8 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   heldLights.insert(heldLights.end(), result.lights.begin() + static_cast<std::ptrdiff_t>(knownLights), result.lights.end());
   // The luminance q3map2's model gives each sample: of the known emitters alone (their strength as
   // q3map2 gives it), and of the dataset's lights (weighted, with the fitted ones).
-  const auto modelLuminance = [&](const std::vector<Sample>& samples, Receiver receiver, double inhibitRadius, std::vector<double>& knownLum,
-                                  std::vector<double>& allLum) {
-    const std::vector<Column> columnsHere = groupColumns(samples, all, heldLights, unweightedSurfaces, *occluders, receiver, inhibitRadius);
+  const auto modelLuminance = [&](const std::vector<Sample>& samples, std::vector<double>& knownLum, std::vector<double>& allLum) {
+    const std::vector<Column> columnsHere = groupColumns(samples, all, heldLights, unweightedSurfaces, *occluders);
     knownLum.assign(samples.size(), 0.0);
     allLum.assign(samples.size(), 0.0);
     for (std::size_t k = 0; k < all.size(); ++k) {
@@ -1099,7 +1188,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   };
   std::vector<double> texel(heldOut.size()), knownLum, allLum;
   for (std::size_t i = 0; i < heldOut.size(); ++i) texel[i] = luminance(heldOut[i].value);
-  modelLuminance(heldOut, Receiver::kSurface, 0.0, knownLum, allLum);
+  modelLuminance(heldOut, knownLum, allLum);
   r.heldOutCorrelation = pearson(texel, allLum);
   r.knownCorrelation = pearson(texel, knownLum);
   const auto explained = [&](const std::vector<double>& model, double offset) {
@@ -1119,22 +1208,19 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   // points of the map's open space, where players move (gridPointLight). Left out: points with
   // nothing (outside the map), a byte clipped, or the ambient at the map's floor (_minlight raises
   // the grid's ambient too).
-  const LightGrid& grid = bsp->lightGrid;
   std::vector<std::size_t> usable;
   for (std::size_t i = 0; i < grid.points.size(); ++i) {
+    if (r.gridFitted && grid.even(i)) continue;  // fitted
     const LightGridPoint& g = grid.points[i];
-    constexpr std::array<std::uint8_t, 3> kNone{};
-    const bool empty = g.ambient == kNone && g.directed == kNone;
     const bool clipped = std::max({g.ambient[0], g.ambient[1], g.ambient[2], g.directed[0], g.directed[1], g.directed[2]}) >= kClippedByte;
-    if (!empty && !clipped && !atFloor(g.ambient.data(), r.floorBytes)) usable.push_back(i);
+    if (!emptyGridPoint(g) && !clipped && !atFloor(g.ambient.data(), r.floorBytes)) usable.push_back(i);
   }
-  const std::size_t gridStride = std::max<std::size_t>(1, (usable.size() + options.gridSamples - 1) / std::max(options.gridSamples, 1));
+  const std::size_t gridStride = subsetStride(usable.size(), options.gridSamples);
   std::vector<Sample> gridSamples;
   std::vector<double> gridLum;
   for (std::size_t u = 0; u < usable.size(); u += gridStride) {
     const LightGridPoint& g = grid.points[usable[u]];
-    Sample s;
-    s.position = grid.position(usable[u]);
+    Sample s = gridPointSample(grid, usable[u]);
     s.value = gridPointLight(g, r.gamma);
     gridSamples.push_back(s);
     gridLum.push_back(luminance(s.value));
@@ -1142,7 +1228,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   r.gridPoints = gridSamples.size();
   if (gridSamples.size() >= 16) {
     report("light grid", 0, 1);
-    modelLuminance(gridSamples, Receiver::kPoint, grid.inhibitRadius(), knownLum, allLum);
+    modelLuminance(gridSamples, knownLum, allLum);
     r.gridCorrelation = pearson(gridLum, allLum);
     r.gridKnownCorrelation = pearson(gridLum, knownLum);
     report("light grid", 1, 1);

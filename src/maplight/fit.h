@@ -76,6 +76,16 @@ struct SurfaceEmitter {
   std::string shaderName;
 };
 
+// When the light grid (BSP lump 15) joins the lightmap texels as fit data, on the lattice's even
+// points (the odd ones then judge the lights). Its directed light has no floor and each point says
+// where its light mainly comes from, so it shows lights that a map's lightmap floor (_minlight)
+// hides; where nothing is floored the lightmaps alone fit better.
+enum class GridFit {
+  kWhereFloored,  // where the floor hides most of the map's texels (oa_ctf2 of the stock maps)
+  kNever,
+  kAlways,
+};
+
 struct MapLightFitOptions {
   // Leave the map's light entities out of the known emitters: how the fit's recovery is measured on
   // the maps that keep them.
@@ -90,6 +100,8 @@ struct MapLightFitOptions {
   // fit's time). The lights do not depend on it: a capture's cached fit leaves it out.
   bool judgeOnHeldOut = true;
   int gridSamples = 8000;  // light grid points the lights are judged on at most (a regular subset)
+  GridFit gridFit = GridFit::kWhereFloored;
+  int gridFitSamples = 8000;  // grid points fitted at most
 };
 
 struct MapLightFitReport {
@@ -115,7 +127,8 @@ struct MapLightFitReport {
   // lights that the fit never sees: q3map2's light from every direction at points of open space,
   // against its model of the dataset's lights and of the known emitters alone there. 0 where the
   // map has no usable grid points (gridPoints: those judged).
-  std::size_t gridPoints = 0;
+  std::size_t gridPoints = 0, gridFitPoints = 0;  // grid points judged on; fitted
+  bool gridFitted = false;                        // whether the grid was fit data (MapLightFitOptions::gridFit)
   double gridCorrelation = 0.0, gridKnownCorrelation = 0.0;
   std::size_t skyLightShaders = 0;  // shaders with q3map_skylight (not modelled)
   // With the entity lights hidden: their total value (suns left out), and the share of it whose
