@@ -1,6 +1,7 @@
 #include "maplight/fit.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <map>
 #include <set>
@@ -585,7 +586,11 @@ double formFactor(const std::vector<glm::dvec3>& polygon, const glm::dvec3& poin
   // edge i subtends and u_i the unit normal of the plane through it and the point.
   const std::size_t n = polygon.size();
   if (n < 3) return 0.0;
-  std::vector<glm::dvec3> dirs(n);
+  // on the stack for the usual windings (q3map2's subdivided pieces have 3-8 corners): this runs
+  // for every sample and piece of every surface light
+  std::array<glm::dvec3, 16> small;
+  std::vector<glm::dvec3> large(n > small.size() ? n : 0);
+  glm::dvec3* dirs = n > small.size() ? large.data() : small.data();
   for (std::size_t i = 0; i < n; ++i) {
     const glm::dvec3 d = polygon[i] - point;
     const double l = glm::length(d);
@@ -1039,6 +1044,10 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
       double currentError = withoutNorm - 2.0 * currentWeight * currentDot + currentWeight * currentWeight * current->norm2;
       Column best;
       bool moved = false;
+      // Positions already tried for this light. A tried position's error was at least the error
+      // then held, which only falls, so the strict test below never picks it again: skipping it
+      // (the step back to where the light came from, above all) leaves the search's path as it was.
+      std::set<std::array<double, 3>> tried;
       // A pattern search: at each scale the light keeps stepping to its best axis neighbour
       // while that lowers the residual (up to kRefineStepsPerScale steps), then the scale halves.
       for (const double step : {spacing / 2, spacing / 4, spacing / 8, spacing / 16}) {
@@ -1048,7 +1057,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
             for (const double sign : {-1.0, 1.0}) {
               glm::dvec3 p = position;
               p[axis] += sign * step;
-              trials.push_back(p);
+              if (tried.insert({p.x, p.y, p.z}).second) trials.push_back(p);
             }
           std::vector<Column> trialColumns(trials.size());
           std::vector<char> usable(trials.size(), 0);
