@@ -8,12 +8,12 @@
 # for it here (checked), and if(TEST) is always false in a file ctest reads.
 set(dynbench_test_costs
   Demo.WholeChainOnAShortMatch=172
+  OpenArena.StrippedLightsAreFittedToTheLightmaps=152
   Slurm.SuiteAsAChainOfJobsGivesTheLocalSuitesNumbers=129
+  DiscardCli.ASubPixelPanOverAFineTextureDiscardsNothingWhenRadianceIsFiltered=127
   Suite.SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught=119
-  OpenArena.StrippedLightsAreFittedToTheLightmaps=118
   Cube2.SeededMatchIsDeterministicAndConverts=101
   Slurm.ASignalledTaskRequeuesAndACancelledOneIsReportedAndRerun=95
-  DiscardCli.ASubPixelPanOverAFineTextureDiscardsNothingWhenRadianceIsFiltered=90
   Slurm.DemoAsAChainOfJobsGivesTheLocalDemosTables=74
   Cube2.SecondMapsLavaAndWaterConvertValidateAndAgreeWithTheGame=55
   Cube2.TheGamesOwnFramesAgreeWithTheDatasetsRenderOfThem=46
