@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <cctype>
 #include <cstring>
 #include <optional>
@@ -197,7 +198,7 @@ Expected<Bsp> parseBsp(const std::string& bytes, const std::string& name) {
 }
 
 glm::dvec3 LightGridPoint::mainDirection() const {
-  constexpr double kPerByte = 2.0 * 3.14159265358979323846 / 255.0;  // NormalToLatLong's 255 / 360 per degree
+  constexpr double kPerByte = 2.0 * std::numbers::pi / 255.0;  // NormalToLatLong's 255 / 360 per degree
   const double polar = direction[0] * kPerByte, azimuth = direction[1] * kPerByte;
   return {std::cos(azimuth) * std::sin(polar), std::sin(azimuth) * std::sin(polar), std::cos(polar)};
 }

@@ -39,6 +39,9 @@ constexpr std::uint8_t kClippedByte = 254;
 // -gamma (255 (x / 255)^(1 / gamma)), undone here.
 double linearFromByte(std::uint8_t b, double gamma) { return 255.0 * std::pow(b / 255.0, gamma); }
 
+// Whether some channel of a stored colour is clipped (kClippedByte or above).
+bool clippedColor(const std::uint8_t* rgb) { return std::max({rgb[0], rgb[1], rgb[2]}) >= kClippedByte; }
+
 // Whether some channel of a stored colour reads the map's floor (minimumLightBytes; 0: none).
 bool atFloor(const std::uint8_t* rgb, const glm::dvec3& floorBytes) {
   for (int k = 0; k < 3; ++k)
@@ -221,7 +224,7 @@ LightmapTexels lightmapTexels(const Bsp& bsp, const ShaderScripts& scripts, doub
           ++out.texels;
           // ColorToBytes normalises a colour whose brightest channel passes 255 to 255 in float and
           // truncates, so the clipped channel reads 254 or 255: its level is lost
-          if (std::max({rgb[0], rgb[1], rgb[2]}) >= kClippedByte) {
+          if (clippedColor(rgb)) {
             ++out.clipped;
             continue;
           }
@@ -829,7 +832,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
     std::vector<std::size_t> usable;
     for (std::size_t i = 0; i < grid.points.size(); ++i) {
       const LightGridPoint& g = grid.points[i];
-      if (!emptyGridPoint(g) && grid.even(i) && std::max({g.directed[0], g.directed[1], g.directed[2]}) < kClippedByte) usable.push_back(i);
+      if (!emptyGridPoint(g) && grid.even(i) && !clippedColor(g.directed.data())) usable.push_back(i);
     }
     const std::size_t stride = subsetStride(usable.size(), options.gridFitSamples);
     for (std::size_t u = 0; u < usable.size(); u += stride) {
@@ -839,7 +842,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
       // The light from every direction where the ambient is neither clipped nor floored (what the
       // grid's judge compares, gridPointLight); else the directed light alone, each light's times
       // its cosine to the main direction (TraceGrid), with no floor in it.
-      const bool whole = std::max({g.ambient[0], g.ambient[1], g.ambient[2]}) < kClippedByte && !atFloor(g.ambient.data(), r.floorBytes);
+      const bool whole = !clippedColor(g.ambient.data()) && !atFloor(g.ambient.data(), r.floorBytes);
       if (whole) s.value = gridPointLight(g, r.gamma);
       else {
         s.mainDirection = s.normal;
@@ -1221,7 +1224,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   for (std::size_t i = 0; i < grid.points.size(); ++i) {
     if (r.gridFitted && grid.even(i)) continue;  // fitted
     const LightGridPoint& g = grid.points[i];
-    const bool clipped = std::max({g.ambient[0], g.ambient[1], g.ambient[2], g.directed[0], g.directed[1], g.directed[2]}) >= kClippedByte;
+    const bool clipped = clippedColor(g.ambient.data()) || clippedColor(g.directed.data());
     if (!emptyGridPoint(g) && !clipped && !atFloor(g.ambient.data(), r.floorBytes)) usable.push_back(i);
   }
   const std::size_t gridStride = subsetStride(usable.size(), options.gridSamples);
