@@ -45,8 +45,10 @@ packages=(
   libsdl2-dev libsdl2-image-dev libsdl2-mixer-dev libenet-dev libgl-dev cube2-data xvfb xauth
   libgl1-mesa-dri
   # OpenArena (`dynbench capture openarena`): Debian's ioquake3 engine and the game's data; its
-  # game code is rebuilt from the source package with the capture hooks (below)
-  openarena
+  # game code is rebuilt from the source package with the capture hooks (below); qemu-user runs
+  # the engine on an emulated CPU, so that a seed plays the same match on every host
+  # (integrations/openarena/README.md, "Across CPUs")
+  openarena qemu-user
 )
 
 missing=()

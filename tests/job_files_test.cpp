@@ -209,6 +209,7 @@ TEST(JobFiles, DemoJobRoundTripsEveryField) {
   o.map = "oa_dm4";
   o.bots = 3;
   o.seconds = 7.5;
+  o.gameCpu = "host";
   o.fps = 30;
   o.width = 160;
   o.height = 90;
@@ -231,6 +232,7 @@ TEST(JobFiles, DemoJobRoundTripsEveryField) {
 
   for (const auto& [key, value, message] :
        {std::tuple{"engine", nlohmann::json("quake"), "demo.json: /engine: expected \"cube2\" or \"openarena\", found \"quake\""},
+        std::tuple{"game_cpu", nlohmann::json("arm"), "demo.json: /game_cpu: expected \"emulated\" or \"host\", found \"arm\""},
         std::tuple{"max_spp", nlohmann::json(4), "demo.json: /max_spp: expected at least /spp"},
         std::tuple{"methods", nlohmann::json({"none", 3}), "demo.json: /methods/1: expected a string, found 3"},
         std::tuple{"res", nlohmann::json("96x54"), "demo.json: /res: expected one of the demo job's keys"}}) {

@@ -83,6 +83,7 @@ TEST(Suite, ManifestErrorsNameTheFileAndPointer) {
       {"/datasets/0/preset", "frantic", "/datasets/0/preset"},
       {"/datasets/0/engine", "quake", "/datasets/0/engine: expected \"cube2\" or \"openarena\""},
       {"/datasets/0/engine", "openarena", "/datasets/0/preset: expected no preset"},  // dataset 0 has preset fps
+      {"/datasets/0/game_cpu", "host", "/datasets/0/game_cpu: expected no game_cpu: Cube 2 runs on the host"},
       {"/datasets/2/seconds", -3, "/datasets/2/seconds"},
       {"/datasets/0/seed", nullptr, "/datasets/0/seed: missing"},
       {"/render/width", 3, "/render/width: expected a whole number in [8, 7680]"},

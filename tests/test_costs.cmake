@@ -16,6 +16,7 @@ set(dynbench_test_costs
   Slurm.ASignalledTaskRequeuesAndACancelledOneIsReportedAndRerun=95
   Slurm.DemoAsAChainOfJobsGivesTheLocalDemosTables=74
   Cube2.SecondMapsLavaAndWaterConvertValidateAndAgreeWithTheGame=55
+  OpenArena.AnEmulatedMatchIsTheSameOnEveryHost=50
   Cube2.TheGamesOwnFramesAgreeWithTheDatasetsRenderOfThem=46
   Slurm.CaptureArrayOfSeedsMatchesLocalCaptures=40
   OpenArena.SeededMatchesOnTwoMapsAreByteIdentical=33

@@ -20,6 +20,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Debian's user-mode emulator (qemu-user). Under it the guest's floating point is qemu's software
+// IEEE arithmetic (RSQRTSS and RCPPS come out exact, not a vendor's estimate), and the CPU the
+// guest's C library sees is the model named, whatever the host is.
+constexpr const char* kQemu = "qemu-x86_64";
+
 // The game modules the capture replaces; every other file of baseoa/ (the paks, the menu module)
 // is Debian's own, linked into the run's private base folder.
 constexpr const char* kModules[] = {"cgamex86_64.so", "qagamex86_64.so"};
@@ -52,6 +57,14 @@ Expected<void> makeBaseFolder(const fs::path& data, const fs::path& modules, con
 }
 
 }  // namespace
+
+std::string_view gameCpuName(GameCpu cpu) { return cpu == GameCpu::kEmulated ? "emulated" : "host"; }
+
+Expected<GameCpu> parseGameCpu(std::string_view name) {
+  if (name == "emulated") return GameCpu::kEmulated;
+  if (name == "host") return GameCpu::kHost;
+  return fail(ErrorCode::kUsage, "--game-cpu '{}': expected emulated or host", name);
+}
 
 Expected<std::vector<std::string>> openArenaBots(int bots) {
   // OpenArena 0.8.8's bots (scripts/bots.txt in pak6-patch088.pk3), a varied order.
@@ -146,6 +159,8 @@ Expected<void> checkOpenArenaOptions(const OpenArenaOptions& o) {
   if (!fs::is_directory(o.data / "baseoa", ec))
     return fail(ErrorCode::kExternalTool, "{}: missing: install Debian's openarena (scripts/setup.sh does)", (o.data / "baseoa").string());
   if (!o.window && findOnPath("Xvfb").empty()) return fail(ErrorCode::kExternalTool, "Xvfb is missing: install Debian's xvfb (scripts/setup.sh does)");
+  if (o.gameCpu == GameCpu::kEmulated && findOnPath(kQemu).empty())
+    return fail(ErrorCode::kExternalTool, "{} is missing: install Debian's qemu-user (scripts/setup.sh does), or pass --game-cpu host", kQemu);
   if (fs::exists(o.output / "Capture.txt", ec))
     return fail(ErrorCode::kUsage, "{}: already holds a capture; choose an empty folder", o.output.string());
   return {};
@@ -177,8 +192,10 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
   auto arguments = openArenaArguments(o, run / "base", run / "home");
   if (!arguments) return std::unexpected(arguments.error());
 
-  // A stalled game is stopped: at least 2 frames/s of wall time plus a minute for loading.
-  const int timeout = 60 + static_cast<int>((o.seconds + o.warmup) * o.fps / 2.0);
+  // A stalled game is stopped: at least 2 frames/s of wall time plus a minute for loading; emulated
+  // (0.33-0.4 s a frame measured, 30-60 s to load), at least one frame every 2 s plus 3 minutes.
+  const double frameCount = (o.seconds + o.warmup) * o.fps;
+  const int timeout = o.gameCpu == GameCpu::kEmulated ? 180 + static_cast<int>(frameCount * 2.0) : 60 + static_cast<int>(frameCount / 2.0);
   ProcessOptions game;
   game.workingDirectory = run;
   game.environment = {{"DYNBENCH_CAPTURE_DIR", fs::absolute(o.output).string()},
@@ -216,7 +233,12 @@ Expected<OpenArenaReport> captureOpenArena(const OpenArenaOptions& o, const Open
   // if the engine is still there. ioquake3's SIGTERM handler shuts the engine down from inside the
   // handler and can deadlock there: once, under load, a `--map no_such_map` capture hung with the
   // signal blocked in its handler and the main thread waiting on a lock, past both signals.
-  game.argv = {"timeout", "-k", "10", std::to_string(timeout), o.engine.string()};
+  game.argv = {"timeout", "-k", "10", std::to_string(timeout)};
+  // Nehalem (SSE4.2, no AVX): a model qemu 7.2 emulates in full, so that what the guest's C library
+  // and Mesa choose by CPUID is fixed; with `max` (which follows qemu's version) Mesa's rasteriser
+  // emits FMA, which qemu computes in software: 2 s a frame against 0.4 s (oa_dm1, 384x216).
+  if (o.gameCpu == GameCpu::kEmulated) game.argv.insert(game.argv.end(), {kQemu, "-cpu", kEmulatedCpuModel});
+  game.argv.push_back(o.engine.string());
   game.argv.insert(game.argv.end(), arguments->begin(), arguments->end());
   std::size_t frames = 0;
   unsigned long windowMs = 0, offClock = 0;

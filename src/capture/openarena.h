@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -16,6 +17,15 @@ namespace dynbench::capture {
 inline constexpr std::pair<int, int> kOpenArenaBotsRange{1, 16};
 inline constexpr std::pair<int, int> kOpenArenaSkillRange{1, 5};  // Quake 3's bot skills
 inline constexpr double kOpenArenaMinWarmup = 2.0;                // s: the camera follows a bot by then
+
+// The CPU the game runs on. Debian's engine keeps 7 RSQRTSS and 1 RCPPS in the bots' library, whose
+// bits differ between CPU vendors, and a match follows them (integrations/openarena/README.md,
+// "Across CPUs"). Emulated, every instruction of the engine and the game modules is computed by
+// Debian's qemu-x86_64 in software, for one fixed CPU model: the same match on every host.
+enum class GameCpu { kEmulated, kHost };
+inline constexpr const char* kEmulatedCpuModel = "Nehalem";  // SSE4.2, no AVX: see openarena.cpp
+std::string_view gameCpuName(GameCpu cpu);                     // "emulated" or "host"
+Expected<GameCpu> parseGameCpu(std::string_view name);         // a usage error names the values
 
 struct OpenArenaOptions {
   std::filesystem::path output;  // the capture folder
@@ -40,6 +50,7 @@ struct OpenArenaOptions {
   bool window = false;           // on the user's display instead of Xvfb
   std::filesystem::path modules;  // folder with cgamex86_64.so and qagamex86_64.so; empty: the build's
   std::filesystem::path engine = "/usr/lib/ioquake3/ioquake3";  // Debian's ioquake3
+  GameCpu gameCpu = GameCpu::kEmulated;  // kHost: about 30 times faster, the match the host's CPU plays
   std::filesystem::path data = "/usr/lib/openarena";             // Debian's openarena (baseoa/)
   // The map's lights for the adapter (maplight::cachedAdapterLights: the emitters the BSP names and
   // the stripped lights fitted to its lightmaps). Empty: the adapter's own rough approximation

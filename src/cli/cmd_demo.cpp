@@ -85,7 +85,7 @@ void addDemoCommand(CLI::App& app, CommandRun& run) {
   auto o = std::make_shared<DemoCli>();
   auto* cmd = app.add_subcommand("demo", "The whole chain on a seeded bot match (Cube 2 or OpenArena): capture, convert, stats, render, discard, report");
   cmd->footer("Also makes a smooth fly-through over the same match as a second dataset, so the report shows the contrast.\n"
-              "A rerun reuses the capture when --engine, --map, --bots, --seconds and --seed are the same, and the frames already rendered.\n"
+              "A rerun reuses the capture when --engine, --map, --bots, --seconds, --seed and --game-cpu are the same, and the frames already rendered.\n"
               "Example: dynbench demo -o demo --seconds 20");
   cmd->add_option("-o,--output", o->options.output, "Output folder");
   cmd->add_option("--engine", o->options.engine, "The game captured: cube2 (Cube 2: Sauerbraten) or openarena (OpenArena, id Tech 3)")
@@ -94,6 +94,10 @@ void addDemoCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--bots", o->options.bots, "Bots (cube2: 1-32, openarena: 1-16)")->check(between(capture::kBotsRange.first, capture::kBotsRange.second));
   cmd->add_option("--seconds", o->options.seconds, "Game seconds captured")->check(positive());
   cmd->add_option("--seed", o->options.seed, "Seed");
+  cmd->add_option("--game-cpu", o->options.gameCpu,
+                  "openarena: emulated (under qemu-x86_64, the same match on every host) or host (faster; the match follows the CPU's "
+                  "vendor): capture openarena --game-cpu")
+      ->check(CLI::IsMember({"emulated", "host"}))->capture_default_str();
   cmd->add_option("--fps", o->options.fps, "Sampling rate of stats, render and discard")->check(positive());
   cmd->add_option("--res", o->resolution, "Render resolution");
   cmd->add_option("--spp", o->options.samplesPerPixel, "Samples per pixel of the first round (render --converge)")->check(positive());

@@ -29,8 +29,8 @@ std::string captureRecord(const capture::Cube2Options& c) {
 
 std::string captureRecord(const capture::OpenArenaOptions& c) {
   return fmt::format("{{\"engine\": \"openarena\", \"map\": \"{}\", \"bots\": {}, \"skill\": {}, \"follow\": \"{}\", \"seconds\": {}, "
-                     "\"fps\": {}, \"seed\": {}, \"adapter\": {}}}\n",
-                     c.map, c.bots, c.skill, c.follow, c.seconds, c.fps, c.seed, kOpenArenaAdapterVersion);
+                     "\"fps\": {}, \"seed\": {}, \"game_cpu\": \"{}\", \"adapter\": {}}}\n",
+                     c.map, c.bots, c.skill, c.follow, c.seconds, c.fps, c.seed, capture::gameCpuName(c.gameCpu), kOpenArenaAdapterVersion);
 }
 
 // The capture (`capture` runs the engine) unless `record` says it exists with these options, then

@@ -38,6 +38,9 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
   if (openArena) {
     capture::OpenArenaOptions c;
     c.output = capture, c.map = map, c.bots = o.bots, c.seconds = o.seconds, c.seed = o.seed;
+    auto cpu = capture::parseGameCpu(o.gameCpu);
+    if (!cpu) return std::unexpected(cpu.error());
+    c.gameCpu = *cpu;
     if (auto ok = captureAndConvert(c, record, bot, log); !ok) return std::unexpected(ok.error());
   } else {
     capture::Cube2Options c;
@@ -81,20 +84,23 @@ nlohmann::json demoJobJson(const DemoOptions& o) {
   j["map"] = o.map;
   j["bots"] = o.bots;
   j["seconds"] = o.seconds;
+  j["game_cpu"] = o.gameCpu;
   return j;
 }
 
 Expected<DemoOptions> parseDemoJob(const nlohmann::json& document, const fs::path& source) {
   const JsonSettingsReader r(document, source);
-  std::vector<const char*> keys = {"dynbench_demo", "output", "engine", "map", "bots", "seconds"};
+  std::vector<const char*> keys = {"dynbench_demo", "output", "engine", "map", "bots", "seconds", "game_cpu"};
   for (const char* k : pipeline::datasetRunSettingsKeys(true)) keys.push_back(k);
   if (auto ok = r.jobDocument("the demo job", keys, "dynbench_demo", kDemoJobVersion); !ok) return std::unexpected(ok.error());
   DemoOptions o;
   std::string output = o.output.string();
   for (auto ok : {r.string("/output", output), r.string("/engine", o.engine), r.string("/map", o.map),
-                  r.integer("/bots", o.bots, capture::kBotsRange.first, capture::kBotsRange.second), r.number("/seconds", o.seconds, 0.0, 1e6, true)})
+                  r.integer("/bots", o.bots, capture::kBotsRange.first, capture::kBotsRange.second), r.number("/seconds", o.seconds, 0.0, 1e6, true),
+                  r.string("/game_cpu", o.gameCpu)})
     if (!ok) return std::unexpected(ok.error());
   if (o.engine != "cube2" && o.engine != "openarena") return r.bad("/engine", fmt::format("\"cube2\" or \"openarena\", found \"{}\"", o.engine));
+  if (o.gameCpu != "emulated" && o.gameCpu != "host") return r.bad("/game_cpu", fmt::format("\"emulated\" or \"host\", found \"{}\"", o.gameCpu));
   o.output = output;
   if (auto ok = pipeline::readDatasetRunSettings(r, "", o, true); !ok) return std::unexpected(ok.error());
   return o;

@@ -32,6 +32,7 @@ struct DemoOptions : pipeline::DatasetRunSettings {
   std::string map;               // empty: the engine's default (colos, oa_dm1)
   int bots = 6;
   double seconds = 10.0;  // game time captured
+  std::string gameCpu = "emulated";  // openarena: capture::parseGameCpu's names
   DemoPart part = DemoPart::kAll;
   int renderTask = 0, framesPerTask = 8;  // with kRenderTask
 };

@@ -120,6 +120,14 @@ Expected<Manifest> parseManifest(const nlohmann::json& document, const fs::path&
       if (*bots < range.first || *bots > range.second) return bad(at + "/bots", fmt::format("a whole number in [{}, {}]", range.first, range.second));
       d.bots = static_cast<int>(*bots);
     }
+    if (f.has(at + "/game_cpu")) {
+      if (!openArena) return bad(at + "/game_cpu", "no game_cpu: Cube 2 runs on the host (its build has no reciprocal estimates)");
+      auto cpu = f.string(at + "/game_cpu");
+      if (!cpu) return std::unexpected(cpu.error());
+      auto parsed = capture::parseGameCpu(*cpu);
+      if (!parsed) return bad(at + "/game_cpu", fmt::format("\"emulated\" or \"host\", found \"{}\"", *cpu));
+      d.gameCpu = *parsed;
+    }
     auto seed = f.count(at + "/seed");
     if (!seed) return std::unexpected(seed.error());
     d.seed = static_cast<unsigned>(*seed);

@@ -25,6 +25,7 @@ struct DatasetSpec {
   int bots = 0;                 // 0: the preset's (or 6)
   unsigned seed = 1;
   double seconds = 10.0;        // game time captured
+  capture::GameCpu gameCpu = capture::GameCpu::kEmulated;  // openarena: the CPU the game runs on (capture/openarena.h)
   std::string camera = "bot";   // "bot" (the first-person bot), "slowed" (its turns slowed: camera/slowed.h) or "flythrough"
   // Pins (/datasets/N/sha256/capture and /dataset): the SHA-256 the capture folder and the dataset
   // must have (captureDigest, scene::datasetDigest); empty: not checked.

@@ -46,7 +46,9 @@ Expected<CapturePlan> capturePlan(const DatasetSpec& d, const fs::path& root) {
     if (d.bots > 0) c.bots = d.bots;
     c.seed = d.seed;
     c.seconds = d.seconds;
-    plan.key = fmt::format("openarena-custom-{}-{}bots-seed{}-{}s", c.map, c.bots, c.seed, c.seconds);
+    c.gameCpu = d.gameCpu;
+    // host-CPU captures apart from emulated ones: they are other matches
+    plan.key = fmt::format("openarena-custom-{}-{}bots-seed{}-{}s{}", c.map, c.bots, c.seed, c.seconds, d.gameCpu == capture::GameCpu::kHost ? "-host" : "");
     c.output = root / "captures" / plan.key / "capture";
     return plan;
   }

@@ -44,7 +44,7 @@ grep -q "calling init: $prefix/lib/dynbench/libdynbench_image.so" "$work/ld.log"
 # the installed SDK (a real engine linked with the SDK as installed).
 if [[ -e "$prefix/lib/dynbench/openarena/cgamex86_64.so" && -x /usr/lib/ioquake3/ioquake3 ]]; then
   mkdir -p "$work/ld_oa"
-  LD_DEBUG=libs LD_DEBUG_OUTPUT="$work/ld_oa/ld" "$prefix/bin/dynbench" capture openarena -o "$work/oa" --seconds 1 --bots 2 >"$work/oa.log" 2>&1 ||
+  LD_DEBUG=libs LD_DEBUG_OUTPUT="$work/ld_oa/ld" "$prefix/bin/dynbench" capture openarena -o "$work/oa" --seconds 1 --bots 2 --game-cpu host >"$work/oa.log" 2>&1 ||
     { echo "install_test: the installed capture openarena failed"; tail "$work/oa.log"; exit 1; }
   cat "$work"/ld_oa/ld.* >"$work/ld_oa.log"
   grep -q "calling init: .*/baseoa/cgamex86_64.so" "$work/ld_oa.log" &&
