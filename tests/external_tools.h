@@ -52,6 +52,12 @@ inline std::string missingOpenArena() {
   return {};
 }
 
+// OpenArena's default, --game-cpu emulated, runs the engine under qemu-x86_64.
+inline std::string missingEmulatedOpenArena() {
+  if (auto missing = missingOpenArena(); !missing.empty()) return missing;
+  return onPath("qemu-x86_64") ? "" : "qemu-x86_64 is not installed (Debian package qemu-user; scripts/setup.sh)";
+}
+
 inline bool requireAll() {
   const char* v = std::getenv("DYNBENCH_REQUIRE_ALL");
   return v && std::string(v) == "1";

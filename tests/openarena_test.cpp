@@ -126,7 +126,7 @@ TEST(OpenArena, SeededMatchesOnTwoMapsAreByteIdentical) {
 // CPU model already decides). On the host's own CPU the same seed plays another match: Debian's
 // engine computes 1/sqrt(x) in the bots' library from RSQRTSS's estimate, qemu exactly.
 TEST(OpenArena, AnEmulatedMatchIsTheSameOnEveryHost) {
-  DYNBENCH_NEEDS(test::missingOpenArena());
+  DYNBENCH_NEEDS(test::missingEmulatedOpenArena());
   const auto dir = test::freshDir("openarena_emulated");
   // A small window: it records nothing but its aspect, and emulated, drawing is most of the time.
   const std::string match = "--map oa_dm1 --bots 3 --seconds 0.4 --warmup 2 --seed 7 --map-lights none --width 128 --height 72";
@@ -436,6 +436,17 @@ TEST(OpenArena, BadOptionsFailClearly) {
     EXPECT_NE(r.status, 0);
     EXPECT_NE(r.err.find("lights.txt:2: expected 'point X Y Z R G B D'"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "h" / "Capture.txt"));
+    // The default, emulated, on a machine without qemu-user: told what to install, before anything
+    // is made (PATH holding Xvfb alone).
+    fs::create_directories(dir / "path");
+    fs::create_symlink(findOnPath("Xvfb"), dir / "path" / "Xvfb");
+    const std::string path = std::getenv("PATH");
+    ::setenv("PATH", (dir / "path").c_str(), 1);
+    r = dynbench(fmt::format("capture openarena -o {} --seconds 1 --map-lights none", (dir / "j").string()), dir);
+    ::setenv("PATH", path.c_str(), 1);
+    EXPECT_EQ(r.status, 7) << r.err;
+    EXPECT_NE(r.err.find("qemu-x86_64 is missing: install Debian's qemu-user"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "j" / "Capture.txt"));
   }
 }
 
