@@ -231,6 +231,7 @@ Expected<DatasetRunOutcome> measureDataset(const fs::path& dataset, const fs::pa
   auto rendered = runRender(render);
   if (!rendered) return std::unexpected(rendered.error());
   log(fmt::format("  rendered {} frames ({} already there) in {:.0f} s", rendered->rendered.size(), rendered->skipped.size(), rendered->seconds));
+  outcome.framesRendered = rendered->rendered.size();
 
   DiscardStage discard;
   discard.frames = render.job.output;
@@ -248,8 +249,11 @@ Expected<DatasetRunOutcome> measureDataset(const fs::path& dataset, const fs::pa
 
   // Temporal methods: each run over the input window and scored against the converged frames above.
   for (const auto& stage : {std::optional(input), stillInput})
-    if (stage)
-      if (auto rendered = runRender(*stage); !rendered) return std::unexpected(rendered.error());
+    if (stage) {
+      auto renderedInput = runRender(*stage);
+      if (!renderedInput) return std::unexpected(renderedInput.error());
+      outcome.framesRendered += renderedInput->rendered.size();
+    }
   auto evaluated = evaluateOnTheirInputs(run, o, {}, true);
   if (!evaluated) return std::unexpected(evaluated.error());
   for (const auto* group : {&evaluated->jittered, &evaluated->still})
@@ -261,6 +265,7 @@ Expected<DatasetRunOutcome> measureDataset(const fs::path& dataset, const fs::pa
   if (floor) {
     auto renderedFloor = runRender(*floor);
     if (!renderedFloor) return std::unexpected(renderedFloor.error());
+    outcome.framesRendered += renderedFloor->rendered.size();
     auto noise = evaluate::referenceNoiseFloor(render.job.output, floor->job.output);
     if (!noise) return std::unexpected(noise.error());
     outcome.referenceFloor = *noise;

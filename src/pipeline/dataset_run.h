@@ -127,6 +127,7 @@ struct DatasetRunOutcome {
   discard::FramePercentages discard;  // Table 6.7 (the window's mean)
   MethodsOnTheirInputs methods;
   std::optional<evaluate::MeanWithError> referenceFloor;  // with floorFrames > 0
+  std::size_t framesRendered = 0;  // frame renders this call made (reference, inputs, floor); 0: all were complete
 };
 // stats, render, discard, input render and evaluate of one dataset into RUN; renders already
 // complete with the same settings are reused.

@@ -212,14 +212,23 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
                         {"files", nlohmann::json::object()}};
   auto prepared = prepareDatasets(*manifest, root, settings.fps, log);
   if (!prepared) return std::unexpected(prepared.error());
+  // Progress: datasets done, and the time left at the mean time of the datasets this run rendered
+  // (a resumed run re-reads finished datasets in seconds; they would make the estimate a guess).
   const auto start = std::chrono::steady_clock::now();
+  double renderingSeconds = 0.0;
+  std::size_t renderedDatasets = 0;
   for (std::size_t i = 0; i < manifest->datasets.size(); ++i) {
     const DatasetSpec& spec = manifest->datasets[i];
-    // Progress: datasets done, and the time left at the mean time a dataset has taken so far.
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const std::string pace = i == 0 ? std::string()
-                                    : fmt::format(" ({} done in {:.1f} min, about {:.0f} min left)", i, elapsed / 60.0,
-                                                  elapsed / static_cast<double>(i) * static_cast<double>(manifest->datasets.size() - i) / 60.0);
+    const auto datasetStart = std::chrono::steady_clock::now();
+    const double elapsed = std::chrono::duration<double>(datasetStart - start).count();
+    const std::size_t left = manifest->datasets.size() - i;
+    std::string pace;
+    if (i > 0 && renderedDatasets > 0)
+      pace = fmt::format(" ({} done in {:.1f} min; about {:.0f} min left at the {:.0f} min a dataset this run rendered took)", i, elapsed / 60.0,
+                         renderingSeconds / static_cast<double>(renderedDatasets) * static_cast<double>(left) / 60.0,
+                         renderingSeconds / static_cast<double>(renderedDatasets) / 60.0);
+    else if (i > 0)
+      pace = fmt::format(" ({} done in {:.1f} min, all rendered before this run)", i, elapsed / 60.0);
     log(fmt::format("[{}/{}] {}{}", i + 1, manifest->datasets.size(), spec.name, pace));
     const auto& [dataset, digests] = (*prepared)[i];
     const fs::path run = root / "runs" / spec.name;
@@ -227,6 +236,10 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
     s.seed = spec.seed;
     auto measured = pipeline::measureDataset(dataset, run, s, log);
     if (!measured) return std::unexpected(measured.error());
+    if (measured->framesRendered > 0) {
+      renderingSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - datasetStart).count();
+      ++renderedDatasets;
+    }
     DatasetResult result;
     result.name = spec.name;
     result.measures = measuresOf(measured->motion, measured->firstFrame, measured->lastFrame, measured->discard);
