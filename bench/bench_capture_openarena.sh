@@ -21,8 +21,8 @@ off_s=$(sed -E 's/.*took ([0-9.]+) s.*/\1/' <<<"$off")
 on_s=$(sed -E 's/.*the recorded window ([0-9.]+) s.*/\1/' <<<"$on")
 frames=$(sed -E 's/.*window of ([0-9]+) frames.*/\1/' <<<"$off")
 size=$(du -sh "$work/on" | cut -f1)
-awk -v off="$off_s" -v on="$on_s" -v n="$frames" -v size="$size" -v map="$map" -v bots="$bots" 'BEGIN {
-  printf "%s, %d bots, %d frames at a fixed 50 fps clock (640x360, Xvfb + Mesa llvmpipe)\n", map, bots, n
+awk -v off="$off_s" -v on="$on_s" -v n="$frames" -v size="$size" -v map="$map" -v bots="$bots" -v cpu="$game_cpu" 'BEGIN {
+  printf "%s, %d bots, %d frames at a fixed 50 fps clock (game CPU %s; 384x216, Xvfb + Mesa llvmpipe)\n", map, bots, n, cpu
   printf "capture off: %.3f s, %.2f ms/frame (%.1f fps)\n", off, 1000 * off / n, n / off
   printf "capture on:  %.3f s, %.2f ms/frame (%.1f fps), capture folder %s\n", on, 1000 * on / n, n / on, size
   printf "overhead: %.3fx (%.2f ms/frame)\n", on / off, 1000 * (on - off) / n
