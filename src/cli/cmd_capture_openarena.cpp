@@ -40,7 +40,7 @@ void addCaptureOpenArenaCommand(CLI::App* capture, CommandRun& run) {
   auto gameCpu = std::make_shared<std::string>("emulated");
   cmd->add_option("--game-cpu", *gameCpu,
                   "emulated (the game run under Debian's qemu-x86_64 as a Nehalem: the same match on every host, a frame about 0.4 s) "
-                  "or host (about 30 times faster; the match follows the CPU's vendor: integrations/openarena/README.md)")
+                  "or host (about 18 times faster; the match follows the CPU's vendor: integrations/openarena/README.md)")
       ->capture_default_str();
   cmd->add_option("--data", o->data, "OpenArena's base path, holding baseoa/ (Debian's openarena)");
   auto mapLights = std::make_shared<std::string>("fit");

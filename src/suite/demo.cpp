@@ -100,7 +100,7 @@ Expected<DemoOptions> parseDemoJob(const nlohmann::json& document, const fs::pat
                   r.string("/game_cpu", o.gameCpu)})
     if (!ok) return std::unexpected(ok.error());
   if (o.engine != "cube2" && o.engine != "openarena") return r.bad("/engine", fmt::format("\"cube2\" or \"openarena\", found \"{}\"", o.engine));
-  if (o.gameCpu != "emulated" && o.gameCpu != "host") return r.bad("/game_cpu", fmt::format("\"emulated\" or \"host\", found \"{}\"", o.gameCpu));
+  if (!capture::parseGameCpu(o.gameCpu)) return r.bad("/game_cpu", fmt::format("\"emulated\" or \"host\", found \"{}\"", o.gameCpu));
   o.output = output;
   if (auto ok = pipeline::readDatasetRunSettings(r, "", o, true); !ok) return std::unexpected(ok.error());
   return o;
