@@ -82,6 +82,7 @@ TEST(Cli, SameMistakeSameStatusInEveryCommand) {
                         Case{"render x.gltf -o y --bounces -1", "--bounces: must be 0 or more (got -1)"},
                         Case{"demo --spp 0", "--spp: must be positive (got 0)"},
                         Case{"demo --bots 40", "--bots: must be from 1 to 32 (got 40)"},
+                        Case{"demo --game-cpu arm", "--game-cpu 'arm': expected emulated or host"},
                         Case{"discard x --threshold-normal -1", "--threshold-normal: must be 0 or more (got -1)"},
                         Case{"report x -o y.html --thumbnails -1", "--thumbnails: must be 0 or more (got -1)"},
                         Case{"convert x -o y.gltf --turbidity 1", "--turbidity: must be from 1.7 to 10 (got 1)"},

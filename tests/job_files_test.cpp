@@ -209,7 +209,7 @@ TEST(JobFiles, DemoJobRoundTripsEveryField) {
   o.map = "oa_dm4";
   o.bots = 3;
   o.seconds = 7.5;
-  o.gameCpu = "host";
+  o.gameCpu = capture::GameCpu::kHost;
   o.fps = 30;
   o.width = 160;
   o.height = 90;

@@ -63,8 +63,10 @@ std::string_view gameCpuName(GameCpu cpu) { return cpu == GameCpu::kEmulated ? "
 Expected<GameCpu> parseGameCpu(std::string_view name) {
   if (name == "emulated") return GameCpu::kEmulated;
   if (name == "host") return GameCpu::kHost;
-  return fail(ErrorCode::kUsage, "--game-cpu '{}': expected emulated or host", name);
+  return fail(ErrorCode::kUsage, "--game-cpu '{}': expected {} or {}", name, gameCpuName(GameCpu::kEmulated), gameCpuName(GameCpu::kHost));
 }
+
+std::string gameCpuChoices() { return fmt::format("\"{}\" or \"{}\"", gameCpuName(GameCpu::kEmulated), gameCpuName(GameCpu::kHost)); }
 
 Expected<std::vector<std::string>> openArenaBots(int bots) {
   // OpenArena 0.8.8's bots (scripts/bots.txt in pak6-patch088.pk3), a varied order.

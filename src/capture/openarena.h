@@ -26,6 +26,7 @@ enum class GameCpu { kEmulated, kHost };
 inline constexpr const char* kEmulatedCpuModel = "Nehalem";  // SSE4.2, no AVX: see openarena.cpp
 std::string_view gameCpuName(GameCpu cpu);                     // "emulated" or "host"
 Expected<GameCpu> parseGameCpu(std::string_view name);         // a usage error names the values
+std::string gameCpuChoices();                                  // "\"emulated\" or \"host\"", for errors naming a JSON value
 
 struct OpenArenaOptions {
   std::filesystem::path output;  // the capture folder

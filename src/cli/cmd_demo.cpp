@@ -1,5 +1,6 @@
 // `dynbench demo [-o DIR]`: the whole chain on a seeded Cube 2 match (src/suite/demo.h).
 #include "capture/cube2.h"
+#include "capture/openarena.h"
 #include "cli/commands.h"
 #include "core/progress.h"
 #include "suite/demo.h"
@@ -12,6 +13,7 @@ struct DemoCli {
   demo::DemoOptions options;
   std::string resolution = fmt::format("{}x{}", demo::DemoOptions{}.width, demo::DemoOptions{}.height);
   std::string part = "all";
+  std::string gameCpu{capture::gameCpuName(demo::DemoOptions{}.gameCpu)};  // parsed by capture::parseGameCpu, the names' one home
   bool slurm = false;
   cluster::Options slurmOptions;
   std::filesystem::path jobFile;          // --job: the options from a file (suite/demo.h)
@@ -64,6 +66,9 @@ Expected<void> runDemo(const DemoCli& cli) {
     auto res = parseResolution(cli.resolution);
     if (!res) return std::unexpected(res.error());
     std::tie(o.width, o.height) = *res;
+    auto cpu = capture::parseGameCpu(cli.gameCpu);
+    if (!cpu) return std::unexpected(cpu.error());
+    o.gameCpu = *cpu;
   }
   o.part = cli.part == "datasets" ? demo::DemoPart::kDatasets : cli.part == "render" ? demo::DemoPart::kRenderTask : demo::DemoPart::kAll;
   if (cli.slurm) {
@@ -94,10 +99,10 @@ void addDemoCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--bots", o->options.bots, "Bots (cube2: 1-32, openarena: 1-16)")->check(between(capture::kBotsRange.first, capture::kBotsRange.second));
   cmd->add_option("--seconds", o->options.seconds, "Game seconds captured")->check(positive());
   cmd->add_option("--seed", o->options.seed, "Seed");
-  cmd->add_option("--game-cpu", o->options.gameCpu,
+  cmd->add_option("--game-cpu", o->gameCpu,
                   "openarena: emulated (under qemu-x86_64, the same match on every host) or host (faster; the match follows the CPU's "
                   "vendor): capture openarena --game-cpu")
-      ->check(CLI::IsMember({"emulated", "host"}))->capture_default_str();
+      ->capture_default_str();
   cmd->add_option("--fps", o->options.fps, "Sampling rate of stats, render and discard")->check(positive());
   cmd->add_option("--res", o->resolution, "Render resolution");
   cmd->add_option("--spp", o->options.samplesPerPixel, "Samples per pixel of the first round (render --converge)")->check(positive());

@@ -38,9 +38,7 @@ Expected<fs::path> runDemo(const DemoOptions& o, const DemoLog& log) {
   if (openArena) {
     capture::OpenArenaOptions c;
     c.output = capture, c.map = map, c.bots = o.bots, c.seconds = o.seconds, c.seed = o.seed;
-    auto cpu = capture::parseGameCpu(o.gameCpu);
-    if (!cpu) return std::unexpected(cpu.error());
-    c.gameCpu = *cpu;
+    c.gameCpu = o.gameCpu;
     if (auto ok = captureAndConvert(c, record, bot, log); !ok) return std::unexpected(ok.error());
   } else {
     capture::Cube2Options c;
@@ -84,7 +82,7 @@ nlohmann::json demoJobJson(const DemoOptions& o) {
   j["map"] = o.map;
   j["bots"] = o.bots;
   j["seconds"] = o.seconds;
-  j["game_cpu"] = o.gameCpu;
+  j["game_cpu"] = capture::gameCpuName(o.gameCpu);
   return j;
 }
 
@@ -94,13 +92,15 @@ Expected<DemoOptions> parseDemoJob(const nlohmann::json& document, const fs::pat
   for (const char* k : pipeline::datasetRunSettingsKeys(true)) keys.push_back(k);
   if (auto ok = r.jobDocument("the demo job", keys, "dynbench_demo", kDemoJobVersion); !ok) return std::unexpected(ok.error());
   DemoOptions o;
-  std::string output = o.output.string();
+  std::string output = o.output.string(), gameCpu{capture::gameCpuName(o.gameCpu)};
   for (auto ok : {r.string("/output", output), r.string("/engine", o.engine), r.string("/map", o.map),
                   r.integer("/bots", o.bots, capture::kBotsRange.first, capture::kBotsRange.second), r.number("/seconds", o.seconds, 0.0, 1e6, true),
-                  r.string("/game_cpu", o.gameCpu)})
+                  r.string("/game_cpu", gameCpu)})
     if (!ok) return std::unexpected(ok.error());
   if (o.engine != "cube2" && o.engine != "openarena") return r.bad("/engine", fmt::format("\"cube2\" or \"openarena\", found \"{}\"", o.engine));
-  if (!capture::parseGameCpu(o.gameCpu)) return r.bad("/game_cpu", fmt::format("\"emulated\" or \"host\", found \"{}\"", o.gameCpu));
+  auto cpu = capture::parseGameCpu(gameCpu);
+  if (!cpu) return r.bad("/game_cpu", fmt::format("{}, found \"{}\"", capture::gameCpuChoices(), gameCpu));
+  o.gameCpu = *cpu;
   o.output = output;
   if (auto ok = pipeline::readDatasetRunSettings(r, "", o, true); !ok) return std::unexpected(ok.error());
   return o;

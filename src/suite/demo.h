@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "capture/openarena.h"
 #include "core/error.h"
 #include "pipeline/dataset_run.h"
 #include "cluster/slurm.h"
@@ -32,7 +33,7 @@ struct DemoOptions : pipeline::DatasetRunSettings {
   std::string map;               // empty: the engine's default (colos, oa_dm1)
   int bots = 6;
   double seconds = 10.0;  // game time captured
-  std::string gameCpu = "emulated";  // openarena: capture::parseGameCpu's names
+  capture::GameCpu gameCpu = capture::GameCpu::kEmulated;  // openarena: the CPU the game runs on
   DemoPart part = DemoPart::kAll;
   int renderTask = 0, framesPerTask = 8;  // with kRenderTask
 };

@@ -125,7 +125,7 @@ Expected<Manifest> parseManifest(const nlohmann::json& document, const fs::path&
       auto cpu = f.string(at + "/game_cpu");
       if (!cpu) return std::unexpected(cpu.error());
       auto parsed = capture::parseGameCpu(*cpu);
-      if (!parsed) return bad(at + "/game_cpu", fmt::format("\"emulated\" or \"host\", found \"{}\"", *cpu));
+      if (!parsed) return bad(at + "/game_cpu", fmt::format("{}, found \"{}\"", capture::gameCpuChoices(), *cpu));
       d.gameCpu = *parsed;
     }
     auto seed = f.count(at + "/seed");
