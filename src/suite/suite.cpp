@@ -223,11 +223,11 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
     const double elapsed = std::chrono::duration<double>(datasetStart - start).count();
     const std::size_t left = manifest->datasets.size() - i;
     std::string pace;
-    if (i > 0 && renderedDatasets > 0)
+    if (i > 0 && renderedDatasets > 0) {
+      const double minutesPerDataset = renderingSeconds / static_cast<double>(renderedDatasets) / 60.0;
       pace = fmt::format(" ({} done in {:.1f} min; about {:.0f} min left at the {:.0f} min a dataset this run rendered took)", i, elapsed / 60.0,
-                         renderingSeconds / static_cast<double>(renderedDatasets) * static_cast<double>(left) / 60.0,
-                         renderingSeconds / static_cast<double>(renderedDatasets) / 60.0);
-    else if (i > 0)
+                         minutesPerDataset * static_cast<double>(left), minutesPerDataset);
+    } else if (i > 0)
       pace = fmt::format(" ({} done in {:.1f} min, all rendered before this run)", i, elapsed / 60.0);
     log(fmt::format("[{}/{}] {}{}", i + 1, manifest->datasets.size(), spec.name, pace));
     const auto& [dataset, digests] = (*prepared)[i];
