@@ -61,8 +61,8 @@ Expected<void> makeBaseFolder(const fs::path& data, const fs::path& modules, con
 std::string_view gameCpuName(GameCpu cpu) { return cpu == GameCpu::kEmulated ? "emulated" : "host"; }
 
 Expected<GameCpu> parseGameCpu(std::string_view name) {
-  if (name == "emulated") return GameCpu::kEmulated;
-  if (name == "host") return GameCpu::kHost;
+  for (const GameCpu cpu : {GameCpu::kEmulated, GameCpu::kHost})
+    if (name == gameCpuName(cpu)) return cpu;
   return fail(ErrorCode::kUsage, "--game-cpu '{}': expected {} or {}", name, gameCpuName(GameCpu::kEmulated), gameCpuName(GameCpu::kHost));
 }
 
