@@ -413,8 +413,9 @@ TEST(OpenArena, StrippedLightsAreFittedToTheLightmaps) {
   std::filesystem::create_directories(dir);
   ASSERT_TRUE(writeAdapterLights(dir / "a.txt", *here));
   {
-    // as another machine would fit it (Embree's SSE4.2 kernels, glibc's maths without AVX2 and FMA),
-    // and as a capture fits it, unjudged
+    // as another machine would fit it (glibc's maths without AVX2 and FMA; the fit's tracer has no
+    // instruction a vendor decides: TriangleBvh.TheFitsCodeHasNoInstructionAVendorDecides), and as
+    // a capture fits it, unjudged
     test::OtherMachine other;
     const auto r = ::dynbench::dynbench(fmt::format("map-lights q3dm6ish --hide-entity-lights --fit-samples 6000 --max-candidates 2000 --grid-fit always "
                                                     "--no-judge --adapter-lights {}",

@@ -10,7 +10,8 @@
 namespace dynbench::maplight {
 
 // Bumped whenever the fit or the file's meaning changes, so that older cached files are not used.
-inline constexpr int kFitVersion = 7;
+// Version 8: visibility traced by maplight/triangle_bvh.h, the same on every CPU (7: Embree).
+inline constexpr int kFitVersion = 8;
 
 // $XDG_CACHE_HOME/dynbench/map-lights, else $HOME/.cache/dynbench/map-lights.
 std::filesystem::path defaultCacheFolder();

@@ -17,7 +17,7 @@
 #include "core/files.h"
 #include "core/math.h"
 #include "maplight/nnls.h"
-#include "render/raytracing_scene.h"
+#include "maplight/triangle_bvh.h"
 
 namespace dynbench::maplight {
 
@@ -68,23 +68,28 @@ struct Sample {
   glm::dvec3 mainDirection{0.0};
 };
 
-// The map's geometry as Embree sees it: `all` holds the solid surfaces (node 0) and the sky's
-// (node 1); `solid` the solid ones alone, as q3map2's light traces see the map (light_trace.c
-// ignores sky surfaces: light passes through them).
+// The map's geometry as the fit's traces see it (maplight/triangle_bvh.h: why not Embree): `all`
+// holds the solid surfaces (group 0) and the sky's (group 1); `solid` the solid ones alone, as
+// q3map2's light traces see the map (light_trace.c ignores sky surfaces: light passes through them).
+// Units a visibility trace leaves out at either end: its ends lie on surfaces (a texel nudged onto
+// another face, an emitter's own face), which rounding would otherwise put in front of or behind
+// them (Embree's tnear = 0 and float rounding did the same at the near end).
+constexpr double kTraceMargin = 1e-3;
+
 struct Occluders {
-  std::unique_ptr<render::RayTracingScene> all, solid;
+  TriangleBvh all, solid;
   // Surfaces nearer `from` than `inhibit` are passed through (q3map2's inhibitRadius: a grid
   // point's traces ignore what lies within half a grid step of it).
   bool visible(const glm::dvec3& from, const glm::dvec3& to, double inhibit = 0.0) const {
     const glm::dvec3 d = to - from;
     const double length = glm::length(d);
     if (length <= inhibit + 1e-6) return true;
-    return !solid->occluded(from + inhibit * (d / length), d / length, length - inhibit - 1e-3);
+    return !solid.occluded(from + inhibit * (d / length), d / length, kTraceMargin, length - inhibit - kTraceMargin);
   }
   // Whether a ray from `from` towards `direction` reaches the sky (or leaves the map).
   bool seesSky(const glm::dvec3& from, const glm::dvec3& direction, double inhibit = 0.0) const {
-    const render::SurfaceHit hit = all->intersect(render::Ray{from + inhibit * direction, direction});
-    return !hit.hit || hit.node == 1;
+    const BvhHit hit = all.intersect(from + inhibit * direction, direction, kTraceMargin);
+    return !hit.hit || hit.group == 1;
   }
 };
 
@@ -97,47 +102,19 @@ bool drawn(const Bsp& bsp, const ShaderScripts& scripts, const BspSurface& s, bo
   return !(script && script->translucent) || sky;
 }
 
-Expected<Occluders> buildOccluders(const Bsp& bsp, const ShaderScripts& scripts) {
-  scene::Scene scene;
-  scene.meshes.resize(2);
-  for (int k = 0; k < 2; ++k) {
-    scene.meshes[static_cast<std::size_t>(k)].primitives.resize(1);
-    scene::Node node;
-    node.mesh = k;
-    scene.nodes.push_back(node);
-    scene.roots.push_back(k);
-  }
+Occluders buildOccluders(const Bsp& bsp, const ShaderScripts& scripts) {
+  std::vector<BvhTriangle> all, solid;
   const BspModel& world = bsp.models[0];
   for (int i = world.firstSurface; i < world.firstSurface + world.surfaceCount; ++i) {
     bool sky = false;
     if (!drawn(bsp, scripts, bsp.surfaces[static_cast<std::size_t>(i)], sky)) continue;
-    scene::Primitive& p = scene.meshes[sky ? 1 : 0].primitives[0];
     for (const SurfaceTriangle& t : surfaceTriangles(bsp, i)) {
-      for (int k = 0; k < 3; ++k) {
-        p.indices.push_back(static_cast<std::uint32_t>(p.positions.size()));
-        p.positions.push_back(glm::vec3(t.position[static_cast<std::size_t>(k)]));
-        p.normals.push_back(glm::vec3(t.normal[static_cast<std::size_t>(k)]));
-      }
+      const BvhTriangle triangle{t.position, t.normal, sky ? 1 : 0};
+      all.push_back(triangle);
+      if (!sky) solid.push_back(triangle);
     }
   }
-  // Embree's SSE4.2 kernels whatever the CPU: its AVX2 and AVX-512 kernels hit grazing edges
-  // differently, and a different hit early in the greedy fit gives a different set of lights (seen
-  // on oa_dm1). The fit is a property of the map, so every machine traces it the same way.
-  const auto tracerOf = [](const scene::Scene& s) -> Expected<std::unique_ptr<render::RayTracingScene>> {
-    auto tracer = render::RayTracingScene::create(s, {}, "max_isa=sse4.2");
-    if (!tracer) return std::unexpected(tracer.error());
-    if (auto updated = (*tracer)->update(0.0); !updated) return std::unexpected(updated.error());
-    return std::move(*tracer);
-  };
-  scene::Scene solidScene;
-  solidScene.meshes.push_back(scene.meshes[0]);
-  solidScene.nodes.push_back(scene.nodes[0]);
-  solidScene.roots.push_back(0);
-  auto all = tracerOf(scene);
-  if (!all) return std::unexpected(all.error());
-  auto solid = tracerOf(solidScene);
-  if (!solid) return std::unexpected(solid.error());
-  return Occluders{std::move(*all), std::move(*solid)};
+  return Occluders{TriangleBvh(std::move(all)), TriangleBvh(std::move(solid))};
 }
 
 double gammaOf(const Bsp& bsp) {
@@ -499,9 +476,9 @@ bool inOpenSpace(const glm::dvec3& p, const Occluders& occluders) {
     return d;
   }();
   for (const glm::dvec3& d : directions) {
-    const render::SurfaceHit hit = occluders.all->intersect(render::Ray{p, d});
+    const BvhHit hit = occluders.all.intersect(p, d, kTraceMargin);
     if (!hit.hit) return false;
-    if (hit.node == 1) continue;  // the sky
+    if (hit.group == 1) continue;  // the sky
     // the surface's own side: its vertex normals (the BSP's), not a winding convention
     if (hit.distance < kCandidateClearance || glm::dot(hit.shadingNormal, d) > 0) return false;
   }
@@ -513,6 +490,11 @@ std::vector<glm::dvec3> openSpaceLattice(const Bsp& bsp, const Occluders& occlud
   const glm::dvec3 lo = glm::dvec3(bsp.models[0].mins) + kMinimumDistance, hi = glm::dvec3(bsp.models[0].maxs) - kMinimumDistance;
   const glm::dvec3 size = glm::max(hi - lo, glm::dvec3(1.0));
   const auto open = [&](const glm::dvec3& p) { return inOpenSpace(p, occluders); };
+  // Off the map's grid by a fraction of a unit: brushes lie on whole (mostly 8- and 16-unit)
+  // coordinates, so a lattice on them sends its axis and diagonal rays along walls' planes and
+  // edges, where whether a ray hits is decided by rounding (half a million such rays on oa_dm1:
+  // 14,155 hit differently in Embree and in triangle_bvh.h; none once off the grid).
+  const glm::dvec3 offGrid(0.37, 0.23, 0.11);
   // Coarsen the lattice until the open points are few enough (deterministic: spacing in 8-unit steps).
   for (double step = 32.0;; step += 8.0) {
     const glm::ivec3 n = glm::ivec3(glm::floor(size / step)) + 1;
@@ -521,7 +503,7 @@ std::vector<glm::dvec3> openSpaceLattice(const Bsp& bsp, const Occluders& occlud
     std::vector<char> isOpen(total, 0);
     tbb::parallel_for(std::size_t(0), total, [&](std::size_t k) {
       const int x = static_cast<int>(k % n.x), y = static_cast<int>((k / n.x) % n.y), z = static_cast<int>(k / (static_cast<std::size_t>(n.x) * n.y));
-      isOpen[k] = open(lo + glm::dvec3(x, y, z) * step) ? 1 : 0;
+      isOpen[k] = open(lo + offGrid + glm::dvec3(x, y, z) * step) ? 1 : 0;
     });
     const auto count = static_cast<std::size_t>(std::count(isOpen.begin(), isOpen.end(), 1));
     if (count > static_cast<std::size_t>(maxCandidates)) continue;
@@ -529,7 +511,7 @@ std::vector<glm::dvec3> openSpaceLattice(const Bsp& bsp, const Occluders& occlud
     for (std::size_t k = 0; k < total; ++k)
       if (isOpen[k]) {
         const int x = static_cast<int>(k % n.x), y = static_cast<int>((k / n.x) % n.y), z = static_cast<int>(k / (static_cast<std::size_t>(n.x) * n.y));
-        points.push_back(lo + glm::dvec3(x, y, z) * step);
+        points.push_back(lo + offGrid + glm::dvec3(x, y, z) * step);
       }
     spacing = static_cast<std::size_t>(step);
     return points;
@@ -765,8 +747,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   if (!bsp) return std::unexpected(bsp.error());
   auto scripts = ShaderScripts::read(files);
   if (!scripts) return std::unexpected(scripts.error());
-  auto occluders = buildOccluders(*bsp, *scripts);
-  if (!occluders) return std::unexpected(occluders.error());
+  const Occluders occluders = buildOccluders(*bsp, *scripts);
 
   MapLighting result;
   result.map = map;
@@ -867,7 +848,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   r.heldOutSamples = heldOut.size();
   if (texelRows < 16) return fail(ErrorCode::kUnsupported, "{}: {} lightmap texels to fit; the map has no lightmaps to recover lights from", path, texelRows);
   report("known emitters", 0, 1);
-  std::vector<Column> columns = groupColumns(fit, groups, result.lights, result.surfaceLights, *occluders);
+  std::vector<Column> columns = groupColumns(fit, groups, result.lights, result.surfaceLights, occluders);
   if (!gridRows.empty()) {
     Column& c = columns[gridConstant];
     for (std::size_t i = texelRows; i < fit.size(); ++i) {
@@ -970,17 +951,17 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   double error = residualOf(target, solve(target, 3), 3, residual);
 
   // Candidates and their columns, after the groups': the lattice, then the residual's hot spots.
-  std::vector<glm::dvec3> candidates = openSpaceLattice(*bsp, *occluders, options.maxCandidates, r.latticeSpacing);
+  std::vector<glm::dvec3> candidates = openSpaceLattice(*bsp, occluders, options.maxCandidates, r.latticeSpacing);
   r.latticeCandidates = candidates.size();
   if (options.hotSpotPeaks > 0) {
-    const std::vector<glm::dvec3> hot = hotSpotCandidates(fit, residual, *occluders, static_cast<std::size_t>(options.hotSpotPeaks));
+    const std::vector<glm::dvec3> hot = hotSpotCandidates(fit, residual, occluders, static_cast<std::size_t>(options.hotSpotPeaks));
     candidates.insert(candidates.end(), hot.begin(), hot.end());
   }
   r.candidates = candidates.size();
   columns.resize(groupCount + candidates.size());
   std::atomic<std::size_t> done{0};
   tbb::parallel_for(std::size_t(0), candidates.size(), [&](std::size_t j) {
-    columns[groupCount + j] = candidateColumn(candidates[j], fit, *occluders);
+    columns[groupCount + j] = candidateColumn(candidates[j], fit, occluders);
     const std::size_t finished = ++done;
     if (finished % 64 == 0) report("candidate lights", finished, candidates.size());
   });
@@ -1065,8 +1046,8 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
           std::vector<Column> trialColumns(trials.size());
           std::vector<char> usable(trials.size(), 0);
           tbb::parallel_for(std::size_t(0), trials.size(), [&](std::size_t t) {
-            if (!inOpenSpace(trials[t], *occluders)) return;
-            trialColumns[t] = candidateColumn(trials[t], fit, *occluders);
+            if (!inOpenSpace(trials[t], occluders)) return;
+            trialColumns[t] = candidateColumn(trials[t], fit, occluders);
             usable[t] = trialColumns[t].norm2 > 0;
           });
           bool improved = false;
@@ -1148,7 +1129,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
     const std::vector<MapLight> hidden = entityLights(*bsp);
     std::vector<EmitterGroup> hiddenGroups;
     for (std::size_t i = 0; i < hidden.size(); ++i) hiddenGroups.push_back({hidden[i].source, hidden[i].color, {i}, {}});
-    const std::vector<Column> hiddenColumns = groupColumns(fit, hiddenGroups, hidden, {}, *occluders);
+    const std::vector<Column> hiddenColumns = groupColumns(fit, hiddenGroups, hidden, {}, occluders);
     double total = 0.0, found = 0.0, shown = 0.0, shownFound = 0.0;
     for (std::size_t h = 0; h < hidden.size(); ++h) {
       if (hidden[h].kind == MapLightKind::kSun) continue;
@@ -1186,7 +1167,7 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   // The luminance q3map2's model gives each sample: of the known emitters alone (their strength as
   // q3map2 gives it), and of the dataset's lights (weighted, with the fitted ones).
   const auto modelLuminance = [&](const std::vector<Sample>& samples, std::vector<double>& knownLum, std::vector<double>& allLum) {
-    const std::vector<Column> columnsHere = groupColumns(samples, all, heldLights, unweightedSurfaces, *occluders);
+    const std::vector<Column> columnsHere = groupColumns(samples, all, heldLights, unweightedSurfaces, occluders);
     knownLum.assign(samples.size(), 0.0);
     allLum.assign(samples.size(), 0.0);
     for (std::size_t k = 0; k < all.size(); ++k) {

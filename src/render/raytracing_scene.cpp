@@ -131,8 +131,7 @@ namespace {
 // unless DYNBENCH_EMBREE_CONFIG passes another device configuration (rtcNewDevice(3), e.g.
 // "max_isa=sse4.2"), so that one machine can run as another would: the reproducibility checks of
 // issue 45 use it (docs/suite.md, "Pins").
-RTCDevice newDevice(const char* fixedConfig) {
-  if (fixedConfig) return rtcNewDevice(fixedConfig);
+RTCDevice newDevice() {
   const char* config = std::getenv("DYNBENCH_EMBREE_CONFIG");
   return rtcNewDevice(config && *config ? config : core::kEmbreeDeviceConfig);
 }
@@ -142,10 +141,10 @@ RTCDevice newDevice(const char* fixedConfig) {
 RayTracingScene::RayTracingScene(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 RayTracingScene::~RayTracingScene() = default;
 
-Expected<std::unique_ptr<RayTracingScene>> RayTracingScene::create(const scene::Scene& scene, AlphaTest alphaTest, const char* deviceConfig) {
+Expected<std::unique_ptr<RayTracingScene>> RayTracingScene::create(const scene::Scene& scene, AlphaTest alphaTest) {
   auto impl = std::make_unique<Impl>(scene);
   impl->alphaTest = std::move(alphaTest);
-  impl->device = newDevice(deviceConfig);
+  impl->device = newDevice();
   if (!impl->device) return fail(ErrorCode::kExternalTool, "Embree: cannot create a device (error {})", static_cast<int>(rtcGetDeviceError(nullptr)));
   rtcSetDeviceErrorFunction(impl->device, onEmbreeError, &impl->error);
   impl->staticScene = rtcNewScene(impl->device);
@@ -442,7 +441,7 @@ Expected<void> SphereIndex::build(const std::vector<glm::dvec4>& spheres) {
       return fail(ErrorCode::kInternal, "sphere index: sphere {} has radius {}; expected a finite positive radius", i, spheres[i].w);
   spheres_ = spheres;
   if (!impl_->device) {
-    impl_->device = newDevice(nullptr);
+    impl_->device = newDevice();
     if (!impl_->device) return fail(ErrorCode::kExternalTool, "Embree: cannot create a device (error {})", static_cast<int>(rtcGetDeviceError(nullptr)));
     rtcSetDeviceErrorFunction(impl_->device, onEmbreeError, &impl_->error);
   }

@@ -53,10 +53,10 @@ struct RayTracingStats {
 
 class RayTracingScene {
  public:
-  // deviceConfig: an Embree device configuration that holds whatever the machine or
-  // DYNBENCH_EMBREE_CONFIG say (e.g. "max_isa=sse4.2": the same kernels, so the same hits, on every
-  // x86-64 machine; maplight's fit needs that to give every machine the same lights).
-  static Expected<std::unique_ptr<RayTracingScene>> create(const scene::Scene& scene, AlphaTest alphaTest = {}, const char* deviceConfig = nullptr);
+  // Embree's kernels compute reciprocals from RCPPS/RCP14 estimates, whose bits differ between
+  // Intel and AMD: the same kernels give the same hits only on one vendor's CPUs (a hit at a grazing
+  // edge can differ). maplight's fit, which must be the same everywhere, traces its own hierarchy.
+  static Expected<std::unique_ptr<RayTracingScene>> create(const scene::Scene& scene, AlphaTest alphaTest = {});
   ~RayTracingScene();
 
   // Refits the dynamic part to time t (node transforms, skinning, morph targets, visibility). The
