@@ -68,14 +68,14 @@ struct Sample {
   glm::dvec3 mainDirection{0.0};
 };
 
-// The map's geometry as the fit's traces see it (maplight/triangle_bvh.h: why not Embree): `all`
-// holds the solid surfaces (group 0) and the sky's (group 1); `solid` the solid ones alone, as
-// q3map2's light traces see the map (light_trace.c ignores sky surfaces: light passes through them).
 // Units a visibility trace leaves out at either end: its ends lie on surfaces (a texel nudged onto
 // another face, an emitter's own face), which rounding would otherwise put in front of or behind
 // them (Embree's tnear = 0 and float rounding did the same at the near end).
 constexpr double kTraceMargin = 1e-3;
 
+// The map's geometry as the fit's traces see it (maplight/triangle_bvh.h: why not Embree): `all`
+// holds the solid surfaces (group 0) and the sky's (group 1); `solid` the solid ones alone, as
+// q3map2's light traces see the map (light_trace.c ignores sky surfaces: light passes through them).
 struct Occluders {
   TriangleBvh all, solid;
   // Surfaces nearer `from` than `inhibit` are passed through (q3map2's inhibitRadius: a grid

@@ -17,14 +17,16 @@ constexpr std::size_t kMaxLeafTriangles = 16;  // more than this: never a leaf
 constexpr std::size_t kBins = 16;
 constexpr double kTraversalCost = 1.0;  // a box test against a triangle test, in the heuristic
 
+// The traversal's stack holds at most one node a level, plus one. From kSahDepth down the splits
+// halve (median), so no hierarchy of fewer than 2^60 triangles is deeper than kStackDepth.
+constexpr std::size_t kSahDepth = 192;
+constexpr std::size_t kStackDepth = 256;
+
+// The bin of a centroid along one axis: (centroid - lo) * kBins / extent, clamped to [0, kBins).
 std::size_t binOf(double centroid, double lo, double scale) {
   const double b = (centroid - lo) * scale;
   return b <= 0.0 ? 0 : std::min(kBins - 1, static_cast<std::size_t>(b));
 }
-// The traversal's stack holds at most one node a level, plus one. Below kSahDepth the splits halve
-// (median), so no hierarchy of fewer than 2^60 triangles is deeper than kStackDepth.
-constexpr std::size_t kSahDepth = 192;
-constexpr std::size_t kStackDepth = 256;
 
 // A direction component of 0 gets this reciprocal instead of infinity: (plane - origin) times it
 // stays finite for any map coordinate (below 1e8), so no 0 x inf NaN reaches the slab test.
