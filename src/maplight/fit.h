@@ -5,14 +5,17 @@
 // light entities from the BSP (writebsp.c), so most shipped maps keep none. What is left: the
 // lightmaps, which hold what the lights did, and the emitters the BSP still names (surface lights
 // of its shaders, a sky shader's sun, the light entities of the maps that keep them). This module
-//   1. reads the lightmap texels as samples (position, normal, linear value),
+//   1. reads the lightmap texels as samples (position, normal, linear value): lightmap_samples.h,
 //   2. predicts the known emitters' light at them with q3map2's own model (light.c,
-//      LightContributionToSample), with Embree for visibility,
+//      LightContributionToSample), with its own tracer for visibility: known_emitters.h,
+//      q3map2_model.h, fit_visibility.h,
 //   3. fits what is left with non-negative point lights: candidates on a lattice in open space and
-//      along the normals of the residual's hot spots, chosen greedily, weighted by non-negative
-//      least squares, plus a constant term that absorbs bounced light and ambient and is then
-//      dropped (the path tracer makes its own indirect light),
-//   4. judges the lights on held-out texels and on the map's light grid, which the fit never sees.
+//      along the normals of the residual's hot spots (fit_candidates.h), chosen greedily, weighted
+//      by non-negative least squares, plus a constant term that absorbs bounced light and ambient
+//      and is then dropped (the path tracer makes its own indirect light): light_solver.h,
+//   4. judges the lights on held-out texels and on the map's light grid, which the fit never sees:
+//      fit_judge.h.
+// fit.cpp runs the steps in that order; the step headers are the maplight stage's own.
 // The result is deterministic: the same map gives the same lights, byte for byte.
 #include <array>
 #include <filesystem>
@@ -185,7 +188,7 @@ std::vector<MapLight> entityLights(const Bsp& bsp);
 
 // The lights file the OpenArena capture adapter reads (DYNBENCH_CAPTURE_MAP_LIGHTS,
 // integrations/openarena): game axes and units, light in the capture format's full-light units, one
-// light per line: "point X Y Z R G B D" (an inverse-square light giving R G B at D units), "sun DX
+// light per line (adapter_lights.cpp): "point X Y Z R G B D" (an inverse-square light giving R G B at D units), "sun DX
 // DY DZ R G B" (towards the sun), "surface SHADER R G B" (the emission of a light-emitting shader's
 // surfaces). Written to a temporary name and renamed.
 Expected<void> writeAdapterLights(const std::filesystem::path& file, const MapLighting& lighting);
