@@ -12,6 +12,7 @@
 #include "core/files.h"
 #include "frames/frame_io.h"
 #include "metrics/rank_correlation.h"
+#include "suite/record.h"
 #include "suite/score.h"
 #include "suite/suite.h"
 #include "external_tools.h"
@@ -227,6 +228,110 @@ TEST(Suite, MethodsToScoreAreNamedAndTheirRatioUsesTheRecordedNone) {
   EXPECT_DOUBLE_EQ(suite::errorsOf({none, added}, 0.08)["mine"]["flip_ratio_to_none"], 0.5);
 }
 
+// A record (suite/record.h) as a run writes it, read back; then refused, naming the file and the
+// JSON pointer, when it is of another manifest, another dataset or pins, other settings, a version
+// that cannot be compared, or malformed. No game needed: the record is made here.
+TEST(Suite, RecordsOfAnotherManifestSettingsOrVersionAndMalformedOnesAreRefused) {
+  const fs::path dir = test::freshDir("suite_records");
+  auto manifest = suite::readManifest(kSmoke);
+  ASSERT_TRUE(manifest) << manifest.error().message;
+  const nlohmann::json entry = {{"name", "fps-1-flythrough"},
+                                {"dataset", "captures/x/flythrough.gltf"},
+                                {"run", "runs/fps-1-flythrough"},
+                                {"sha256", manifest->document["datasets"][1]["sha256"]},
+                                {"window", {{"first", 30}, {"last", 35}}},
+                                {"measures", {{"frustum", 1.25}, {"direct_radiance", 0.5}}},
+                                {"errors", {{"none", {{"flip", 0.2}}}, {"taa", {{"flip", 0.1}, {"flip_ratio_to_none", 0.5}}}}},
+                                {"match", "x"},
+                                {"camera", "flythrough"},
+                                {"reference_floor", {{"flip", 0.01}, {"frames", 4}}}};
+  const std::map<std::string, std::string> files{{"runs/fps-1-flythrough/frames/frame_00030.exr", std::string(64, 'a')}};
+  const nlohmann::json record =
+      suite::recordJson(*manifest, 1, entry, files, {{"measure", {2.5, 4.0}}}, 12345, core::MachineInfo{"A CPU", "AuthenticAMD", "x86-64-v3", 2});
+  const fs::path good = dir / "good.json";
+  ASSERT_TRUE(writeFileAtomic(good, record.dump(2)));
+  auto read = suite::readRecord(good, *manifest);
+  ASSERT_TRUE(read) << read.error().message;
+  EXPECT_EQ(read->dataset, "fps-1-flythrough");
+  EXPECT_EQ(read->entry, entry);
+  EXPECT_EQ(read->result.measures.at("frustum"), 1.25);
+  EXPECT_EQ(read->result.errors.at("taa").at("flip_ratio_to_none"), 0.5);
+  EXPECT_EQ(read->result.referenceFloor, 0.01);
+  EXPECT_EQ(read->files, files);
+  EXPECT_EQ(record["machine"]["isa"], "x86-64-v3");
+  EXPECT_EQ(record["seconds"]["measure"]["cpu"], 4.0);
+  EXPECT_EQ(record["manifest_sha256"].get<std::string>().size(), 64u);
+  // The manifest's digest ignores spacing and key order, not values.
+  {
+    auto respaced = suite::parseManifest(nlohmann::json::parse(manifest->document.dump(7)), "respaced.json");
+    ASSERT_TRUE(respaced);
+    EXPECT_EQ(suite::manifestDigest(*respaced), suite::manifestDigest(*manifest));
+    nlohmann::json other = manifest->document;
+    other["render"]["spp"] = 2;
+    auto changed = suite::parseManifest(other, "changed.json");
+    ASSERT_TRUE(changed);
+    EXPECT_NE(suite::manifestDigest(*changed), suite::manifestDigest(*manifest));
+    // A record of that manifest is refused by this one, and the other way round.
+    const auto refused = suite::readRecord(good, *changed);
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().message.find("good.json: /manifest_sha256: a record of another manifest ('smoke'"), std::string::npos)
+        << refused.error().message;
+  }
+  struct Case {
+    std::string pointer;
+    nlohmann::json value;  // replaces the record's value there (null: removed)
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {"/dynbench_suite_record", 2, "/dynbench_suite_record: a record of version 2, which this dynbench (record version 1) cannot compare"},
+      {"/results_version", 2, "/results_version: numbers of results version 2"},
+      {"/manifest_sha256", std::string(64, '0'), "/manifest_sha256: a record of another manifest"},
+      {"/dataset/name", "fps-9-bot", "/dataset/name: 'fps-9-bot' is no dataset of"},
+      {"/dataset/sha256/capture", std::string(64, '1'), "/dataset: dataset 'fps-1-flythrough' with other pins or settings than"},
+      {"/settings/max_pairs", 1024, "/settings: made with other settings"},
+      {"/settings/method_inputs/taa", "still", "/settings: made with other settings"},
+      {"/result/measures/frustum", "high", "/result/measures/frustum: expected a number, found \"high\""},
+      {"/result/window", nullptr, "/result/window/first: missing"},
+      {"/result/name", "fps-2-bot", "/result/name: 'fps-2-bot', not the record's dataset 'fps-1-flythrough'"},
+      {"/files/runs~1fps-1-flythrough~1frames~1frame_00030.exr", "abc", "/files/runs/fps-1-flythrough/frames/frame_00030.exr: expected 64 lower-case hex digits"},
+      {"/machine", nullptr, "/machine/cpu: missing"},
+  };
+  for (const Case& c : cases) {
+    nlohmann::json bad = record;
+    const nlohmann::json::json_pointer at(c.pointer);
+    if (c.value.is_null()) bad[at.parent_pointer()].erase(at.back());
+    else bad[at] = c.value;
+    const fs::path file = dir / "bad.json";
+    ASSERT_TRUE(writeFileAtomic(file, bad.dump()));
+    const auto refused = suite::readRecord(file, *manifest);
+    ASSERT_FALSE(refused) << c.pointer;
+    EXPECT_EQ(refused.error().code, ErrorCode::kInvalidData) << c.pointer;
+    EXPECT_NE(refused.error().message.find(file.string() + ": " + c.message), std::string::npos) << c.pointer << ": " << refused.error().message;
+  }
+  // Not JSON at all: the JSON reader's error, naming the file; not an object: said so.
+  ASSERT_TRUE(writeFileAtomic(dir / "broken.json", "{\"dynbench_suite_record\": 1,"));
+  const auto broken = suite::readRecord(dir / "broken.json", *manifest);
+  ASSERT_FALSE(broken);
+  EXPECT_NE(broken.error().message.find("broken.json"), std::string::npos) << broken.error().message;
+  ASSERT_TRUE(writeFileAtomic(dir / "array.json", "[1, 2]"));
+  const auto array = suite::readRecord(dir / "array.json", *manifest);
+  ASSERT_FALSE(array);
+  EXPECT_NE(array.error().message.find("array.json: expected a dynbench suite record"), std::string::npos) << array.error().message;
+  // A folder of records: two of one dataset are refused, naming both.
+  const fs::path folder = dir / "records";
+  fs::create_directories(folder);
+  fs::copy_file(good, folder / "a.json");
+  fs::copy_file(good, folder / "b.json");
+  const auto twice = suite::readRecords(folder, *manifest);
+  ASSERT_FALSE(twice);
+  EXPECT_NE(twice.error().message.find("b.json: /dataset/name: a second record of dataset 'fps-1-flythrough' (the first: "), std::string::npos)
+      << twice.error().message;
+  fs::remove(folder / "b.json");
+  const auto once = suite::readRecords(folder, *manifest);
+  ASSERT_TRUE(once) << once.error().message;
+  EXPECT_EQ(once->size(), 1u);
+}
+
 TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
   DYNBENCH_NEEDS(test::missingCube2());
   const fs::path dir = test::freshDir("suite_smoke");
@@ -395,18 +500,82 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
   EXPECT_NE(md.find("| fps-2-flythrough "), std::string::npos);
   for (const char* method : {"none", "accumulate", "taa", "svgf"}) EXPECT_TRUE(fs::exists(out / "plots" / fmt::format("scatter_{}.png", method)));
 
-  // Resumed: nothing captured again, the same numbers.
+  // Each dataset left its record (suite/record.h): suite.json's entry and files for it, the manifest's
+  // digest, the machine and the seconds each part took.
+  for (std::size_t i = 0; i < 6; ++i) {
+    const auto record = nlohmann::json::parse(test::slurp(out / "records" / (doc["datasets"][i]["name"].get<std::string>() + ".json")));
+    EXPECT_EQ(record["result"], doc["datasets"][i]) << i;
+    EXPECT_EQ(record["dataset"], manifest["datasets"][i]) << i;
+    for (const auto& [file, sum] : record["files"].items()) EXPECT_EQ(doc["files"][file], sum) << file;
+    EXPECT_TRUE(record["files"].contains(doc["datasets"][i]["dataset"].get<std::string>())) << i;
+    EXPECT_GT(record["seconds"]["measure"]["wall"].get<double>(), 0.0) << i;
+    EXPECT_GT(record["disk_bytes"].get<double>(), 0.0) << i;
+    EXPECT_FALSE(record["machine"]["cpu"].get<std::string>().empty());
+  }
+
+  // Resumed: every dataset has its record, so nothing is captured, rendered or measured again, and
+  // the same suite.json is assembled.
+  const std::string json1 = test::slurp(out / "suite.json"), md1 = test::slurp(out / "suite.md");
   const auto again = dynbench(fmt::format("suite {} -o {}", kSmoke.string(), out.string()), dir);
   ASSERT_EQ(again.status, 0) << again.err;
   EXPECT_EQ(again.out.find("capture:"), std::string::npos) << again.out;
-  // Its progress estimates nothing from datasets it only re-read; the first run's, from what it rendered.
-  EXPECT_NE(again.out.find("[6/6] fps-2-slowed (5 done in"), std::string::npos) << again.out;
-  EXPECT_NE(again.out.find("all rendered before this run)"), std::string::npos) << again.out;
+  EXPECT_NE(again.out.find("[6/6] fps-2-slowed: done (record "), std::string::npos) << again.out;
+  EXPECT_NE(again.out.find("(0 records made, 6 there before)"), std::string::npos) << again.out;
   EXPECT_EQ(again.out.find("min left"), std::string::npos) << again.out;
+  // The first run's progress estimated the time left from what it rendered.
   EXPECT_NE(r.out.find("min left at the"), std::string::npos) << r.out;
-  const auto doc2 = nlohmann::json::parse(test::slurp(out / "suite.json"));
-  EXPECT_EQ(doc2["datasets"], doc["datasets"]);
-  EXPECT_EQ(doc2["files"], doc["files"]);
+  EXPECT_EQ(test::slurp(out / "suite.json"), json1);
+
+  // The same suite as two halves on two folders (another machine's, say), the records brought
+  // together and assembled with nothing rendered: suite.json and suite.md byte for byte the
+  // one-shot run's. (The captures are copied to spare the game; each half renders its own frames.)
+  {
+    const fs::path a = dir / "half-a", b = dir / "half-b";
+    for (const fs::path& half : {a, b}) {
+      fs::create_directories(half);
+      fs::copy(out / "captures", half / "captures", fs::copy_options::recursive);
+    }
+    const auto first = dynbench(fmt::format("suite {} -o {} --only fps-1-bot,fps-1-flythrough,fps-1-slowed", kSmoke.string(), a.string()), dir);
+    ASSERT_EQ(first.status, 0) << first.err << first.out;
+    EXPECT_NE(first.out.find("3 of 6 datasets still without one"), std::string::npos) << first.out;
+    EXPECT_FALSE(fs::exists(a / "suite.json"));
+    const auto second = dynbench(fmt::format("suite {} -o {} --only fps-2-bot --only fps-2-flythrough,fps-2-slowed", kSmoke.string(), b.string()), dir);
+    ASSERT_EQ(second.status, 0) << second.err << second.out;
+    // Assembling without every record: an error naming those missing, nothing written.
+    const auto partial = dynbench(fmt::format("suite {} -o {} --assemble", kSmoke.string(), b.string()), dir);
+    EXPECT_EQ(partial.status, 8) << partial.err;
+    EXPECT_NE(partial.err.find("no record of 3 of the 6 datasets (fps-1-bot, fps-1-flythrough, fps-1-slowed)"), std::string::npos) << partial.err;
+    const fs::path together = dir / "together";
+    const auto assembled = dynbench(fmt::format("suite {} -o {} --records {} --records {} --assemble", kSmoke.string(), together.string(),
+                                                (a / "records").string(), (b / "records").string()),
+                                    dir);
+    ASSERT_EQ(assembled.status, 0) << assembled.err << assembled.out;
+    EXPECT_FALSE(fs::exists(together / "runs")) << "rendered";
+    EXPECT_EQ(test::slurp(together / "suite.json"), json1);
+    EXPECT_EQ(test::slurp(together / "suite.md"), md1);
+    EXPECT_EQ(std::distance(fs::directory_iterator(together / "records"), fs::directory_iterator()), 6);
+    // A record of another manifest among them: refused, naming the file and the field.
+    nlohmann::json foreign = nlohmann::json::parse(test::slurp(a / "records" / "fps-1-bot.json"));
+    foreign["manifest_sha256"] = std::string(64, 'f');
+    fs::create_directories(dir / "foreign");
+    ASSERT_TRUE(writeFileAtomic(dir / "foreign" / "fps-1-bot.json", foreign.dump(1)));
+    const auto refused = dynbench(fmt::format("suite {} -o {} --records {} --assemble", kSmoke.string(), (dir / "fresh").string(),
+                                              (dir / "foreign").string()),
+                                  dir);
+    EXPECT_EQ(refused.status, 5) << refused.err;
+    EXPECT_NE(refused.err.find("fps-1-bot.json: /manifest_sha256: a record of another manifest"), std::string::npos) << refused.err;
+  }
+
+  // One run at a time in a folder: while another process holds its lock, a second run refuses.
+  {
+    std::string holder;
+    ASSERT_EQ(runShell(fmt::format("flock -n {} sleep 20 > /dev/null 2>&1 & sleep 1; echo started", (out / ".suite.lock").string()), holder), 0);
+    const auto locked = dynbench(fmt::format("suite {} -o {}", kSmoke.string(), out.string()), dir);
+    EXPECT_EQ(locked.status, 3) << locked.err;
+    EXPECT_NE(locked.err.find("another `dynbench suite` is running in this folder"), std::string::npos) << locked.err;
+    std::string ignored;
+    runShell(fmt::format("pkill -f 'flock -n {}'", (out / ".suite.lock").string()), ignored);
+  }
 
   // A clean run verifies.
   const auto clean = dynbench(fmt::format("suite verify {}", out.string()), dir);

@@ -19,6 +19,8 @@ struct SuiteCli {
   int renderTask = 0, framesPerTask = 8;
   bool slurm = false;
   cluster::Options slurmOptions;
+  std::vector<std::string> only, records;
+  bool assemble = false;
 };
 
 // One line per stage, flushed: a suite runs for an hour, and its log (redirected, so fully
@@ -56,14 +58,25 @@ Expected<void> runSuiteCli(const SuiteCli& cli) {
   options.part = cli.part == "datasets" ? suite::SuitePart::kDatasets : cli.part == "render" ? suite::SuitePart::kRenderTask : suite::SuitePart::kAll;
   options.renderTask = cli.renderTask;
   options.framesPerTask = cli.framesPerTask;
+  options.only = cli.only;
+  options.records.assign(cli.records.begin(), cli.records.end());
+  options.assembleOnly = cli.assemble;
+  if (options.part != suite::SuitePart::kAll && (!cli.only.empty() || !cli.records.empty() || cli.assemble))
+    return fail(ErrorCode::kUsage, "--only, --records and --assemble: with --part all only (they choose what of the whole suite is made)");
   if (cli.slurm) {
+    if (!cli.only.empty() || !cli.records.empty() || cli.assemble) return fail(ErrorCode::kUsage, "--only, --records and --assemble: not with --slurm");
     if (options.part != suite::SuitePart::kAll) return fail(ErrorCode::kUsage, "--part: not with --slurm (the jobs it submits run the parts)");
     return suiteOnSlurm(options, cli.slurmOptions);
   }
   auto outcome = suite::runSuite(options, printLine);
   if (!outcome) return std::unexpected(outcome.error());
-  if (options.part == suite::SuitePart::kAll)
-    fmt::print("suite: {} datasets; {} and {}\n", outcome->datasets.size(), outcome->json.string(), outcome->markdown.string());
+  if (options.part != suite::SuitePart::kAll) return {};
+  if (outcome->json.empty())
+    fmt::print("suite: {} records made, {} there before; {} of {} datasets still without one\n", outcome->recordsMade, outcome->recordsReused,
+               outcome->missing.size(), outcome->recordsMade + outcome->recordsReused + outcome->missing.size());
+  else
+    fmt::print("suite: {} datasets ({} records made, {} there before); {} and {}\n", outcome->datasets.size(), outcome->recordsMade,
+               outcome->recordsReused, outcome->json.string(), outcome->markdown.string());
   return {};
 }
 
@@ -102,8 +115,12 @@ void addSuiteCommand(CLI::App& app, CommandRun& run) {
       "Captures, converts, flies through, renders (converged reference and real-time input), discards and evaluates every\n"
       "dataset of MANIFEST into DIR (resuming what is complete), then writes DIR/suite.json (tool version, manifest,\n"
       "numbers, SHA-256 of every file they come from) and DIR/suite.md (the validity table: Spearman's rho of each\n"
-      "difficulty measure with each method's error, bootstrap 95 % intervals). Format and definitions: docs/suite.md.\n"
-      "Example: dynbench suite suites/smoke.json -o smoke && dynbench suite verify smoke");
+      "difficulty measure with each method's error, bootstrap 95 % intervals). Each dataset leaves DIR/records/NAME.json as\n"
+      "soon as it is finished: a dataset with a record is not made again, and records made elsewhere (--records) complete\n"
+      "the suite. Format and definitions: docs/suite.md.\n"
+      "Example: dynbench suite suites/smoke.json -o smoke && dynbench suite verify smoke\n"
+      "Split:   dynbench suite suites/v2.json -o a --only calm-1-bot,calm-1-slowed   (elsewhere: -o b --only ...)\n"
+      "         dynbench suite suites/v2.json -o a --records b/records --assemble");
   cmd->add_option("MANIFEST", cli->manifest, "The suite manifest (JSON, docs/suite.md)");
   cmd->add_option("-o,--output", cli->output, "The suite's folder");
   cmd->add_option("--threads", cli->threads, "Render threads (0: all cores)")->check(CLI::Range(0, 1024));
@@ -112,6 +129,13 @@ void addSuiteCommand(CLI::App& app, CommandRun& run) {
                                        "dataset) or render (task --render-task's frame renders); all: everything")
       ->check(CLI::IsMember({"all", "datasets", "render"}));
   cmd->add_option("--render-task", cli->renderTask, "With --part render: which task's frame renders")->check(nonNegative());
+  cmd->add_option("--only", cli->only, "Make only these datasets (names, comma-separated or repeated); the others are left to other runs, "
+                                       "whose records (DIR/records) complete the suite")
+      ->delimiter(',');
+  cmd->add_option("--records", cli->records, "Folders (or files) of records made elsewhere (their DIR/records): each checked against MANIFEST, "
+                                             "copied into DIR/records and counted as done; repeat for several");
+  cmd->add_flag("--assemble", cli->assemble, "Make nothing: write suite.json and suite.md from the records alone (an error naming the "
+                                             "datasets that have none)");
   addSlurmOptions(cmd, cli->slurm, cli->slurmOptions,
                   "DIR/slurm: the datasets, then an array of render tasks of --frames-per-task frame renders, then the whole suite, chained with afterok",
                   false);

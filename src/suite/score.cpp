@@ -60,6 +60,52 @@ std::string storedPrefix(const std::string& dataset, const std::string& method) 
 
 }  // namespace
 
+Expected<RecordedDataset> readRecordedDataset(const JsonFields& f, const std::string& at) {
+  RecordedDataset d;
+  auto name = f.string(at + "/name");
+  auto dataset = f.string(at + "/dataset");
+  auto run = f.string(at + "/run");
+  for (const auto* e : {&name, &dataset, &run})
+    if (!*e) return std::unexpected(e->error());
+  auto first = f.integer(at + "/window/first");
+  auto last = f.integer(at + "/window/last");
+  for (const auto* e : {&first, &last})
+    if (!*e) return std::unexpected(e->error());
+  d.result.name = *name, d.dataset = *dataset, d.run = *run, d.first = *first, d.last = *last;
+  for (const auto& [key, target] : {std::pair{"/match", &d.result.match}, std::pair{"/camera", &d.result.camera}})
+    if (f.has(at + key)) {
+      auto v = f.string(at + key);
+      if (!v) return std::unexpected(v.error());
+      *target = *v;
+    }
+  for (const char* group : {"/measures", "/errors"}) {
+    auto object = f.value(at + group);
+    if (!object) return std::unexpected(object.error());
+    if (!(*object)->is_object()) return fail(ErrorCode::kInvalidData, "{}: {}{}: expected an object", f.file().string(), at, group);
+  }
+  for (const auto& [measure, value] : (*f.value(at + "/measures"))->items()) {
+    auto v = f.number(at + "/measures/" + measure);
+    if (!v) return std::unexpected(v.error());
+    d.result.measures[measure] = *v;
+  }
+  for (const auto& [method, errors] : (*f.value(at + "/errors"))->items()) {
+    if (!errors.is_object()) return fail(ErrorCode::kInvalidData, "{}: {}/errors/{}: expected an object", f.file().string(), at, method);
+    for (const auto& [error, value] : errors.items()) {
+      auto v = f.number(fmt::format("{}/errors/{}/{}", at, method, error));
+      if (!v) return std::unexpected(v.error());
+      d.result.errors[method][error] = *v;
+    }
+  }
+  if (f.has(at + "/reference_floor") && !(*f.value(at + "/reference_floor"))->is_null()) {
+    auto floor = f.number(at + "/reference_floor/flip");
+    auto frames = f.integer(at + "/reference_floor/frames");
+    if (!floor) return std::unexpected(floor.error());
+    if (!frames) return std::unexpected(frames.error());
+    d.result.referenceFloor = *floor, d.result.floorFrames = static_cast<int>(*frames);
+  }
+  return d;
+}
+
 Expected<SuiteResults> readSuiteResults(const fs::path& dir) {
   SuiteResults out;
   out.path = dir / "suite.json";
@@ -81,50 +127,9 @@ Expected<SuiteResults> readSuiteResults(const fs::path& dir) {
   if (!datasets) return std::unexpected(datasets.error());
   if (!(*datasets)->is_array()) return fail(ErrorCode::kInvalidData, "{}: /datasets: expected an array", out.path.string());
   for (std::size_t i = 0; i < (*datasets)->size(); ++i) {
-    const std::string at = fmt::format("/datasets/{}", i);
-    RecordedDataset d;
-    auto name = f.string(at + "/name");
-    auto dataset = f.string(at + "/dataset");
-    auto run = f.string(at + "/run");
-    for (const auto* e : {&name, &dataset, &run})
-      if (!*e) return std::unexpected(e->error());
-    auto first = f.integer(at + "/window/first");
-    auto last = f.integer(at + "/window/last");
-    for (const auto* e : {&first, &last})
-      if (!*e) return std::unexpected(e->error());
-    d.result.name = *name, d.dataset = *dataset, d.run = *run, d.first = *first, d.last = *last;
-    for (const auto& [key, target] : {std::pair{"/match", &d.result.match}, std::pair{"/camera", &d.result.camera}})
-      if (f.has(at + key)) {
-        auto v = f.string(at + key);
-        if (!v) return std::unexpected(v.error());
-        *target = *v;
-      }
-    for (const char* group : {"/measures", "/errors"}) {
-      auto object = f.value(at + group);
-      if (!object) return std::unexpected(object.error());
-      if (!(*object)->is_object()) return fail(ErrorCode::kInvalidData, "{}: {}{}: expected an object", out.path.string(), at, group);
-    }
-    for (const auto& [measure, value] : (*f.value(at + "/measures"))->items()) {
-      auto v = f.number(at + "/measures/" + measure);
-      if (!v) return std::unexpected(v.error());
-      d.result.measures[measure] = *v;
-    }
-    for (const auto& [method, errors] : (*f.value(at + "/errors"))->items()) {
-      if (!errors.is_object()) return fail(ErrorCode::kInvalidData, "{}: {}/errors/{}: expected an object", out.path.string(), at, method);
-      for (const auto& [error, value] : errors.items()) {
-        auto v = f.number(fmt::format("{}/errors/{}/{}", at, method, error));
-        if (!v) return std::unexpected(v.error());
-        d.result.errors[method][error] = *v;
-      }
-    }
-    if (f.has(at + "/reference_floor") && !(*f.value(at + "/reference_floor"))->is_null()) {
-      auto floor = f.number(at + "/reference_floor/flip");
-      auto frames = f.integer(at + "/reference_floor/frames");
-      if (!floor) return std::unexpected(floor.error());
-      if (!frames) return std::unexpected(frames.error());
-      d.result.referenceFloor = *floor, d.result.floorFrames = static_cast<int>(*frames);
-    }
-    out.datasets.push_back(std::move(d));
+    auto d = readRecordedDataset(f, fmt::format("/datasets/{}", i));
+    if (!d) return std::unexpected(d.error());
+    out.datasets.push_back(std::move(*d));
   }
   return out;
 }

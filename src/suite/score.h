@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/json_fields.h"
 #include "evaluate/method.h"
 #include "pipeline/dataset_run.h"
 #include "suite/manifest.h"
@@ -35,6 +36,9 @@ struct SuiteResults {
   std::vector<RecordedDataset> datasets;
 };
 Expected<SuiteResults> readSuiteResults(const std::filesystem::path& dir);
+// One dataset's entry of suite.json (or of a record: suite/record.h) at JSON pointer `at`; errors
+// name f's file and the pointer.
+Expected<RecordedDataset> readRecordedDataset(const JsonFields& f, const std::string& at);
 
 // One method to score. `spec` is a built-in method's name (then `name` must be the same), or
 // "external:PATH": PATH/DATASET/frame_NNNNN.exr per dataset, or PATH with "{dataset}" where the

@@ -4,6 +4,14 @@
 #include <chrono>
 #include <cmath>
 #include <set>
+#include <utility>
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/resource.h>
+#include <unistd.h>
+#include <cerrno>
+#include <cstring>
 
 #include <fmt/format.h>
 
@@ -12,6 +20,7 @@
 #include "core/checksum.h"
 #include "core/files.h"
 #include "core/json_fields.h"
+#include "core/machine.h"
 #include "dynbench/version.h"
 #include "camera/flythrough.h"
 #include "camera/slowed.h"
@@ -20,6 +29,7 @@
 #include "scene/load.h"
 #include "scene/dataset_digest.h"
 
+#include "suite/record.h"
 #include "suite/suite_markdown.h"
 
 namespace dynbench::suite {
@@ -28,6 +38,29 @@ namespace fs = std::filesystem;
 using pipeline::DatasetRunSettings;
 
 namespace {
+
+// Wall and CPU seconds since it was made (CPU: this process's and its waited-for children's, the
+// games and Blender included).
+class StageClock {
+ public:
+  StageClock() : wall_(std::chrono::steady_clock::now()), cpu_(cpuSeconds()) {}
+  StageSeconds elapsed() const {
+    return {std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_).count(), cpuSeconds() - cpu_};
+  }
+
+ private:
+  static double cpuSeconds() {
+    double total = 0.0;
+    for (const int who : {RUSAGE_SELF, RUSAGE_CHILDREN}) {
+      rusage u{};
+      if (::getrusage(who, &u) == 0)
+        total += static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+    }
+    return total;
+  }
+  std::chrono::steady_clock::time_point wall_;
+  double cpu_;
+};
 
 // Where a dataset's capture and converted datasets live: one folder per capture, shared by the
 // datasets that differ only in camera.
@@ -137,14 +170,26 @@ Expected<Digests> checkPins(const Manifest& manifest, std::size_t index, const f
   return Digests{capture, *made};
 }
 
-// Every dataset of the suite captured, converted and flown through as needed, and its pins
-// checked: all of them before anything is rendered.
-Expected<std::vector<std::pair<fs::path, Digests>>> prepareDatasets(const Manifest& manifest, const fs::path& root, double fps,
-                                                                   const pipeline::RunLog& log) {
-  std::vector<std::pair<fs::path, Digests>> prepared;
+// A suite's datasets captured, converted and flown through as needed, and their pins checked: all
+// of them before anything is rendered. `which` are the manifest's indices to prepare (all when
+// empty); each comes back with the wall and CPU seconds its preparation took (a shared capture's
+// are its first dataset's).
+struct PreparedDataset {
+  std::size_t index = 0;
+  fs::path dataset;
+  Digests digests;
+  StageSeconds seconds;
+};
+Expected<std::vector<PreparedDataset>> prepareDatasets(const Manifest& manifest, const std::vector<std::size_t>& which, const fs::path& root,
+                                                       double fps, const pipeline::RunLog& log) {
+  std::vector<PreparedDataset> prepared;
   std::map<fs::path, std::string> captureDigests;
-  for (std::size_t i = 0; i < manifest.datasets.size(); ++i) {
+  std::vector<std::size_t> indices = which;
+  if (indices.empty())
+    for (std::size_t i = 0; i < manifest.datasets.size(); ++i) indices.push_back(i);
+  for (const std::size_t i : indices) {
     log(fmt::format("[{}/{}] {}: dataset", i + 1, manifest.datasets.size(), manifest.datasets[i].name));
+    const StageClock clock;
     auto dataset = prepareDataset(manifest.datasets[i], root, fps, log);
     if (!dataset) return std::unexpected(dataset.error());
     auto digests = checkPins(manifest, i, *dataset, root, captureDigests);
@@ -152,9 +197,116 @@ Expected<std::vector<std::pair<fs::path, Digests>>> prepareDatasets(const Manife
     const DatasetSpec& d = manifest.datasets[i];
     log(fmt::format("  sha256: capture {}{}, dataset {}{}", digests->capture, d.captureSha256.empty() ? "" : " (as pinned)", digests->dataset,
                     d.datasetSha256.empty() ? "" : " (as pinned)"));
-    prepared.emplace_back(*dataset, *digests);
+    prepared.push_back({i, *dataset, *digests, clock.elapsed()});
   }
   return prepared;
+}
+
+// One `suite` at a time in a folder: an advisory lock on DIR/.suite.lock (flock(2)), released when
+// the process ends however it ends. Render tasks (--part render) take none: a Slurm array runs many
+// at once in one folder, each on frames of its own.
+class FolderLock {
+ public:
+  static Expected<FolderLock> take(const fs::path& root) {
+    const fs::path file = root / ".suite.lock";
+    const int fd = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) return fail(ErrorCode::kIo, "{}: cannot open: {}", file.string(), std::strerror(errno));
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      std::string holder(32, '\0');
+      const auto n = ::pread(fd, holder.data(), holder.size(), 0);
+      holder.resize(n > 0 ? static_cast<std::size_t>(n) : 0);
+      ::close(fd);
+      return fail(ErrorCode::kIo, "{}: another `dynbench suite` is running in this folder (process {} holds {}); wait for it, or use another folder",
+                  root.string(), holder.empty() ? std::string("?") : holder, file.string());
+    }
+    const std::string pid = std::to_string(::getpid());
+    if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, pid.data(), pid.size(), 0) < 0) {}  // who holds it, for the message above only
+    return FolderLock(fd);
+  }
+  FolderLock(FolderLock&& o) noexcept : fd_(std::exchange(o.fd_, -1)) {}
+  FolderLock& operator=(FolderLock&&) = delete;
+  ~FolderLock() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+
+ private:
+  explicit FolderLock(int fd) : fd_(fd) {}
+  int fd_ = -1;
+};
+
+// The bytes of every file under `folder`.
+std::uintmax_t folderBytes(const fs::path& folder) {
+  std::uintmax_t total = 0;
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(folder, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
+    if (it->is_regular_file(ec)) total += it->file_size(ec);
+  return total;
+}
+
+// The records of DIR/records and those of `elsewhere` (folders of records, or record files) that
+// DIR lacks, the latter copied into DIR/records as they are. Every one is checked (readRecord).
+Expected<std::map<std::string, SuiteRecord>> gatherRecords(const Manifest& manifest, const fs::path& root, const std::vector<fs::path>& elsewhere,
+                                                           const pipeline::RunLog& log) {
+  auto records = readRecords(root / "records", manifest);
+  if (!records) return std::unexpected(records.error());
+  for (const fs::path& source : elsewhere) {
+    std::map<std::string, SuiteRecord> found;
+    std::error_code ec;
+    if (fs::is_directory(source, ec)) {
+      auto read = readRecords(source, manifest);
+      if (!read) return std::unexpected(read.error());
+      found = std::move(*read);
+    } else {
+      auto read = readRecord(source, manifest);
+      if (!read) return std::unexpected(read.error());
+      found.emplace(read->dataset, std::move(*read));
+    }
+    if (found.empty()) return fail(ErrorCode::kIo, "{}: no records (NAME.json) there", source.string());
+    for (auto& [name, record] : found) {
+      if (records->count(name)) {
+        log(fmt::format("  {}: {} has its own record already; {} left as it is", name, root.string(), record.file.string()));
+        continue;
+      }
+      auto bytes = readWholeFile(record.file);
+      if (!bytes) return std::unexpected(bytes.error());
+      const fs::path copy = recordPath(root, name);
+      if (auto ok = writeFileAtomic(copy, *bytes); !ok) return std::unexpected(ok.error());
+      log(fmt::format("  {}: record taken from {}", name, record.file.string()));
+      record.file = copy;
+      records->emplace(name, std::move(record));
+    }
+  }
+  return records;
+}
+
+// suite.json and suite.md from one record per dataset of the manifest, in the manifest's order:
+// what a run that made every dataset at once writes, byte for byte (the run writes them this way).
+Expected<void> assembleSuite(const Manifest& manifest, const std::map<std::string, SuiteRecord>& records, const fs::path& root, SuiteOutcome& outcome) {
+  nlohmann::json doc = {{"dynbench_suite_results", kResultsVersion},
+                        {"tool_version", kVersion},
+                        {"manifest", manifest.document},
+                        {"ranking_error", "flip_ratio_to_none (flip for none)"},
+                        {"method_inputs", manifest.run.methodInputs},
+                        {"datasets", nlohmann::json::array()},
+                        {"files", nlohmann::json::object()}};
+  outcome.datasets.clear();
+  for (const DatasetSpec& spec : manifest.datasets) {
+    const SuiteRecord& record = records.at(spec.name);
+    doc["datasets"].push_back(record.entry);
+    for (const auto& [file, sum] : record.files) doc["files"][file] = sum;
+    outcome.datasets.push_back(record.result);
+  }
+  outcome.validity = validity(outcome.datasets);
+  doc["validity"] = validityJson(outcome.validity);
+  const std::vector<WithinMatchCell> paired = withinMatches(outcome.datasets);
+  doc["within_matches"] = withinMatchesJson(paired);
+  outcome.json = root / "suite.json";
+  outcome.markdown = root / "suite.md";
+  auto md = suiteMarkdown(manifest, outcome.datasets, outcome.validity, paired, root);
+  if (!md) return std::unexpected(md.error());
+  if (auto ok = writeFileAtomic(outcome.markdown, *md); !ok) return std::unexpected(ok.error());
+  // suite.json last: its presence says the suite is complete.
+  return writeFileAtomic(outcome.json, jsonFileText(doc));
 }
 
 }  // namespace
@@ -187,10 +339,6 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
   DatasetRunSettings settings = manifest->run;
   settings.threads = options.threads;
   SuiteOutcome outcome;
-  if (options.part == SuitePart::kDatasets) {
-    if (auto prepared = prepareDatasets(*manifest, root, settings.fps, log); !prepared) return std::unexpected(prepared.error());
-    return outcome;
-  }
   if (options.part == SuitePart::kRenderTask) {
     std::vector<pipeline::DatasetJob> jobs;
     for (const DatasetSpec& spec : manifest->datasets) {
@@ -203,79 +351,111 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
     if (auto ok = pipeline::renderTask(jobs, options.renderTask, options.framesPerTask, "the suite", log); !ok) return std::unexpected(ok.error());
     return outcome;
   }
-  nlohmann::json doc = {{"dynbench_suite_results", kResultsVersion},
-                        {"tool_version", kVersion},
-                        {"manifest", manifest->document},
-                        {"ranking_error", "flip_ratio_to_none (flip for none)"},
-                        {"method_inputs", manifest->run.methodInputs},
-                        {"datasets", nlohmann::json::array()},
-                        {"files", nlohmann::json::object()}};
-  auto prepared = prepareDatasets(*manifest, root, settings.fps, log);
-  if (!prepared) return std::unexpected(prepared.error());
-  // Progress: datasets done, and the time left at the mean time of the datasets this run rendered
-  // (a resumed run re-reads finished datasets in seconds; they would make the estimate a guess).
-  const auto start = std::chrono::steady_clock::now();
-  double renderingSeconds = 0.0;
-  std::size_t renderedDatasets = 0;
+  auto lock = FolderLock::take(root);
+  if (!lock) return std::unexpected(lock.error());
+  if (options.part == SuitePart::kDatasets) {
+    if (auto prepared = prepareDatasets(*manifest, {}, root, settings.fps, log); !prepared) return std::unexpected(prepared.error());
+    return outcome;
+  }
+  // The datasets to make: those asked for (all unless --only) that have no record yet.
+  std::set<std::string> asked(options.only.begin(), options.only.end());
+  for (const std::string& name : asked)
+    if (std::none_of(manifest->datasets.begin(), manifest->datasets.end(), [&](const DatasetSpec& d) { return d.name == name; }))
+      return fail(ErrorCode::kUsage, "--only {}: no dataset of {} has that name", name, options.manifest.string());
+  auto records = gatherRecords(*manifest, root, options.records, log);
+  if (!records) return std::unexpected(records.error());
+  std::vector<std::size_t> todo;
   for (std::size_t i = 0; i < manifest->datasets.size(); ++i) {
     const DatasetSpec& spec = manifest->datasets[i];
-    const auto datasetStart = std::chrono::steady_clock::now();
-    const double elapsed = std::chrono::duration<double>(datasetStart - start).count();
-    const std::size_t left = manifest->datasets.size() - i;
-    std::string pace;
-    if (i > 0 && renderedDatasets > 0) {
-      const double minutesPerDataset = renderingSeconds / static_cast<double>(renderedDatasets) / 60.0;
-      pace = fmt::format(" ({} done in {:.1f} min; about {:.0f} min left at the {:.0f} min a dataset this run rendered took)", i, elapsed / 60.0,
-                         minutesPerDataset * static_cast<double>(left), minutesPerDataset);
-    } else if (i > 0)
-      pace = fmt::format(" ({} done in {:.1f} min, all rendered before this run)", i, elapsed / 60.0);
-    log(fmt::format("[{}/{}] {}{}", i + 1, manifest->datasets.size(), spec.name, pace));
-    const auto& [dataset, digests] = (*prepared)[i];
-    const fs::path run = root / "runs" / spec.name;
-    DatasetRunSettings s = settings;
-    s.seed = spec.seed;
-    auto measured = pipeline::measureDataset(dataset, run, s, log);
-    if (!measured) return std::unexpected(measured.error());
-    if (measured->framesRendered > 0) {
-      renderingSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - datasetStart).count();
-      ++renderedDatasets;
-    }
-    DatasetResult result;
-    result.name = spec.name;
-    result.measures = measuresOf(measured->motion, measured->firstFrame, measured->lastFrame, measured->discard);
-    result.errors = errorsOf(measured->methods);
-    auto plan = capturePlan(spec, root);
-    if (!plan) return std::unexpected(plan.error());
-    result.match = plan->key, result.camera = spec.camera;
-    if (measured->referenceFloor) result.referenceFloor = measured->referenceFloor->mean, result.floorFrames = static_cast<int>(measured->referenceFloor->count);
-    outcome.datasets.push_back(result);
-    doc["datasets"].push_back({{"name", spec.name},
-                               {"dataset", fs::relative(dataset, root).string()},
-                               {"run", fs::relative(run, root).string()},
-                               {"sha256", {{"capture", digests.capture}, {"dataset", digests.dataset}}},
-                               {"window", {{"first", measured->firstFrame}, {"last", measured->lastFrame}}},
-                               {"measures", result.measures},
-                               {"errors", result.errors},
-                               {"match", result.match},
-                               {"camera", result.camera},
-                               {"reference_floor", referenceFloorJson(result)}});
-    for (const fs::path& file : recordedFiles(root, dataset, run)) {
-      auto sum = sha256File(root / file);
-      if (!sum) return std::unexpected(sum.error());
-      doc["files"][file.string()] = *sum;
+    if (auto found = records->find(spec.name); found != records->end()) {
+      const nlohmann::json& machine = found->second.document["machine"];
+      log(fmt::format("[{}/{}] {}: done (record {}, made on {} at {})", i + 1, manifest->datasets.size(), spec.name, found->second.file.string(),
+                      machine["cpu"].get<std::string>(), found->second.document["tool"]["commit"].get<std::string>().substr(0, 12)));
+      ++outcome.recordsReused;
+    } else if (!options.assembleOnly && (asked.empty() || asked.count(spec.name))) {
+      todo.push_back(i);
     }
   }
-  outcome.validity = validity(outcome.datasets);
-  doc["validity"] = validityJson(outcome.validity);
-  const std::vector<WithinMatchCell> paired = withinMatches(outcome.datasets);
-  doc["within_matches"] = withinMatchesJson(paired);
-  outcome.json = root / "suite.json";
-  outcome.markdown = root / "suite.md";
-  auto md = suiteMarkdown(*manifest, outcome.datasets, outcome.validity, paired, root);
-  if (!md) return std::unexpected(md.error());
-  if (auto ok = writeFileAtomic(outcome.markdown, *md); !ok) return std::unexpected(ok.error());
-  // suite.json last: its presence says the run is complete.
-  if (auto ok = writeFileAtomic(outcome.json, jsonFileText(doc)); !ok) return std::unexpected(ok.error());
+  if (!todo.empty()) {
+    auto prepared = prepareDatasets(*manifest, todo, root, settings.fps, log);
+    if (!prepared) return std::unexpected(prepared.error());
+    const core::MachineInfo machine = core::machineInfo();
+    // Progress: datasets made, and the time left at the mean time of those this run rendered (a
+    // dataset whose frames were complete is re-read in seconds; it would make the estimate a guess).
+    const auto start = std::chrono::steady_clock::now();
+    double renderingSeconds = 0.0;
+    std::size_t renderedDatasets = 0;
+    for (std::size_t k = 0; k < prepared->size(); ++k) {
+      const PreparedDataset& p = (*prepared)[k];
+      const DatasetSpec& spec = manifest->datasets[p.index];
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const std::size_t left = prepared->size() - k;
+      std::string pace;
+      if (k > 0 && renderedDatasets > 0) {
+        const double minutesPerDataset = renderingSeconds / static_cast<double>(renderedDatasets) / 60.0;
+        pace = fmt::format(" ({} of {} made in {:.1f} min; about {:.0f} min left at the {:.0f} min a dataset this run rendered took)", k,
+                           prepared->size(), elapsed / 60.0, minutesPerDataset * static_cast<double>(left), minutesPerDataset);
+      } else if (k > 0)
+        pace = fmt::format(" ({} of {} made in {:.1f} min, all rendered before this run)", k, prepared->size(), elapsed / 60.0);
+      log(fmt::format("[{}/{}] {}{}", p.index + 1, manifest->datasets.size(), spec.name, pace));
+      const fs::path run = root / "runs" / spec.name;
+      DatasetRunSettings s = settings;
+      s.seed = spec.seed;
+      const StageClock clock;
+      auto measured = pipeline::measureDataset(p.dataset, run, s, log);
+      if (!measured) return std::unexpected(measured.error());
+      const StageSeconds measuring = clock.elapsed();
+      if (measured->framesRendered > 0) {
+        renderingSeconds += measuring.wall;
+        ++renderedDatasets;
+      }
+      DatasetResult result;
+      result.name = spec.name;
+      result.measures = measuresOf(measured->motion, measured->firstFrame, measured->lastFrame, measured->discard);
+      result.errors = errorsOf(measured->methods);
+      auto plan = capturePlan(spec, root);
+      if (!plan) return std::unexpected(plan.error());
+      result.match = plan->key, result.camera = spec.camera;
+      if (measured->referenceFloor) result.referenceFloor = measured->referenceFloor->mean, result.floorFrames = static_cast<int>(measured->referenceFloor->count);
+      const nlohmann::json entry = {{"name", spec.name},
+                                    {"dataset", fs::relative(p.dataset, root).string()},
+                                    {"run", fs::relative(run, root).string()},
+                                    {"sha256", {{"capture", p.digests.capture}, {"dataset", p.digests.dataset}}},
+                                    {"window", {{"first", measured->firstFrame}, {"last", measured->lastFrame}}},
+                                    {"measures", result.measures},
+                                    {"errors", result.errors},
+                                    {"match", result.match},
+                                    {"camera", result.camera},
+                                    {"reference_floor", referenceFloorJson(result)}};
+      std::map<std::string, std::string> files;
+      for (const fs::path& file : recordedFiles(root, p.dataset, run)) {
+        auto sum = sha256File(root / file);
+        if (!sum) return std::unexpected(sum.error());
+        files[file.string()] = *sum;
+      }
+      // The record, as soon as the dataset is finished; read back as any record is, so that a run
+      // and an assembly of records give the same tables.
+      const fs::path file = recordPath(root, spec.name);
+      const nlohmann::json record = recordJson(*manifest, p.index, entry, files, {{"dataset", p.seconds}, {"measure", measuring}}, folderBytes(run), machine);
+      if (auto ok = writeFileAtomic(file, jsonFileText(record)); !ok) return std::unexpected(ok.error());
+      auto readBack = readRecord(file, *manifest);
+      if (!readBack) return std::unexpected(readBack.error());
+      records->emplace(spec.name, std::move(*readBack));
+      ++outcome.recordsMade;
+      log(fmt::format("  record: {}", file.string()));
+    }
+  }
+  for (const DatasetSpec& spec : manifest->datasets)
+    if (!records->count(spec.name)) outcome.missing.push_back(spec.name);
+  if (!outcome.missing.empty()) {
+    if (options.assembleOnly)
+      return fail(ErrorCode::kIncomplete, "{}: no record of {} of the {} datasets ({}): run them (`dynbench suite {} -o {}`), or bring their records (--records PATH)",
+                  root.string(), outcome.missing.size(), manifest->datasets.size(), fmt::join(outcome.missing, ", "), options.manifest.string(), root.string());
+    log(fmt::format("{} of {} datasets have records; suite.json and suite.md are assembled when every one has (still to make: {})", records->size(),
+                    manifest->datasets.size(), fmt::join(outcome.missing, ", ")));
+    return outcome;
+  }
+  if (auto ok = assembleSuite(*manifest, *records, root, outcome); !ok) return std::unexpected(ok.error());
   return outcome;
 }
 

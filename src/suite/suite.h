@@ -37,19 +37,29 @@ struct SuiteOptions {
   int threads = 0;  // render threads (0: all cores)
   SuitePart part = SuitePart::kAll;
   int renderTask = 0, framesPerTask = 8;  // with kRenderTask
+  // With kAll: the datasets to make (names; empty: every one), folders or files of records made
+  // elsewhere to take in (suite/record.h), and whether to make nothing: suite.json and suite.md from
+  // the records alone (an error naming the datasets without one).
+  std::vector<std::string> only;
+  std::vector<std::filesystem::path> records;
+  bool assembleOnly = false;
 };
 // The most frame renders a suite makes (every dataset's reference and input window): what
 // `suite --slurm` divides among its render tasks.
 int suiteFrameRenders(const Manifest& manifest);
 struct SuiteOutcome {
-  std::filesystem::path json, markdown;
+  std::filesystem::path json, markdown;  // empty until every dataset has a record
+  std::size_t recordsMade = 0, recordsReused = 0;
+  std::vector<std::string> missing;  // datasets without a record
   std::vector<DatasetResult> datasets;
   std::vector<ValidityCell> validity;
 };
-// Runs (or resumes) the suite into DIR: DIR/captures, DIR/runs/NAME, DIR/suite.json, DIR/suite.md
-// and DIR/plots. A capture is reused when it was made with the same options, a converted dataset
+// Runs (or resumes) the suite into DIR: DIR/captures, DIR/runs/NAME, DIR/records/NAME.json (each as
+// soon as its dataset is finished), then DIR/suite.json, DIR/suite.md and DIR/plots assembled from
+// the records once every dataset has one. A dataset with a matching record is done and not made
+// again; otherwise a capture is reused when it was made with the same options, a converted dataset
 // and a fly-through when newer than their sources, rendered frames when complete with the same
-// settings.
+// settings. One run at a time in DIR (a lock; render tasks aside).
 Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::RunLog& log);
 
 // The files a dataset's numbers come from, relative to DIR: the dataset's .gltf and .bin, and the
