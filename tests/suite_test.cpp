@@ -1,7 +1,10 @@
 // `dynbench suite` and `suite verify` (pipeline/suite.h): the manifest's errors, and the smoke suite
 // run for real (Cube 2, the renderer, discard, evaluate), resumed, verified, and caught when a frame
 // is edited by hand.
+#include <algorithm>
+#include <functional>
 #include <map>
+#include <random>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -15,6 +18,7 @@
 #include "suite/record.h"
 #include "suite/score.h"
 #include "suite/suite.h"
+#include "suite/verify.h"
 #include "external_tools.h"
 #include "gltf_builder.h"
 #include "other_machine.h"
@@ -285,6 +289,8 @@ TEST(Suite, RecordsOfAnotherManifestSettingsOrVersionAndMalformedOnesAreRefused)
   const std::vector<Case> cases = {
       {"/dynbench_suite_record", 2, "/dynbench_suite_record: a record of version 2, which this dynbench (record version 1) cannot compare"},
       {"/results_version", 2, "/results_version: numbers of results version 2"},
+      {"/numbers_version", 0, "/numbers_version: numbers of version 0, and this dynbench makes version 1: made by a build whose numbers differ"},
+      {"/manifest/description", "edited", "/manifest: not the document its /manifest_sha256 is the digest of"},
       {"/manifest_sha256", std::string(64, '0'), "/manifest_sha256: a record of another manifest"},
       {"/dataset/name", "fps-9-bot", "/dataset/name: 'fps-9-bot' is no dataset of"},
       {"/dataset/sha256/capture", std::string(64, '1'), "/dataset: dataset 'fps-1-flythrough' with other pins or settings than"},
@@ -330,6 +336,91 @@ TEST(Suite, RecordsOfAnotherManifestSettingsOrVersionAndMalformedOnesAreRefused)
   const auto once = suite::readRecords(folder, *manifest);
   ASSERT_TRUE(once) << once.error().message;
   EXPECT_EQ(once->size(), 1u);
+}
+
+// Verifying a record made again (suite verify --record): what counts as the same, checked on a
+// record against edited copies of itself. Measures to suite.md's 3 decimals; scores within a tenth
+// of the noise floor (0.01 here: 0.001); the ratio to none within what that allows it; frame
+// digests only between records of one CPU vendor.
+TEST(Suite, ARecordMadeAgainAgreesToTheTablesDigitsAndATenthOfTheFloor) {
+  const fs::path dir = test::freshDir("suite_record_compare");
+  auto manifest = suite::readManifest(kSmoke);
+  ASSERT_TRUE(manifest) << manifest.error().message;
+  const nlohmann::json entry = {{"name", "fps-2-bot"},
+                                {"dataset", "captures/x/bot.gltf"},
+                                {"run", "runs/fps-2-bot"},
+                                {"sha256", manifest->document["datasets"][2]["sha256"]},
+                                {"window", {{"first", 30}, {"last", 35}}},
+                                {"measures", {{"frustum", 1.25}, {"direct_radiance", 0.5}}},
+                                {"errors", {{"none", {{"flip", 0.2}}}, {"taa", {{"flip", 0.1}, {"flip_over_none", -0.1}, {"flip_ratio_to_none", 0.5}}}}},
+                                {"match", "x"},
+                                {"camera", "bot"},
+                                {"reference_floor", {{"flip", 0.01}, {"frames", 4}}}};
+  const std::map<std::string, std::string> files{{"runs/fps-2-bot/frames/frame_00030.exr", std::string(64, 'a')}};
+  const auto make = [&](const std::string& name, const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json record = suite::recordJson(*manifest, 2, entry, files, {}, 1, core::MachineInfo{"A", "AuthenticAMD", "x86-64-v3", 2});
+    edit(record);
+    EXPECT_TRUE(writeFileAtomic(dir / name, record.dump()));
+    auto read = suite::readRecord(dir / name, *manifest);
+    EXPECT_TRUE(read) << read.error().message;
+    return *read;
+  };
+  const suite::SuiteRecord recorded = make("recorded.json", [](nlohmann::json&) {});
+  const auto differences = [&](const std::function<void(nlohmann::json&)>& edit, bool sameVendor = true) {
+    return suite::compareRecords(recorded, make("remade.json", edit), sameVendor).differences;
+  };
+  const auto same = suite::compareRecords(recorded, recorded, true);
+  EXPECT_TRUE(same.differences.empty());
+  EXPECT_EQ(same.files, 1u);
+  EXPECT_TRUE(same.filesCompared);
+  EXPECT_EQ(same.numbers, 6u + 2u + 1u + 4u);  // exact fields, measures, floor, scores
+  // Within what the tables show and a tenth of the floor: the same.
+  EXPECT_TRUE(differences([](nlohmann::json& r) {
+                r["result"]["measures"]["frustum"] = 1.2504;
+                r["result"]["errors"]["taa"]["flip"] = 0.1009;
+                r["result"]["errors"]["taa"]["flip_ratio_to_none"] = 0.5074;  // allowed 0.001 (1 + 0.5) / 0.2 = 0.0075
+                r["result"]["reference_floor"]["flip"] = 0.0109;
+              }).empty());
+  // Beyond: named with the record, the pointer and both values.
+  const auto moved = differences([](nlohmann::json& r) { r["result"]["measures"]["frustum"] = 1.2506; });
+  ASSERT_EQ(moved.size(), 1u);
+  EXPECT_EQ(moved[0], (dir / "recorded.json").string() + ": /result/measures/frustum: recorded 1.250, remade 1.251 (as suite.md shows them)");
+  const auto score = differences([](nlohmann::json& r) { r["result"]["errors"]["taa"]["flip"] = 0.1011; });
+  ASSERT_EQ(score.size(), 1u);
+  EXPECT_NE(score[0].find(": /result/errors/taa/flip: recorded 0.1, remade 0.1011 (more than 0.001 apart: a tenth of the noise floor)"), std::string::npos)
+      << score[0];
+  EXPECT_EQ(differences([](nlohmann::json& r) { r["result"]["errors"]["taa"]["flip_ratio_to_none"] = 0.508; }).size(), 1u);
+  EXPECT_EQ(differences([](nlohmann::json& r) { r["result"]["window"]["first"] = 31; }).size(), 1u);
+  // Frame digests: compared on one vendor, not across vendors (said so instead).
+  const auto otherFrame = [](nlohmann::json& r) { r["files"]["runs/fps-2-bot/frames/frame_00030.exr"] = std::string(64, 'b'); };
+  ASSERT_EQ(differences(otherFrame).size(), 1u);
+  EXPECT_NE(differences(otherFrame)[0].find("/files/runs/fps-2-bot/frames/frame_00030.exr: recorded aaaaaaaaaaaa…, remade bbbbbbbbbbbb… (SHA-256)"),
+            std::string::npos);
+  const auto acrossVendors = suite::compareRecords(recorded, make("remade.json", otherFrame), false);
+  EXPECT_TRUE(acrossVendors.differences.empty());
+  EXPECT_FALSE(acrossVendors.filesCompared);
+  EXPECT_NE(acrossVendors.filesNote.find("not compared across CPU vendors"), std::string::npos);
+}
+
+// --sample's choice: K of the records, the same for a seed on every machine (mt19937_64's sequence
+// is fixed by the standard: its 10,000th output is 9981545732273789042), another for another seed.
+TEST(Suite, ARecordSampleIsTheSameForASeed) {
+  std::mt19937_64 reference;
+  reference.discard(9999);
+  EXPECT_EQ(reference(), 9981545732273789042ull);
+  std::vector<fs::path> records;
+  for (int i = 0; i < 15; ++i) records.push_back(fmt::format("records/d{:02d}.json", i));
+  const auto a = suite::sampleRecords(records, 3, 7);
+  ASSERT_EQ(a.size(), 3u);
+  EXPECT_TRUE(std::is_sorted(a.begin(), a.end()));
+  EXPECT_EQ(std::set<fs::path>(a.begin(), a.end()).size(), 3u);
+  EXPECT_EQ(suite::sampleRecords(records, 3, 7), a);
+  std::reverse(records.begin(), records.end());
+  EXPECT_EQ(suite::sampleRecords(records, 3, 7), a);  // the input's order does not matter
+  std::set<std::vector<fs::path>> seen;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) seen.insert(suite::sampleRecords(records, 3, seed));
+  EXPECT_GT(seen.size(), 15u);
+  EXPECT_EQ(suite::sampleRecords(records, 40, 1).size(), 15u);
 }
 
 TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
@@ -577,6 +668,69 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
     runShell(fmt::format("pkill -f 'flock -n {}'", (out / ".suite.lock").string()), ignored);
   }
 
+  // A record made again from nothing (its own manifest, a fresh folder: capture, convert, renders,
+  // discard, evaluate) agrees with it, its frames the same bytes on this machine.
+  {
+    const auto remade = dynbench(fmt::format("suite verify {} --record fps-1-flythrough --work {}", out.string(), (dir / "remade").string()), dir);
+    EXPECT_EQ(remade.status, 0) << remade.err << remade.out;
+    EXPECT_NE(remade.out.find("capture:"), std::string::npos) << "not made from nothing: " << remade.out;
+    const auto recorded = nlohmann::json::parse(test::slurp(out / "records" / "fps-1-flythrough.json"));
+    std::size_t numbers = 6 + recorded["result"]["measures"].size() + 1;  // the exact fields, measures, floor, every score
+    for (const auto& [method, errors] : recorded["result"]["errors"].items()) numbers += errors.size();
+    EXPECT_NE(remade.out.find(fmt::format("verify fps-1-flythrough: {} numbers and {} file digests, 0 differ", numbers, recorded["files"].size())),
+              std::string::npos)
+        << remade.out;
+  }
+  // Killed (SIGKILL) at pseudo-random moments five times, resumed each time: at no point is a
+  // half-written record or suite.json there to be taken as finished, and the end is the
+  // uninterrupted run's: the same suite.json, each record's result and files. (The captures are
+  // copied, the cameras' datasets not: the kills land in the cameras, renders, measuring and
+  // record writing, which is where a run spends its time.)
+  {
+    const fs::path killed = dir / "killed";
+    fs::create_directories(killed);
+    fs::copy(out / "captures", killed / "captures", fs::copy_options::recursive);
+    for (const auto& entry : fs::recursive_directory_iterator(killed / "captures"))
+      if (entry.path().stem() == "flythrough" || entry.path().stem() == "slowed") fs::remove(entry.path());
+    std::mt19937 random(2026);
+    std::uniform_real_distribution<double> seconds(1.0, 12.0);  // a smoke dataset takes about 5-15 s here
+    auto smokeManifest = suite::readManifest(kSmoke);
+    ASSERT_TRUE(smokeManifest);
+    for (int k = 0; k < 5; ++k) {
+      const double after = seconds(random);
+      SCOPED_TRACE(fmt::format("kill {} after {:.2f} s", k, after));
+      std::string log;
+      const int status = runShell(fmt::format("timeout -s KILL {:.2f} '{}' suite '{}' -o '{}' 2>&1", after, DYNBENCH_EXE, kSmoke.string(), killed.string()), log);
+      EXPECT_TRUE(status == 137 || status == 0) << "kill " << k << " after " << after << " s: " << log;
+      // Whatever is in records/ is whole and checks; suite.json is there only once every record is.
+      auto records = suite::readRecords(killed / "records", *smokeManifest);
+      ASSERT_TRUE(records) << "kill " << k << ": " << records.error().message;
+      if (fs::exists(killed / "suite.json")) EXPECT_EQ(records->size(), 6u) << k;
+    }
+    const auto resumed = dynbench(fmt::format("suite {} -o {}", kSmoke.string(), killed.string()), dir);
+    ASSERT_EQ(resumed.status, 0) << resumed.err << resumed.out;
+    EXPECT_EQ(test::slurp(killed / "suite.json"), json1);
+    for (const auto& entry : fs::directory_iterator(out / "records")) {
+      const auto a = nlohmann::json::parse(test::slurp(entry.path())), b = nlohmann::json::parse(test::slurp(killed / "records" / entry.path().filename()));
+      EXPECT_EQ(a["result"], b["result"]) << entry.path().filename();
+      EXPECT_EQ(a["files"], b["files"]) << entry.path().filename();
+    }
+  }
+
+  // Published: the records copied and the tables assembled from them alone, the one-shot run's bytes.
+  {
+    const fs::path published = dir / "published";
+    const auto r2 = dynbench(fmt::format("suite publish {} -o {}", out.string(), published.string()), dir);
+    ASSERT_EQ(r2.status, 0) << r2.err;
+    EXPECT_EQ(test::slurp(published / "suite.json"), json1);
+    EXPECT_EQ(test::slurp(published / "suite.md"), md1);
+    EXPECT_EQ(std::distance(fs::directory_iterator(published / "records"), fs::directory_iterator()), 6);
+    const auto incomplete = dynbench(fmt::format("suite publish {} -o {}", (dir / "half-a").string(), (dir / "published-half").string()), dir);
+    EXPECT_EQ(incomplete.status, 8) << incomplete.err;
+    EXPECT_NE(incomplete.err.find("no record of 3 of the 6 datasets of suite 'smoke' (fps-2-bot, fps-2-flythrough, fps-2-slowed)"), std::string::npos)
+        << incomplete.err;
+  }
+
   // A clean run verifies.
   const auto clean = dynbench(fmt::format("suite verify {}", out.string()), dir);
   EXPECT_EQ(clean.status, 0) << clean.err << clean.out;
@@ -588,6 +742,41 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
   if (fs::exists(python / "dynbench" / "__init__.py")) {
     const std::string env = fmt::format("PYTHONPATH='{}' /usr/bin/python3 ", python.string());
     const std::string example = (fs::path(DYNBENCH_SOURCE_DIR) / "examples" / "python" / "ema.py").string();
+    // The records from Python, checked by the same reader: a suite folder's and a folder of records.
+    for (const fs::path& folder : {out, dir / "together" / "records"}) {
+      std::string listed;
+      ASSERT_EQ(runShell(env + fmt::format("-c \"import dynbench; r = dynbench.suite_records('{}'); "
+                                           "print(len(r), r['fps-2-bot']['result']['measures']['frustum'], r['fps-2-bot']['manifest']['name'])\" 2>&1",
+                                           folder.string()),
+                         listed),
+                0)
+          << listed;
+      EXPECT_EQ(listed, fmt::format("6 {} smoke\n", nlohmann::json(doc["datasets"][2]["measures"]["frustum"]).dump())) << folder;
+    }
+    // Scoring needs frames, and says which datasets have none here: a folder assembled from records.
+    {
+      std::string refused;
+      EXPECT_NE(runShell(env + fmt::format("-c \"import dynbench; dynbench.suite_score('{}', methods=['mine=external:{}'])\" 2>&1",
+                                           (dir / "together").string(), (dir / "nowhere").string()),
+                         refused),
+                0);
+      EXPECT_NE(refused.find("the frames of 6 of the 6 datasets are not here (fps-1-bot, fps-1-flythrough, fps-2-bot, fps-2-flythrough, fps-1-slowed, "
+                             "fps-2-slowed)"),
+                std::string::npos)
+          << refused;
+      const auto cli = dynbench(fmt::format("suite score {} --method mine=external:{}", (dir / "together").string(), (dir / "nowhere").string()), dir);
+      EXPECT_EQ(cli.status, 3) << cli.err;
+      EXPECT_NE(cli.err.find("the frames of 6 of the 6 datasets are not here"), std::string::npos) << cli.err;
+      EXPECT_EQ(test::slurp(dir / "together" / "suite.json"), json1);
+    }
+    {
+      nlohmann::json edited = nlohmann::json::parse(test::slurp(dir / "together" / "records" / "fps-1-bot.json"));
+      edited["settings"]["max_pairs"] = 1;
+      ASSERT_TRUE(writeFileAtomic(dir / "edited" / "fps-1-bot.json", edited.dump()));
+      std::string refused;
+      EXPECT_NE(runShell(env + fmt::format("-c \"import dynbench; dynbench.suite_records('{}')\" 2>&1", (dir / "edited").string()), refused), 0);
+      EXPECT_NE(refused.find("fps-1-bot.json: /settings: made with other settings"), std::string::npos) << refused;
+    }
     std::string table;
     ASSERT_EQ(runShell(env + fmt::format("'{}' --suite '{}' --check 2>&1", example, out.string()), table), 0) << table;
     EXPECT_NE(table.find("fps-2-flythrough"), std::string::npos) << table;

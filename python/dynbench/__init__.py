@@ -17,10 +17,10 @@ _image_module = _os.path.normpath(_os.path.join(_os.path.dirname(__file__), ".."
 if _os.path.isfile(_image_module):
     _os.environ.setdefault("DYNBENCH_IMAGE_MODULE", _image_module)
 
-from ._core import Error, Frame, compare, discard, evaluate, read_frame, stats, suite_score
+from ._core import Error, Frame, compare, discard, evaluate, read_frame, stats, suite_records, suite_score
 from ._core import _list_frames
 
-__all__ = ["Error", "Frame", "compare", "discard", "evaluate", "frames", "read_frame", "stats", "suite_score"]
+__all__ = ["Error", "Frame", "compare", "discard", "evaluate", "frames", "read_frame", "stats", "suite_records", "suite_score"]
 
 
 def frames(dir):

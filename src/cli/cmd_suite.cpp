@@ -2,13 +2,18 @@
 // verify DIR` (suite/suite.h, suite/score.h, suite/verify.h).
 #include <cstdio>
 
+#include <filesystem>
+
 #include "cli/commands.h"
+#include "suite/record.h"
 #include "suite/score.h"
 #include "suite/suite.h"
 #include "suite/verify.h"
 
 namespace dynbench::cli {
 namespace {
+
+namespace fs = std::filesystem;
 
 struct SuiteCli {
   std::string manifest, output, verifyDir, scoreDir;
@@ -21,6 +26,11 @@ struct SuiteCli {
   cluster::Options slurmOptions;
   std::vector<std::string> only, records;
   bool assemble = false;
+  std::vector<std::string> verifyRecords;  // suite verify --record
+  std::size_t verifySample = 0;            // suite verify --sample
+  std::uint64_t verifySeed = 1;
+  std::string verifyWork;
+  std::string publishDir, publishTo;       // suite publish
 };
 
 // One line per stage, flushed: a suite runs for an hour, and its log (redirected, so fully
@@ -80,7 +90,43 @@ Expected<void> runSuiteCli(const SuiteCli& cli) {
   return {};
 }
 
+// suite verify DIR --record NAME... / --sample K: each record made again from nothing and compared.
+Expected<void> runVerifyRecords(const SuiteCli& cli) {
+  const fs::path dir = cli.verifyDir;
+  std::vector<fs::path> files;
+  for (const std::string& name : cli.verifyRecords) {
+    const fs::path given(name);
+    files.push_back(given.extension() == ".json" && fs::exists(given) ? given : suite::recordPath(dir, name));
+    if (!fs::exists(files.back())) return fail(ErrorCode::kIo, "{}: no such record (--record {})", files.back().string(), name);
+  }
+  if (cli.verifySample > 0) {
+    std::vector<fs::path> all;
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(dir / "records", ec))
+      if (entry.path().extension() == ".json") all.push_back(entry.path());
+    if (all.empty()) return fail(ErrorCode::kIo, "{}: no records to sample", (dir / "records").string());
+    for (const fs::path& f : suite::sampleRecords(all, cli.verifySample, cli.verifySeed)) files.push_back(f);
+  }
+  std::size_t differing = 0;
+  for (const fs::path& file : files) {
+    const std::string name = file.stem().string();
+    const fs::path work = cli.verifyWork.empty() ? dir / "remade" / name : fs::path(cli.verifyWork) / name;
+    printLine(fmt::format("{}: made again from nothing in {}", file.string(), work.string()));
+    auto compared = suite::verifyRecord(file, work, cli.threads, [](const std::string& line) { printLine("  " + line); });
+    if (!compared) return std::unexpected(compared.error());
+    for (const std::string& d : compared->differences) fmt::print("differs: {}\n", d);
+    fmt::print("verify {}: {} numbers{}, {} differ{}\n", compared->dataset, compared->numbers,
+               compared->filesCompared ? fmt::format(" and {} file digests", compared->files) : std::string(), compared->differences.size(),
+               compared->filesNote.empty() ? std::string() : "; " + compared->filesNote);
+    differing += compared->differences.empty() ? 0 : 1;
+  }
+  if (differing > 0)
+    return fail(ErrorCode::kInvalidData, "{}: {} of {} records differ from what making them again gives", dir.string(), differing, files.size());
+  return {};
+}
+
 Expected<void> runVerify(const SuiteCli& cli) {
+  if (!cli.verifyRecords.empty() || cli.verifySample > 0) return runVerifyRecords(cli);
   auto outcome = suite::verifySuite(cli.verifyDir, printLine);
   if (!outcome) return std::unexpected(outcome.error());
   for (const std::string& d : outcome->differences) fmt::print("differs: {}\n", d);
@@ -88,6 +134,13 @@ Expected<void> runVerify(const SuiteCli& cli) {
   if (!outcome->differences.empty())
     return fail(ErrorCode::kInvalidData, "{}: {} of the recorded files and numbers differ from what the files give now", cli.verifyDir,
                 outcome->differences.size());
+  return {};
+}
+
+Expected<void> runPublish(const SuiteCli& cli) {
+  auto outcome = suite::publishSuite(cli.publishDir, cli.publishTo, printLine);
+  if (!outcome) return std::unexpected(outcome.error());
+  fmt::print("suite publish: {} records; {} and {}\n", outcome->recordsReused, outcome->json.string(), outcome->markdown.string());
   return {};
 }
 
@@ -141,6 +194,13 @@ void addSuiteCommand(CLI::App& app, CommandRun& run) {
                   false);
   auto* verify = cmd->add_subcommand("verify", "Recompute every number of DIR/suite.json from its files and report any that differ");
   verify->add_option("DIR", cli->verifyDir, "The suite's folder")->required();
+  verify->add_option("--record", cli->verifyRecords, "Make this dataset's record (DIR/records/NAME.json, or a record file) again from "
+                                                     "nothing in a fresh folder and compare every number with it, instead of re-deriving "
+                                                     "suite.json from the files; repeat for several");
+  verify->add_option("--sample", cli->verifySample, "Make K records of DIR/records, chosen at random with --seed, again from nothing and compare");
+  verify->add_option("--seed", cli->verifySeed, "The seed of --sample's choice (the same records on every machine)");
+  verify->add_option("--work", cli->verifyWork, "Where records are made again (WORK/NAME, emptied first; default DIR/remade)");
+  verify->add_option("--threads", cli->threads, "Render threads (0: all cores)")->check(CLI::Range(0, 1024));
   auto* score = cmd->add_subcommand("score", "Score a method that is not in the manifest on every dataset of a finished suite, "
                                              "from its stored frames (nothing captured or rendered), and add it to suite.json and suite.md");
   score->add_option("DIR", cli->scoreDir, "The suite's folder (with suite.json)")->required();
@@ -154,7 +214,16 @@ void addSuiteCommand(CLI::App& app, CommandRun& run) {
       ->check(CLI::IsMember({"jittered", "still"}));
   score->footer("Example: dynbench suite score smoke --method mine=external:my-outputs   (my-outputs/fps-1-bot/frame_00034.exr, ...)\n"
                 "Outputs are kept in DIR/scored/DATASET/NAME, so `suite verify` re-derives the new column. docs/suite.md.");
-  cmd->callback([cmd, verify, score, cli, &run] {
+  auto* publish = cmd->add_subcommand("publish", "Copy a finished suite's records to a folder of published results and assemble its "
+                                                 "suite.json and suite.md there from them alone");
+  publish->add_option("DIR", cli->publishDir, "The suite's folder (its records in DIR/records)")->required();
+  publish->add_option("-o,--output", cli->publishTo, "The published results' folder (suites/results/SUITE for a versioned suite)")->required();
+  publish->footer("Example: dynbench suite publish runs/v1 -o suites/results/v1   (then commit it; docs/suite.md, \"Records\")");
+  cmd->callback([cmd, verify, score, publish, cli, &run] {
+    if (publish->parsed()) {
+      run = [cli] { return runPublish(*cli); };
+      return;
+    }
     if (verify->parsed()) {
       run = [cli] { return runVerify(*cli); };
       return;

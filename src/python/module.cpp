@@ -2,6 +2,7 @@
 // function returns what the CLI's --json writes for the same arguments, as a dict; errors raise
 // dynbench.Error with the library's message and the CLI's exit status; nothing exits the
 // interpreter. The package's dynbench/__init__.py re-exports these and adds frames().
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <optional>
@@ -23,6 +24,7 @@
 #include "python/frame_objects.h"
 #include "python/python_method.h"
 #include "report/stats_output.h"
+#include "suite/record.h"
 #include "suite/score.h"
 
 namespace py = pybind11;
@@ -233,6 +235,21 @@ py::object scoreSuite(const fs::path& dir, const py::list& methods, const std::s
   return document(unwrap(readJsonFile(dir / "suite.json")));
 }
 
+// dynbench.suite_records: every record in a suite folder's records/ (or a folder of records), each
+// read and checked by suite/record.h against the manifest it carries, as `suite --records` checks them.
+py::dict suiteRecords(const fs::path& folder) {
+  const fs::path records = fs::is_directory(folder / "records") ? folder / "records" : folder;
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(records))
+    if (entry.is_regular_file() && entry.path().extension() == ".json") files.push_back(entry.path());
+  py::dict out;
+  if (files.empty()) return out;
+  std::sort(files.begin(), files.end());
+  const suite::Manifest manifest = unwrap(suite::recordManifest(files.front()));
+  for (const auto& [name, record] : unwrap(suite::readRecords(records, manifest))) out[py::str(name)] = document(record.document);
+  return out;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_core, m) {
@@ -273,4 +290,7 @@ PYBIND11_MODULE(_core, m) {
         "Methods (objects with reset() and process(frame), \"NAME=external:PATH\" or built-in names) scored on every dataset of the "
         "finished suite in dir, on its jittered or still input, added to its suite.json and suite.md as `dynbench suite score` adds "
         "them; returns suite.json");
+  m.def("suite_records", &suiteRecords, py::arg("dir"),
+        "Every record (records/NAME.json) of the suite folder dir (or of a folder of records), each checked against the manifest it "
+        "carries as `dynbench suite --records` checks it, by dataset name (docs/suite.md, \"Records\")");
 }

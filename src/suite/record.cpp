@@ -35,8 +35,10 @@ nlohmann::json recordJson(const Manifest& manifest, std::size_t index, const nlo
   for (const auto& [part, s] : seconds) timing[part] = {{"wall", s.wall}, {"cpu", s.cpu}};
   return {{"dynbench_suite_record", kRecordVersion},
           {"results_version", kResultsVersion},
+          {"numbers_version", kNumbersVersion},
           {"suite", manifest.name},
           {"manifest_sha256", manifestDigest(manifest)},
+          {"manifest", manifest.document},
           {"dataset", manifest.document["datasets"][index]},
           {"settings", recordSettings(manifest)},
           {"tool", {{"version", kVersion}, {"commit", kBuildCommit}}},
@@ -67,6 +69,13 @@ Expected<SuiteRecord> readRecord(const fs::path& file, const Manifest& manifest)
   if (*results != kResultsVersion)
     return fail(ErrorCode::kInvalidData, "{}: /results_version: numbers of results version {}, which this dynbench (version {}) cannot compare with its own",
                 name, *results, kResultsVersion);
+  auto numbers = f.integer("/numbers_version");
+  if (!numbers) return std::unexpected(numbers.error());
+  if (*numbers != kNumbersVersion)
+    return fail(ErrorCode::kInvalidData,
+                "{}: /numbers_version: numbers of version {}, and this dynbench makes version {}: made by a build whose numbers differ "
+                "(make the dataset again)",
+                name, *numbers, kNumbersVersion);
   auto digest = f.string("/manifest_sha256");
   if (!digest) return std::unexpected(digest.error());
   if (*digest != manifestDigest(manifest)) {
@@ -74,6 +83,10 @@ Expected<SuiteRecord> readRecord(const fs::path& file, const Manifest& manifest)
     return fail(ErrorCode::kInvalidData, "{}: /manifest_sha256: a record of another manifest ('{}', SHA-256 {}), not {}'s ('{}', SHA-256 {})", name,
                 suite ? *suite : std::string("?"), *digest, manifest.path.string(), manifest.name, manifestDigest(manifest));
   }
+  auto copy = f.value("/manifest");
+  if (!copy) return std::unexpected(copy.error());
+  if (**copy != manifest.document)
+    return fail(ErrorCode::kInvalidData, "{}: /manifest: not the document its /manifest_sha256 is the digest of (the record was edited)", name);
   auto dataset = f.value("/dataset");
   if (!dataset) return std::unexpected(dataset.error());
   auto datasetName = f.string("/dataset/name");
@@ -113,6 +126,28 @@ Expected<SuiteRecord> readRecord(const fs::path& file, const Manifest& manifest)
   for (const char* key : {"/tool/version", "/tool/commit", "/machine/cpu", "/machine/vendor", "/machine/isa"})
     if (auto v = f.string(key); !v) return std::unexpected(v.error());
   return record;
+}
+
+Expected<Manifest> recordManifest(const fs::path& file) {
+  auto doc = readJsonFile(file);
+  if (!doc) return std::unexpected(doc.error());
+  if (!doc->is_object()) return fail(ErrorCode::kInvalidData, "{}: expected a dynbench suite record (a JSON object)", file.string());
+  const JsonFields f(*doc, file);
+  auto version = f.integer("/dynbench_suite_record");
+  if (!version) return std::unexpected(version.error());
+  if (*version != kRecordVersion)
+    return fail(ErrorCode::kInvalidData, "{}: /dynbench_suite_record: a record of version {}, which this dynbench (record version {}) cannot read",
+                file.string(), *version, kRecordVersion);
+  auto document = f.value("/manifest");
+  if (!document) return std::unexpected(document.error());
+  auto digest = f.string("/manifest_sha256");
+  if (!digest) return std::unexpected(digest.error());
+  auto manifest = parseManifest(**document, file.string() + " /manifest");
+  if (!manifest) return std::unexpected(manifest.error());
+  if (manifestDigest(*manifest) != *digest)
+    return fail(ErrorCode::kInvalidData, "{}: /manifest: its SHA-256 is {}, not the record's /manifest_sha256 {} (the record was edited)",
+                file.string(), manifestDigest(*manifest), *digest);
+  return manifest;
 }
 
 Expected<std::map<std::string, SuiteRecord>> readRecords(const fs::path& folder, const Manifest& manifest) {

@@ -23,6 +23,11 @@ namespace dynbench::suite {
 
 // "dynbench_suite_record" in a record: bumped when a record's meaning changes.
 inline constexpr int kRecordVersion = 1;
+// "numbers_version" in a record: bumped by every change that moves a number a record holds for the
+// same manifest (capture adapters, convert, cameras, the renderer, discard, the metrics, the
+// methods), so that records of builds whose numbers differ are never assembled into one table. A
+// record of another numbers version is refused; make it again.
+inline constexpr int kNumbersVersion = 1;
 
 // The manifest's digest a record carries: the SHA-256 of its document as compact JSON with sorted
 // keys (nlohmann::json::dump()), so spacing and key order do not matter, every value does.
@@ -63,6 +68,11 @@ Expected<SuiteRecord> readRecord(const std::filesystem::path& file, const Manife
 // Every record (*.json) in `folder`, each read as readRecord does, by dataset name; an error for the
 // first one refused, or for two records of one dataset. A missing folder has none.
 Expected<std::map<std::string, SuiteRecord>> readRecords(const std::filesystem::path& folder, const Manifest& manifest);
+
+// The manifest a record was made from: its /manifest (a copy of the manifest's document, so that a
+// record can be re-made, checked and assembled with nothing else), parsed, and refused when its
+// digest is not the record's /manifest_sha256. `file` names the record in errors.
+Expected<Manifest> recordManifest(const std::filesystem::path& file);
 
 // DIR/records/NAME.json.
 std::filesystem::path recordPath(const std::filesystem::path& suiteFolder, const std::string& dataset);

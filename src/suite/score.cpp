@@ -226,6 +226,25 @@ Expected<ScoreOutcome> scoreSuite(const fs::path& dir, const std::vector<MethodT
       return fail(ErrorCode::kUsage, "suite score: method '{}': input '{}': expected \"jittered\" or \"still\"", m.name, m.input);
   }
 
+  // The frames every dataset's scoring reads (its reference and the jittered input), all named
+  // before anything is scored: a folder assembled from records (`suite --assemble`,
+  // published results) has the numbers but not the frames.
+  std::vector<std::string> withoutFrames;
+  for (const RecordedDataset& d : suite->datasets) {
+    // (a still input the suite never rendered, with the rest there, has its own message below)
+    std::vector<fs::path> needed{dir / d.run / "frames"};
+    for (const MethodToScore& m : methods)
+      if (m.input != evaluate::kStillInput) needed.push_back(dir / d.run / "input");
+    if (std::any_of(needed.begin(), needed.end(), [](const fs::path& folder) { return !fs::is_directory(folder); }))
+      withoutFrames.push_back(d.result.name);
+  }
+  if (!withoutFrames.empty())
+    return fail(ErrorCode::kIo,
+                "{}: the frames of {} of the {} datasets are not here ({}): a method is scored on every dataset's stored reference and "
+                "input frames, and this folder has only their numbers (records). Score in the folder that made them, or make them again "
+                "here (move their records aside and run `dynbench suite MANIFEST -o {}`)",
+                dir.string(), withoutFrames.size(), suite->datasets.size(), fmt::join(withoutFrames, ", "), dir.string());
+
   // Every dataset's outputs go to DIR/scored/.pending first and move into place only when every
   // dataset has been scored: a failure leaves the suite as it was.
   const fs::path pending = dir / "scored" / ".pending";

@@ -459,6 +459,39 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
   return outcome;
 }
 
+Expected<SuiteOutcome> publishSuite(const fs::path& dir, const fs::path& to, const pipeline::RunLog& log) {
+  std::vector<fs::path> files;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir / "records", ec))
+    if (entry.is_regular_file() && entry.path().extension() == ".json") files.push_back(entry.path());
+  if (files.empty()) return fail(ErrorCode::kIo, "{}: no records to publish", (dir / "records").string());
+  std::sort(files.begin(), files.end());
+  auto manifest = recordManifest(files.front());
+  if (!manifest) return std::unexpected(manifest.error());
+  auto records = readRecords(dir / "records", *manifest);
+  if (!records) return std::unexpected(records.error());
+  std::vector<std::string> missing;
+  for (const DatasetSpec& spec : manifest->datasets)
+    if (!records->count(spec.name)) missing.push_back(spec.name);
+  if (!missing.empty())
+    return fail(ErrorCode::kIncomplete, "{}: no record of {} of the {} datasets of suite '{}' ({}): a suite is published whole", dir.string(),
+                missing.size(), manifest->datasets.size(), manifest->name, fmt::join(missing, ", "));
+  // The folder holds this suite's records and nothing else that looks like one.
+  fs::remove_all(to / "records", ec);
+  if (ec) return fail(ErrorCode::kIo, "{}: cannot empty: {}", (to / "records").string(), ec.message());
+  for (auto& [name, record] : *records) {
+    auto bytes = readWholeFile(record.file);
+    if (!bytes) return std::unexpected(bytes.error());
+    record.file = recordPath(to, name);
+    if (auto ok = writeFileAtomic(record.file, *bytes); !ok) return std::unexpected(ok.error());
+  }
+  log(fmt::format("{} records of suite '{}' -> {}", records->size(), manifest->name, (to / "records").string()));
+  SuiteOutcome outcome;
+  if (auto ok = assembleSuite(*manifest, *records, to, outcome); !ok) return std::unexpected(ok.error());
+  outcome.recordsReused = records->size();
+  return outcome;
+}
+
 Expected<cluster::ChainOutcome> runSuiteOnSlurm(const SuiteOptions& options, const cluster::Options& slurm,
                                                         const std::function<void(const cluster::ChainStatus&)>& progress) {
   auto manifest = readManifest(options.manifest);

@@ -62,6 +62,12 @@ struct SuiteOutcome {
 // settings. One run at a time in DIR (a lock; render tasks aside).
 Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::RunLog& log);
 
+// A finished suite's records (DIR/records, one for every dataset of the manifest they carry) copied
+// to `to`/records, and suite.json, suite.md and plots assembled there from them alone: what a
+// versioned suite's published results are (suites/results/SUITE, docs/suite.md). Records of
+// another suite already there are replaced.
+Expected<SuiteOutcome> publishSuite(const std::filesystem::path& dir, const std::filesystem::path& to, const pipeline::RunLog& log);
+
 // The files a dataset's numbers come from, relative to DIR: the dataset's .gltf and .bin, and the
 // run's reference, input and noise-floor frames with their sidecars (suite.json's /files).
 std::vector<std::filesystem::path> recordedFiles(const std::filesystem::path& root, const std::filesystem::path& dataset,

@@ -1,10 +1,14 @@
 #include "suite/verify.h"
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 
 #include <fmt/format.h>
 
 #include "core/checksum.h"
+#include "core/files.h"
+#include "core/machine.h"
 #include "core/json_fields.h"
 #include "pipeline/stages.h"
 #include "suite/manifest.h"
@@ -125,6 +129,135 @@ Expected<VerifyOutcome> verifySuite(const fs::path& root, const pipeline::RunLog
       }
     }
   return out;
+}
+
+RecordComparison compareRecords(const SuiteRecord& recorded, const SuiteRecord& remade, bool sameVendor) {
+  RecordComparison out;
+  out.dataset = recorded.dataset;
+  const std::string file = recorded.file.string();
+  const auto differs = [&](const std::string& pointer, const std::string& was, const std::string& now, const std::string& why) {
+    out.differences.push_back(fmt::format("{}: {}: recorded {}, remade {}{}", file, pointer, was, now, why.empty() ? "" : " (" + why + ")"));
+  };
+  const DatasetResult &a = recorded.result, &b = remade.result;
+  // What is exact: the window and the digests the pins are checked against.
+  for (const char* pointer : {"/window/first", "/window/last", "/sha256/capture", "/sha256/dataset", "/match", "/camera"}) {
+    ++out.numbers;
+    const nlohmann::json::json_pointer p(pointer);
+    const nlohmann::json was = recorded.entry.contains(p) ? recorded.entry[p] : nlohmann::json(), now = remade.entry.contains(p) ? remade.entry[p] : nlohmann::json();
+    if (was != now) differs(std::string("/result") + pointer, was.dump(), now.dump(), "");
+  }
+  // The measures to the digits the tables show.
+  for (const auto& [measure, value] : a.measures) {
+    ++out.numbers;
+    const auto found = b.measures.find(measure);
+    const std::string shown = fmt::format("{:.3f}", value);
+    if (found == b.measures.end()) differs("/result/measures/" + measure, shown, "nothing", "");
+    else if (fmt::format("{:.3f}", found->second) != shown) differs("/result/measures/" + measure, shown, fmt::format("{:.3f}", found->second), "as suite.md shows them");
+  }
+  // The scores within a tenth of the noise floor: the reference cannot tell finer differences apart.
+  const double tolerance = 0.1 * a.referenceFloor.value_or(0.0);
+  const auto within = [&](const std::string& pointer, double was, double now, double allowed) {
+    ++out.numbers;
+    if (!(std::abs(was - now) <= allowed))
+      differs(pointer, fmt::format("{:.6g}", was), fmt::format("{:.6g}", now), fmt::format("more than {:.3g} apart: a tenth of the noise floor", allowed));
+  };
+  if (a.referenceFloor.has_value() != b.referenceFloor.has_value()) {
+    ++out.numbers;
+    differs("/result/reference_floor", a.referenceFloor ? fmt::format("{:.6g}", *a.referenceFloor) : "null",
+            b.referenceFloor ? fmt::format("{:.6g}", *b.referenceFloor) : "null", "");
+  } else if (a.referenceFloor) {
+    within("/result/reference_floor/flip", *a.referenceFloor, *b.referenceFloor, tolerance);
+  }
+  for (const auto& [method, errors] : a.errors) {
+    const auto found = b.errors.find(method);
+    if (found == b.errors.end()) {
+      ++out.numbers;
+      differs("/result/errors/" + method, "its scores", "nothing", "");
+      continue;
+    }
+    // the `none` its ratio is to: the one on its own input
+    const nlohmann::json& inputs = recorded.document["settings"]["method_inputs"];
+    const bool still = inputs.is_object() && inputs.value(method, std::string()) == evaluate::kStillInput;
+    const std::string none = method == kStillNone || method == "none" ? method : still ? kStillNone : "none";
+    const double noneFlip = a.errors.count(none) && a.errors.at(none).count("flip") ? a.errors.at(none).at("flip") : 0.0;
+    for (const auto& [error, value] : errors) {
+      const std::string pointer = fmt::format("/result/errors/{}/{}", method, error);
+      const auto now = found->second.find(error);
+      if (now == found->second.end()) {
+        ++out.numbers;
+        differs(pointer, fmt::format("{:.6g}", value), "nothing", "");
+      } else if (error == "flip_ratio_to_none") {
+        within(pointer, value, now->second, noneFlip > 0 ? tolerance * (1.0 + value) / noneFlip : 0.0);
+      } else {
+        within(pointer, value, now->second, tolerance);
+      }
+    }
+  }
+  // The files, where both records' frames come from one CPU vendor's instructions (docs/suite.md).
+  const std::string vendorA = recorded.document["machine"].value("vendor", ""), vendorB = remade.document["machine"].value("vendor", "");
+  if (!sameVendor) {
+    out.filesNote = fmt::format("the record was made on {} ({}), this machine is {} ({}): frame digests are not compared across CPU vendors",
+                                recorded.document["machine"].value("cpu", "?"), vendorA, remade.document["machine"].value("cpu", "?"), vendorB);
+    return out;
+  }
+  out.filesCompared = true;
+  for (const auto& [path, sum] : recorded.files) {
+    ++out.files;
+    const auto now = remade.files.find(path);
+    if (now == remade.files.end()) differs("/files/" + path, sum.substr(0, 12) + "…", "no such file", "");
+    else if (now->second != sum) differs("/files/" + path, sum.substr(0, 12) + "…", now->second.substr(0, 12) + "…", "SHA-256");
+  }
+  for (const auto& [path, sum] : remade.files)
+    if (!recorded.files.count(path)) {
+      ++out.files;
+      differs("/files/" + path, "no such file", sum.substr(0, 12) + "…", "");
+    }
+  return out;
+}
+
+Expected<RecordComparison> verifyRecord(const fs::path& file, const fs::path& work, int threads, const pipeline::RunLog& log) {
+  auto manifest = recordManifest(file);
+  if (!manifest) return std::unexpected(manifest.error());
+  auto recorded = readRecord(file, *manifest);
+  if (!recorded) return std::unexpected(recorded.error());
+  // From nothing: an empty folder with the record's own manifest in it.
+  std::error_code ec;
+  fs::remove_all(work, ec);
+  if (ec) return fail(ErrorCode::kIo, "{}: cannot empty: {}", work.string(), ec.message());
+  const fs::path manifestFile = work / (manifest->name + ".json");
+  if (auto ok = writeFileAtomic(manifestFile, manifest->document.dump(2) + "\n"); !ok) return std::unexpected(ok.error());
+  SuiteOptions options;
+  options.manifest = manifestFile;
+  options.output = work;
+  options.threads = threads;
+  options.only = {recorded->dataset};
+  auto run = runSuite(options, log);
+  if (!run) return std::unexpected(run.error());
+  auto remade = readRecord(recordPath(work, recorded->dataset), *manifest);
+  if (!remade) return std::unexpected(remade.error());
+  const std::string vendor = recorded->document["machine"].value("vendor", "");
+  return compareRecords(*recorded, *remade, !vendor.empty() && vendor == core::machineInfo().vendor);
+}
+
+std::vector<fs::path> sampleRecords(std::vector<fs::path> records, std::size_t k, std::uint64_t seed) {
+  std::sort(records.begin(), records.end());
+  std::mt19937_64 random(seed);
+  std::vector<std::size_t> order(records.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  // Fisher-Yates with the generator's raw output (std::shuffle and the distributions are not the
+  // same across standard libraries; mt19937_64's sequence is): j uniform in [0, i] by rejection.
+  for (std::size_t i = order.size(); i > 1; --i) {
+    const std::uint64_t n = i, limit = std::numeric_limits<std::uint64_t>::max() - std::numeric_limits<std::uint64_t>::max() % n;
+    std::uint64_t r;
+    do r = random();
+    while (r >= limit);
+    std::swap(order[i - 1], order[r % n]);
+  }
+  order.resize(std::min(k, order.size()));
+  std::sort(order.begin(), order.end());
+  std::vector<fs::path> chosen;
+  for (std::size_t i : order) chosen.push_back(records[i]);
+  return chosen;
 }
 
 }  // namespace dynbench::suite
