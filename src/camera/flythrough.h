@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/rates.h"
 #include "metrics/camera_motion.h"
 
 namespace dynbench::camera {
@@ -47,7 +48,7 @@ struct FlythroughOptions {
   double speed = 2.5;            // m/s (ORCA's Table 6.4 rows: 0.3-3.7 m/s at 24 fps); less when the stretch is shorter
   double lookAhead = 4.0;        // m along the path
   double maxSmoothing = 64.0;    // scene units: the widest moving average of the path tried (halved until clear of walls)
-  double frameRate = 24.0;       // the rate the dataset is rendered at: its chords are checked, its turn rates bounded
+  double frameRate = kDefaultFrameRate;  // the rate the dataset is rendered at: its chords are checked, its turn rates bounded
   // Bounds on the per-frame yaw and pitch changes at frameRate (degrees, Table 6.6): the largest of
   // the thesis's three ORCA rows (yaw: Emerald Square's 0.511 and 0.095; pitch: Bistro Interior's
   // 0.053 and 0.004). The yaw's and the pitch's smoothing each widen until their two hold.

@@ -68,12 +68,12 @@ void addDiscardCommand(CLI::App& app, CommandRun& run) {
   cmd->add_flag("--absolute-radiance", o->thresholds.absoluteRadiance, "Radiance thresholds in radiance units, not relative");
   using Test = discard::Thresholds::RadianceTest;
   cmd->add_option("--radiance-test", o->thresholds.radianceTest,
-                  "pairs (default): the frames' radiance-change pairs (render --converge or --pairs) decide each pixel, no noise "
-                  "where nothing changed (docs/metrics.md); expected: the image-against-image test, each pixel counting with the "
-                  "probability that its radiance truly changed given its noise (*.var channels), with 95% intervals; noise-aware: "
-                  "the change must also exceed 3 standard deviations of the noise; plain: the thesis's test on the rendered values")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, Test>{{"pairs", Test::kPairs}, {"expected", Test::kExpected},
-                                                                      {"noise-aware", Test::kNoiseAware}, {"plain", Test::kPlain}}));
+                  fmt::format("pairs (default): the frames' radiance-change pairs (render --converge or --pairs) decide each pixel, no noise "
+                              "where nothing changed (docs/metrics.md); expected: the image-against-image test, each pixel counting with the "
+                              "probability that its radiance truly changed given its noise (*.var channels), with 95% intervals; noise-aware: "
+                              "the change must also exceed {} standard deviations of the noise; plain: the thesis's test on the rendered values",
+                              discard::Thresholds{}.noiseSigmas))
+      ->transform(CLI::CheckedTransformer(std::map<std::string, Test>(discard::radianceTestsByName().begin(), discard::radianceTestsByName().end())));
   cmd->add_flag_callback("--noise-aware", [o] { o->thresholds.radianceTest = Test::kNoiseAware; },
                          fmt::format("Same as --radiance-test noise-aware: radiance discards only when the change exceeds {} standard "
                                      "deviations of the pixels' noise (needs *.var channels)",

@@ -78,6 +78,16 @@ const char* radianceTestName(Thresholds::RadianceTest test) {
   return "?";
 }
 
+const std::vector<std::pair<std::string, Thresholds::RadianceTest>>& radianceTestsByName() {
+  using Test = Thresholds::RadianceTest;
+  static const std::vector<std::pair<std::string, Test>> tests = [] {
+    std::vector<std::pair<std::string, Test>> out;
+    for (const Test t : {Test::kPairs, Test::kExpected, Test::kNoiseAware, Test::kPlain}) out.emplace_back(radianceTestName(t), t);
+    return out;
+  }();
+  return tests;
+}
+
 const char* geometryTestName(Thresholds::GeometryTest test) {
   return test == Thresholds::GeometryTest::kTaps ? "taps" : "bilinear";
 }

@@ -11,6 +11,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -45,10 +46,10 @@ struct Thresholds {
   // kTaps: plane distance / view depth. kBilinear: world-position distance, in scene units; with
   // relativePosition, a fraction of the scene's size (the diagonal of the first frame's
   // world-position bounding box).
-  double position = 0.01;
+  double position = reprojection::kDefaultPositionThreshold;
   bool relativePosition = false;
   // Shading-normal vector distance ||n_i - n_{i-1}|| (0.1 is a turn of about 5.7 degrees).
-  double normal = 0.1;
+  double normal = reprojection::kDefaultNormalThreshold;
   // Radiance vector distance ||L_i - L_{i-1}|| (RGB). By default a fraction of the current frame's
   // mean luminance of that buffer (the exposure-like tuning the thesis did by hand);
   // absoluteRadiance takes it in radiance units, as the thesis's functions literally do.
@@ -75,6 +76,9 @@ struct Thresholds {
 };
 
 const char* radianceTestName(Thresholds::RadianceTest test);  // "pairs", "expected", "noise-aware", "plain"
+// Every radiance test with its name, in that order: the one list the CLI, the Python module and
+// discard.json's reader take the names from.
+const std::vector<std::pair<std::string, Thresholds::RadianceTest>>& radianceTestsByName();
 const char* geometryTestName(Thresholds::GeometryTest test);  // "taps", "bilinear"
 // The thesis's default world-position threshold of the bilinear test: 0.05 scene units.
 inline constexpr double kBilinearPositionThreshold = 0.05;

@@ -108,16 +108,15 @@ Expected<DiscardRun> readDiscardJson(const std::filesystem::path& path) {
   if (f.has("/thresholds/radiance_test")) {
     auto name = f.string("/thresholds/radiance_test");
     if (!name) return std::unexpected(name.error());
-    bool known = false;
-    for (const auto test : {Thresholds::RadianceTest::kPairs, Thresholds::RadianceTest::kExpected, Thresholds::RadianceTest::kNoiseAware,
-                            Thresholds::RadianceTest::kPlain})
-      if (*name == radianceTestName(test)) {
-        run.thresholds.radianceTest = test;
-        known = true;
-      }
-    if (!known)
-      return fail(ErrorCode::kInvalidData, "{}: /thresholds/radiance_test: expected pairs, expected, noise-aware or plain (got '{}')",
-                  path.string(), *name);
+    const auto& tests = radianceTestsByName();
+    const auto known = std::find_if(tests.begin(), tests.end(), [&](const auto& t) { return t.first == *name; });
+    if (known == tests.end()) {
+      std::vector<std::string> names;
+      for (const auto& t : tests) names.push_back(t.first);
+      return fail(ErrorCode::kInvalidData, "{}: /thresholds/radiance_test: expected one of {} (got '{}')", path.string(), fmt::join(names, ", "),
+                  *name);
+    }
+    run.thresholds.radianceTest = known->second;
   }
   auto mean = readPercentages(f, "/mean");
   if (!mean) return std::unexpected(mean.error());

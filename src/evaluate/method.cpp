@@ -29,15 +29,15 @@ frames::FeatureFrame historyFrame(const frames::FeatureFrame& frame) {
 
 const std::vector<MethodInfo>& builtInMethods() {
   static const std::vector<MethodInfo> methods{
-      {"none", "the input as it is, reusing nothing: the floor the others must beat",
+      {kNoneMethod, "the input as it is, reusing nothing: the floor the others must beat",
        [](const MethodContext&) { return makeNoneMethod(); }},
-      {"accumulate", "reprojected history blended in, rejected by the discard stage's tests",
+      {kAccumulateMethod, "reprojected history blended in, rejected by the discard stage's tests",
        [](const MethodContext& context) { return makeAccumulateMethod(context); }, kStillInput},
-      {"taa", "temporal anti-aliasing (Karis 2014, Salvi 2016): Catmull-Rom history, variance clipping",
+      {kTaaMethod, "temporal anti-aliasing (Karis 2014, Salvi 2016): Catmull-Rom history, variance clipping",
        [](const MethodContext&) { return makeTaaMethod(); }},
       // [S17] §3 filters "1 sample per pixel path traced" frames at the pixel centre; its temporal
       // reprojection has no jitter to undo.
-      {"svgf", "spatiotemporal variance-guided filtering (Schied et al. 2017)", [](const MethodContext&) { return makeSvgfMethod(); }, kStillInput},
+      {kSvgfMethod, "spatiotemporal variance-guided filtering (Schied et al. 2017)", [](const MethodContext&) { return makeSvgfMethod(); }, kStillInput},
   };
   return methods;
 }

@@ -86,6 +86,8 @@ long sumOverRows(int height, const std::function<long(int)>& row);
 frames::FeatureFrame historyFrame(const frames::FeatureFrame& frame);
 
 // Factories, one per method file.
+// The built-in methods' names: the registry's (builtInMethods) and each method's name().
+inline constexpr const char *kNoneMethod = "none", *kAccumulateMethod = "accumulate", *kTaaMethod = "taa", *kSvgfMethod = "svgf";
 std::unique_ptr<TemporalMethod> makeNoneMethod();
 std::unique_ptr<TemporalMethod> makeAccumulateMethod(const MethodContext& context);
 std::unique_ptr<TemporalMethod> makeTaaMethod();

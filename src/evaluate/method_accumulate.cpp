@@ -12,7 +12,7 @@ namespace {
 class AccumulateMethod final : public TemporalMethod {
  public:
   explicit AccumulateMethod(const MethodContext& context) : context_(context) {}
-  std::string name() const override { return "accumulate"; }
+  std::string name() const override { return kAccumulateMethod; }
   nlohmann::json parameters() const override {
     return {{"alpha_min", kAlphaMin},
             {"geometry_test", discard::geometryTestName(context_.thresholds.geometryTest)},

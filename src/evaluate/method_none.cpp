@@ -6,7 +6,7 @@ namespace {
 
 class NoneMethod final : public TemporalMethod {
  public:
-  std::string name() const override { return "none"; }
+  std::string name() const override { return kNoneMethod; }
   nlohmann::json parameters() const override { return nlohmann::json::object(); }
   void reset() override {}
   Expected<MethodOutput> process(const frames::FeatureFrame& frame) override { return MethodOutput{frameRadiance(frame), 0.0}; }

@@ -30,7 +30,7 @@ float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 
 
 class SvgfMethod final : public TemporalMethod {
  public:
-  std::string name() const override { return "svgf"; }
+  std::string name() const override { return kSvgfMethod; }
   nlohmann::json parameters() const override {
     return {{"alpha_colour", kAlphaColour}, {"alpha_moments", kAlphaMoments}, {"iterations", kIterations}, {"sigma_z", kSigmaZ},
             {"sigma_n", kSigmaN}, {"sigma_l", kSigmaL}, {"history_cap", kHistoryCap}};

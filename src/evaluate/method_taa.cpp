@@ -28,7 +28,7 @@ namespace {
 
 class TaaMethod final : public TemporalMethod {
  public:
-  std::string name() const override { return "taa"; }
+  std::string name() const override { return kTaaMethod; }
   nlohmann::json parameters() const override {
     return {{"blend", kBlend}, {"gamma", kGamma}, {"history", "variance clip in YCoCg, 3x3"}, {"reprojection", "motion vectors, Catmull-Rom"}};
   }

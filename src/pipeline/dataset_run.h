@@ -15,6 +15,7 @@
 #include "capture/openarena.h"
 #include "core/error.h"
 #include "core/json_fields.h"
+#include "core/rates.h"
 #include "discard/discard.h"
 #include "evaluate/evaluate.h"
 #include "metrics/camera_motion.h"
@@ -24,7 +25,7 @@
 namespace dynbench::pipeline {
 
 struct DatasetRunSettings {
-  double fps = 24.0;  // stats, render and discard sample the dataset at this rate
+  double fps = kDefaultFrameRate;  // stats, render and discard sample the dataset at this rate
   // Converged feature buffers (render --converge) of a window of renderFrames consecutive frames
   // in the middle of the dataset: fewer pixels rather than less convergence, so Table 6.7
   // describes the dataset, not the noise. The defaults are the demo's budget (issue 47: the

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/rates.h"
 #include "discard/discard.h"
 #include "render/render_job.h"
 #include "report/html_report.h"
@@ -20,8 +21,8 @@ namespace dynbench::pipeline {
 // ---- stats: Tables 6.1-6.6 -------------------------------------------------------------------
 struct StatsStage {
   std::vector<std::filesystem::path> inputs;  // datasets: one row each
-  double fps = 24.0;                          // sampling rate, frames per second (the thesis's)
-  double sequenceRate = 24.0;                 // key frames per second of an OBJ sequence
+  double fps = kDefaultFrameRate;             // sampling rate, frames per second (the thesis's)
+  double sequenceRate = kDefaultSequenceRate;  // key frames per second of an OBJ sequence
   std::optional<std::string> camera;          // index or name; default: the first animated camera
   std::optional<std::string> animation;       // index or name; default: all together on one clock
   std::filesystem::path json, csv;            // optional outputs (empty: not written)

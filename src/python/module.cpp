@@ -15,8 +15,10 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 #include <pybind11_json/pybind11_json.hpp>
+#include <fmt/ranges.h>
 
 #include "discard/discard.h"
+#include "core/rates.h"
 #include "evaluate/compare.h"
 #include "evaluate/evaluate.h"
 #include "frames/frame_io.h"
@@ -122,12 +124,18 @@ py::object discardFrames(const fs::path& frames, const std::string& geometryTest
                    double thresholdNormal, double thresholdDirect, double thresholdIndirect, bool absoluteRadiance,
                    const std::string& radianceTest, bool includeCuts) {
   using Geometry = discard::Thresholds::GeometryTest;
-  using Radiance = discard::Thresholds::RadianceTest;
   discard::Thresholds t;
   t.geometryTest = choice<Geometry>(geometryTest, "geometry_test", {{"taps", Geometry::kTaps}, {"bilinear", Geometry::kBilinear}});
-  t.radianceTest = choice<Radiance>(radianceTest, "radiance_test",
-                                    {{"pairs", Radiance::kPairs}, {"expected", Radiance::kExpected}, {"noise-aware", Radiance::kNoiseAware},
-                                     {"plain", Radiance::kPlain}});
+  {
+    const auto& tests = discard::radianceTestsByName();
+    const auto known = std::find_if(tests.begin(), tests.end(), [&](const auto& test) { return test.first == radianceTest; });
+    if (known == tests.end()) {
+      std::vector<std::string> names;
+      for (const auto& test : tests) names.push_back(test.first);
+      raiseError({ErrorCode::kUsage, fmt::format("radiance_test: \"{}\" is not one of {}", radianceTest, fmt::join(names, ", "))});
+    }
+    t.radianceTest = known->second;
+  }
   for (const auto& [value, name] : {std::pair{thresholdPosition.value_or(0.0), "threshold_position"}, {thresholdNormal, "threshold_normal"},
                                     {thresholdDirect, "threshold_direct"}, {thresholdIndirect, "threshold_indirect"}})
     if (!(value >= 0)) raiseError({ErrorCode::kUsage, fmt::format("{}: {} (expected a number >= 0)", name, value)});
@@ -273,8 +281,8 @@ PYBIND11_MODULE(_core, m) {
 
   m.def("read_frame", &readFrame, py::arg("path"), "Reads frame_NNNNN.exr (and its frame_NNNNN.json sidecar)");
   m.def("_list_frames", &listFrameImages, py::arg("dir"), "The frames of a folder in frame order, as image paths");
-  m.def("stats", &measureStats, py::arg("paths"), py::kw_only(), py::arg("fps") = 24.0, py::arg("camera") = py::none(), py::arg("animation") = py::none(),
-        py::arg("sequence_rate") = 24.0, "Tables 6.1-6.6 of datasets, as `dynbench stats --json` writes them");
+  m.def("stats", &measureStats, py::arg("paths"), py::kw_only(), py::arg("fps") = kDefaultFrameRate, py::arg("camera") = py::none(), py::arg("animation") = py::none(),
+        py::arg("sequence_rate") = kDefaultSequenceRate, "Tables 6.1-6.6 of datasets, as `dynbench stats --json` writes them");
   const discard::Thresholds defaults;
   m.def("discard", &discardFrames, py::arg("frames_dir"), py::kw_only(), py::arg("geometry_test") = "taps", py::arg("threshold_position") = py::none(),
         py::arg("relative_position") = false, py::arg("threshold_normal") = defaults.normal, py::arg("threshold_direct") = defaults.direct,

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/rates.h"
 #include <nlohmann/json.hpp>
 
 #include "render/path_tracer.h"
@@ -30,7 +31,7 @@ struct RenderJob {
   std::filesystem::path output;
   RenderSettings settings;
   std::string engine = "embree";  // a backend name (render/backend.h)
-  double fps = 24.0;
+  double fps = kDefaultFrameRate;
   FrameRange frames;
   std::optional<std::string> camera;
   // The animation played (index or name), when the scene was reduced to one with

@@ -11,6 +11,7 @@
 #include "core/image_io.h"
 #include "core/process.h"
 #include "core/progress.h"
+#include "core/rates.h"
 
 namespace dynbench::report {
 namespace {
@@ -147,7 +148,7 @@ Expected<Video> writeRunVideo(const std::vector<frames::FrameEntry>& frames, con
     if (auto ok = writeImage(pngs.dir / fmt::format("{:05d}.png", k), image); !ok) return std::unexpected(ok.error());
   }
   progress.update(count);
-  video.fps = steps.empty() ? 24.0 : 1.0 / median(steps);
+  video.fps = steps.empty() ? kDefaultFrameRate : 1.0 / median(steps);
   videoSize(width, height, masks, options, video.width, video.height);
 
   const fs::path temporary = temporarySibling(out).string() + ".webm";  // ffmpeg picks the container by extension

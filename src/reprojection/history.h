@@ -18,12 +18,17 @@ using frames::FeatureFrame;
 // more); kBilinear: the thesis's bilinear sample of the four taps.
 enum class GeometryTest { kTaps, kBilinear };
 
+// The geometry test's default thresholds, shared by SurfaceThresholds and discard::Thresholds:
+// position 0.01 (NRD's disocclusionThreshold: plane distance / view depth) and a shading-normal
+// vector distance of 0.1 (a turn of about 5.7 degrees).
+inline constexpr double kDefaultPositionThreshold = 0.01, kDefaultNormalThreshold = 0.1;
+
 // The geometry test's thresholds, absolute: position (kTaps: plane distance / view depth;
 // kBilinear: scene units) and the shading normals' vector distance.
 struct SurfaceThresholds {
   GeometryTest test = GeometryTest::kTaps;
-  double position = 0.01;
-  double normal = 0.1;
+  double position = kDefaultPositionThreshold;
+  double normal = kDefaultNormalThreshold;
 };
 
 // The geometry test of one reprojected surface pixel (SurfaceThresholds::test) against the

@@ -7,13 +7,14 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/rates.h"
 #include "scene/scene.h"
 
 namespace dynbench::scene {
 
 struct LoadOptions {
   // Key frames per second of an OBJ sequence (one OBJ file per key frame).
-  double sequenceRate = 24.0;
+  double sequenceRate = kDefaultSequenceRate;
 };
 
 Expected<Scene> loadScene(const std::filesystem::path& path, const LoadOptions& options = {});
