@@ -423,6 +423,39 @@ TEST(Suite, ARecordSampleIsTheSameForASeed) {
   EXPECT_EQ(suite::sampleRecords(records, 40, 1).size(), 15u);
 }
 
+// The results committed under suites/results/SUITE (`suite publish`): every record parses and
+// belongs to suites/SUITE.json as this dynbench makes it (a record of a build whose numbers differ is
+// refused: such results are made again, never kept beside newer ones); a complete set's suite.json
+// and suite.md are what assembling its records gives, byte for byte; a set still being run
+// (`publish --partial`) has no tables.
+TEST(Suite, PublishedResultsAreTheirRecordsAssembled) {
+  const fs::path results = fs::path(DYNBENCH_SOURCE_DIR) / "suites" / "results";
+  std::size_t checked = 0;
+  std::error_code ec;
+  for (const auto& folder : fs::directory_iterator(results, ec)) {
+    const std::string name = folder.path().filename().string();
+    auto manifest = suite::readManifest(fs::path(DYNBENCH_SOURCE_DIR) / "suites" / (name + ".json"));
+    ASSERT_TRUE(manifest) << name << ": " << manifest.error().message;
+    auto records = suite::readRecords(folder.path() / "records", *manifest);
+    ASSERT_TRUE(records) << records.error().message;
+    ASSERT_FALSE(records->empty()) << name;
+    ++checked;
+    if (records->size() < manifest->datasets.size()) {
+      EXPECT_FALSE(fs::exists(folder.path() / "suite.json")) << name << ": tables of a set still being run";
+      EXPECT_FALSE(fs::exists(folder.path() / "suite.md")) << name;
+      continue;
+    }
+    const fs::path out = test::freshDir("published_" + name);
+    const auto r = dynbench(fmt::format("suite {} -o {} --records {} --assemble", manifest->path.string(), out.string(),
+                                        (folder.path() / "records").string()),
+                            out);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(test::slurp(out / "suite.json"), test::slurp(folder.path() / "suite.json")) << name;
+    EXPECT_EQ(test::slurp(out / "suite.md"), test::slurp(folder.path() / "suite.md")) << name;
+  }
+  EXPECT_GE(checked, 1u) << "no published results under " << results.string();
+}
+
 TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
   DYNBENCH_NEEDS(test::missingCube2());
   const fs::path dir = test::freshDir("suite_smoke");
@@ -729,6 +762,13 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
     EXPECT_EQ(incomplete.status, 8) << incomplete.err;
     EXPECT_NE(incomplete.err.find("no record of 3 of the 6 datasets of suite 'smoke' (fps-2-bot, fps-2-flythrough, fps-2-slowed)"), std::string::npos)
         << incomplete.err;
+    // A run still going, published with --partial: its records, no tables (over the complete ones).
+    const auto partial = dynbench(fmt::format("suite publish {} -o {} --partial", (dir / "half-a").string(), published.string()), dir);
+    ASSERT_EQ(partial.status, 0) << partial.err;
+    EXPECT_NE(partial.out.find("3 records, 3 datasets still without one"), std::string::npos) << partial.out;
+    EXPECT_EQ(std::distance(fs::directory_iterator(published / "records"), fs::directory_iterator()), 3);
+    EXPECT_FALSE(fs::exists(published / "suite.json"));
+    EXPECT_FALSE(fs::exists(published / "suite.md"));
   }
 
   // A clean run verifies.

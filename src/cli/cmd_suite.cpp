@@ -31,6 +31,7 @@ struct SuiteCli {
   std::uint64_t verifySeed = 1;
   std::string verifyWork;
   std::string publishDir, publishTo;       // suite publish
+  bool publishPartial = false;
 };
 
 // One line per stage, flushed: a suite runs for an hour, and its log (redirected, so fully
@@ -138,9 +139,13 @@ Expected<void> runVerify(const SuiteCli& cli) {
 }
 
 Expected<void> runPublish(const SuiteCli& cli) {
-  auto outcome = suite::publishSuite(cli.publishDir, cli.publishTo, printLine);
+  auto outcome = suite::publishSuite(cli.publishDir, cli.publishTo, cli.publishPartial, printLine);
   if (!outcome) return std::unexpected(outcome.error());
-  fmt::print("suite publish: {} records; {} and {}\n", outcome->recordsReused, outcome->json.string(), outcome->markdown.string());
+  if (outcome->json.empty())
+    fmt::print("suite publish: {} records, {} datasets still without one (no tables until every dataset has one)\n", outcome->recordsReused,
+               outcome->missing.size());
+  else
+    fmt::print("suite publish: {} records; {} and {}\n", outcome->recordsReused, outcome->json.string(), outcome->markdown.string());
   return {};
 }
 
@@ -218,6 +223,7 @@ void addSuiteCommand(CLI::App& app, CommandRun& run) {
                                                  "suite.json and suite.md there from them alone");
   publish->add_option("DIR", cli->publishDir, "The suite's folder (its records in DIR/records)")->required();
   publish->add_option("-o,--output", cli->publishTo, "The published results' folder (suites/results/SUITE for a versioned suite)")->required();
+  publish->add_flag("--partial", cli->publishPartial, "A suite still being run: copy the records it has so far, write no tables");
   publish->footer("Example: dynbench suite publish runs/v1 -o suites/results/v1   (then commit it; docs/suite.md, \"Records\")");
   cmd->callback([cmd, verify, score, publish, cli, &run] {
     if (publish->parsed()) {

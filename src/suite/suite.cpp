@@ -459,7 +459,7 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
   return outcome;
 }
 
-Expected<SuiteOutcome> publishSuite(const fs::path& dir, const fs::path& to, const pipeline::RunLog& log) {
+Expected<SuiteOutcome> publishSuite(const fs::path& dir, const fs::path& to, bool partial, const pipeline::RunLog& log) {
   std::vector<fs::path> files;
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dir / "records", ec))
@@ -473,9 +473,11 @@ Expected<SuiteOutcome> publishSuite(const fs::path& dir, const fs::path& to, con
   std::vector<std::string> missing;
   for (const DatasetSpec& spec : manifest->datasets)
     if (!records->count(spec.name)) missing.push_back(spec.name);
-  if (!missing.empty())
-    return fail(ErrorCode::kIncomplete, "{}: no record of {} of the {} datasets of suite '{}' ({}): a suite is published whole", dir.string(),
-                missing.size(), manifest->datasets.size(), manifest->name, fmt::join(missing, ", "));
+  if (!missing.empty() && !partial)
+    return fail(ErrorCode::kIncomplete,
+                "{}: no record of {} of the {} datasets of suite '{}' ({}): a suite is published whole (--partial keeps the records of a run "
+                "still going, without tables)",
+                dir.string(), missing.size(), manifest->datasets.size(), manifest->name, fmt::join(missing, ", "));
   // The folder holds this suite's records and nothing else that looks like one.
   fs::remove_all(to / "records", ec);
   if (ec) return fail(ErrorCode::kIo, "{}: cannot empty: {}", (to / "records").string(), ec.message());
@@ -487,6 +489,14 @@ Expected<SuiteOutcome> publishSuite(const fs::path& dir, const fs::path& to, con
   }
   log(fmt::format("{} records of suite '{}' -> {}", records->size(), manifest->name, (to / "records").string()));
   SuiteOutcome outcome;
+  outcome.missing = missing;
+  if (!missing.empty()) {
+    // A run still going: its records, and no tables that could be taken for the suite's.
+    for (const char* stale : {"suite.json", "suite.md"}) fs::remove(to / stale, ec);
+    fs::remove_all(to / "plots", ec);
+    outcome.recordsReused = records->size();
+    return outcome;
+  }
   if (auto ok = assembleSuite(*manifest, *records, to, outcome); !ok) return std::unexpected(ok.error());
   outcome.recordsReused = records->size();
   return outcome;

@@ -64,9 +64,10 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
 
 // A finished suite's records (DIR/records, one for every dataset of the manifest they carry) copied
 // to `to`/records, and suite.json, suite.md and plots assembled there from them alone: what a
-// versioned suite's published results are (suites/results/SUITE, docs/suite.md). Records of
-// another suite already there are replaced.
-Expected<SuiteOutcome> publishSuite(const std::filesystem::path& dir, const std::filesystem::path& to, const pipeline::RunLog& log);
+// versioned suite's published results are (suites/results/SUITE, docs/suite.md). Records already
+// there are replaced. With `partial`, a suite still being run: the records it has so far (the next
+// run, on any machine, takes them in with `suite --records`), and no tables.
+Expected<SuiteOutcome> publishSuite(const std::filesystem::path& dir, const std::filesystem::path& to, bool partial, const pipeline::RunLog& log);
 
 // The files a dataset's numbers come from, relative to DIR: the dataset's .gltf and .bin, and the
 // run's reference, input and noise-floor frames with their sidecars (suite.json's /files).
