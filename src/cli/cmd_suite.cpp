@@ -101,10 +101,7 @@ Expected<void> runVerifyRecords(const SuiteCli& cli) {
     if (!fs::exists(files.back())) return fail(ErrorCode::kIo, "{}: no such record (--record {})", files.back().string(), name);
   }
   if (cli.verifySample > 0) {
-    std::vector<fs::path> all;
-    std::error_code ec;
-    for (const auto& entry : fs::directory_iterator(dir / "records", ec))
-      if (entry.path().extension() == ".json") all.push_back(entry.path());
+    const std::vector<fs::path> all = suite::recordFiles(dir / "records");
     if (all.empty()) return fail(ErrorCode::kIo, "{}: no records to sample", (dir / "records").string());
     for (const fs::path& f : suite::sampleRecords(all, cli.verifySample, cli.verifySeed)) files.push_back(f);
   }

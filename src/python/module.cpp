@@ -247,12 +247,9 @@ py::object scoreSuite(const fs::path& dir, const py::list& methods, const std::s
 // read and checked by suite/record.h against the manifest it carries, as `suite --records` checks them.
 py::dict suiteRecords(const fs::path& folder) {
   const fs::path records = fs::is_directory(folder / "records") ? folder / "records" : folder;
-  std::vector<fs::path> files;
-  for (const auto& entry : fs::directory_iterator(records))
-    if (entry.is_regular_file() && entry.path().extension() == ".json") files.push_back(entry.path());
+  const std::vector<fs::path> files = suite::recordFiles(records);
   py::dict out;
   if (files.empty()) return out;
-  std::sort(files.begin(), files.end());
   const suite::Manifest manifest = unwrap(suite::recordManifest(files.front()));
   for (const auto& [name, record] : unwrap(suite::readRecords(records, manifest))) out[py::str(name)] = document(record.document);
   return out;

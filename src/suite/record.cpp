@@ -150,17 +150,19 @@ Expected<Manifest> recordManifest(const fs::path& file) {
   return manifest;
 }
 
-Expected<std::map<std::string, SuiteRecord>> readRecords(const fs::path& folder, const Manifest& manifest) {
-  std::map<std::string, SuiteRecord> records;
-  std::error_code ec;
-  if (!fs::is_directory(folder, ec)) return records;
+std::vector<fs::path> recordFiles(const fs::path& folder) {
   std::vector<fs::path> files;
+  std::error_code ec;
   for (const auto& entry : fs::directory_iterator(folder, ec))
     if (entry.is_regular_file() && entry.path().extension() == ".json" && !entry.path().filename().string().starts_with("."))
       files.push_back(entry.path());
-  if (ec) return fail(ErrorCode::kIo, "{}: cannot list: {}", folder.string(), ec.message());
   std::sort(files.begin(), files.end());
-  for (const fs::path& file : files) {
+  return files;
+}
+
+Expected<std::map<std::string, SuiteRecord>> readRecords(const fs::path& folder, const Manifest& manifest) {
+  std::map<std::string, SuiteRecord> records;
+  for (const fs::path& file : recordFiles(folder)) {
     auto record = readRecord(file, manifest);
     if (!record) return std::unexpected(record.error());
     if (auto [it, fresh] = records.emplace(record->dataset, *record); !fresh)

@@ -65,6 +65,9 @@ nlohmann::json recordJson(const Manifest& manifest, std::size_t index, const nlo
 // a value missing or of the wrong type).
 Expected<SuiteRecord> readRecord(const std::filesystem::path& file, const Manifest& manifest);
 
+// The record files (*.json, hidden names aside) in `folder`, sorted; none for a missing folder.
+std::vector<std::filesystem::path> recordFiles(const std::filesystem::path& folder);
+
 // Every record (*.json) in `folder`, each read as readRecord does, by dataset name; an error for the
 // first one refused, or for two records of one dataset. A missing folder has none.
 Expected<std::map<std::string, SuiteRecord>> readRecords(const std::filesystem::path& folder, const Manifest& manifest);

@@ -460,12 +460,9 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
 }
 
 Expected<SuiteOutcome> publishSuite(const fs::path& dir, const fs::path& to, bool partial, const pipeline::RunLog& log) {
-  std::vector<fs::path> files;
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(dir / "records", ec))
-    if (entry.is_regular_file() && entry.path().extension() == ".json") files.push_back(entry.path());
+  const std::vector<fs::path> files = recordFiles(dir / "records");
   if (files.empty()) return fail(ErrorCode::kIo, "{}: no records to publish", (dir / "records").string());
-  std::sort(files.begin(), files.end());
+  std::error_code ec;
   auto manifest = recordManifest(files.front());
   if (!manifest) return std::unexpected(manifest.error());
   auto records = readRecords(dir / "records", *manifest);
