@@ -590,6 +590,31 @@ TEST(Convert, AnInverseSquareLightGivesItsColourAtItsRange) {
   EXPECT_EQ(status, 0) << validation;
 }
 
+// A windowed inverse-square light (id Tech 3's map lights ended at q3map2's envelope) is KHR's point
+// light with that range: I = E_u max(c) R^2 as for the inverse square (its light at d < R is then
+// E_u c (R/d)^2 before the window, the capture's), and the range kept.
+TEST(Convert, AWindowedInverseSquareLightKeepsItsRange) {
+  OneLight l;
+  l.sun = glm::vec3(0.5f);
+  l.colour = {2.0f, 1.0f, 0.5f};
+  l.range = 240.0f;
+  l.falloff = DBC_FALLOFF_WINDOWED_INVERSE_SQUARE;
+  l.type = "maplight";
+  const fs::path dir = freshDir("convert_windowed_inverse_square");
+  const fs::path dataset = convertOneLight(dir, l);
+  ASSERT_FALSE(dataset.empty());
+  EXPECT_NE(test::slurp(dir / "capture" / "Capture.txt").find(":240:windowed_inverse_square:point:0:maplight"), std::string::npos);
+  const auto j = readJson(dataset);
+  const double sunLux = j["extensions"]["DYNBENCH_environment"]["sky"]["sun_illuminance_lux"].get<double>();
+  const auto& light = j["extensions"]["KHR_lights_punctual"]["lights"][0];
+  EXPECT_EQ(light["range"].get<double>(), 240.0);
+  EXPECT_EQ(light["color"], nlohmann::json({1.0, 0.5, 0.25}));
+  EXPECT_NEAR(light["intensity"].get<double>(), sunLux / 0.5 * 2.0 * 240.0 * 240.0, 1e-3 * light["intensity"].get<double>());
+  int status = 0;
+  const std::string validation = test::validateGltf(dataset, status);
+  EXPECT_EQ(status, 0) << validation;
+}
+
 // An engine that records its lighting with neither a sky light nor an ambient floor (id Tech 3 with
 // dynbench's map lights) says its sky gives no light but its sun: the dataset's sky is black but
 // the sun disc (all of the sky's light on a horizontal surface comes from the disc, as much as

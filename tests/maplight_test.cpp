@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstring>
 #include <numbers>
 #include <random>
@@ -168,6 +169,42 @@ TEST(MapLight, PointSpotAndSunFollowQ3map2) {
   sun.value = 80.0;
   sun.towardsSun = glm::normalize(glm::dvec3(1, 0, 1));
   EXPECT_NEAR(lightContribution(sun, glm::dvec3(0.0), up), 80.0 / std::sqrt(2.0), 1e-12);
+}
+
+// q3map2's envelope (SetupEnvelopes): sqrt(V pointScale / falloffTolerance) for the inverse
+// square, nothing from it on; the dataset's end instead (MapLight::range): KHR's window
+// max(0, 1 - (d/range)^4) on the inverse square, which never takes more than the tolerance (1
+// lightmap unit) from the hard cut's light, the most at the range itself.
+TEST(MapLight, LightsEndAtQ3map2sEnvelope) {
+  MapLight l;
+  l.value = 300.0;
+  l.position = {0, 0, 0};
+  const double envelope = std::sqrt(300.0 * 7500.0);  // 1500 units
+  EXPECT_DOUBLE_EQ(lightEnvelope(l), envelope);
+  const glm::dvec3 facing(0, 0, -1);
+  // just inside the envelope: the inverse square; from it on: nothing
+  EXPECT_NEAR(lightContribution(l, glm::dvec3(0, 0, envelope - 1.0), facing), 300.0 * 7500.0 / ((envelope - 1.0) * (envelope - 1.0)), 1e-12);
+  EXPECT_EQ(lightContribution(l, glm::dvec3(0, 0, envelope), facing), 0.0);
+  l.linear = true;
+  l.fade = 2.0;
+  EXPECT_DOUBLE_EQ(lightEnvelope(l), (300.0 * 7500.0 / 8000.0 - 1.0) / 2.0);
+  l.linear = false;
+  MapLight sun;
+  sun.kind = MapLightKind::kSun;
+  EXPECT_TRUE(std::isinf(lightEnvelope(sun)));
+  // the window: at half the range 1 - 1/16 of the inverse square, at 0.9 of it 1 - 0.9^4
+  l.range = envelope;
+  for (const double x : {0.5, 0.9, 0.999}) {
+    const double d = x * envelope;
+    const double inverseSquare = 300.0 * 7500.0 / (d * d);
+    const double windowed = lightContribution(l, glm::dvec3(0, 0, d), facing);
+    EXPECT_NEAR(windowed, inverseSquare * (1.0 - x * x * x * x), 1e-9 * inverseSquare);
+    EXPECT_LE(inverseSquare - windowed, kFalloffTolerance * (1.0 + 1e-9)) << "at " << x << " of the range";
+  }
+  EXPECT_EQ(lightContribution(l, glm::dvec3(0, 0, envelope * 1.01), facing), 0.0);
+  // an infinite range: no end (the candidates the fit chooses from)
+  l.range = std::numeric_limits<double>::infinity();
+  EXPECT_DOUBLE_EQ(lightContribution(l, glm::dvec3(0, 0, 2.0 * envelope), facing), 300.0 * 7500.0 / (4.0 * envelope * envelope));
 }
 
 std::string header(const std::vector<std::pair<int, int>>& lumps) {

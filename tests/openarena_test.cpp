@@ -365,7 +365,8 @@ TEST(OpenArena, DemoMakesItsDatasetsFromAnOpenArenaMatch) {
 
 // A map-lights file's colours are the game's (lightmap tints, shown through 8-bit sRGB): the
 // capture records them as linear colours of the same peak, each channel over the peak decoded as
-// sRGB (IEC 61966-2-1), the level unchanged.
+// sRGB (IEC 61966-2-1), the level unchanged. A light with its end (8 numbers: D and E) is recorded
+// as the windowed inverse square of the same light: colour x (D/E)^2 at range E.
 TEST(OpenArena, MapLightColoursAreRecordedLinear) {
   DYNBENCH_NEEDS(test::missingOpenArena());
   const auto dir = test::freshDir("openarena_light_colours");
@@ -373,6 +374,7 @@ TEST(OpenArena, MapLightColoursAreRecordedLinear) {
                                        "point 0 0 64 1 0.5 0.5 100\n"
                                        "point 0 64 64 0.2 0.2 0.1 50\n"
                                        "point 64 0 64 0.02 0.02 0.02 30\n"
+                                       "point 64 64 64 1 1 1 40 320\n"
                                        "sun 0 0 1 0.5 0.25 0\n";
   auto r = dynbench(fmt::format("capture openarena -o {} --seconds 1 --bots 1 --map-lights {} --game-cpu host", (dir / "cap").string(),
                                 (dir / "lights.txt").string()),
@@ -380,19 +382,24 @@ TEST(OpenArena, MapLightColoursAreRecordedLinear) {
   ASSERT_EQ(r.status, 0) << r.err;
   // decode(0.5) = ((0.5 + 0.055) / 1.055)^2.4 = 0.2140411; decode(0.1 / 0.2) the same
   const std::vector<std::array<double, 4>> expected = {
-      {1.0, 0.2140411, 0.2140411, 100.0}, {0.2, 0.2, 0.2 * 0.2140411, 50.0}, {0.02, 0.02, 0.02, 30.0}};
+      {1.0, 0.2140411, 0.2140411, 100.0}, {0.2, 0.2, 0.2 * 0.2140411, 50.0}, {0.02, 0.02, 0.02, 30.0}, {0.015625, 0.015625, 0.015625, 320.0}};
+  const std::vector<std::string> falloffs = {"inverse_square", "inverse_square", "inverse_square", "windowed_inverse_square"};
   std::vector<std::array<double, 4>> recorded;
+  std::vector<std::string> recordedFalloffs;
   std::vector<double> sun;
   std::ifstream capture(dir / "cap" / "Capture.txt");
   for (std::string line; std::getline(capture, line);) {
     const auto f = splitFields(line);
-    if (f[0] == "l" && f.size() >= 13 && f[12] == "maplight")
+    if (f[0] == "l" && f.size() >= 13 && f[12] == "maplight") {
       recorded.push_back({std::stod(f[5]), std::stod(f[6]), std::stod(f[7]), std::stod(f[8])});
+      recordedFalloffs.push_back(f[9]);
+    }
     if (f[0] == "L" && f.size() >= 7) sun = {std::stod(f[4]), std::stod(f[5]), std::stod(f[6])};
   }
   ASSERT_EQ(recorded.size(), expected.size());
   for (std::size_t i = 0; i < expected.size(); ++i)
     for (int k = 0; k < 4; ++k) EXPECT_NEAR(recorded[i][k], expected[i][k], 1e-6) << "light " << i << " value " << k;
+  EXPECT_EQ(recordedFalloffs, falloffs);
   ASSERT_EQ(sun.size(), 3u);
   EXPECT_NEAR(sun[0], 0.5, 1e-6);
   EXPECT_NEAR(sun[1], 0.5 * 0.2140411, 1e-6);
@@ -435,7 +442,7 @@ TEST(OpenArena, BadOptionsFailClearly) {
     std::ofstream(dir / "lights.txt") << "point 0 0 64 1 1 1 100\nspot 0 0 0\n";
     r = dynbench(fmt::format("capture openarena -o {} --seconds 1 --map-lights {} --game-cpu host", (dir / "h").string(), (dir / "lights.txt").string()), dir);
     EXPECT_NE(r.status, 0);
-    EXPECT_NE(r.err.find("lights.txt:2: expected 'point X Y Z R G B D'"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("lights.txt:2: expected 'point X Y Z R G B D E'"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "h" / "Capture.txt"));
     // The default, emulated, on a machine without qemu-user: told what to install, before anything
     // is made (PATH holding Xvfb alone).

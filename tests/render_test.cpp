@@ -81,8 +81,9 @@ PlaneScene pointLightOverPlane() {
 // centre's hit, exact with one sample) and checks every pixel that sees it: direct radiance the
 // analytic (albedo / pi) I h / d^3 times `colour` per channel, no indirect light (a plane cannot
 // light itself), no variance, `spp` samples. Returns how many pixels were checked.
-int checkAnalyticDirect(const PlaneScene& p, int spp, int w, int h, glm::dvec3 colour) {
+int checkAnalyticDirect(const PlaneScene& p, int spp, int w, int h, glm::dvec3 colour, bool learnedSelection = true) {
   RenderSettings settings;
+  settings.learnedLightSelection = learnedSelection;
   settings.pixelFilter = {PixelFilterType::kCentre, 0.0};
   settings.samplesPerPixel = spp;
   settings.useEnvironment = false;
@@ -116,8 +117,11 @@ TEST(Render, PointLightOverDiffusePlaneGivesTheAnalyticRadianceWithoutNoise) {
   // L = (albedo / pi) I cos(theta) / d^2 = (albedo / pi) I h / d^3 at a point of the plane y = 0.
   // Punctual light is summed, not sampled, and with the centre "filter" radiance is taken at the
   // pixel centre's hit: one sample gives the exact answer, with zero variance.
+  // The same with the learned light selection and with the tree's alone.
   const PlaneScene p = pointLightOverPlane();
-  for (const int spp : {1, 4}) EXPECT_GT(checkAnalyticDirect(p, spp, 80, 60, glm::dvec3(1.0)), 3000) << spp << " spp";
+  for (const bool learned : {true, false})
+    for (const int spp : {1, 4})
+      EXPECT_GT(checkAnalyticDirect(p, spp, 80, 60, glm::dvec3(1.0), learned), 3000) << spp << " spp, learned " << learned;
 }
 
 TEST(Render, VertexColoursMultiplyTheBaseColour) {

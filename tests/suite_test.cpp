@@ -289,7 +289,9 @@ TEST(Suite, RecordsOfAnotherManifestSettingsOrVersionAndMalformedOnesAreRefused)
   const std::vector<Case> cases = {
       {"/dynbench_suite_record", 2, "/dynbench_suite_record: a record of version 2, which this dynbench (record version 1) cannot compare"},
       {"/results_version", 2, "/results_version: numbers of results version 2"},
-      {"/numbers_version", 0, "/numbers_version: numbers of version 0, and this dynbench makes version 1: made by a build whose numbers differ"},
+      {"/numbers_version", 0,
+       fmt::format("/numbers_version: numbers of version 0, and this dynbench makes version {}: made by a build whose numbers differ",
+                   suite::kNumbersVersion)},
       {"/manifest/description", "edited", "/manifest: not the document its /manifest_sha256 is the digest of"},
       {"/manifest_sha256", std::string(64, '0'), "/manifest_sha256: a record of another manifest"},
       {"/dataset/name", "fps-9-bot", "/dataset/name: 'fps-9-bot' is no dataset of"},
@@ -428,6 +430,46 @@ TEST(Suite, ARecordSampleIsTheSameForASeed) {
 // refused: such results are made again, never kept beside newer ones); a complete set's suite.json
 // and suite.md are what assembling its records gives, byte for byte; a set still being run
 // (`publish --partial`) has no tables.
+// Published results of an earlier numbers version (suites/results/v1, made before version 2) still
+// assemble, all of one version; a run that would make records beside them refuses them, a set of
+// two versions is refused naming the odd record, and `suite verify --record` names the commit that
+// can re-make the numbers instead of re-making them with other ones.
+TEST(Suite, RecordsOfAnEarlierNumbersVersionAssembleButAreNotMixed) {
+  const fs::path published = fs::path(DYNBENCH_SOURCE_DIR) / "suites" / "results" / "v1" / "records";
+  auto manifest = suite::readManifest(fs::path(DYNBENCH_SOURCE_DIR) / "suites" / "v1.json");
+  ASSERT_TRUE(manifest) << manifest.error().message;
+  auto any = suite::readRecords(published, *manifest, suite::NumbersVersions::kAnyOne);
+  ASSERT_TRUE(any) << any.error().message;
+  ASSERT_FALSE(any->empty());
+  const int version = any->begin()->second.numbersVersion;
+  if (version == suite::kNumbersVersion) GTEST_SKIP() << "v1's records are of this build's numbers version";
+  const auto refused = suite::readRecords(published, *manifest);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find(fmt::format("/numbers_version: numbers of version {}, and this dynbench makes version {}", version,
+                                                     suite::kNumbersVersion)),
+            std::string::npos)
+      << refused.error().message;
+  // one record of another version among them
+  const fs::path dir = test::freshDir("suite_numbers_versions");
+  fs::copy(published, dir / "records");
+  const fs::path odd = dir / "records" / "calm-1-bot.json";
+  auto doc = nlohmann::json::parse(test::slurp(odd));
+  doc["numbers_version"] = version + 100;
+  std::ofstream(odd) << doc.dump(2);
+  const auto mixed = suite::readRecords(dir / "records", *manifest, suite::NumbersVersions::kAnyOne);
+  ASSERT_FALSE(mixed);
+  for (const std::string& part : {fmt::format("numbers version {}", version + 100), fmt::format("numbers version {}", version),
+                                  std::string("calm-1-bot.json"), std::string("never assembled into one table")})
+    EXPECT_NE(mixed.error().message.find(part), std::string::npos) << part << " in " << mixed.error().message;
+  // verify names the build that made it and re-makes nothing
+  const fs::path v1 = fs::path(DYNBENCH_SOURCE_DIR) / "suites" / "results" / "v1";
+  const std::string commit = any->begin()->second.document["tool"]["commit"].get<std::string>();
+  const auto r = dynbench(fmt::format("suite verify {} --record {} --work {}", v1.string(), any->begin()->first, (dir / "work").string()), dir);
+  EXPECT_EQ(r.status, 6) << r.err;
+  EXPECT_NE(r.err.find(fmt::format("made by a build of numbers version {} (git commit {})", version, commit)), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "work" / "captures")) << "nothing is re-made";
+}
+
 TEST(Suite, PublishedResultsAreTheirRecordsAssembled) {
   const fs::path results = fs::path(DYNBENCH_SOURCE_DIR) / "suites" / "results";
   std::size_t checked = 0;
@@ -436,7 +478,8 @@ TEST(Suite, PublishedResultsAreTheirRecordsAssembled) {
     const std::string name = folder.path().filename().string();
     auto manifest = suite::readManifest(fs::path(DYNBENCH_SOURCE_DIR) / "suites" / (name + ".json"));
     ASSERT_TRUE(manifest) << name << ": " << manifest.error().message;
-    auto records = suite::readRecords(folder.path() / "records", *manifest);
+    // published results of an earlier numbers version still assemble (all of one version)
+    auto records = suite::readRecords(folder.path() / "records", *manifest, suite::NumbersVersions::kAnyOne);
     ASSERT_TRUE(records) << records.error().message;
     ASSERT_FALSE(records->empty()) << name;
     ++checked;

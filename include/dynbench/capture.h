@@ -49,8 +49,16 @@ typedef enum dbc_light_type { DBC_LIGHT_POINT = 0, DBC_LIGHT_SPOT = 1, DBC_LIGHT
 /* How a light with a range fades, as the engine's light does: colour x (1 - d/range) (LINEAR: Cube
  * 2's lightmaps) or colour x (1 - (d/range)^2) (QUADRATIC: Cube 2's dynamic lights), nothing beyond
  * the range; or colour x (range/d)^2 (INVERSE_SQUARE: a physical point light, id Tech 3's map
- * lights as q3map2 bakes them), where the range is the distance at which it gives `rgb`, and no end. */
-typedef enum dbc_light_falloff { DBC_FALLOFF_LINEAR = 0, DBC_FALLOFF_QUADRATIC = 1, DBC_FALLOFF_INVERSE_SQUARE = 2 } dbc_light_falloff;
+ * lights as q3map2 bakes them), where the range is the distance at which it gives `rgb`, and no end;
+ * or colour x (range/d)^2 x max(0, 1 - (d/range)^4) (WINDOWED_INVERSE_SQUARE: KHR_lights_punctual's
+ * point light with a range, which ends there; id Tech 3's map lights ended at q3map2's envelope),
+ * `rgb` being the inverse square's light at the range before the window. */
+typedef enum dbc_light_falloff {
+  DBC_FALLOFF_LINEAR = 0,
+  DBC_FALLOFF_QUADRATIC = 1,
+  DBC_FALLOFF_INVERSE_SQUARE = 2,
+  DBC_FALLOFF_WINDOWED_INVERSE_SQUARE = 3
+} dbc_light_falloff;
 
 /* One mesh of a model. Arrays hold vertex_count elements of the given width; normals, uvs,
  * joints and weights may be NULL. joints/weights: 4 per vertex, unused influences have weight 0

@@ -48,7 +48,9 @@ LightRecord lightRecord(const Line& l) {
   if (falloff == "linear") r.falloff = LightFalloff::kLinear;
   else if (falloff == "quadratic") r.falloff = LightFalloff::kQuadratic;
   else if (falloff == "inverse_square") r.falloff = LightFalloff::kInverseSquare;
-  else if (falloff != "none") l.fail(fmt::format("light falloff '{}'; expected none, linear, quadratic or inverse_square", falloff));
+  else if (falloff == "windowed_inverse_square") r.falloff = LightFalloff::kWindowedInverseSquare;
+  else if (falloff != "none")
+    l.fail(fmt::format("light falloff '{}'; expected none, linear, quadratic, inverse_square or windowed_inverse_square", falloff));
   if ((r.range > 0) != (r.falloff != LightFalloff::kNone)) l.fail("a light has a falloff exactly when it has a range");
   const std::string type = l.text(10);
   if (type == "point") r.type = LightType::kPoint;

@@ -78,7 +78,9 @@ struct CaptureSettings {
 enum class LightType { kPoint, kSpot, kDirectional };
 // How the engine's light fades to nothing at its range: colour x (1 - d/range) or x (1 - (d/range)^2).
 // kInverseSquare: colour x (range / d)^2, no end (the range is where it gives its colour).
-enum class LightFalloff { kNone, kLinear, kQuadratic, kInverseSquare };
+// kWindowedInverseSquare: colour x (range / d)^2 x max(0, 1 - (d / range)^4), KHR_lights_punctual's
+// point light with a range, which ends there.
+enum class LightFalloff { kNone, kLinear, kQuadratic, kInverseSquare, kWindowedInverseSquare };
 
 struct CameraRecord {
   std::uint64_t id = 0;

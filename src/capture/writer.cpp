@@ -444,7 +444,8 @@ int dbc_light(dbc_session* s, uint64_t id, const float p[3], const float rgb[3],
   if (int rc = s->requireFrame("dbc_light"); rc != DBC_OK) return rc;
   if (!finite({p[0], p[1], p[2], rgb[0], rgb[1], rgb[2], range})) return error(DBC_ERROR_ARGUMENT, fmt::format("light {}: a value is not finite", id));
   if (range < 0) return error(DBC_ERROR_ARGUMENT, fmt::format("light {}: range must be 0 (none) or positive (got {})", id, range));
-  if (falloff != DBC_FALLOFF_LINEAR && falloff != DBC_FALLOFF_QUADRATIC && falloff != DBC_FALLOFF_INVERSE_SQUARE)
+  if (falloff != DBC_FALLOFF_LINEAR && falloff != DBC_FALLOFF_QUADRATIC && falloff != DBC_FALLOFF_INVERSE_SQUARE &&
+      falloff != DBC_FALLOFF_WINDOWED_INVERSE_SQUARE)
     return error(DBC_ERROR_ARGUMENT, fmt::format("light {}: unknown falloff {}", id, static_cast<int>(falloff)));
   if (type != DBC_LIGHT_POINT && type != DBC_LIGHT_SPOT && type != DBC_LIGHT_DIRECTIONAL)
     return error(DBC_ERROR_ARGUMENT, fmt::format("light {}: unknown type {}", id, static_cast<int>(type)));
@@ -457,6 +458,7 @@ int dbc_light(dbc_session* s, uint64_t id, const float p[3], const float rgb[3],
   const char* falloffName = !(range > 0)                        ? "none"
                             : falloff == DBC_FALLOFF_LINEAR         ? "linear"
                             : falloff == DBC_FALLOFF_INVERSE_SQUARE ? "inverse_square"
+                            : falloff == DBC_FALLOFF_WINDOWED_INVERSE_SQUARE ? "windowed_inverse_square"
                                                                     : "quadratic";
   return s->writeRecord(line + fmt::format(":{}:{}:{}:{}", falloffName, typeNames[type], dynamic ? 1 : 0, escapeField(kindText)));
 }

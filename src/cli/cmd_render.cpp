@@ -223,6 +223,12 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
                   "more can reach the point; 0: every light, slow; docs/feature-buffers.md)")
       ->check(CLI::Range(0, 64))
       ->capture_default_str();
+  cmd->add_option_function<std::string>(
+         "--light-selection", [o](const std::string& name) { o->job.settings.learnedLightSelection = *render::parseLightSelection(name); },
+         "How the light tree picks a point's lights: learned (its importance weighted by the visibility learned from a pilot "
+         "before each frame; unbiased) or tree (its importance alone, as before; for comparison). docs/feature-buffers.md")
+      ->check(CLI::IsMember({"learned", "tree"}))
+      ->default_str("learned");
   addSlurmOptions(cmd, o->slurm, o->slurmOptions, "DIR/slurm/render.sbatch, one task per --frames-per-task frames", true);
   cmd->callback([o, cmd, &run] {
     o->threadsGiven = cmd->count("--threads") > 0;

@@ -84,9 +84,11 @@ std::pair<glm::dvec3, double> Converter::lightColorIntensity(const glm::dvec3& c
   const double peak = std::max({captured.r, captured.g, captured.b});
   const LightRule& rule = options_.lightRules.rule(modelType);
   const glm::dvec3 color = peak > 0 ? captured / peak : glm::dvec3(1.0);
-  // An inverse-square light is a physical point light already: E_u c (R/d)^2 is I / d^2 with I = E_u c R^2.
-  const double perUnit = constantAt > 0                           ? luxPerUnit_ * constantAt * constantAt
-                         : falloff == LightFalloff::kInverseSquare ? luxPerUnit_ * range * range
+  // An inverse-square light is a physical point light already: E_u c (R/d)^2 is I / d^2 with I = E_u c R^2
+  // (windowed: KHR's point light with range R, the window the same on both sides).
+  const bool inverseSquare = falloff == LightFalloff::kInverseSquare || falloff == LightFalloff::kWindowedInverseSquare;
+  const double perUnit = constantAt > 0      ? luxPerUnit_ * constantAt * constantAt
+                         : inverseSquare     ? luxPerUnit_ * range * range
                          : range > 0                              ? luxPerUnit_ * range * range * fluxFactor(falloff)
                                                                   : options_.lightRules.candelaPerUnit;
   return {color, perUnit * peak * rule.intensityScale * share};

@@ -19,9 +19,14 @@ Expected<void> writeAdapterLights(const std::filesystem::path& file, const MapLi
     } else {
       // V pointScale / d^2 lightmap units is full light at d = sqrt(V pointScale / kFullLight). Spots
       // and linear lights are written as the inverse-square point light of the same value.
+      // It ends at its range (MapLight::range), or, for a light the fit did not end, at the envelope
+      // of that inverse-square light.
       const double fullLightDistance = std::sqrt(l.value * kPointScale / kFullLight);
-      out << fmt::format("point {:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g}\n", l.position.x, l.position.y, l.position.z, l.color.r, l.color.g,
-                         l.color.b, fullLightDistance);
+      MapLight inverseSquare = l;
+      inverseSquare.linear = false;
+      const double range = l.range > 0 ? l.range : lightEnvelope(inverseSquare);
+      out << fmt::format("point {:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g}\n", l.position.x, l.position.y, l.position.z, l.color.r,
+                         l.color.g, l.color.b, fullLightDistance, range);
     }
   }
   std::set<int> shaders;

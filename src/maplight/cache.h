@@ -10,8 +10,9 @@
 namespace dynbench::maplight {
 
 // Bumped whenever the fit or the file's meaning changes, so that older cached files are not used.
+// Version 9: point lights end at q3map2's envelope, by KHR's window (MapLight::range; 8: no end).
 // Version 8: visibility traced by maplight/triangle_bvh.h, the same on every CPU (7: Embree).
-inline constexpr int kFitVersion = 8;
+inline constexpr int kFitVersion = 9;
 
 // $XDG_CACHE_HOME/dynbench/map-lights, else $HOME/.cache/dynbench/map-lights.
 std::filesystem::path defaultCacheFolder();

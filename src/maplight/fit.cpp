@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include <tbb/parallel_for.h>
@@ -126,21 +127,33 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   columns.resize(groupCount + candidates.size());
   std::atomic<std::size_t> done{0};
   tbb::parallel_for(std::size_t(0), candidates.size(), [&](std::size_t j) {
-    columns[groupCount + j] = candidateColumn(candidates[j], fit, occluders);
+    columns[groupCount + j] = candidateColumn(candidates[j], fit, occluders, std::numeric_limits<double>::infinity());
     const std::size_t finished = ++done;
     if (finished % 64 == 0) report("candidate lights", finished, candidates.size());
   });
   report("candidate lights", candidates.size(), candidates.size());
 
-  // 3b. Candidates chosen greedily, moved off the lattice, and the weights solved together again.
+  // 3b. Candidates chosen greedily, moved off the lattice, ended at their envelopes, and the weights
+  // solved together again.
   chooseLights(system, columns, target, signal, residual, error, options, report);
   if (options.refine)
     r.refinedLights = refineLights(system, columns, candidates, target, static_cast<double>(r.latticeSpacing), fit, occluders, report);
+  const std::vector<double> ranges = endLights(system, columns, candidates, fit, occluders, report);
   MapLighting unweighted;  // q3map2's own strengths, for judging the fit on held-out texels below
   unweighted.lights = result.lights;
   unweighted.surfaceLights = result.surfaceLights;
-  const std::vector<double> weights = setStrengths(system, target, fit, groups, candidates, result);
+  const std::vector<double> weights = setStrengths(system, target, fit, groups, candidates, ranges, result);
   r.fittedLights = result.lights.size() - knownLights;
+  // The known point lights end as the dataset ends them too (the lightmaps were baked with q3map2's
+  // hard cut, which `unweighted` keeps): KHR's window at their envelope. A linear light is written
+  // as the inverse-square light of its value (writeAdapterLights), so it takes that one's envelope.
+  for (std::size_t i = 0; i < knownLights; ++i) {
+    MapLight& l = result.lights[i];
+    if (l.kind == MapLightKind::kSun) continue;
+    MapLight inverseSquare = l;
+    inverseSquare.linear = false;
+    l.range = lightEnvelope(inverseSquare);
+  }
 
   // 4. The judging, on what the fit never saw.
   if (options.hideEntityLights) judgeRecovery(*bsp, fit, knownLights, occluders, result);

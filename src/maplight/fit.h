@@ -44,6 +44,9 @@ inline constexpr double kFullLight = 63.75;       // lightmap units of the engin
 inline constexpr double kDefaultLightSubdivide = 999.0;  // q3map2.h's defaultLightSubdivide, units
 inline constexpr double kShownLightmapUnits = 1.0;  // a hidden light shows in the lightmaps where its model gives a texel this much
 inline constexpr double kRecoveryRadius = 64.0;   // units: a hidden light counts as found with a fitted light this near
+// q3map2's falloffTolerance (light.c, SetupEnvelopes): a light's envelope ends where it would add
+// less than this many lightmap units; an inverse-square light's is sqrt(V pointScale / tolerance).
+inline constexpr double kFalloffTolerance = 1.0;
 
 enum class MapLightKind { kPoint, kSpot, kSun };
 
@@ -59,8 +62,19 @@ struct MapLight {
   glm::dvec3 spotAxis{0.0};      // a spot's unit axis (towards its target)
   double spotRadiusByDist = 0.0;  // (radius + 16) / distance to the target: the cone's radius per unit along the axis
   glm::dvec3 towardsSun{0.0};     // a sun's unit direction towards it
+  // Where the light ends, as the dataset has it: KHR_lights_punctual's window
+  // max(0, 1 - (d/range)^4) on the inverse square, range = lightEnvelope(*this). 0: q3map2's own
+  // cut, nothing from the envelope on (known lights, as the lightmaps were baked). The window never
+  // takes more than the tolerance from the hard cut's light (docs/dataset.md), and the fit models it
+  // for the lights it fits, so that they reproduce the lightmaps as the dataset renders them.
+  double range = 0.0;
   std::string source;             // "entity 12", "shader textures/sky/x", "fitted"
 };
+
+// q3map2's envelope of a point or spot light (SetupEnvelopes): sqrt(V pointScale / falloffTolerance)
+// units for the inverse square, (V pointScale linearScale - falloffTolerance) / fade for a linear
+// light; infinite for a sun.
+double lightEnvelope(const MapLight& light);
 
 // One of a surface light's area lights as q3map2 makes them (light_bounce.c,
 // RadSubdivideDiffuseLight): a triangle of the surface, halved at the mid-plane of its bounds along
@@ -188,7 +202,8 @@ std::vector<MapLight> entityLights(const Bsp& bsp);
 
 // The lights file the OpenArena capture adapter reads (DYNBENCH_CAPTURE_MAP_LIGHTS,
 // integrations/openarena): game axes and units, light in the capture format's full-light units, one
-// light per line (adapter_lights.cpp): "point X Y Z R G B D" (an inverse-square light giving R G B at D units), "sun DX
+// light per line (adapter_lights.cpp): "point X Y Z R G B D E" (an inverse-square light giving R G B at D units,
+// ended by KHR's window at E units: MapLight::range), "sun DX
 // DY DZ R G B" (towards the sun), "surface SHADER R G B" (the emission of a light-emitting shader's
 // surfaces). Written to a temporary name and renamed.
 Expected<void> writeAdapterLights(const std::filesystem::path& file, const MapLighting& lighting);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <set>
 
@@ -196,7 +197,7 @@ std::size_t refineLights(LightSystem& system, std::vector<Column>& columns, std:
         std::vector<char> usable(trials.size(), 0);
         tbb::parallel_for(std::size_t(0), trials.size(), [&](std::size_t t) {
           if (!inOpenSpace(trials[t], occluders)) return;
-          trialColumns[t] = candidateColumn(trials[t], fit, occluders);
+          trialColumns[t] = candidateColumn(trials[t], fit, occluders, std::numeric_limits<double>::infinity());
           usable[t] = trialColumns[t].norm2 > 0;
         });
         bool improved = false;
@@ -232,18 +233,57 @@ std::size_t refineLights(LightSystem& system, std::vector<Column>& columns, std:
   return refined;
 }
 
-std::vector<double> setStrengths(const LightSystem& system, const std::vector<double>& target, const std::vector<Sample>& fit,
-                                 const std::vector<EmitterGroup>& groups, const std::vector<glm::dvec3>& candidates, MapLighting& lighting) {
-  const std::size_t groupCount = system.groupCount();
-  const std::vector<double> weights = system.solve(target, 3);
+namespace {
 
+// The chosen columns' weights fitted per channel (the constant last in each).
+std::array<std::vector<double>, 3> channelWeights(const LightSystem& system, const std::vector<Sample>& fit) {
   std::array<std::vector<double>, 3> perChannel;
   for (int c = 0; c < 3; ++c) {
     std::vector<double> y(system.rows());
     for (std::size_t i = 0; i < system.rows(); ++i) y[i] = fit[i].value[c];
     perChannel[static_cast<std::size_t>(c)] = system.solve(y, c);
-    lighting.report.constant[c] = perChannel[static_cast<std::size_t>(c)].back();
   }
+  return perChannel;
+}
+
+}  // namespace
+
+std::vector<double> endLights(LightSystem& system, std::vector<Column>& columns, std::vector<glm::dvec3>& candidates, const std::vector<Sample>& fit,
+                              const Occluders& occluders, const MapLightProgress& report) {
+  const std::size_t groupCount = system.groupCount();
+  std::vector<double> ranges(system.chosen().size(), 0.0);
+  for (int round = 0; round < kEndRounds; ++round) {
+    const std::array<std::vector<double>, 3> perChannel = channelWeights(system, fit);
+    const std::size_t lights = system.chosen().size() - groupCount;
+    std::vector<Column> ended(lights);
+    tbb::parallel_for(std::size_t(0), lights, [&](std::size_t k) {
+      const std::size_t a = groupCount + k;
+      MapLight light;  // q3map2's value V is the largest channel's (its colour's largest channel is 1)
+      light.value = std::max({perChannel[0][a], perChannel[1][a], perChannel[2][a], 0.0});
+      ranges[a] = light.value > 0 ? lightEnvelope(light) : 0.0;
+      // a light the fit weighs 0 keeps its column: it gives no light and becomes no light
+      if (ranges[a] > 0) ended[k] = candidateColumn(candidates[system.chosen()[a] - groupCount], fit, occluders, ranges[a]);
+    });
+    for (std::size_t k = 0; k < lights; ++k) {
+      const std::size_t a = groupCount + k;
+      if (!(ranges[a] > 0)) continue;
+      candidates.push_back(candidates[system.chosen()[a] - groupCount]);
+      columns.push_back(std::move(ended[k]));
+      system.replace(a, columns.size() - 1);
+    }
+    report("ending lights", static_cast<std::size_t>(round) + 1, kEndRounds);
+  }
+  return ranges;
+}
+
+std::vector<double> setStrengths(const LightSystem& system, const std::vector<double>& target, const std::vector<Sample>& fit,
+                                 const std::vector<EmitterGroup>& groups, const std::vector<glm::dvec3>& candidates,
+                                 const std::vector<double>& ranges, MapLighting& lighting) {
+  const std::size_t groupCount = system.groupCount();
+  const std::vector<double> weights = system.solve(target, 3);
+
+  const std::array<std::vector<double>, 3> perChannel = channelWeights(system, fit);
+  for (int c = 0; c < 3; ++c) lighting.report.constant[c] = perChannel[static_cast<std::size_t>(c)].back();
   for (std::size_t k = 0; k < groupCount; ++k) {
     lighting.report.groupWeights.push_back({groups[k].name, weights[k]});
     for (std::size_t li : groups[k].lights) lighting.lights[li].value *= weights[k];
@@ -259,6 +299,7 @@ std::vector<double> setStrengths(const LightSystem& system, const std::vector<do
     l.position = candidates[system.chosen()[a] - groupCount];
     l.color = v / peak;
     l.value = peak;
+    l.range = ranges[a];
     l.source = "fitted";
     lighting.lights.push_back(l);
   }

@@ -74,12 +74,24 @@ void chooseLights(LightSystem& system, const std::vector<Column>& columns, const
 std::size_t refineLights(LightSystem& system, std::vector<Column>& columns, std::vector<glm::dvec3>& candidates, const std::vector<double>& target,
                          double spacing, const std::vector<Sample>& fit, const Occluders& occluders, const MapLightProgress& report);
 
+// After the choice and the refinement, whose columns have no end: each chosen candidate ended at
+// q3map2's envelope of its strength by KHR's window (MapLight::range), as the dataset renders it, and
+// the weights solved again with the ended columns. The envelope follows the strength and the
+// strength the window, so the two are solved in turns: kEndRounds of them (the envelope moves with
+// the square root of the strength, which changes by a few per cent after the first). An ended
+// column and its position are appended to `columns` and `candidates`. Returns each chosen column's
+// range (as chosen(); 0 for the groups).
+inline constexpr int kEndRounds = 3;
+std::vector<double> endLights(LightSystem& system, std::vector<Column>& columns, std::vector<glm::dvec3>& candidates, const std::vector<Sample>& fit,
+                              const Occluders& occluders, const MapLightProgress& report);
+
 // Colours and strengths: the same set fitted per channel. A group's weight is the luminance fit's
 // (its colour is the map's): its lights and surface lights in `lighting` are scaled by it (a
 // two-sided emitter by its front's; the back's is reported). Each chosen candidate with light
-// becomes a fitted light at its position, its colour its channels' ratio. Returns the luminance
+// becomes a fitted light at its position, its colour its channels' ratio, its range `ranges`'. Returns the luminance
 // fit's weights (the chosen columns', then the constant).
 std::vector<double> setStrengths(const LightSystem& system, const std::vector<double>& target, const std::vector<Sample>& fit,
-                                 const std::vector<EmitterGroup>& groups, const std::vector<glm::dvec3>& candidates, MapLighting& lighting);
+                                 const std::vector<EmitterGroup>& groups, const std::vector<glm::dvec3>& candidates,
+                                 const std::vector<double>& ranges, MapLighting& lighting);
 
 }  // namespace dynbench::maplight

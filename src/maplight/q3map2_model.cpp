@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <tbb/parallel_for.h>
@@ -61,6 +62,13 @@ double formFactor(const std::vector<glm::dvec3>& polygon, const glm::dvec3& poin
   return (side > 0 ? -total : total) / (2.0 * std::numbers::pi);
 }
 
+double lightEnvelope(const MapLight& light) {
+  if (light.kind == MapLightKind::kSun) return std::numeric_limits<double>::infinity();
+  const double photons = light.value * kPointScale;
+  if (light.linear) return std::max(0.0, photons * kLinearScale - kFalloffTolerance) / light.fade;
+  return std::sqrt(photons / kFalloffTolerance);
+}
+
 double lightContribution(const MapLight& light, const glm::dvec3& point, const glm::dvec3& normal) {
   if (light.kind == MapLightKind::kSun) {
     const double angle = light.angleAttenuation ? glm::dot(normal, light.towardsSun) : 1.0;
@@ -74,6 +82,14 @@ double lightContribution(const MapLight& light, const glm::dvec3& point, const g
   const double angle = light.angleAttenuation ? glm::dot(normal, toLight / d) : 1.0;
   const double photons = light.value * kPointScale;
   double add = light.linear ? std::max(0.0, angle * photons * kLinearScale - dist * light.fade) : photons / (dist * dist) * angle;
+  if (!light.linear) {
+    if (light.range > 0) {  // the dataset's end: KHR_lights_punctual's window on the true distance
+      const double x = d / light.range;
+      add *= std::clamp(1.0 - x * x * x * x, 0.0, 1.0);
+    } else if (dist >= lightEnvelope(light)) {
+      return 0.0;  // q3map2's: nothing from the envelope on
+    }
+  }
   if (light.kind == MapLightKind::kSpot) {
     const double along = glm::dot(point - light.position, light.spotAxis);
     if (along < 0.0) return 0.0;
@@ -180,11 +196,12 @@ std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::
   return columns;
 }
 
-Column candidateColumn(const glm::dvec3& position, const std::vector<Sample>& samples, const Occluders& occluders) {
+Column candidateColumn(const glm::dvec3& position, const std::vector<Sample>& samples, const Occluders& occluders, double range) {
   Column c;
   MapLight light;
   light.position = position;
   light.value = 1.0;
+  light.range = range;
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const Sample& s = samples[i];
     const glm::dvec3 normal = receivingNormal(s, position);

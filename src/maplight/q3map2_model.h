@@ -27,7 +27,10 @@ struct Column {
 std::vector<Column> groupColumns(const std::vector<Sample>& samples, const std::vector<EmitterGroup>& groups, const std::vector<MapLight>& lights,
                                  const std::vector<SurfaceEmitter>& surfaces, const Occluders& occluders);
 
-// A candidate point light of V = 1 at `position`: its light at every sample, visibility included.
-Column candidateColumn(const glm::dvec3& position, const std::vector<Sample>& samples, const Occluders& occluders);
+// A candidate point light of V = 1 at `position`: its light at every sample, visibility included,
+// ended by KHR's window at `range` (MapLight::range). Infinite: no end, for the choice of candidates,
+// which comes before their strengths and so their envelopes are known (0 would be q3map2's envelope
+// of V = 1, 87 units).
+Column candidateColumn(const glm::dvec3& position, const std::vector<Sample>& samples, const Occluders& occluders, double range);
 
 }  // namespace dynbench::maplight

@@ -251,7 +251,7 @@ py::dict suiteRecords(const fs::path& folder) {
   py::dict out;
   if (files.empty()) return out;
   const suite::Manifest manifest = unwrap(suite::recordManifest(files.front()));
-  for (const auto& [name, record] : unwrap(suite::readRecords(records, manifest))) out[py::str(name)] = document(record.document);
+  for (const auto& [name, record] : unwrap(suite::readRecords(records, manifest, suite::NumbersVersions::kAnyOne))) out[py::str(name)] = document(record.document);
   return out;
 }
 

@@ -98,11 +98,19 @@ double LightTree::importance(const Node& node, const glm::dvec3& p, const glm::d
   return node.power * cosBound * window / std::max({distance2, radius2, 1e-18});
 }
 
-bool LightTree::descend(std::uint32_t n, const glm::dvec3& point, const glm::dvec3& normal, double u, Selected& out) const {
+void LightTree::sumOverNodes(std::span<const double> perLight, std::span<double> perNode) const {
+  // Depth first with the first child after its parent: children come after their parent, so a
+  // pass from the last node back sums each node's children into it.
+  for (std::size_t n = nodes_.size(); n-- > 0;)
+    perNode[n] = nodes_[n].count == 1 ? perLight[nodes_[n].first] : perNode[n + 1] + perNode[nodes_[n].first];
+}
+
+bool LightTree::descend(std::uint32_t n, const glm::dvec3& point, const glm::dvec3& normal, double u, Selected& out, const float* factors) const {
   double probability = 1.0;
   while (nodes_[n].count > 1) {
     const std::uint32_t a = n + 1, b = nodes_[n].first;
-    const double ia = importance(nodes_[a], point, normal), ib = importance(nodes_[b], point, normal);
+    double ia = importance(nodes_[a], point, normal), ib = importance(nodes_[b], point, normal);
+    if (factors) ia *= factors[a], ib *= factors[b];
     const double total = ia + ib;
     if (!(total > 0)) return false;  // neither child can light the point
     const double pa = ia / total;
@@ -121,7 +129,8 @@ bool LightTree::descend(std::uint32_t n, const glm::dvec3& point, const glm::dve
   return probability > 0;
 }
 
-void LightTree::select(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights, std::vector<Selected>& selected) const {
+void LightTree::select(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights, std::vector<Selected>& selected,
+                       const float* factors) const {
   selected.clear();
   if (nodes_.empty()) return;
   // The cut: nodes that together hold every light that can reach the point, each to be sampled
@@ -132,7 +141,7 @@ void LightTree::select(const glm::dvec3& point, const glm::dvec3& normal, double
   std::array<std::uint32_t, kMaxCut> cut;
   std::array<double, kMaxCut> weight;
   int size = 0;
-  const double rootImportance = importance(nodes_[0], point, normal);
+  const double rootImportance = importance(nodes_[0], point, normal) * (factors ? factors[0] : 1.0);
   if (!(rootImportance > 0)) return;
   cut[0] = 0;
   weight[0] = rootImportance;
@@ -143,7 +152,8 @@ void LightTree::select(const glm::dvec3& point, const glm::dvec3& normal, double
       if (nodes_[cut[k]].count > 1 && (best < 0 || weight[k] > weight[best])) best = k;
     if (best < 0) break;  // only single lights left
     const std::uint32_t n = cut[best], a = n + 1, b = nodes_[n].first;
-    const double ia = importance(nodes_[a], point, normal), ib = importance(nodes_[b], point, normal);
+    double ia = importance(nodes_[a], point, normal), ib = importance(nodes_[b], point, normal);
+    if (factors) ia *= factors[a], ib *= factors[b];
     const int children = (ia > 0) + (ib > 0);
     if (size - 1 + children > budget) break;
     // Replace the node with its children that can light the point.
@@ -155,7 +165,7 @@ void LightTree::select(const glm::dvec3& point, const glm::dvec3& normal, double
   }
   for (int k = 0; k < size; ++k) {
     Selected s;
-    if (descend(cut[k], point, normal, u, s)) selected.push_back(s);
+    if (descend(cut[k], point, normal, u, s, factors)) selected.push_back(s);
   }
 }
 

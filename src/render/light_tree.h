@@ -39,8 +39,35 @@ class LightTree {
 
   // The lights for shading point `point` whose surface faces `normal` (unit; lights behind its
   // plane give nothing there: the BSDFs reflect only above the geometric surface), chosen with one
-  // uniform number u in [0, 1). `selected` is cleared first. maxLights >= 1.
-  void select(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights, std::vector<Selected>& selected) const;
+  // uniform number u in [0, 1). `selected` is cleared first. maxLights >= 1. `factors` (optional,
+  // one per node, each > 0; LightVisibility::factors): each node's importance is multiplied by its
+  // factor, so that the cut and the walk down follow what was learned to arrive; any positive
+  // factors keep every light that can reach the point selectable, and the estimate unbiased.
+  void select(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights, std::vector<Selected>& selected,
+              const float* factors = nullptr) const;
+
+  // Every light whose importance at the point is above zero (the lights that can light it), in
+  // the tree's order: `visit(light)`.
+  template <class Visit>
+  void forEachReaching(const glm::dvec3& point, const glm::dvec3& normal, Visit&& visit) const {
+    if (nodes_.empty()) return;
+    std::uint32_t stack[64];
+    int size = 0;
+    stack[size++] = 0;
+    while (size > 0) {
+      const std::uint32_t n = stack[--size];
+      if (!(importance(nodes_[n], point, normal) > 0)) continue;
+      if (nodes_[n].count == 1) {
+        visit(nodes_[n].first);
+        continue;
+      }
+      stack[size++] = nodes_[n].first;  // the second child, visited after the first
+      stack[size++] = n + 1;
+    }
+  }
+  // Node sums of per-light values: perNode[n] = the sum of perLight over the lights below node n.
+  void sumOverNodes(std::span<const double> perLight, std::span<double> perNode) const;
+  std::size_t nodeCount() const { return nodes_.size(); }
 
   // The importance select() gives a node or light at a point: an upper-bound-shaped estimate of
   // the light it sends there, zero only where it provably sends none. Exposed for tests.
@@ -58,9 +85,9 @@ class LightTree {
   std::size_t lightCount_ = 0;
 
   std::uint32_t buildRange(std::vector<std::uint32_t>& order, std::span<const Light> lights, std::size_t begin, std::size_t end);
-  // From node `n`, one light chosen by importance; probability multiplied into *probability.
-  // Returns false when no light below can light the point.
-  bool descend(std::uint32_t n, const glm::dvec3& point, const glm::dvec3& normal, double u, Selected& out) const;
+  // From node `n`, one light chosen by importance (times `factors`, if given); probability
+  // multiplied into *probability. Returns false when no light below can light the point.
+  bool descend(std::uint32_t n, const glm::dvec3& point, const glm::dvec3& normal, double u, Selected& out, const float* factors) const;
 };
 
 }  // namespace dynbench::render

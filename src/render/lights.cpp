@@ -223,9 +223,9 @@ Expected<void> LightSet::build(const scene::Scene& scene, const RayTracingScene&
 }
 
 void LightSet::selectPunctual(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights,
-                              std::vector<LightTree::Selected>& selected) const {
+                              std::vector<LightTree::Selected>& selected, const float* factors) const {
   if (maxLights > 0) {
-    tree_.select(point, normal, u, maxLights, selected);
+    tree_.select(point, normal, u, maxLights, selected, factors);
     for (auto& s : selected) s.light = treeLight_[s.light];
   } else {
     // Every light that can reach the point, each with probability 1, found without the tree:

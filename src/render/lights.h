@@ -103,8 +103,14 @@ class LightSet {
   // with probability 1, so a scene lit by few lights renders without noise from them). u: one
   // uniform number. maxLights 0: every light that can reach the point, without the tree (exact and
   // slow: the independent estimator the tests compare the tree with).
+  // `factors`: the tree's node factors learned for the point's cell (LightVisibility::factors), or
+  // nullptr for the tree's own importance.
   void selectPunctual(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights,
-                      std::vector<LightTree::Selected>& selected) const;
+                      std::vector<LightTree::Selected>& selected, const float* factors = nullptr) const;
+  // The light tree over the point and spot lights, and its light k's index among punctual lights
+  // (LightVisibility learns on it).
+  const LightTree& punctualTree() const { return tree_; }
+  std::uint32_t treeLight(std::size_t k) const { return treeLight_[k]; }
   // Light `light` at `point`, into `sample` (every field, as sample() below; pdf 1); false where
   // it gives none.
   bool samplePunctual(std::size_t light, const glm::dvec3& point, LightSample& sample) const;

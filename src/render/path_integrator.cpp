@@ -180,7 +180,8 @@ bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const S
         scratch.pairLights->select(scratch.pairHalf, hit.position, s.geometricNormal, uLight,
                                    depth == 0 ? pairLightsPerPoint(settings_.lightsPerPoint) : settings_.lightsPerPoint, scratch.selected);
       else
-        scratch.lights->selectPunctual(hit.position, s.geometricNormal, uLight, settings_.lightsPerPoint, scratch.selected);
+        scratch.lights->selectPunctual(hit.position, s.geometricNormal, uLight, settings_.lightsPerPoint, scratch.selected,
+                                       scratch.visibility ? scratch.visibility->factors(hit.position, s.geometricNormal) : nullptr);
       scratch.punctualEvaluated += scratch.selected.size();
       if (!scratch.selected.empty()) {
         const Bsdf bsdf(s.material, Frame(s.shadingNormal), s.geometricNormal);

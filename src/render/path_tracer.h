@@ -25,6 +25,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/error.h"
@@ -32,12 +33,18 @@
 #include "frames/radiance_change.h"
 #include "render/bsdf.h"
 #include "render/camera.h"
+#include "render/light_visibility.h"
 #include "render/lights.h"
 #include "render/pixel_filter.h"
 #include "render/raytracing_scene.h"
 #include "render/textures.h"
 
 namespace dynbench::render {
+
+// The learned light visibility's pilot (PathTracer::learnLightVisibility): every 4th pixel of every
+// 4th row, and cells of 1/128 of the scene's diameter (about 30 units on oa_dm1, a tenth of a room).
+inline constexpr int kPilotStride = 4;
+inline constexpr double kVisibilityCellsAcross = 128.0;
 
 struct RenderSettings {
   int width = 480, height = 270;
@@ -54,6 +61,11 @@ struct RenderSettings {
   // (LightSet::selectPunctual: unbiased, no light skipped; exact where no more than this many can
   // reach the point). 0: every light that can reach it, without the tree (exact, slow).
   int lightsPerPoint = 4;
+  // The tree's selection weighted by what was learned to arrive, per cell and tree node, from a
+  // pilot before each frame (render/light_visibility.h; unbiased); false: the tree's own importance,
+  // as before (`render --light-selection tree`, kept for comparison). Radiance-change pairs select
+  // from their shared tree without it either way, so both halves take the same decisions.
+  bool learnedLightSelection = true;
   // Adaptive sampling (`render --converge`): after samplesPerPixel samples, each pixel takes more
   // in rounds until the standard error of its direct and of its indirect luminance is at most
   // tolerance x the discard threshold (thresholdFraction x the frame's mean luminance of that
@@ -91,6 +103,15 @@ struct RenderSettings {
 // light, 2.5 s with 4 (docs/feature-buffers.md).
 constexpr int kPairLightsPerPoint = 32;
 inline int pairLightsPerPoint(int lightsPerPoint) { return lightsPerPoint == 0 ? 0 : std::max(lightsPerPoint, kPairLightsPerPoint); }
+
+// RenderSettings::learnedLightSelection by name: "learned" (true) or "tree" (false); nullopt for
+// another name.
+inline const char* lightSelectionName(bool learned) { return learned ? "learned" : "tree"; }
+inline std::optional<bool> parseLightSelection(std::string_view name) {
+  if (name == "learned") return true;
+  if (name == "tree") return false;
+  return std::nullopt;
+}
 
 // One frame's buffers: the feature-buffer contract's frame (frames/feature_frame.h).
 using FrameBuffers = frames::FeatureFrame;
@@ -172,6 +193,11 @@ class PathTracer {
   const scene::Material* materialOf(int node, int primitive) const;
   const scene::Material* materialOf(const scene::Primitive& primitive) const;
   SurfaceHit trace(const Ray& ray) const;
+  // The frame's learned light visibility (settings().learnedLightSelection; LightVisibility): pilot
+  // points where the rays through every kPilotStride-th pixel centre of `camera` (both axes) first
+  // hit, and one cosine-sampled bounce from each (a stream keyed by the frame and pixel alone), in
+  // cells of kVisibilityCellsAcross across the scene's diameter. Empty without point or spot lights.
+  LightVisibility learnLightVisibility(const RenderCamera& camera, std::uint64_t frameIndex) const;
   struct PathSample;
   struct PathState;
   struct PathScratch;

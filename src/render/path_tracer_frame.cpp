@@ -52,6 +52,50 @@ int nextSampleCount(int n, double ratioSquared, int round, int cap) {
 
 }  // namespace
 
+LightVisibility PathTracer::learnLightVisibility(const RenderCamera& camera, std::uint64_t frameIndex) const {
+  LightVisibility visibility;
+  if (!settings_.learnedLightSelection || !settings_.nextEventEstimation || settings_.lightsPerPoint <= 0 || !lights_.hasPunctualTree())
+    return visibility;
+  const int columns = (camera.width() + kPilotStride - 1) / kPilotStride, rows = (camera.height() + kPilotStride - 1) / kPilotStride;
+  const auto lattice = static_cast<std::size_t>(columns) * static_cast<std::size_t>(rows);
+  // Two slots a lattice pixel (its first hit, its bounce's hit), filled in parallel, then the
+  // points found kept in slot order.
+  std::vector<LightVisibility::Point> slots(2 * lattice);
+  std::vector<std::uint8_t> found(2 * lattice, 0);
+  auto facing = [](const SurfaceHit& hit, const glm::dvec3& direction) {
+    return glm::dot(hit.geometricNormal, direction) < 0 ? hit.geometricNormal : -hit.geometricNormal;
+  };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lattice, 64), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t k = range.begin(); k < range.end(); ++k) {
+      const int px = static_cast<int>(k % static_cast<std::size_t>(columns)) * kPilotStride;
+      const int py = static_cast<int>(k / static_cast<std::size_t>(columns)) * kPilotStride;
+      const Ray ray = camera.ray(px + 0.5, py + 0.5);
+      const SurfaceHit hit = trace(ray);
+      if (!hit.hit) continue;
+      const glm::dvec3 normal = facing(hit, ray.direction);
+      slots[2 * k] = {hit.position, normal};
+      found[2 * k] = 1;
+      const auto pixel = static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(camera.width()) + static_cast<std::uint64_t>(px);
+      Random rng(kPilotSeed, frameIndex, pixel, 0);
+      const Ray bounce{offsetOrigin(hit.position, normal), Frame(normal).toWorld(sampleCosineHemisphere(rng.uniform2()))};
+      const SurfaceHit next = trace(bounce);
+      if (!next.hit) continue;
+      slots[2 * k + 1] = {next.position, facing(next, bounce.direction)};
+      found[2 * k + 1] = 1;
+    }
+  });
+  std::vector<LightVisibility::Point> points;
+  for (std::size_t s = 0; s < slots.size(); ++s)
+    if (found[s]) points.push_back(slots[s]);
+  const double cellSize = 2.0 * sceneRadius_.value_or(1.0) / kVisibilityCellsAcross;
+  visibility.learn(lights_, points, cellSize, [this](const LightVisibility::Point& p, const LightSample& sample) {
+    // the shadow ray as addLight traces it
+    const double tMax = std::isinf(sample.distance) ? 1e30 : sample.distance * (1.0 - 1e-4) - 3e-5;
+    return !rayTracing_->occluded(offsetOrigin(p.position, p.normal), sample.direction, tMax);
+  });
+  return visibility;
+}
+
 FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& camera, const RenderCamera& previousCamera,
                                 std::atomic<int>* rowsDone, RenderStatistics* statistics) const {
   FrameBuffers out;
@@ -66,10 +110,12 @@ FrameBuffers PathTracer::render(std::uint64_t frameIndex, const RenderCamera& ca
   std::vector<SurfaceHit> firstHits(pixels);
   // A pixel's ray cone spreads by this angle (radians) per unit of length (textureLod).
   const double pixelSpread = std::atan(2.0 * std::tan(0.5 * camera.yfov()) / height);
-  tbb::enumerable_thread_specific<PathScratch> scratches([this, pixelSpread] {
+  const LightVisibility visibility = learnLightVisibility(camera, frameIndex);
+  tbb::enumerable_thread_specific<PathScratch> scratches([this, pixelSpread, &visibility] {
     PathScratch scratch;
     scratch.scene = rayTracing_.get();
     scratch.lights = &lights_;
+    scratch.visibility = visibility.empty() ? nullptr : &visibility;
     scratch.pixelSpread = pixelSpread;
     return scratch;
   });

@@ -16,6 +16,9 @@ namespace dynbench::render {
 inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
 // Adaptive sampling needs a variance estimate to stop on: its first round has at least this many samples.
 inline constexpr int kMinFirstRound = 16;
+// The pilot's random streams' seed, the word pilot in ASCII (the frame and pixel key them; the
+// render's seed does not).
+inline constexpr std::uint64_t kPilotSeed = 0x70696c6f74ull;
 
 // Rays leave a surface from a point pushed off it along the geometric normal, by an amount that
 // grows with the coordinates' magnitude (Embree intersects in single precision).
@@ -99,6 +102,8 @@ struct PathTracer::PathScratch {
   // frame, 1: the previous) is traced.
   const PairLights* pairLights = nullptr;
   int pairHalf = 0;
+  // The frame's learned light visibility (render), or nullptr: the tree's own importance.
+  const LightVisibility* visibility = nullptr;
   // What advance computes at a path vertex, written in place (returned by value, GCC zeroed and
   // copied them, with loads that waited on the stores just made).
   Shading shading;

@@ -113,8 +113,13 @@ nlohmann::json renderRecord(const RenderJob& job) {
   if (s.pairs) r["pairs"] = {{"max_pairs", s.maxPairs}, {"first_pairs", frames::kFirstPairs}, {"z", frames::kChangeZ},
                              {"direct_threshold", s.directThresholdFraction}, {"indirect_threshold", s.indirectThresholdFraction},
                              {"lights", {{"sampler", "shared_tree"}, {"per_point", pairLightsPerPoint(s.lightsPerPoint)}}}};
-  // Point and spot lights through the light tree (frames of the earlier cut-off are not reused).
+  // Point and spot lights through the light tree (frames of the earlier cut-off are not reused), its
+  // importance weighted by the learned visibility (render/light_visibility.h) and its parameters,
+  // or not (frames of the tree alone are not taken for learned ones, nor the other way round).
   r["lights"] = {{"sampler", "tree"}, {"per_point", s.lightsPerPoint}};
+  if (s.learnedLightSelection)
+    r["lights"]["learned_visibility"] = {{"pilot_stride", kPilotStride}, {"cells_across", kVisibilityCellsAcross},
+                                         {"defensive_share", LightVisibility::kDefensiveShare}};
   if (s.jitter) r["jitter"] = "halton23x8";
   // --float32 is recorded, so such a job does not take half-stored frames as complete.
   if (job.float32) r["storage"] = "float32";

@@ -18,8 +18,8 @@ namespace fs = std::filesystem;
 
 constexpr std::array kKeys = {"dynbench_render_job", "dataset", "output", "engine", "fps", "frames", "camera", "animation", "threads", "float32",
                               "blender", "width", "height", "samples_per_pixel", "bounces", "seed", "environment", "jitter", "pixel_filter",
-                              "converge", "tolerance", "max_spp", "pairs", "max_pairs", "lights_per_point", "direct_threshold",
-                              "indirect_threshold"};
+                              "converge", "tolerance", "max_spp", "pairs", "max_pairs", "lights_per_point", "light_selection",
+                              "direct_threshold", "indirect_threshold"};
 
 }  // namespace
 
@@ -47,6 +47,7 @@ nlohmann::json renderJobJson(const RenderJob& job) {
                       {"pairs", s.pairs},
                       {"max_pairs", s.maxPairs},
                       {"lights_per_point", s.lightsPerPoint},
+                      {"light_selection", lightSelectionName(s.learnedLightSelection)},
                       {"direct_threshold", s.directThresholdFraction},
                       {"indirect_threshold", s.indirectThresholdFraction}};
   if (s.constantEnvironment) j["environment"] = {s.constantEnvironment->r, s.constantEnvironment->g, s.constantEnvironment->b};
@@ -67,6 +68,7 @@ Expected<RenderJob> parseRenderJob(const nlohmann::json& document, const fs::pat
   std::string dataset, output;
   std::optional<std::string> camera, animation;
   std::string pixelFilter = pixelFilterName(s.pixelFilter.type);
+  std::string lightSelection = lightSelectionName(s.learnedLightSelection);
   bool widthGiven = r.has("/pixel_filter/width");
   for (auto ok : {r.string("/dataset", dataset), r.string("/output", output), r.string("/engine", job.engine), r.number("/fps", job.fps, 0.0, 1e6, true),
                   r.integer("/frames/first", job.frames.first, 0, INT_MAX), r.integer("/frames/last", job.frames.last, -1, INT_MAX),
@@ -78,7 +80,7 @@ Expected<RenderJob> parseRenderJob(const nlohmann::json& document, const fs::pat
                   r.number("/pixel_filter/width", s.pixelFilter.width, 1e-3, 8.0), r.boolean("/converge", s.converge),
                   r.number("/tolerance", s.tolerance, 1e-4, 10.0), r.integer("/max_spp", s.maxSamplesPerPixel, 1, INT_MAX),
                   r.boolean("/pairs", s.pairs), r.integer("/max_pairs", s.maxPairs, frames::kFirstPairs, 1 << 20),
-                  r.integer("/lights_per_point", s.lightsPerPoint, 0, 64), r.number("/direct_threshold", s.directThresholdFraction, 0.0, 10.0, true),
+                  r.integer("/lights_per_point", s.lightsPerPoint, 0, 64), r.string("/light_selection", lightSelection), r.number("/direct_threshold", s.directThresholdFraction, 0.0, 10.0, true),
                   r.number("/indirect_threshold", s.indirectThresholdFraction, 0.0, 10.0, true)})
     if (!ok) return std::unexpected(ok.error());
   if (dataset.empty()) return r.bad("/dataset", "a path, found \"\"");
@@ -90,6 +92,9 @@ Expected<RenderJob> parseRenderJob(const nlohmann::json& document, const fs::pat
   if (job.frames.last >= 0 && job.frames.last < job.frames.first)
     return r.bad("/frames/last", fmt::format("-1 (to the end) or at least /frames/first ({}), found {}", job.frames.first, job.frames.last));
   if (!findBackend(job.engine)) return r.bad("/engine", fmt::format("one of {}, found \"{}\"", fmt::join(backendNames(), ", "), job.engine));
+  const auto learned = parseLightSelection(lightSelection);
+  if (!learned) return r.bad("/light_selection", fmt::format("\"learned\" or \"tree\", found \"{}\"", lightSelection));
+  s.learnedLightSelection = *learned;
   auto filter = parsePixelFilter(pixelFilter);
   if (!filter) return r.bad("/pixel_filter/type", fmt::format("a pixel filter ({})", filter.error().message));
   s.pixelFilter.type = *filter;

@@ -49,7 +49,7 @@ nlohmann::json recordJson(const Manifest& manifest, std::size_t index, const nlo
           {"files", files}};
 }
 
-Expected<SuiteRecord> readRecord(const fs::path& file, const Manifest& manifest) {
+Expected<SuiteRecord> readRecord(const fs::path& file, const Manifest& manifest, NumbersVersions accept) {
   auto doc = readJsonFile(file);
   if (!doc) return std::unexpected(doc.error());
   SuiteRecord record;
@@ -71,11 +71,12 @@ Expected<SuiteRecord> readRecord(const fs::path& file, const Manifest& manifest)
                 name, *results, kResultsVersion);
   auto numbers = f.integer("/numbers_version");
   if (!numbers) return std::unexpected(numbers.error());
-  if (*numbers != kNumbersVersion)
+  if (*numbers != kNumbersVersion && accept == NumbersVersions::kThisBuild)
     return fail(ErrorCode::kInvalidData,
                 "{}: /numbers_version: numbers of version {}, and this dynbench makes version {}: made by a build whose numbers differ "
                 "(make the dataset again)",
                 name, *numbers, kNumbersVersion);
+  record.numbersVersion = static_cast<int>(*numbers);
   auto digest = f.string("/manifest_sha256");
   if (!digest) return std::unexpected(digest.error());
   if (*digest != manifestDigest(manifest)) {
@@ -160,15 +161,29 @@ std::vector<fs::path> recordFiles(const fs::path& folder) {
   return files;
 }
 
-Expected<std::map<std::string, SuiteRecord>> readRecords(const fs::path& folder, const Manifest& manifest) {
+Expected<void> requireOneNumbersVersion(const std::map<std::string, SuiteRecord>& records) {
+  const SuiteRecord* first = nullptr;
+  for (const auto& [name, record] : records) {
+    if (!first) first = &record;
+    else if (record.numbersVersion != first->numbersVersion)
+      return fail(ErrorCode::kInvalidData,
+                  "{}: /numbers_version: numbers version {}, and {} numbers version {}: records of builds whose numbers differ are never "
+                  "assembled into one table",
+                  record.file.string(), record.numbersVersion, first->file.string(), first->numbersVersion);
+  }
+  return {};
+}
+
+Expected<std::map<std::string, SuiteRecord>> readRecords(const fs::path& folder, const Manifest& manifest, NumbersVersions accept) {
   std::map<std::string, SuiteRecord> records;
   for (const fs::path& file : recordFiles(folder)) {
-    auto record = readRecord(file, manifest);
+    auto record = readRecord(file, manifest, accept);
     if (!record) return std::unexpected(record.error());
     if (auto [it, fresh] = records.emplace(record->dataset, *record); !fresh)
       return fail(ErrorCode::kInvalidData, "{}: /dataset/name: a second record of dataset '{}' (the first: {})", file.string(), record->dataset,
                   it->second.file.string());
   }
+  if (auto one = requireOneNumbersVersion(records); !one) return std::unexpected(one.error());
   return records;
 }
 

@@ -26,8 +26,17 @@ inline constexpr int kRecordVersion = 1;
 // "numbers_version" in a record: bumped by every change that moves a number a record holds for the
 // same manifest (capture adapters, convert, cameras, the renderer, discard, the metrics, the
 // methods), so that records of builds whose numbers differ are never assembled into one table. A
-// record of another numbers version is refused; make it again.
-inline constexpr int kNumbersVersion = 1;
+// record of another numbers version is refused where records are made (a run resumes or takes in
+// records); published results of an earlier version still assemble (all of one version) and say
+// which commit made them, which is the build that can re-make them.
+// Version 2: OpenArena's map lights end at q3map2's envelope (fit version 9) and the references'
+// light selection learns visibility (render/light_visibility.h).
+inline constexpr int kNumbersVersion = 2;
+
+// Which numbers versions a read accepts: this build's alone (a run that makes records beside them),
+// or any one (assembling or publishing tables of records already made: readRecords then requires
+// every record to share it).
+enum class NumbersVersions { kThisBuild, kAnyOne };
 
 // The manifest's digest a record carries: the SHA-256 of its document as compact JSON with sorted
 // keys (nlohmann::json::dump()), so spacing and key order do not matter, every value does.
@@ -50,6 +59,7 @@ struct SuiteRecord {
   std::map<std::string, std::string> files;  // path relative to the suite folder -> SHA-256
   DatasetResult result;        // entry's numbers, parsed
   nlohmann::json document;     // the whole record as read
+  int numbersVersion = kNumbersVersion;
 };
 
 // The record's JSON for dataset `index` of `manifest`: `entry` is suite.json's entry for it, `files`
@@ -63,14 +73,18 @@ nlohmann::json recordJson(const Manifest& manifest, std::size_t index, const nlo
 // /results_version), of another manifest (/manifest_sha256), of a dataset the manifest does not
 // have or has otherwise (/dataset), made with other settings (/settings), or malformed (not JSON,
 // a value missing or of the wrong type).
-Expected<SuiteRecord> readRecord(const std::filesystem::path& file, const Manifest& manifest);
+Expected<SuiteRecord> readRecord(const std::filesystem::path& file, const Manifest& manifest,
+                                 NumbersVersions accept = NumbersVersions::kThisBuild);
 
 // The record files (*.json, hidden names aside) in `folder`, sorted; none for a missing folder.
 std::vector<std::filesystem::path> recordFiles(const std::filesystem::path& folder);
 
 // Every record (*.json) in `folder`, each read as readRecord does, by dataset name; an error for the
 // first one refused, or for two records of one dataset. A missing folder has none.
-Expected<std::map<std::string, SuiteRecord>> readRecords(const std::filesystem::path& folder, const Manifest& manifest);
+Expected<std::map<std::string, SuiteRecord>> readRecords(const std::filesystem::path& folder, const Manifest& manifest,
+                                                         NumbersVersions accept = NumbersVersions::kThisBuild);
+// An error naming two records of different numbers versions, if `records` has them.
+Expected<void> requireOneNumbersVersion(const std::map<std::string, SuiteRecord>& records);
 
 // The manifest a record was made from: its /manifest (a copy of the manifest's document, so that a
 // record can be re-made, checked and assembled with nothing else), parsed, and refused when its

@@ -246,18 +246,18 @@ std::uintmax_t folderBytes(const fs::path& folder) {
 // The records of DIR/records and those of `elsewhere` (folders of records, or record files) that
 // DIR lacks, the latter copied into DIR/records as they are. Every one is checked (readRecord).
 Expected<std::map<std::string, SuiteRecord>> gatherRecords(const Manifest& manifest, const fs::path& root, const std::vector<fs::path>& elsewhere,
-                                                           const pipeline::RunLog& log) {
-  auto records = readRecords(root / "records", manifest);
+                                                           NumbersVersions accept, const pipeline::RunLog& log) {
+  auto records = readRecords(root / "records", manifest, accept);
   if (!records) return std::unexpected(records.error());
   for (const fs::path& source : elsewhere) {
     std::map<std::string, SuiteRecord> found;
     std::error_code ec;
     if (fs::is_directory(source, ec)) {
-      auto read = readRecords(source, manifest);
+      auto read = readRecords(source, manifest, accept);
       if (!read) return std::unexpected(read.error());
       found = std::move(*read);
     } else {
-      auto read = readRecord(source, manifest);
+      auto read = readRecord(source, manifest, accept);
       if (!read) return std::unexpected(read.error());
       found.emplace(read->dataset, std::move(*read));
     }
@@ -276,6 +276,7 @@ Expected<std::map<std::string, SuiteRecord>> gatherRecords(const Manifest& manif
       records->emplace(name, std::move(record));
     }
   }
+  if (auto one = requireOneNumbersVersion(*records); !one) return std::unexpected(one.error());
   return records;
 }
 
@@ -362,7 +363,9 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
   for (const std::string& name : asked)
     if (std::none_of(manifest->datasets.begin(), manifest->datasets.end(), [&](const DatasetSpec& d) { return d.name == name; }))
       return fail(ErrorCode::kUsage, "--only {}: no dataset of {} has that name", name, options.manifest.string());
-  auto records = gatherRecords(*manifest, root, options.records, log);
+  // Assembling alone reads records of an earlier build too (all of one numbers version); a run
+  // that makes records beside them takes this build's alone.
+  auto records = gatherRecords(*manifest, root, options.records, options.assembleOnly ? NumbersVersions::kAnyOne : NumbersVersions::kThisBuild, log);
   if (!records) return std::unexpected(records.error());
   std::vector<std::size_t> todo;
   for (std::size_t i = 0; i < manifest->datasets.size(); ++i) {
@@ -465,7 +468,7 @@ Expected<SuiteOutcome> publishSuite(const fs::path& dir, const fs::path& to, boo
   std::error_code ec;
   auto manifest = recordManifest(files.front());
   if (!manifest) return std::unexpected(manifest.error());
-  auto records = readRecords(dir / "records", *manifest);
+  auto records = readRecords(dir / "records", *manifest, NumbersVersions::kAnyOne);
   if (!records) return std::unexpected(records.error());
   std::vector<std::string> missing;
   for (const DatasetSpec& spec : manifest->datasets)

@@ -528,9 +528,10 @@ static void game_colour_to_linear(float rgb[3]) {
   }
 }
 
-/* dynbench's lights of the map (src/maplight/fit.h, writeAdapterLights): "point X Y Z R G B D",
- * "sun DX DY DZ R G B", "surface SHADER R G B", game axes, full-light units; their colours made
- * linear here (game_colour_to_linear). */
+/* dynbench's lights of the map (src/maplight/fit.h, writeAdapterLights): "point X Y Z R G B D E"
+ * (R G B at D units, ended by KHR's window at E; "point X Y Z R G B D", an older file's, has no
+ * end), "sun DX DY DZ R G B", "surface SHADER R G B", game axes, full-light units; their colours
+ * made linear here (game_colour_to_linear). */
 static int load_map_lights(const char* path) {
   if (!path || !path[0]) return 1;
   FILE* file = fopen(path, "r");
@@ -543,15 +544,22 @@ static int load_map_lights(const char* path) {
   while (fgets(line, sizeof(line), file)) {
     ++number;
     char kind[16], shader[MAX_QPATH];
-    float v[7];
+    float v[8];
+    int read;
     if (line[0] == '#' || line[0] == '\n') continue;
-    if (sscanf(line, "point %f %f %f %f %f %f %f", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6]) == 7) {
+    if ((read = sscanf(line, "point %f %f %f %f %f %f %f %f", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6], &v[7])) >= 7) {
       if (g_db.static_light_count >= MAX_STATIC_LIGHTS) continue;
       float* light = g_db.static_lights[g_db.static_light_count++];
       to_capture(v, light);
       game_colour_to_linear(v + 3);
       memcpy(light + 3, v + 3, 4 * sizeof(float));
       light[7] = (float)DBC_FALLOFF_INVERSE_SQUARE;
+      if (read == 8 && v[7] > 0.0f) { /* the same light given at its end: colour x (D/E)^2 at E */
+        const float atEnd = (v[6] / v[7]) * (v[6] / v[7]);
+        for (int k = 3; k < 6; ++k) light[k] *= atEnd;
+        light[6] = v[7];
+        light[7] = (float)DBC_FALLOFF_WINDOWED_INVERSE_SQUARE;
+      }
     } else if (sscanf(line, "sun %f %f %f %f %f %f", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5]) == 6) {
       g_db.map_sun = 1;
       memcpy(g_db.map_sun_towards, v, 3 * sizeof(float));
@@ -564,7 +572,7 @@ static int load_map_lights(const char* path) {
       memcpy(g_db.map_surface_emission[g_db.map_surface_count++], v, 3 * sizeof(float));
     } else if (sscanf(line, "%15s", kind) == 1) {
       fclose(file);
-      fprintf(stderr, "dynbench-capture: error: %s:%d: expected 'point X Y Z R G B D', 'sun DX DY DZ R G B' or 'surface SHADER R G B'\n", path, number);
+      fprintf(stderr, "dynbench-capture: error: %s:%d: expected 'point X Y Z R G B D E', 'sun DX DY DZ R G B' or 'surface SHADER R G B'\n", path, number);
       return 0;
     }
   }

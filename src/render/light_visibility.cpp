@@ -1,0 +1,98 @@
+#include "render/light_visibility.h"
+
+#include <cmath>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "core/math.h"
+
+namespace dynbench::render {
+
+namespace {
+// A light seen from a pilot point: its unoccluded light there and what arrived of it.
+struct Seen {
+  std::uint32_t light;  // the tree's light index
+  double unoccluded, arriving;
+};
+}  // namespace
+
+std::uint64_t LightVisibility::key(const glm::dvec3& point, const glm::dvec3& normal, int level) const {
+  // 19 bits a coordinate: cells 2^19 apart share a key, which costs only the quality of the factors
+  const double size = std::ldexp(cellSize_, level);
+  const auto cell = [&](double v) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v / size))) & 0x7FFFFu; };
+  const glm::dvec3 a = glm::abs(normal);
+  const int axis = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
+  const std::uint64_t facing = static_cast<std::uint64_t>(2 * axis + (normal[axis] < 0 ? 1 : 0));
+  return cell(point.x) | cell(point.y) << 19 | cell(point.z) << 38 | facing << 57 | static_cast<std::uint64_t>(level) << 60;
+}
+
+void LightVisibility::learn(const LightSet& lights, std::span<const Point> points, double cellSize, const Visible& visible) {
+  cells_.clear();
+  points_.clear();
+  factors_.clear();
+  cellSize_ = cellSize;
+  const LightTree& tree = lights.punctualTree();
+  nodes_ = tree.nodeCount();
+  if (tree.empty() || points.empty() || !(cellSize > 0)) return;
+
+  std::vector<std::vector<Seen>> seen(points.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 16), [&](const tbb::blocked_range<std::size_t>& range) {
+    LightSample sample;
+    for (std::size_t i = range.begin(); i < range.end(); ++i) {
+      const Point& p = points[i];
+      tree.forEachReaching(p.position, p.normal, [&](std::uint32_t k) {
+        if (!lights.samplePunctual(lights.treeLight(k), p.position, sample)) return;
+        const double unoccluded = luminance(sample.radiance) * glm::dot(p.normal, sample.direction);
+        if (!(unoccluded > 0)) return;
+        seen[i].push_back({k, unoccluded, visible(p, sample) ? unoccluded : 0.0});
+      });
+    }
+  });
+
+  // Cells numbered in the order of their first point (each point's levels in turn); each cell's
+  // points in their order.
+  std::vector<std::vector<std::uint32_t>> members;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    for (int level = 0; level < kLevels; ++level) {
+      const auto [it, inserted] = cells_.try_emplace(key(points[i].position, points[i].normal, level), static_cast<std::uint32_t>(members.size()));
+      if (inserted) members.emplace_back();
+      members[it->second].push_back(static_cast<std::uint32_t>(i));
+    }
+  points_.resize(members.size());
+  for (std::size_t c = 0; c < members.size(); ++c) points_[c] = static_cast<std::uint32_t>(members[c].size());
+  factors_.assign(members.size() * nodes_, 1.0f);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, members.size(), 8), [&](const tbb::blocked_range<std::size_t>& range) {
+    std::vector<double> unoccluded(tree.size()), arriving(tree.size()), nodeUnoccluded(nodes_), nodeArriving(nodes_);
+    for (std::size_t c = range.begin(); c < range.end(); ++c) {
+      std::fill(unoccluded.begin(), unoccluded.end(), 0.0);
+      std::fill(arriving.begin(), arriving.end(), 0.0);
+      for (const std::uint32_t i : members[c])
+        for (const Seen& s : seen[i]) {
+          unoccluded[s.light] += s.unoccluded;
+          arriving[s.light] += s.arriving;
+        }
+      tree.sumOverNodes(unoccluded, nodeUnoccluded);
+      tree.sumOverNodes(arriving, nodeArriving);
+      float* f = &factors_[c * nodes_];
+      for (std::size_t n = 0; n < nodes_; ++n)
+        if (nodeUnoccluded[n] > 0)
+          f[n] = static_cast<float>(kDefensiveShare + (1.0 - kDefensiveShare) * std::min(1.0, nodeArriving[n] / nodeUnoccluded[n]));
+    }
+  });
+}
+
+const float* LightVisibility::factors(const glm::dvec3& point, const glm::dvec3& normal) const {
+  if (cells_.empty()) return nullptr;
+  const float* coarse = nullptr;
+  for (int level = 0; level < kLevels; ++level) {
+    const auto it = cells_.find(key(point, normal, level));
+    if (it == cells_.end()) continue;
+    const float* f = &factors_[static_cast<std::size_t>(it->second) * nodes_];
+    if (points_[it->second] >= kMinPoints) return f;
+    coarse = f;
+  }
+  return coarse;
+}
+
+}  // namespace dynbench::render

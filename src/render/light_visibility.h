@@ -1,0 +1,73 @@
+#pragma once
+// What the light tree cannot see: walls. The tree's importance (light_tree.h) bounds what each
+// node's lights would send a point with nothing in between; in id Tech 3 and Cube 2 maps, rooms and
+// corridors, most lights in reach by distance and orientation are behind a wall, so most of the
+// tree's picks were shadow rays that found nothing. A frame's LightVisibility learns, before the
+// frame is rendered, what share of that unoccluded light actually arrives, per cell of a hash grid
+// over surface points (and the axis their normal faces) and per node of the tree; the tree's
+// selection then multiplies each node's importance by
+//   f = s + (1 - s) A / U,
+// A the light of the node's lights that arrived at the cell's pilot points (shadow rays traced), U
+// the light they would have sent unoccluded, s = kDefensiveShare. Every f is at least s > 0, so every
+// light that can reach a point keeps a non-zero probability and the estimate stays unbiased (the
+// defensive mixture of Vévoda et al. 2018, "Bayesian online regression for adaptive direct
+// illumination sampling", whose per-cell learned contributions this is in a simpler, counted form);
+// a node that no pilot point of the cell could receive light from keeps f = 1 (nothing learned).
+//
+// Cells come in kLevels sizes, each twice the one before: a shading point takes the smallest cell
+// around it that holds at least kMinPoints pilot points (else the largest that holds any), so
+// surfaces the pilot saw densely get fine factors and those it saw sparsely (far away, or reached
+// only by bounces) coarse ones.
+//
+// Deterministic: the pilot points are fixed by the frame (PathTracer::learnLightVisibility: camera
+// rays through a lattice of pixel centres and one cosine bounce each, from a stream of their own),
+// their shadow rays are traced in parallel into per-point slots, and the sums are made cell by cell
+// in point order, so the factors do not depend on threads or their schedule.
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <unordered_map>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "render/lights.h"
+
+namespace dynbench::render {
+
+class LightVisibility {
+ public:
+  // The share of a node's importance kept where nothing of its light was seen to arrive.
+  static constexpr double kDefensiveShare = 0.1;
+  static constexpr int kLevels = 5;
+  static constexpr std::uint32_t kMinPoints = 4;
+
+  // A pilot point: a surface point and the unit normal of its side facing the ray that found it.
+  struct Point {
+    glm::dvec3 position{0.0}, normal{0.0};
+  };
+  // Whether the shadow ray from pilot point `point` towards the light of `sample` arrives.
+  using Visible = std::function<bool(const Point& point, const LightSample& sample)>;
+
+  // Learns from `points` (in their order) on `lights`' tree: at each point, every point or spot
+  // light the tree says can reach it gives U = luminance(irradiance) cos (LightSet::samplePunctual)
+  // and, where `visible`, A = U. Cells are cubes of side `cellSize` (world units), split by the axis
+  // and side the normal mostly faces (the smallest level's; the others' are 2, 4, ... times it).
+  void learn(const LightSet& lights, std::span<const Point> points, double cellSize, const Visible& visible);
+
+  // The node factors (LightTree::select's) of the cell holding a shading point, or nullptr where
+  // no pilot point fell in it (the tree's own importance).
+  const float* factors(const glm::dvec3& point, const glm::dvec3& normal) const;
+  bool empty() const { return cells_.empty(); }
+  std::size_t cellCount() const { return cells_.size(); }
+
+ private:
+  std::uint64_t key(const glm::dvec3& point, const glm::dvec3& normal, int level) const;
+  double cellSize_ = 1.0;
+  std::size_t nodes_ = 0;
+  std::unordered_map<std::uint64_t, std::uint32_t> cells_;  // cell key -> index
+  std::vector<std::uint32_t> points_;                       // pilot points in cell c
+  std::vector<float> factors_;                              // cell c's node n at c * nodes_ + n
+};
+
+}  // namespace dynbench::render
