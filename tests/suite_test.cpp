@@ -2,6 +2,8 @@
 // run for real (Cube 2, the renderer, discard, evaluate), resumed, verified, and caught when a frame
 // is edited by hand.
 #include <algorithm>
+#include <cstdlib>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <random>
@@ -468,6 +470,39 @@ TEST(Suite, RecordsOfAnEarlierNumbersVersionAssembleButAreNotMixed) {
   EXPECT_EQ(r.status, 6) << r.err;
   EXPECT_NE(r.err.find(fmt::format("made by a build of numbers version {} (git commit {})", version, commit)), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "work" / "captures")) << "nothing is re-made";
+}
+
+// cmake/build_commit.cmake, which writes the commit a record names at every build: HEAD of a clean
+// tree; HEAD and "-dirty" once a tracked file differs from it (a record made from uncommitted code
+// then names no commit whose code it did not run); untracked files do not count; "unknown" outside
+// a git checkout.
+TEST(Suite, TheBuildCommitIsHeadAndSaysWhenTheTreeDiffers) {
+  const fs::path dir = test::freshDir("build_commit");
+  const fs::path repo = dir / "repo", out = dir / "build_commit.h";
+  fs::create_directories(repo / "src" / "core");
+  fs::copy_file(fs::path(DYNBENCH_SOURCE_DIR) / "src" / "core" / "build_commit.h.in", repo / "src" / "core" / "build_commit.h.in");
+  auto sh = [&](const std::string& command) { return std::system(fmt::format("cd '{}' && {{ {}; }} >/dev/null 2>&1", repo.string(), command).c_str()); };
+  auto written = [&] {
+    const std::string script = (fs::path(DYNBENCH_SOURCE_DIR) / "cmake" / "build_commit.cmake").string();
+    EXPECT_EQ(sh(fmt::format("cmake -DSOURCE_DIR='{}' -DOUTPUT='{}' -DGIT_EXECUTABLE=git -P '{}'", repo.string(), out.string(), script)), 0);
+    const std::string text = test::slurp(out);
+    const auto start = text.find("kBuildCommit = \"") + 16;
+    return text.substr(start, text.find('"', start) - start);
+  };
+  EXPECT_EQ(written(), "unknown");
+  ASSERT_EQ(sh("git init -q . && git -c user.name=t -c user.email=t@t add -A && git -c user.name=t -c user.email=t@t commit -qm one"), 0);
+  const std::string head = [&] {
+    const std::string file = (dir / "head").string();
+    std::system(fmt::format("cd '{}' && git rev-parse HEAD > '{}'", repo.string(), file).c_str());
+    std::string h = test::slurp(file);
+    return h.substr(0, h.find('\n'));
+  }();
+  ASSERT_EQ(head.size(), 40u);
+  EXPECT_EQ(written(), head);
+  std::ofstream(repo / "untracked.txt") << "not part of the build\n";
+  EXPECT_EQ(written(), head) << "untracked files do not make the tree dirty";
+  std::ofstream(repo / "src" / "core" / "build_commit.h.in", std::ios::app) << "// edited\n";
+  EXPECT_EQ(written(), head + "-dirty");
 }
 
 TEST(Suite, PublishedResultsAreTheirRecordsAssembled) {
