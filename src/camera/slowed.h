@@ -1,5 +1,5 @@
 #pragma once
-// The third camera policy of issue 48's paired design: the bot's own camera with its turns slowed.
+// The slowed camera: the bot's own camera with its turns slowed (the third camera of the suites' paired design).
 // Its positions are the bot's, key for key, cuts included; its heading and pitch are the bot's
 // smoothed by a centred moving average `window` seconds wide within each cut-free stretch, so
 // flicks and aim corrections shorter than the window are gone while turns to a new direction stay.

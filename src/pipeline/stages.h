@@ -1,6 +1,6 @@
 #pragma once
 // Stage runners: each pipeline stage as one library function taking a typed options struct. The
-// CLI commands, `demo` and (later) cluster jobs all call these, so a stage does the same thing
+// CLI commands, `demo`, `suite` and the Slurm jobs all call these, so a stage does the same thing
 // however it is started. Runners write the stage's files and return what was measured; printing
 // is the caller's.
 #include <filesystem>
