@@ -565,54 +565,47 @@ TEST(Convert, TheMapsSunPlacesTheSkysSunAndCalibratesTheLights) {
   }
 }
 
+// A map light of colour (2, 1, 0.5) and `falloff`, `range`, in a map lit by a sun of engine colour
+// 0.5, converted (the capture's record checked for `token`, the dataset by the glTF validator):
+// the dataset's light and the sky's sun illuminance.
+std::pair<nlohmann::json, double> convertMapLight(dbc_light_falloff falloff, float range, const std::string& token, const std::string& name) {
+  OneLight l;
+  l.sun = glm::vec3(0.5f);
+  l.colour = {2.0f, 1.0f, 0.5f};
+  l.range = range;
+  l.falloff = falloff;
+  l.type = "maplight";
+  const fs::path dir = freshDir(name);
+  const fs::path dataset = convertOneLight(dir, l);
+  EXPECT_FALSE(dataset.empty());
+  if (dataset.empty()) return {nlohmann::json::object(), 0.0};
+  EXPECT_NE(test::slurp(dir / "capture" / "Capture.txt").find(token), std::string::npos);
+  const auto j = readJson(dataset);
+  int status = 0;
+  const std::string validation = test::validateGltf(dataset, status);
+  EXPECT_EQ(status, 0) << validation;
+  return {j["extensions"]["KHR_lights_punctual"]["lights"][0], j["extensions"]["DYNBENCH_environment"]["sky"]["sun_illuminance_lux"].get<double>()};
+}
+
 TEST(Convert, AnInverseSquareLightGivesItsColourAtItsRange) {
   // id Tech 3's map lights (maplight): colour c x (R / d)^2, no end. In a map lit by a sun of
   // engine colour 0.5, E_u = E_sun / 0.5 and the light is a point light without a range of
   // I = E_u x peak(c) x R^2 cd: at d = R it gives E_u x c, the engine's light of colour c.
-  OneLight l;
-  l.sun = glm::vec3(0.5f);
-  l.colour = {2.0f, 1.0f, 0.5f};
-  l.range = 30.0f;
-  l.falloff = DBC_FALLOFF_INVERSE_SQUARE;
-  l.type = "maplight";
-  const fs::path dir = freshDir("convert_inverse_square");
-  const fs::path dataset = convertOneLight(dir, l);
-  ASSERT_FALSE(dataset.empty());
-  EXPECT_NE(test::slurp(dir / "capture" / "Capture.txt").find(":30:inverse_square:point:0:maplight"), std::string::npos);
-  const auto j = readJson(dataset);
-  const double sunLux = j["extensions"]["DYNBENCH_environment"]["sky"]["sun_illuminance_lux"].get<double>();
-  const auto& light = j["extensions"]["KHR_lights_punctual"]["lights"][0];
+  const auto [light, sunLux] = convertMapLight(DBC_FALLOFF_INVERSE_SQUARE, 30.0f, ":30:inverse_square:point:0:maplight", "convert_inverse_square");
   EXPECT_FALSE(light.contains("range"));
   EXPECT_EQ(light["color"], nlohmann::json({1.0, 0.5, 0.25}));
   EXPECT_NEAR(light["intensity"].get<double>(), sunLux / 0.5 * 2.0 * 900.0, 1e-3 * light["intensity"].get<double>());
-  int status = 0;
-  const std::string validation = test::validateGltf(dataset, status);
-  EXPECT_EQ(status, 0) << validation;
 }
 
 // A windowed inverse-square light (id Tech 3's map lights ended at q3map2's envelope) is KHR's point
 // light with that range: I = E_u max(c) R^2 as for the inverse square (its light at d < R is then
 // E_u c (R/d)^2 before the window, the capture's), and the range kept.
 TEST(Convert, AWindowedInverseSquareLightKeepsItsRange) {
-  OneLight l;
-  l.sun = glm::vec3(0.5f);
-  l.colour = {2.0f, 1.0f, 0.5f};
-  l.range = 240.0f;
-  l.falloff = DBC_FALLOFF_WINDOWED_INVERSE_SQUARE;
-  l.type = "maplight";
-  const fs::path dir = freshDir("convert_windowed_inverse_square");
-  const fs::path dataset = convertOneLight(dir, l);
-  ASSERT_FALSE(dataset.empty());
-  EXPECT_NE(test::slurp(dir / "capture" / "Capture.txt").find(":240:windowed_inverse_square:point:0:maplight"), std::string::npos);
-  const auto j = readJson(dataset);
-  const double sunLux = j["extensions"]["DYNBENCH_environment"]["sky"]["sun_illuminance_lux"].get<double>();
-  const auto& light = j["extensions"]["KHR_lights_punctual"]["lights"][0];
+  const auto [light, sunLux] = convertMapLight(DBC_FALLOFF_WINDOWED_INVERSE_SQUARE, 240.0f, ":240:windowed_inverse_square:point:0:maplight",
+                                               "convert_windowed_inverse_square");
   EXPECT_EQ(light["range"].get<double>(), 240.0);
   EXPECT_EQ(light["color"], nlohmann::json({1.0, 0.5, 0.25}));
   EXPECT_NEAR(light["intensity"].get<double>(), sunLux / 0.5 * 2.0 * 240.0 * 240.0, 1e-3 * light["intensity"].get<double>());
-  int status = 0;
-  const std::string validation = test::validateGltf(dataset, status);
-  EXPECT_EQ(status, 0) << validation;
 }
 
 // An engine that records its lighting with neither a sky light nor an ambient floor (id Tech 3 with

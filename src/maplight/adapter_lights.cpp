@@ -22,9 +22,7 @@ Expected<void> writeAdapterLights(const std::filesystem::path& file, const MapLi
       // It ends at its range (MapLight::range), or, for a light the fit did not end, at the envelope
       // of that inverse-square light.
       const double fullLightDistance = std::sqrt(l.value * kPointScale / kFullLight);
-      MapLight inverseSquare = l;
-      inverseSquare.linear = false;
-      const double range = l.range > 0 ? l.range : lightEnvelope(inverseSquare);
+      const double range = l.range > 0 ? l.range : inverseSquareEnvelope(l.value);
       out << fmt::format("point {:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g}\n", l.position.x, l.position.y, l.position.z, l.color.r,
                          l.color.g, l.color.b, fullLightDistance, range);
     }

@@ -147,13 +147,8 @@ Expected<MapLighting> fitMapLighting(const GameFiles& files, const std::string& 
   // The known point lights end as the dataset ends them too (the lightmaps were baked with q3map2's
   // hard cut, which `unweighted` keeps): KHR's window at their envelope. A linear light is written
   // as the inverse-square light of its value (writeAdapterLights), so it takes that one's envelope.
-  for (std::size_t i = 0; i < knownLights; ++i) {
-    MapLight& l = result.lights[i];
-    if (l.kind == MapLightKind::kSun) continue;
-    MapLight inverseSquare = l;
-    inverseSquare.linear = false;
-    l.range = lightEnvelope(inverseSquare);
-  }
+  for (std::size_t i = 0; i < knownLights; ++i)
+    if (result.lights[i].kind != MapLightKind::kSun) result.lights[i].range = inverseSquareEnvelope(result.lights[i].value);
 
   // 4. The judging, on what the fit never saw.
   if (options.hideEntityLights) judgeRecovery(*bsp, fit, knownLights, occluders, result);

@@ -75,6 +75,10 @@ struct MapLight {
 // units for the inverse square, (V pointScale linearScale - falloffTolerance) / fade for a linear
 // light; infinite for a sun.
 double lightEnvelope(const MapLight& light);
+// The envelope of the inverse-square light of value V, sqrt(V pointScale / falloffTolerance): the
+// range the dataset ends every point light at, a linear one's too (it is written as the inverse
+// square of its value: writeAdapterLights).
+double inverseSquareEnvelope(double value);
 
 // One of a surface light's area lights as q3map2 makes them (light_bounce.c,
 // RadSubdivideDiffuseLight): a triangle of the surface, halved at the mid-plane of its bounds along

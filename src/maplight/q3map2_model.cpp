@@ -62,11 +62,12 @@ double formFactor(const std::vector<glm::dvec3>& polygon, const glm::dvec3& poin
   return (side > 0 ? -total : total) / (2.0 * std::numbers::pi);
 }
 
+double inverseSquareEnvelope(double value) { return std::sqrt(value * kPointScale / kFalloffTolerance); }
+
 double lightEnvelope(const MapLight& light) {
   if (light.kind == MapLightKind::kSun) return std::numeric_limits<double>::infinity();
-  const double photons = light.value * kPointScale;
-  if (light.linear) return std::max(0.0, photons * kLinearScale - kFalloffTolerance) / light.fade;
-  return std::sqrt(photons / kFalloffTolerance);
+  if (light.linear) return std::max(0.0, light.value * kPointScale * kLinearScale - kFalloffTolerance) / light.fade;
+  return inverseSquareEnvelope(light.value);
 }
 
 double lightContribution(const MapLight& light, const glm::dvec3& point, const glm::dvec3& normal) {

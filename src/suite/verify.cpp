@@ -220,12 +220,13 @@ Expected<RecordComparison> verifyRecord(const fs::path& file, const fs::path& wo
   if (!manifest) return std::unexpected(manifest.error());
   auto recorded = readRecord(file, *manifest, NumbersVersions::kAnyOne);
   if (!recorded) return std::unexpected(recorded.error());
-  if (recorded->numbersVersion != kNumbersVersion)
+  if (recorded->numbersVersion != kNumbersVersion) {
+    const std::string commit = recorded->document.value("/tool/commit"_json_pointer, std::string("unknown"));
     return fail(ErrorCode::kUnsupported,
                 "{}: /numbers_version: made by a build of numbers version {} (git commit {}), and this dynbench makes version {}: its numbers "
                 "are re-made by that build (git checkout {}), or the dataset is made again as a new record",
-                file.string(), recorded->numbersVersion, recorded->document.value("/tool/commit"_json_pointer, std::string("unknown")),
-                kNumbersVersion, recorded->document.value("/tool/commit"_json_pointer, std::string("unknown")));
+                file.string(), recorded->numbersVersion, commit, kNumbersVersion, commit);
+  }
   // From nothing: an empty folder with the record's own manifest in it.
   std::error_code ec;
   fs::remove_all(work, ec);
