@@ -42,32 +42,6 @@ std::vector<std::array<double, 8>> readPoses(const fs::path& csv) {
   return rows;
 }
 
-// The U-turn of the fly-through tests (described there): its dataset and the stretch's end time.
-std::pair<fs::path, double> writeUTurn(const fs::path& dir) {
-  test::GltfBuilder b;
-  const int wallPositions = b.accessor({0, -50, -100, 0, 50, -100, 0, 50, 5, 0, -50, 5}, "VEC3");
-  b.doc["meshes"] = nlohmann::json::array({{{"primitives", nlohmann::json::array({{{"attributes", {{"POSITION", wallPositions}}},
-                                                                                   {"indices", b.indices({0, 1, 2, 0, 2, 3})}}})}}});
-  b.node({{"name", "wall"}, {"mesh", 0}});
-  std::vector<float> times, values;
-  auto key = [&](double t, double x, double z) {
-    times.push_back(static_cast<float>(t));
-    values.insert(values.end(), {static_cast<float>(x), 0.0f, static_cast<float>(z)});
-  };
-  double t = 0;
-  for (int z = -60; z <= 10; z += 10, t += 1.0) key(t, -10, z);
-  key(t, 0, 10), t += 1.0;
-  for (int z = 10; z >= -60; z -= 10, t += 1.0) key(t, 10, z);
-  const double stretchEnd = t - 1.0;
-  key(t, 200, 200);
-  key(t + 1.0, 200, 205);
-  const int cam = b.node({{"name", "eye"},
-                          {"camera", b.perspectiveCamera()},
-                          {"extras", {{"dynbench_camera_cuts", {{{"from", stretchEnd}, {"time", t}, {"reason", "respawn"}}}}}}});
-  b.channel(cam, "translation", times, values);
-  return {b.write(dir, "u_turn"), stretchEnd};
-}
-
 // The ORCA ranges come from the thesis's data file, the one copy of its numbers: known answers from
 // its Tables 6.4-6.6 (the smallest and largest of Bistro Interior, Bistro Exterior and Emerald
 // Square), and the fly-through's bounds are those ranges' ends.
@@ -94,7 +68,7 @@ TEST(Demo, FlythroughFollowsTheBotsLongestStretchAroundAWallAndTurnsGently) {
   // units, 16 s), then jumps (a cut) to (200, 0, 200) and walks 5 units. A 64-unit moving average
   // pulls the U's apex to z = 2.4, behind the wall's end; the path must stay out of it.
   const fs::path dir = test::freshDir("demo_fly");
-  const auto [dataset, stretchEnd] = writeUTurn(dir);
+  const auto [dataset, stretchEnd] = test::writeUTurnDataset(dir);
   const double t = stretchEnd + 1.0;
   const auto report = camera::writeFlythroughCsv(dataset, dir / "fly.csv");
   ASSERT_TRUE(report) << report.error().message;
@@ -179,7 +153,7 @@ TEST(Demo, FlythroughFollowsTheBotsLongestStretchAroundAWallAndTurnsGently) {
 
 TEST(Demo, FlythroughCommandWritesTheDatasetAndChecksItAgainstOrca) {
   const fs::path dir = test::freshDir("demo_fly_cli");
-  const auto [dataset, stretchEnd] = writeUTurn(dir);
+  const auto [dataset, stretchEnd] = test::writeUTurnDataset(dir);
   const auto r = dynbench(fmt::format("flythrough {} -o {} --json {}", dataset.string(), (dir / "fly.gltf").string(), (dir / "fly.json").string()), dir);
   ASSERT_EQ(r.status, 0) << r.err << r.out;
   // The new dataset's camera follows the pose log written beside it, and its motion is measured

@@ -139,4 +139,29 @@ std::vector<float> yawQuat(double degrees) {
   return {0.0f, static_cast<float>(std::sin(half)), 0.0f, static_cast<float>(std::cos(half))};
 }
 
+std::pair<std::filesystem::path, double> writeUTurnDataset(const std::filesystem::path& dir) {
+  GltfBuilder b;
+  const int wallPositions = b.accessor({0, -50, -100, 0, 50, -100, 0, 50, 5, 0, -50, 5}, "VEC3");
+  b.doc["meshes"] = nlohmann::json::array({{{"primitives", nlohmann::json::array({{{"attributes", {{"POSITION", wallPositions}}},
+                                                                                   {"indices", b.indices({0, 1, 2, 0, 2, 3})}}})}}});
+  b.node({{"name", "wall"}, {"mesh", 0}});
+  std::vector<float> times, values;
+  auto key = [&](double t, double x, double z) {
+    times.push_back(static_cast<float>(t));
+    values.insert(values.end(), {static_cast<float>(x), 0.0f, static_cast<float>(z)});
+  };
+  double t = 0;
+  for (int z = -60; z <= 10; z += 10, t += 1.0) key(t, -10, z);
+  key(t, 0, 10), t += 1.0;
+  for (int z = 10; z >= -60; z -= 10, t += 1.0) key(t, 10, z);
+  const double stretchEnd = t - 1.0;
+  key(t, 200, 200);
+  key(t + 1.0, 200, 205);
+  const int cam = b.node({{"name", "eye"},
+                          {"camera", b.perspectiveCamera()},
+                          {"extras", {{"dynbench_camera_cuts", {{{"from", stretchEnd}, {"time", t}, {"reason", "respawn"}}}}}}});
+  b.channel(cam, "translation", times, values);
+  return {b.write(dir, "u_turn"), stretchEnd};
+}
+
 }  // namespace dynbench::test

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -34,6 +35,11 @@ struct GltfBuilder {
   // Writes a .glb container.
   std::filesystem::path writeGlb(const std::filesystem::path& dir, const std::string& name);
 };
+
+// The fly-through tests' U-turn (demo_test.cpp describes it): a wall in the plane x = 0 for z in
+// [-100, 5]; a camera walking up x = -10, round the wall's end and down x = 10 (16 s), then a cut.
+// Returns DIR/u_turn.gltf and the time the cut-free stretch ends.
+std::pair<std::filesystem::path, double> writeUTurnDataset(const std::filesystem::path& dir);
 
 // A quaternion (x, y, z, w) for a rotation of `degrees` about world +Y.
 std::vector<float> yawQuat(double degrees);

@@ -85,7 +85,7 @@ TEST(Suite, ManifestErrorsNameTheFileAndPointer) {
   const std::vector<Case> cases{
       {"/dynbench_suite", 2, "/dynbench_suite: expected 1"},
       {"/datasets", nlohmann::json::array(), "/datasets: expected a non-empty array"},
-      {"/datasets/0/camera", "drone", "/datasets/0/camera: expected \"bot\", \"slowed\" or \"flythrough\""},
+      {"/datasets/0/camera", "drone", "/datasets/0/camera: expected \"bot\", \"slowed\", \"flythrough\" or \"vr\""},
       {"/datasets/1/name", "fps-1-bot", "/datasets/1/name: expected a name no other dataset has"},
       {"/datasets/0/preset", "frantic", "/datasets/0/preset"},
       {"/datasets/0/engine", "quake", "/datasets/0/engine: expected \"cube2\" or \"openarena\""},

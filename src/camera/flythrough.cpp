@@ -256,7 +256,7 @@ double totalDistance(const FlythroughReport& r) {
 
 }  // namespace
 
-Expected<FlythroughReport> writeFlythroughCsv(const fs::path& dataset, const fs::path& csv, const FlythroughOptions& o) {
+Expected<FlythroughPoses> flyThroughPoses(const fs::path& dataset, const FlythroughOptions& o) {
   if (!(o.speed > 0) || !(o.lookAhead > 0) || !(o.rate > 0) || !(o.frameRate > 0) || !(o.maxSmoothing >= 0) || !(o.metresPerUnit > 0) ||
       o.candidates < 1)
     return fail(ErrorCode::kUsage, "fly-through: speed, look-ahead, rates and metres per unit must be positive, candidates at least 1");
@@ -304,10 +304,18 @@ Expected<FlythroughReport> writeFlythroughCsv(const fs::path& dataset, const fs:
     return fail(ErrorCode::kInvalidData, "{}: the bot's own path crosses static geometry on each of the {} longest stretches; no fly-through made",
                 dataset.string(), compared);
   best->report.stretchesCompared = compared;
-  std::vector<CameraPoseKey> keys;
-  for (std::size_t n = 0; n < samples; ++n) keys.push_back({flyer.poseTime(n), best->positions[n], orientation(best->yaw[n], best->pitch[n])});
-  if (auto ok = writeCameraRunCsv(csv, keys); !ok) return std::unexpected(ok.error());
-  return best->report;
+  FlythroughPoses flown;
+  flown.report = best->report;
+  for (std::size_t n = 0; n < samples; ++n)
+    flown.keys.push_back({flyer.poseTime(n), best->positions[n], orientation(best->yaw[n], best->pitch[n])});
+  return flown;
+}
+
+Expected<FlythroughReport> writeFlythroughCsv(const fs::path& dataset, const fs::path& csv, const FlythroughOptions& o) {
+  auto flown = flyThroughPoses(dataset, o);
+  if (!flown) return std::unexpected(flown.error());
+  if (auto ok = writeCameraRunCsv(csv, flown->keys); !ok) return std::unexpected(ok.error());
+  return flown->report;
 }
 
 bool FlythroughDataset::insideOrca() const {

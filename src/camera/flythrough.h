@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "camera/merge_camera.h"
 #include "core/error.h"
 #include "core/rates.h"
 #include "metrics/camera_motion.h"
@@ -79,6 +80,12 @@ struct FlythroughReport {
   std::vector<OrcaCheck> checks;       // the chosen flight against ORCA's ranges (from its poses at frameRate)
   bool insideOrca() const;
 };
+// The flight's poses (times from 0, at options.rate poses/s) and its report.
+struct FlythroughPoses {
+  FlythroughReport report;
+  std::vector<CameraPoseKey> keys;
+};
+Expected<FlythroughPoses> flyThroughPoses(const std::filesystem::path& dataset, const FlythroughOptions& options = {});
 // Written as a merge-camera CSV pose log (time,x,y,z,qx,qy,qz,qw) at options.rate poses/s.
 Expected<FlythroughReport> writeFlythroughCsv(const std::filesystem::path& dataset, const std::filesystem::path& csv,
                                               const FlythroughOptions& options = {});

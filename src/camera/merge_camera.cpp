@@ -46,7 +46,9 @@ Expected<std::vector<CameraPoseKey>> readCaptureRun(const fs::path& dir) {
   return keys;
 }
 
-Expected<std::vector<CameraPoseKey>> readCsvRun(const fs::path& file) {
+}  // namespace
+
+Expected<std::vector<CameraPoseKey>> readPoseCsv(const fs::path& file, const PoseCsvRules& rules) {
   std::ifstream in(file);
   if (!in) return fail(ErrorCode::kIo, "{}: cannot open", file.string());
   std::vector<CameraPoseKey> keys;
@@ -79,21 +81,24 @@ Expected<std::vector<CameraPoseKey>> readCsvRun(const fs::path& file) {
       if (!std::isfinite(v)) return fail(ErrorCode::kInvalidData, "{}:{}: values must be finite", file.string(), number);
     const glm::dquat q(values[7], values[4], values[5], values[6]);
     if (glm::length(q) < 1e-6) return fail(ErrorCode::kInvalidData, "{}:{}: the quaternion has zero length", file.string(), number);
+    if (std::abs(glm::length(q) - 1.0) > rules.unitTolerance)
+      return fail(ErrorCode::kInvalidData, "{}:{}: the quaternion (qx,qy,qz,qw) has length {:.6f}; expected a unit quaternion (within {})",
+                  file.string(), number, glm::length(q), rules.unitTolerance);
     if (!keys.empty() && !(values[0] > keys.back().time))
       return fail(ErrorCode::kInvalidData, "{}:{}: time {} is not after {}; times must increase", file.string(), number, values[0],
                   keys.back().time);
     keys.push_back({values[0], {values[1], values[2], values[3]}, glm::normalize(q)});
   }
   if (keys.empty()) return fail(ErrorCode::kInvalidData, "{}: no pose lines", file.string());
+  if (keys.size() < rules.minimumPoses)
+    return fail(ErrorCode::kInvalidData, "{}: {} pose lines; expected at least {}", file.string(), keys.size(), rules.minimumPoses);
   return keys;
 }
-
-}  // namespace
 
 Expected<std::vector<CameraPoseKey>> readCameraRun(const fs::path& run) {
   std::error_code ec;
   if (fs::is_directory(run, ec)) return readCaptureRun(run);
-  return readCsvRun(run);
+  return readPoseCsv(run);
 }
 
 Expected<void> writeCameraRunCsv(const fs::path& csv, const std::vector<CameraPoseKey>& keys) {

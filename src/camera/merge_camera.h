@@ -2,6 +2,7 @@
 // `dynbench merge-camera` (thesis §5.5, the VR workflow): replace a dataset's camera animation
 // with another camera run, keeping everything else byte for byte.
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,6 +24,13 @@ struct CameraPoseKey {
 // with lines `time,x,y,z,qx,qy,qz,qw` (a header line is allowed) such as a head-mounted display
 // records. Errors name file:line.
 Expected<std::vector<CameraPoseKey>> readCameraRun(const std::filesystem::path& run);
+// How strictly a CSV pose log is read: merge-camera normalises any quaternion of non-zero length;
+// a head trace (camera/vr_head.h) refuses one whose length is off 1 by more than unitTolerance.
+struct PoseCsvRules {
+  double unitTolerance = std::numeric_limits<double>::infinity();
+  std::size_t minimumPoses = 1;
+};
+Expected<std::vector<CameraPoseKey>> readPoseCsv(const std::filesystem::path& csv, const PoseCsvRules& rules = {});
 // Writes a CSV pose log readCameraRun reads (header line, one key a line, shortest round-trip
 // decimals), from a temporary file.
 Expected<void> writeCameraRunCsv(const std::filesystem::path& csv, const std::vector<CameraPoseKey>& keys);

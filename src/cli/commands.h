@@ -33,6 +33,7 @@ void addMergeCameraCommand(CLI::App& app, CommandRun& run);
 
 // Registers `flythrough`.
 void addFlythroughCommand(CLI::App& app, CommandRun& run);
+void addVrCameraCommand(CLI::App& app, CommandRun& run);
 
 // Registers `render`.
 void addRenderCommand(CLI::App& app, CommandRun& run);

@@ -61,6 +61,7 @@ int runCommandLine(int argc, char** argv) {
   cli::addConvertCommand(app, run);
   cli::addMergeCameraCommand(app, run);
   cli::addFlythroughCommand(app, run);
+  cli::addVrCameraCommand(app, run);
   cli::addRenderCommand(app, run);
   cli::addDiscardCommand(app, run);
   cli::addReportCommand(app, run);

@@ -497,6 +497,12 @@ std::vector<std::size_t> StaticGeometry::segmentsThrough(const std::vector<glm::
   return crossing;
 }
 
+StaticGeometry::Obstacle StaticGeometry::firstObstacle(const glm::dvec3& origin, const glm::dvec3& direction, double tMax) const {
+  const SurfaceHit hit = tracer_->intersect(Ray{origin, direction}, 0.0, tMax);
+  if (!hit.hit) return {std::numeric_limits<double>::infinity(), glm::dvec3(0.0)};
+  return {hit.distance, hit.geometricNormal};
+}
+
 Expected<std::vector<std::size_t>> segmentsThroughStaticGeometry(const scene::Scene& scene, const std::vector<glm::dvec3>& points) {
   auto geometry = StaticGeometry::create(scene);
   if (!geometry) return std::unexpected(geometry.error());

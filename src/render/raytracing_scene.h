@@ -124,6 +124,14 @@ class StaticGeometry {
  public:
   static Expected<StaticGeometry> create(const scene::Scene& scene);
   std::vector<std::size_t> segmentsThrough(const std::vector<glm::dvec3>& points) const;
+  // The first static surface from `origin` along the unit `direction` within tMax: its distance
+  // (infinity when none) and its unit geometric normal; how far a camera can move that way before
+  // it enters a wall.
+  struct Obstacle {
+    double distance = 0;
+    glm::dvec3 normal{0.0};
+  };
+  Obstacle firstObstacle(const glm::dvec3& origin, const glm::dvec3& direction, double tMax) const;
 
  private:
   explicit StaticGeometry(std::unique_ptr<RayTracingScene> tracer) : tracer_(std::move(tracer)) {}

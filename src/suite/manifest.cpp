@@ -137,9 +137,19 @@ Expected<Manifest> parseManifest(const nlohmann::json& document, const fs::path&
     d.seconds = *seconds;
     auto camera = f.string(at + "/camera");
     if (!camera) return std::unexpected(camera.error());
-    if (*camera != "bot" && *camera != "slowed" && *camera != "flythrough")
-      return bad(at + "/camera", fmt::format("\"bot\", \"slowed\" or \"flythrough\", found \"{}\"", *camera));
+    if (*camera != "bot" && *camera != "slowed" && *camera != "flythrough" && *camera != "vr")
+      return bad(at + "/camera", fmt::format("\"bot\", \"slowed\", \"flythrough\" or \"vr\", found \"{}\"", *camera));
     d.camera = *camera;
+    if (d.camera == "vr") {
+      if (!f.has(at + "/trace")) return bad(at + "/trace", "the head trace of a \"vr\" camera (a CSV, relative to the manifest's folder)");
+      auto trace = f.string(at + "/trace");
+      if (!trace) return std::unexpected(trace.error());
+      if (trace->empty()) return bad(at + "/trace", "a file name, found \"\"");
+      d.trace = *trace;
+      d.tracePath = (path.parent_path() / d.trace).lexically_normal();
+    } else if (f.has(at + "/trace")) {
+      return bad(at + "/trace", "no trace: only a \"vr\" camera has one");
+    }
     if (f.has(at + "/sha256")) {
       auto pins = f.value(at + "/sha256");
       if (!(*pins)->is_object()) return bad(at + "/sha256", "an object with \"capture\" and/or \"dataset\" SHA-256s");
@@ -159,6 +169,8 @@ Expected<Manifest> parseManifest(const nlohmann::json& document, const fs::path&
   }
   return m;
 }
+
+std::string DatasetSpec::cameraLabel() const { return camera == "vr" ? "vr-" + fs::path(trace).stem().string() : camera; }
 
 Expected<std::string> captureDigest(const fs::path& folder) {
   std::vector<std::string> files;

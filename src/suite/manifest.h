@@ -26,7 +26,16 @@ struct DatasetSpec {
   unsigned seed = 1;
   double seconds = 10.0;        // game time captured
   capture::GameCpu gameCpu = capture::GameCpu::kEmulated;  // openarena: the CPU the game runs on (capture/openarena.h)
-  std::string camera = "bot";   // "bot" (the first-person bot), "slowed" (its turns slowed: camera/slowed.h) or "flythrough"
+  // "bot" (the first-person bot), "slowed" (its turns slowed: camera/slowed.h), "flythrough" or
+  // "vr" (a head trace on the fly-through's path: camera/vr_head.h)
+  std::string camera = "bot";
+  // camera "vr": the head trace as the manifest names it (/datasets/N/trace, relative to the
+  // manifest's folder), and that path resolved
+  std::string trace;
+  std::filesystem::path tracePath;
+  // The camera as tables and records name it: the policy, and for "vr" the trace's file name
+  // ("vr-eyenavgs_nthu_london_user7_quickturns"), so that one match's VR datasets stay apart.
+  std::string cameraLabel() const;
   // Pins (/datasets/N/sha256/capture and /dataset): the SHA-256 the capture folder and the dataset
   // must have (captureDigest, scene::datasetDigest); empty: not checked.
   std::string captureSha256, datasetSha256;

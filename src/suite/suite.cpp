@@ -24,6 +24,8 @@
 #include "dynbench/version.h"
 #include "camera/flythrough.h"
 #include "camera/slowed.h"
+#include "camera/vr_head.h"
+#include "capture/reader.h"
 #include "report/plots.h"
 #include "report/stats_output.h"
 #include "scene/load.h"
@@ -102,7 +104,7 @@ Expected<CapturePlan> capturePlan(const DatasetSpec& d, const fs::path& root) {
 Expected<fs::path> datasetPath(const DatasetSpec& d, const fs::path& root) {
   auto plan = capturePlan(d, root);
   if (!plan) return std::unexpected(plan.error());
-  return root / "captures" / plan->key / (d.camera + ".gltf");
+  return root / "captures" / plan->key / (d.cameraLabel() + ".gltf");
 }
 
 // The dataset (bot or fly-through) for one spec, captured, converted and flown as needed.
@@ -129,6 +131,25 @@ Expected<fs::path> prepareDataset(const DatasetSpec& d, const fs::path& root, do
   }
   camera::FlythroughOptions o;
   o.frameRate = fps;  // the rate the suite renders and measures at
+  if (d.camera == "vr") {
+    const fs::path vr = folder / (d.cameraLabel() + ".gltf");
+    if (isNewerThan(vr, bot) && isNewerThan(vr, d.tracePath)) {
+      indented("vr camera: " + vr.string() + " is newer than its sources, reused");
+      return vr;
+    }
+    camera::VrCameraOptions options;
+    options.trace = d.tracePath;
+    options.body = o;  // the fly-through's own path: the VR and fly-through datasets of a match differ by the head alone
+    // The head's offset in the map's units: the capture's own scale (its `k` record).
+    auto reader = capture::CaptureReader::open(plan->openArena ? plan->openArenaOptions.output : plan->options.output);
+    if (!reader) return std::unexpected(reader.error());
+    options.metresPerUnit = (*reader)->settings().metresPerUnit;
+    indented(fmt::format("vr camera: the head trace {} on the fly-through's path -> {}", d.tracePath.string(), vr.string()));
+    auto made = camera::makeVrCameraDataset(bot, vr, folder / (d.cameraLabel() + ".csv"), options);
+    if (!made) return std::unexpected(made.error());
+    indented("  " + camera::describe(made->report));
+    return vr;
+  }
   const fs::path fly = folder / "flythrough.gltf";
   if (auto ok = pipeline::flyThroughUnlessNewer(bot, fly, folder / "flythrough.csv", o, indented); !ok) return std::unexpected(ok.error());
   return fly;
@@ -165,7 +186,7 @@ Expected<Digests> checkPins(const Manifest& manifest, std::size_t index, const f
     return fail(ErrorCode::kInvalidData,
                 "{}: /datasets/{}/sha256/dataset: dataset '{}': the {} stage made {} with SHA-256 {}, not the pinned {} (the capture "
                 "{}; docs/suite.md)",
-                manifestName, index, d.name, d.camera == "bot" ? "convert" : d.camera == "slowed" ? "convert or slowed-turns" : "convert or fly-through", dataset.string(), *made,
+                manifestName, index, d.name, d.camera == "bot" ? "convert" : d.camera == "slowed" ? "convert or slowed-turns" : d.camera == "vr" ? "convert or vr-camera" : "convert or fly-through", dataset.string(), *made,
                 d.datasetSha256, d.captureSha256.empty() ? "is not pinned" : "matches its pin: convert or flythrough made another dataset");
   return Digests{capture, *made};
 }
@@ -418,7 +439,7 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
       result.errors = errorsOf(measured->methods);
       auto plan = capturePlan(spec, root);
       if (!plan) return std::unexpected(plan.error());
-      result.match = plan->key, result.camera = spec.camera;
+      result.match = plan->key, result.camera = spec.cameraLabel();
       if (measured->referenceFloor) result.referenceFloor = measured->referenceFloor->mean, result.floorFrames = static_cast<int>(measured->referenceFloor->count);
       const nlohmann::json entry = {{"name", spec.name},
                                     {"dataset", fs::relative(p.dataset, root).string()},
