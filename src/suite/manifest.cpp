@@ -146,7 +146,7 @@ Expected<Manifest> parseManifest(const nlohmann::json& document, const fs::path&
       if (!trace) return std::unexpected(trace.error());
       if (trace->empty()) return bad(at + "/trace", "a file name, found \"\"");
       d.trace = *trace;
-      d.tracePath = (path.parent_path() / d.trace).lexically_normal();
+      d.tracePath = fs::absolute(path.parent_path() / d.trace).lexically_normal();  // Slurm jobs run elsewhere
     } else if (f.has(at + "/trace")) {
       return bad(at + "/trace", "no trace: only a \"vr\" camera has one");
     }
