@@ -2,6 +2,7 @@
 // whole chain on a short Cube 2 match (skipped, saying why, without the game).
 #include <array>
 #include <cmath>
+#include <map>
 
 #include <gtest/gtest.h>
 
@@ -252,27 +253,50 @@ TEST(Demo, WholeChainOnAShortMatch) {
   const auto discardJson = nlohmann::json::parse(test::slurp(dir / "demo" / "runs" / "colos_bot" / "discard.json"));
   EXPECT_EQ(discardJson["frames"].size(), 11u);
   EXPECT_EQ(discardJson["mean"]["interval"]["direct_radiance"].size(), 2u);
-  // Temporal methods on both datasets: every method scored on every frame of the window, the
-  // first frame a reset, and the Markdown's table with a row per dataset and method.
+  // Temporal methods on both datasets, each on the input it is built for, as the suites score them
+  // (TAA jittered; accumulate and SVGF still; `none` on both): every method scored on every frame
+  // of the window, the first frame a reset, and the Markdown's table with a row per dataset, method
+  // and input, beside the reference's noise floor.
+  const std::map<std::string, std::vector<std::string>> byInput = {{"jittered", {"none", "taa"}}, {"still", {"none", "accumulate", "svgf"}}};
   for (const char* run : {"colos_bot", "colos_flythrough"}) {
-    const auto evaluation = nlohmann::json::parse(test::slurp(dir / "demo" / "runs" / run / "evaluate.json"));
-    ASSERT_EQ(evaluation["methods"].size(), 4u) << run;
-    for (const auto& method : evaluation["methods"]) {
-      EXPECT_EQ(method["frames"].size(), 12u) << run;
-      EXPECT_EQ(method["frames"][0]["history_use"].get<double>(), 0.0) << run;
-      EXPECT_GT(method["mean"]["flip"]["mean"].get<double>(), 0.0) << run;
-      // A line of the Markdown with the dataset in its first column and the method in its second
-      // (cells padded to the column's width).
-      bool found = false;
-      for (std::size_t at = md.find(fmt::format("| {} ", run)); at != std::string::npos && !found; at = md.find(fmt::format("| {} ", run), at + 1)) {
-        const std::size_t second = md.find('|', at + 1), third = md.find('|', second + 1);
-        std::string cell = md.substr(second + 1, third - second - 1);
-        cell.erase(0, cell.find_first_not_of(' '));
-        cell.erase(cell.find_last_not_of(' ') + 1);
-        found = cell == method["name"].get<std::string>();
+    for (const auto& [input, methods] : byInput) {
+      const auto evaluation =
+          nlohmann::json::parse(test::slurp(dir / "demo" / "runs" / run / (input == "still" ? "evaluate-still.json" : "evaluate.json")));
+      ASSERT_EQ(evaluation["methods"].size(), methods.size()) << run << " " << input;
+      for (std::size_t k = 0; k < methods.size(); ++k) {
+        const auto& method = evaluation["methods"][k];
+        EXPECT_EQ(method["name"], methods[k]) << run << " " << input;
+        EXPECT_EQ(method["frames"].size(), 12u) << run;
+        EXPECT_EQ(method["frames"][0]["history_use"].get<double>(), 0.0) << run;
+        EXPECT_GT(method["mean"]["flip"]["mean"].get<double>(), 0.0) << run;
+        // A line of the Markdown with the dataset, the method and its input in its first three
+        // columns (cells padded to the column's width).
+        bool found = false;
+        for (std::size_t at = md.find(fmt::format("| {} ", run)); at != std::string::npos && !found; at = md.find(fmt::format("| {} ", run), at + 1)) {
+          std::vector<std::string> cells;
+          for (std::size_t from = at; cells.size() < 3;) {
+            const std::size_t next = md.find('|', from + 1);
+            std::string cell = md.substr(from + 1, next - from - 1);
+            cell.erase(0, cell.find_first_not_of(' '));
+            cell.erase(cell.find_last_not_of(' ') + 1);
+            cells.push_back(cell);
+            from = next;
+          }
+          found = cells[1] == methods[k] && cells[2] == input;
+        }
+        EXPECT_TRUE(found) << run << " " << methods[k] << " " << input;
       }
-      EXPECT_TRUE(found) << run << " " << method["name"];
     }
+    // The noise floor: four frames of the window rendered with another seed, written beside the
+    // scores, and a row of the table.
+    const auto floor = nlohmann::json::parse(test::slurp(dir / "demo" / "runs" / run / "floor.json"));
+    EXPECT_EQ(floor["frames"], 4);
+    EXPECT_GT(floor["flip"]["mean"].get<double>(), 0.0);
+  }
+  {
+    std::size_t rows = 0;
+    for (std::size_t at = md.find("| reference noise floor "); at != std::string::npos; at = md.find("| reference noise floor ", at + 1)) ++rows;
+    EXPECT_EQ(rows, 2u) << md;
   }
 
   // Convergence (the acceptance, at a size the suite affords): the seeded segment (colos,

@@ -9,6 +9,7 @@
 
 #include "core/files.h"
 #include "core/image_io.h"
+#include "report/tables.h"
 #include "gltf_builder.h"
 #include "external_tools.h"
 #include "run_cli.h"
@@ -249,3 +250,49 @@ TEST(Report, BadRunsFailClearly) {
 
 }  // namespace
 }  // namespace dynbench
+
+namespace dynbench::report {
+namespace {
+
+// The temporal methods' table as the demo and the suites read it: each method with its input and
+// its ratio to `none` on that input; ≈ where the difference with `none` is within the reference's
+// noise floor (strictly less), and a row for the floor; losesToNone only beyond the floor.
+TEST(Report, MethodsTableMarksWhatTheNoiseFloorCannotRank) {
+  auto scores = [](const std::string& name, double flip) {
+    evaluate::MethodScores s;
+    s.name = name;
+    s.flip = {flip, 0.001, 12};
+    return s;
+  };
+  const evaluate::MeanWithError floor{0.02, 0.002, 4};
+  const std::vector<MethodsRow> rows = {{"bot", "jittered", scores("none", 0.10), 0.10, floor},
+                                        {"bot", "jittered", scores("taa", 0.09), 0.10, floor},      // 0.01 better: within
+                                        {"bot", "still", scores("accumulate", 0.05), 0.08, floor},  // 0.03 better: ranked
+                                        {"bot", "still", scores("svgf", 0.11), 0.08, floor},        // 0.03 worse: loses
+                                        {"fly", "still", scores("svgf", 0.099), 0.08, floor}};      // 0.019 worse: within
+  const Table t = temporalMethodsTable(rows);
+  ASSERT_EQ(t.rows.size(), 7u);  // a floor row before each dataset's methods
+  EXPECT_EQ(t.rows[0][1], "reference noise floor");
+  EXPECT_EQ(t.rows[0][3], "0.0200 ± 0.0020");
+  EXPECT_EQ(t.rows[1][3], "0.1000 ± 0.0010");  // none: never marked
+  EXPECT_EQ(t.rows[2][3], "≈ 0.0900 ± 0.0010");
+  EXPECT_EQ(t.rows[2][4], "0.900");
+  EXPECT_EQ(t.rows[3][2], "still");
+  EXPECT_EQ(t.rows[3][3], "0.0500 ± 0.0010");
+  EXPECT_EQ(t.rows[3][4], "0.625");
+  EXPECT_EQ(t.rows[5][1], "reference noise floor");
+  EXPECT_EQ(t.rows[6][3], "≈ 0.0990 ± 0.0010");
+  EXPECT_FALSE(rows[0].losesToNone());
+  EXPECT_FALSE(rows[1].losesToNone());
+  EXPECT_FALSE(rows[2].losesToNone());
+  EXPECT_TRUE(rows[3].losesToNone());
+  EXPECT_FALSE(rows[4].losesToNone());
+  // Without a floor nothing is marked, and any loss counts.
+  MethodsRow bare = rows[4];
+  bare.floor.reset();
+  EXPECT_TRUE(bare.losesToNone());
+  EXPECT_EQ(temporalMethodsTable({bare}).rows.front()[3], "0.0990 ± 0.0010");
+}
+
+}  // namespace
+}  // namespace dynbench::report

@@ -292,9 +292,10 @@ TEST_F(Slurm, DemoAsAChainOfJobsGivesTheLocalDemosTables) {
   DYNBENCH_NEEDS(test::missingFfmpeg());
   const auto dir = test::freshDir("slurm_demo");
   const std::string options = "--seconds 3 --bots 4 --res 32x18 --spp 1 --max-spp 32 --render-frames 12 --bounces 1";
-  auto r = dynbench(fmt::format("demo -o {} {} --slurm --frames-per-task 12", (dir / "cluster").string(), options), dir);
+  auto r = dynbench(fmt::format("demo -o {} {} --slurm --frames-per-task 20", (dir / "cluster").string(), options), dir);
   ASSERT_EQ(r.status, 0) << r.err << r.out;
-  // Three jobs chained: the datasets, an array of 4 render tasks (48 frame renders, 12 a task),
+  // Three jobs chained: the datasets, an array of 4 render tasks (80 frame renders, 20 a task: per
+  // dataset 12 reference frames, 12 of each input, jittered and still, and 4 of the noise floor),
   // the report; Slurm's record of the render job names its dependency on the datasets job.
   std::smatch m;
   ASSERT_TRUE(std::regex_search(r.out, m, std::regex("Slurm jobs: datasets (\\d+) .*render (\\d+) \\(4 tasks.*report (\\d+) "))) << r.out;

@@ -328,6 +328,31 @@ json evaluateJson(const EvaluateRun& run) {
   return j;
 }
 
+Expected<void> writeNoiseFloorJson(const fs::path& path, const MeanWithError& floor, unsigned referenceSeed, unsigned otherSeed) {
+  const json j = {{"format", "dynbench-noise-floor"},
+                  {"flip", {{"mean", floor.mean}, {"stderr", floor.standardError}}},
+                  {"frames", floor.count},
+                  {"seeds", {referenceSeed, otherSeed}}};
+  return writeFileAtomic(path, jsonFileText(j));
+}
+
+Expected<MeanWithError> readNoiseFloorJson(const fs::path& path) {
+  auto j = readJsonFile(path);
+  if (!j) return std::unexpected(j.error());
+  const JsonFields f(*j, path);
+  if (!j->is_object() || j->value("format", "") != "dynbench-noise-floor")
+    return fail(ErrorCode::kInvalidData, "{}: /format: expected \"dynbench-noise-floor\" (a suite's or the demo's RUN/floor.json)", path.string());
+  MeanWithError floor;
+  auto mean = f.number("/flip/mean");
+  if (!mean) return std::unexpected(mean.error());
+  auto error = f.number("/flip/stderr");
+  if (!error) return std::unexpected(error.error());
+  auto frames = f.count("/frames");
+  if (!frames) return std::unexpected(frames.error());
+  floor.mean = *mean, floor.standardError = *error, floor.count = static_cast<long>(*frames);
+  return floor;
+}
+
 Expected<EvaluateRun> readEvaluateJson(const fs::path& path) {
   auto text = readWholeFile(path);
   if (!text) return std::unexpected(text.error());

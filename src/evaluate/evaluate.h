@@ -1,6 +1,7 @@
 #pragma once
 // `dynbench evaluate`: temporal methods run over a low-sample frames folder in order, each output
 // scored against the converged render of the same frames (docs/metrics.md, "Temporal methods").
+#include <cmath>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -83,6 +84,15 @@ Expected<EvaluateRun> runEvaluate(const EvaluateOptions& options, const Evaluate
 // noise is as large (docs/suite.md, "The reference's noise floor").
 Expected<MeanWithError> referenceNoiseFloor(const std::filesystem::path& reference, const std::filesystem::path& other,
                                             double pixelsPerDegree = flip::defaultPixelsPerDegree());
+
+// Whether a method's ꟻLIP difference with `none` on its own input is within the reference's noise
+// floor (strictly less): the reference cannot tell the two apart there (docs/suite.md). The one
+// rule the suites' ≈ and the report's share.
+inline bool withinNoiseFloor(double flipOverNone, double floor) { return std::abs(flipOverNone) < floor; }
+// RUN/floor.json: {"format": "dynbench-noise-floor", "flip": {"mean", "stderr"}, "frames", "seeds":
+// [reference, other]}, written atomically; read back with the file and pointer named in errors.
+Expected<void> writeNoiseFloorJson(const std::filesystem::path& path, const MeanWithError& floor, unsigned referenceSeed, unsigned otherSeed);
+Expected<MeanWithError> readNoiseFloorJson(const std::filesystem::path& path);
 
 // Method x metric table (means with standard errors).
 std::string evaluateMarkdown(const EvaluateRun& run);

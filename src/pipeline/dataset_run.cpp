@@ -110,9 +110,14 @@ Expected<void> flyThroughUnlessNewer(const fs::path& bot, const fs::path& fly, c
   return {};
 }
 
+std::string methodInput(const DatasetRunSettings& settings, const std::string& method) {
+  const auto named = settings.methodInputs.find(method);
+  return named != settings.methodInputs.end() ? named->second : std::string(evaluate::builtForInput(method));
+}
+
 bool needsStillInput(const DatasetRunSettings& settings) {
-  return std::any_of(settings.methodInputs.begin(), settings.methodInputs.end(),
-                     [](const auto& m) { return m.second == evaluate::kStillInput; });
+  return std::any_of(settings.methods.begin(), settings.methods.end(),
+                     [&](const std::string& m) { return methodInput(settings, m) == evaluate::kStillInput; });
 }
 
 Expected<MethodsOnTheirInputs> evaluateOnTheirInputs(const fs::path& run, const DatasetRunSettings& o,
@@ -128,8 +133,7 @@ Expected<MethodsOnTheirInputs> evaluateOnTheirInputs(const fs::path& run, const 
     evaluation.methods.clear();
     if (still) evaluation.methods.push_back("none");
     for (const std::string& m : o.methods) {
-      const auto input = o.methodInputs.find(m);
-      const bool wantsStill = input != o.methodInputs.end() && input->second == evaluate::kStillInput;
+      const bool wantsStill = methodInput(o, m) == evaluate::kStillInput;
       if (wantsStill == still && !(still && m == "none")) evaluation.methods.push_back(m);
     }
     if (still && evaluation.methods.size() == 1 && extraStill.empty()) break;  // no method asked for it
@@ -269,6 +273,8 @@ Expected<DatasetRunOutcome> measureDataset(const fs::path& dataset, const fs::pa
     auto noise = evaluate::referenceNoiseFloor(render.job.output, floor->job.output);
     if (!noise) return std::unexpected(noise.error());
     outcome.referenceFloor = *noise;
+    // Beside the scores, for `report` (evaluate::readNoiseFloorJson).
+    if (auto ok = evaluate::writeNoiseFloorJson(run / "floor.json", *noise, o.seed, o.seed + 2); !ok) return std::unexpected(ok.error());
     log(fmt::format("  the reference's noise floor (seed {} against {}, {} frames): ꟻLIP {:.4f}", o.seed + 2, o.seed, noise->count, noise->mean));
   }
   return outcome;

@@ -24,6 +24,10 @@
 
 namespace dynbench::pipeline {
 
+// Frames of a dataset's window rendered again with another seed for the reference's noise floor:
+// the demo's and a suite manifest's default (/render/floor_frames).
+inline constexpr int kDefaultFloorFrames = 4;
+
 struct DatasetRunSettings {
   double fps = kDefaultFrameRate;  // stats, render and discard sample the dataset at this rate
   // Converged feature buffers (render --converge) of a window of renderFrames consecutive frames
@@ -45,16 +49,16 @@ struct DatasetRunSettings {
   // the converged frames.
   int inputSamplesPerPixel = 4;
   std::vector<std::string> methods = evaluate::builtInMethodNames();
-  // The input each method gets (evaluate::kJitteredInput or kStillInput); a method not named here
-  // gets the jittered one. With any "still", the window is also rendered unjittered (RUN/input-still)
-  // and `none` is scored on both inputs, so each method's ratio to `none` is on its own input. Empty
-  // (the demo's): every method on the jittered input. A suite manifest's default: each method's
-  // own (evaluate::builtForInput).
+  // The input each method gets (evaluate::kJitteredInput or kStillInput) where it is not its own:
+  // a method not named here gets the input it is built for (evaluate::builtForInput; methodInput
+  // below), in the demo as in every suite. With any "still", the window is also rendered
+  // unjittered (RUN/input-still) and `none` is scored on both inputs, so each method's ratio to
+  // `none` is on its own input.
   std::map<std::string, std::string> methodInputs;
   // The reference's noise floor (evaluate::referenceNoiseFloor): this many frames of the window,
-  // evenly spaced, rendered again as the reference is but with seed + 2 (0: none; the demo's
-  // default, a suite manifest's is kDefaultFloorFrames).
-  int floorFrames = 0;
+  // evenly spaced, rendered again as the reference is but with seed + 2 (0: none), and written to
+  // RUN/floor.json.
+  int floorFrames = kDefaultFloorFrames;
   unsigned seed = 1;  // the reference's; the input's is seed + 1, the floor's seed + 2
   int threads = 0;    // render threads (0: all cores)
 };
@@ -99,6 +103,8 @@ DatasetRenders datasetRenders(const std::filesystem::path& dataset, const std::f
 
 // The most frame renders one dataset needs (a window shorter than the dataset's animation needs
 // fewer): the reference and input windows and the floor's frames. What --slurm divides among tasks.
+// The input `method` gets: settings.methodInputs' entry, or the one it is built for.
+std::string methodInput(const DatasetRunSettings& settings, const std::string& method);
 bool needsStillInput(const DatasetRunSettings& settings);
 inline int datasetFrameRenders(const DatasetRunSettings& s) {
   const int window = std::max(2, s.renderFrames);

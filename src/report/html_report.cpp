@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "core/files.h"
 #include "core/image_io.h"
@@ -36,7 +37,32 @@ struct Run {
   std::vector<fs::path> masks;
   std::vector<frames::FrameEntry> frames;
   std::optional<evaluate::EvaluateRun> evaluation;  // RUN/evaluate.json, when the run has one
+  std::optional<evaluate::EvaluateRun> stillEvaluation;  // RUN/evaluate-still.json: the methods built for the unjittered input
+  std::optional<evaluate::MeanWithError> floor;          // RUN/floor.json: the reference's noise floor
+
+  // Each scored method with its input and the folder of its outputs.
+  struct Scored {
+    const evaluate::MethodScores* scores;
+    const char* input;
+    const char* folder;
+    const evaluate::EvaluateRun* run;
+  };
+  std::vector<Scored> scored() const {
+    std::vector<Scored> out;
+    if (evaluation)
+      for (const auto& m : evaluation->methods) out.push_back({&m, stillEvaluation ? "jittered" : "", "evaluate", &*evaluation});
+    if (stillEvaluation)
+      for (const auto& m : stillEvaluation->methods) out.push_back({&m, "still", "evaluate-still", &*stillEvaluation});
+    return out;
+  }
 };
+
+// `none`'s mean ꟻLIP in one evaluation (nullopt without it).
+std::optional<double> noneFlip(const evaluate::EvaluateRun& run) {
+  for (const auto& m : run.methods)
+    if (m.name == "none" && m.flip.count) return m.flip.mean;
+  return std::nullopt;
+}
 
 Expected<Run> readRun(const fs::path& dir) {
   Run run;
@@ -70,14 +96,42 @@ Expected<Run> readRun(const fs::path& dir) {
       if (e.path().extension() == ".png") run.masks.push_back(e.path());
     std::sort(run.masks.begin(), run.masks.end());
   }
-  if (fs::is_regular_file(dir / "evaluate.json", ec)) {
-    auto evaluated = evaluate::readEvaluateJson(dir / "evaluate.json");
-    if (!evaluated) return std::unexpected(evaluated.error());
-    run.evaluation = std::move(*evaluated);
+  for (const auto& [file, target] : {std::pair{"evaluate.json", &run.evaluation}, std::pair{"evaluate-still.json", &run.stillEvaluation}})
+    if (fs::is_regular_file(dir / file, ec)) {
+      auto evaluated = evaluate::readEvaluateJson(dir / file);
+      if (!evaluated) return std::unexpected(evaluated.error());
+      *target = std::move(*evaluated);
+    }
+  if (fs::is_regular_file(dir / "floor.json", ec)) {
+    auto floor = evaluate::readNoiseFloorJson(dir / "floor.json");
+    if (!floor) return std::unexpected(floor.error());
+    run.floor = *floor;
   }
   if (fs::is_directory(dir / "frames", ec))
     if (auto listed = frames::listFrames(dir / "frames")) run.frames = *listed;
   return run;
+}
+
+std::vector<MethodsRow> methodRows(const std::vector<Run>& runs) {
+  std::vector<MethodsRow> rows;
+  for (const auto& r : runs)
+    for (const auto& m : r.scored()) rows.push_back({r.name, m.input, *m.scores, noneFlip(*m.run), r.floor});
+  return rows;
+}
+
+// A sentence for each dataset where a history method ends worse than `none` on its own input by
+// more than the reference's noise floor: what the suite found about why (docs/suite.md).
+std::string losesToNoneNote(const std::vector<Run>& runs) {
+  std::vector<std::string> cases;
+  for (const MethodsRow& row : methodRows(runs))
+    if (row.losesToNone()) cases.push_back(fmt::format("{} on {} ({:.3f} times none's ꟻLIP)", row.scores.name, row.dataset, row.scores.flip.mean / *row.noneFlip));
+  if (cases.empty()) return {};
+  return fmt::format("Worse than `none` on its own input, by more than the reference's noise floor: {}. A method with a history pays for it "
+                     "even with no noise to remove: each frame's history is a resample of the last, and sub-pixel motion blurs texture "
+                     "detail through it (accumulate and SVGF through bilinear taps; TAA's Catmull-Rom taps and neighbourhood clip pay "
+                     "less). Where that cost exceeds the 4-path input's noise, the method loses to `none`; the suites measured it on "
+                     "colos (docs/suite.md, \"Why accumulate and SVGF still lose to none on colos in v2\").",
+                     fmt::join(cases, "; "));
 }
 
 std::vector<Table> tables(const std::vector<Run>& runs) {
@@ -90,11 +144,8 @@ std::vector<Table> tables(const std::vector<Run>& runs) {
   }
   auto all = statsTables(statsRows);
   all.push_back(discardTable(discardRows));
-  std::vector<MethodsRow> methodRows;
-  for (const auto& r : runs)
-    if (r.evaluation)
-      for (const auto& m : r.evaluation->methods) methodRows.push_back({r.name, m});
-  if (!methodRows.empty()) all.push_back(temporalMethodsTable(methodRows));
+  const auto rows = methodRows(runs);
+  if (!rows.empty()) all.push_back(temporalMethodsTable(rows));
   return all;
 }
 
@@ -266,12 +317,11 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
   {
     std::vector<std::pair<std::string, std::vector<double>>> series;
     for (const Run& r : runs)
-      if (r.evaluation)
-        for (const auto& m : r.evaluation->methods) {
-          std::vector<double> values;
-          for (const auto& f : m.frames) values.push_back(f.flip);
-          series.emplace_back(r.name + " " + m.name, std::move(values));
-        }
+      for (const auto& m : r.scored()) {
+        std::vector<double> values;
+        for (const auto& f : m.scores->frames) values.push_back(f.flip);
+        series.emplace_back(fmt::format("{} {}{}", r.name, m.scores->name, std::string(m.input) == "still" ? " (still)" : ""), std::move(values));
+      }
     if (!series.empty()) {
       auto written = writeMethodsPlot(series, files.assets, "all");
       if (!written) return std::unexpected(written.error());
@@ -341,16 +391,17 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
       list.push_back({fmt::format("Discard mask {} ({})", mask.stem().string(), kMaskLegend), copy,
                       false, std::nullopt, true});
     }
-    if (r.evaluation)
-      for (const auto& m : r.evaluation->methods) {
-        const fs::path heat = r.dir / "evaluate" / evaluate::methodFolder(m.name) / "flip_worst.png";
-        if (!fs::is_regular_file(heat, ec)) continue;
-        const fs::path copy = files.assets / fmt::format("{}_{}_flip_worst.png", stem, evaluate::methodFolder(m.name));
-        fs::copy_file(heat, copy, fs::copy_options::overwrite_existing, ec);
-        if (ec) return fail(ErrorCode::kIo, "{}: cannot copy: {}", heat.string(), ec.message());
-        list.push_back(
-            {fmt::format("{}: ꟻLIP error of its worst frame, {} (magma: black 0, yellow 1)", m.name, m.worstFrame), copy, false, std::nullopt, true});
-      }
+    for (const auto& scored : r.scored()) {
+      const evaluate::MethodScores& m = *scored.scores;
+      const fs::path heat = r.dir / scored.folder / evaluate::methodFolder(m.name) / "flip_worst.png";
+      if (!fs::is_regular_file(heat, ec)) continue;
+      const fs::path copy = files.assets / fmt::format("{}_{}_{}_flip_worst.png", stem, scored.folder, evaluate::methodFolder(m.name));
+      fs::copy_file(heat, copy, fs::copy_options::overwrite_existing, ec);
+      if (ec) return fail(ErrorCode::kIo, "{}: cannot copy: {}", heat.string(), ec.message());
+      list.push_back({fmt::format("{}{}: ꟻLIP error of its worst frame, {} (magma: black 0, yellow 1)", m.name,
+                                  *scored.input ? fmt::format(" ({} input)", scored.input) : "", m.worstFrame),
+                      copy, false, std::nullopt, true});
+    }
     if (!sampling.empty())
       sampling = fmt::format("Video and thumbnails: {}/frames, {}; one exposure for all of them.", r.dir.filename().string(), sampling);
     figures.push_back({r.name, sampling, std::move(list)});
@@ -368,7 +419,9 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
   // Markdown twin.
   std::string md = fmt::format("# {}\n\n", options.title);
   if (!referenceNote.empty()) md += referenceNote + "\n\n";
+  const std::string losesNote = losesToNoneNote(runs);
   for (const auto& t : allTables) md += markdownTable(t);
+  if (!losesNote.empty()) md += losesNote + "\n\n";
   for (const auto& f : comparison) md += figureMarkdown(f, files.assets);
   for (const auto& [name, sampling, list] : figures) {
     md += fmt::format("## {}\n\n", name);
@@ -400,6 +453,7 @@ figure:has(img.pixels) figcaption {{ max-width: 400px; }}
                                  escapeHtml(options.title));
   if (!referenceNote.empty()) html += "<p class=\"reference\">" + escapeHtml(referenceNote) + "</p>\n";
   for (const auto& t : allTables) html += htmlTable(t);
+  if (!losesNote.empty()) html += "<p class=\"reference\">" + escapeHtml(losesNote) + "</p>\n";
   for (const auto& f : comparison) {
     auto figure = figureHtml(f);
     if (!figure) return std::unexpected(figure.error());

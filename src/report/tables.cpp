@@ -124,17 +124,33 @@ Table discardTable(const std::vector<DiscardRow>& rows, const std::string& detai
   return t;
 }
 
+bool MethodsRow::losesToNone() const {
+  if (scores.name == "none" || !noneFlip || scores.flip.count == 0) return false;
+  const double over = scores.flip.mean - *noneFlip;
+  return over > 0 && !(floor && evaluate::withinNoiseFloor(over, floor->mean));
+}
+
 Table temporalMethodsTable(const std::vector<MethodsRow>& rows) {
   Table t;
-  t.title = "Temporal methods against the converged reference (mean ± standard error over frames; docs/metrics.md)";
-  t.header = {"dataset", "method", "ꟻLIP ↓", "PSNR (dB) ↑", "SSIM ↑", "tPSNR (dB) ↑", "warped error change ↓", "history use"};
+  t.title = "Temporal methods against the converged reference (mean ± standard error over frames; each method on the input it is built "
+            "for, its ratio to `none` on the same input; ≈: the difference with `none` is within the reference's noise floor, so this "
+            "dataset does not rank them; docs/metrics.md, docs/suite.md)";
+  t.header = {"dataset", "method", "input", "ꟻLIP ↓", "ꟻLIP / none", "PSNR (dB) ↑", "SSIM ↑", "tPSNR (dB) ↑", "warped error change ↓", "history use"};
   auto cell = [](const evaluate::MeanWithError& m, int digits) {
     return m.count ? fmt::format("{:.{}f} ± {:.{}f}", m.mean, digits, m.standardError, digits) : std::string("n/a");
   };
+  std::string floorShown;  // the dataset whose floor row is written
   for (const auto& r : rows) {
+    if (r.floor && r.dataset != floorShown) {
+      t.rows.push_back({r.dataset, "reference noise floor", fmt::format("{} frames, two seeds", r.floor->count), cell(*r.floor, 4), "", "", "",
+                        "", "", ""});
+      floorShown = r.dataset;
+    }
     const auto& s = r.scores;
-    t.rows.push_back({r.dataset, s.name, cell(s.flip, 4), cell(s.psnr, 2), cell(s.ssim, 4), cell(s.tPsnr, 2), cell(s.warpedErrorChange, 4),
-                      cell(s.historyUse, 3)});
+    const bool within = s.name != "none" && r.noneFlip && r.floor && s.flip.count && evaluate::withinNoiseFloor(s.flip.mean - *r.noneFlip, r.floor->mean);
+    const std::string ratio = r.noneFlip && *r.noneFlip > 0 && s.flip.count ? fmt::format("{:.3f}", s.flip.mean / *r.noneFlip) : "";
+    t.rows.push_back({r.dataset, s.name, r.input.empty() ? "—" : r.input, (within ? "≈ " : "") + cell(s.flip, 4), ratio, cell(s.psnr, 2),
+                      cell(s.ssim, 4), cell(s.tPsnr, 2), cell(s.warpedErrorChange, 4), cell(s.historyUse, 3)});
   }
   return t;
 }

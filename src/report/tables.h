@@ -2,6 +2,7 @@
 // The thesis's Tables 6.1-6.7, each defined once: title, columns and how a cell is formatted from
 // the measured structs. `stats` and `discard` print them as Markdown, `report` as HTML and
 // Markdown; nothing else writes these tables.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,10 +30,17 @@ struct DiscardRow {
 Table discardTable(const std::vector<DiscardRow>& rows, const std::string& detail = {});
 
 // "Temporal methods": one row per dataset and method, the means over frames with their standard
-// errors (evaluate --json).
+// errors (evaluate --json), each method on its input with its ratio to `none` on the same input,
+// ≈ where that difference is within the reference's noise floor (evaluate::withinNoiseFloor), and
+// per dataset a row for the floor itself when it was measured.
 struct MethodsRow {
   std::string dataset;
+  std::string input;                   // "jittered" or "still" (empty: not said)
   evaluate::MethodScores scores;
+  std::optional<double> noneFlip;      // `none`'s mean ꟻLIP on the same input
+  std::optional<evaluate::MeanWithError> floor;  // the dataset's reference noise floor (ꟻLIP)
+  // The ratio to `none` is above 1 and the difference is not within the floor.
+  bool losesToNone() const;
 };
 Table temporalMethodsTable(const std::vector<MethodsRow>& rows);
 

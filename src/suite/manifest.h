@@ -15,7 +15,7 @@ namespace dynbench::suite {
 inline constexpr int kManifestVersion = 1;  // "dynbench_suite" in a manifest
 // Frames of each dataset's window rendered again with another seed for the reference's noise floor
 // (/render/floor_frames; DatasetRunSettings::floorFrames).
-inline constexpr int kDefaultFloorFrames = 4;
+using pipeline::kDefaultFloorFrames;
 
 struct DatasetSpec {
   std::string name;             // unique in the suite: the RUN folder's name

@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "evaluate/evaluate.h"
+
 namespace dynbench::suite {
 
 const std::vector<std::string>& measureKeys() {
@@ -48,7 +50,7 @@ bool withinNoiseFloor(const DatasetResult& d, const std::string& method) {
   // flip_over_none is against `none` on the method's own input.
   const auto m = d.errors.find(method);
   if (m == d.errors.end() || !m->second.count("flip_over_none")) return false;
-  return std::abs(m->second.at("flip_over_none")) < *d.referenceFloor;
+  return evaluate::withinNoiseFloor(m->second.at("flip_over_none"), *d.referenceFloor);
 }
 
 std::string rankingError(const std::string& method) { return method == "none" || method == kStillNone ? "flip" : "flip_ratio_to_none"; }
