@@ -327,14 +327,7 @@ Expected<FlythroughDataset> makeFlythroughDataset(const fs::path& dataset, const
   auto flight = writeFlythroughCsv(dataset, csv, o);
   if (!flight) return std::unexpected(flight.error());
   made.flight = *flight;
-  MergeCameraOptions merge;
-  merge.dataset = dataset;
-  merge.run = csv;
-  merge.output = output;
-  if (auto merged = mergeCamera(merge); !merged) return std::unexpected(merged.error());
-  auto scene = scene::loadScene(output);
-  if (!scene) return std::unexpected(scene.error());
-  auto motion = metrics::measureCameraMotion(*scene, o.frameRate, std::nullopt);
+  auto motion = mergeAndMeasure(dataset, csv, output, o.frameRate);
   if (!motion) return std::unexpected(motion.error());
   made.checks = orcaChecks(*motion, o.metresPerUnit);
   return made;

@@ -220,4 +220,15 @@ Expected<MergeCameraReport> mergeCamera(const MergeCameraOptions& options) {
   return MergeCameraReport{*node, times.size(), times.front(), times.back()};
 }
 
+Expected<metrics::CameraMotion> mergeAndMeasure(const fs::path& dataset, const fs::path& csv, const fs::path& output, double fps) {
+  MergeCameraOptions merge;
+  merge.dataset = dataset;
+  merge.run = csv;
+  merge.output = output;
+  if (auto merged = mergeCamera(merge); !merged) return std::unexpected(merged.error());
+  auto scene = scene::loadScene(output);
+  if (!scene) return std::unexpected(scene.error());
+  return metrics::measureCameraMotion(*scene, fps, std::nullopt);
+}
+
 }  // namespace dynbench::camera

@@ -11,6 +11,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "core/error.h"
+#include "metrics/camera_motion.h"
 
 namespace dynbench::camera {
 
@@ -53,5 +54,11 @@ struct MergeCameraReport {
 };
 
 Expected<MergeCameraReport> mergeCamera(const MergeCameraOptions& options);
+
+// A pose log the camera tools wrote (`csv`) merged into a copy of `dataset` (`output`, keepCuts as
+// merge-camera's), then the new dataset's camera measured as `stats` measures it at `fps`: how the
+// fly-through and the VR camera make their datasets.
+Expected<metrics::CameraMotion> mergeAndMeasure(const std::filesystem::path& dataset, const std::filesystem::path& csv,
+                                                const std::filesystem::path& output, double fps);
 
 }  // namespace dynbench::camera

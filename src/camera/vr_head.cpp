@@ -172,14 +172,7 @@ Expected<VrCameraDataset> makeVrCameraDataset(const fs::path& dataset, const fs:
   auto report = writeVrCameraCsv(dataset, csv, o);
   if (!report) return std::unexpected(report.error());
   made.report = *report;
-  MergeCameraOptions merge;
-  merge.dataset = dataset;
-  merge.run = csv;
-  merge.output = output;
-  if (auto merged = mergeCamera(merge); !merged) return std::unexpected(merged.error());
-  auto scene = scene::loadScene(output);
-  if (!scene) return std::unexpected(scene.error());
-  auto motion = metrics::measureCameraMotion(*scene, o.body.frameRate, std::nullopt);
+  auto motion = mergeAndMeasure(dataset, csv, output, o.body.frameRate);
   if (!motion) return std::unexpected(motion.error());
   made.motion = *motion;
   return made;
