@@ -220,7 +220,6 @@ class PairLights {
   // lights. maxLights 0: every light in reach, shared or not.
   void select(int half, const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights,
               std::vector<LightTree::Selected>& selected) const;
-  std::size_t sharedCount() const { return shared_.size(); }
 
  private:
   std::array<const LightSet*, 2> halves_{nullptr, nullptr};
