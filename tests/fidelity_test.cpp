@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pipeline/fidelity.h"
+#include "pipeline/fidelity_run.h"
 
 namespace dynbench::evaluate {
 namespace {

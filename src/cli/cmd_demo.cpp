@@ -52,7 +52,7 @@ Expected<void> demoOnSlurm(const demo::DemoOptions& o, cluster::Options slurm) {
   return {};
 }
 
-Expected<void> runDemo(const DemoCli& cli) {
+Expected<void> runDemoCommand(const DemoCli& cli) {
   demo::DemoOptions o = cli.options;
   if (!cli.jobFile.empty()) {
     if (auto ok = nothingBesideJob(cli.jobFile, cli.givenWithJob, "--part, --render-task, --frames-per-task, --threads"); !ok) return ok;
@@ -131,7 +131,7 @@ void addDemoCommand(CLI::App& app, CommandRun& run) {
   cmd->callback([o, cmd, &run] {
     o->threadsGiven = cmd->count("--threads") > 0;
     if (!o->jobFile.empty()) o->givenWithJob = optionsGivenBesideJob(cmd, {"--part", "--render-task", "--frames-per-task", "--threads"});
-    run = [o] { return runDemo(*o); };
+    run = [o] { return runDemoCommand(*o); };
   });
 }
 

@@ -20,7 +20,7 @@ struct DiscardCli {
   bool includeCuts = false;
 };
 
-Expected<void> runDiscard(const DiscardCli& cli) {
+Expected<void> runDiscardCommand(const DiscardCli& cli) {
   const discard::Thresholds thresholds = discard::withPositionDefault(cli.thresholds, cli.position);
   std::optional<Progress> progress;
   auto outcome = pipeline::runDiscard({cli.frames, thresholds, cli.includeCuts, cli.json, cli.csv, cli.masks, cli.plots},
@@ -83,7 +83,7 @@ void addDiscardCommand(CLI::App& app, CommandRun& run) {
   cmd->add_option("--csv", o->csv, "Per-frame percentages as CSV");
   cmd->add_option("--plots", o->plots, "Write NAME_discard.png and .svg: per-frame discard percentages (gnuplot)");
   cmd->add_option("--masks", o->masks, "Write discard_NNNNN.png per frame: discarded pixels coloured by reason over the dimmed image");
-  cmd->callback([o, &run] { run = [o] { return runDiscard(*o); }; });
+  cmd->callback([o, &run] { run = [o] { return runDiscardCommand(*o); }; });
 }
 
 }  // namespace dynbench::cli

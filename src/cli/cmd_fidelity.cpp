@@ -1,7 +1,7 @@
 // `dynbench fidelity CAPTURE DATASET -o DIR`: the dataset's renders of the frames the game kept
 // (capture cube2 --game-frames) against the game's own images (docs/fidelity.md).
 #include "cli/commands.h"
-#include "pipeline/fidelity.h"
+#include "pipeline/fidelity_run.h"
 
 namespace dynbench::cli {
 

@@ -78,7 +78,7 @@ Expected<render::RenderJob> jobFromFile(const RenderCli& cli) {
   return job;
 }
 
-Expected<void> runRender(const RenderCli& cli) {
+Expected<void> runRenderCommand(const RenderCli& cli) {
   if (!cli.jobFile.empty()) {
     auto job = jobFromFile(cli);
     if (!job) return std::unexpected(job.error());
@@ -233,7 +233,7 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
   cmd->callback([o, cmd, &run] {
     o->threadsGiven = cmd->count("--threads") > 0;
     if (!o->jobFile.empty()) o->givenWithJob = optionsGivenBesideJob(cmd, {"--frames", "--threads"});
-    run = [o] { return runRender(*o); };
+    run = [o] { return runRenderCommand(*o); };
   });
 }
 

@@ -13,7 +13,7 @@ struct ReportCli {
   std::string reference;
 };
 
-Expected<void> runReport(const ReportCli& cli) {
+Expected<void> runReportCommand(const ReportCli& cli) {
   report::ReportOptions options;
   for (const auto& r : cli.runs) options.runs.emplace_back(r);
   options.output = cli.output;
@@ -46,7 +46,7 @@ void addReportCommand(CLI::App& app, CommandRun& run) {
       ->check(nonNegative());
   cmd->add_option("--reference", o->reference, "thesis: add the thesis's published rows (Tables 6.1-6.7), marked as published")
       ->check(CLI::IsMember({"thesis"}));
-  cmd->callback([o, &run] { run = [o] { return runReport(*o); }; });
+  cmd->callback([o, &run] { run = [o] { return runReportCommand(*o); }; });
 }
 
 }  // namespace dynbench::cli

@@ -1,7 +1,7 @@
 #pragma once
 // What the path tracer's files share (path_tracer.cpp: construction and surface queries;
 // path_integrator.cpp: the batched integrator; path_tracer_frame.cpp: a frame and its adaptive
-// sampling; radiance_changes.cpp: the radiance-change pairs): the paths' state between the stages
+// sampling; path_tracer_changes.cpp: the radiance-change pairs): the paths' state between the stages
 // of a batch and small helpers. Not for use outside src/render.
 #include <cmath>
 #include <limits>

@@ -1,5 +1,5 @@
 #include "core/json_fields.h"
-#include "pipeline/fidelity.h"
+#include "pipeline/fidelity_run.h"
 
 #include <algorithm>
 #include <fstream>
