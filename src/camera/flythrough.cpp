@@ -260,16 +260,14 @@ Expected<FlythroughPoses> flyThroughPoses(const fs::path& dataset, const Flythro
   if (!(o.speed > 0) || !(o.lookAhead > 0) || !(o.rate > 0) || !(o.frameRate > 0) || !(o.maxSmoothing >= 0) || !(o.metresPerUnit > 0) ||
       o.candidates < 1)
     return fail(ErrorCode::kUsage, "fly-through: speed, look-ahead, rates and metres per unit must be positive, candidates at least 1");
-  auto scene = scene::loadScene(dataset);
-  if (!scene) return std::unexpected(scene.error());
-  auto cameraNode = scene::selectCameraNode(*scene, std::nullopt);
-  if (!cameraNode) return std::unexpected(cameraNode.error());
-  if (*cameraNode < 0) return fail(ErrorCode::kInvalidData, "{}: no camera to fly along", dataset.string());
-  const auto range = scene->timeRange();
-  const double duration = range.end - range.start;
-  if (!(duration > 0)) return fail(ErrorCode::kInvalidData, "{}: no animation to fly along", dataset.string());
-  const auto& node = scene->nodes[static_cast<std::size_t>(*cameraNode)];
-  const scene::Evaluator evaluator(*scene);
+  auto loaded = loadAnimatedCamera(dataset, "fly along");
+  if (!loaded) return std::unexpected(loaded.error());
+  const scene::Scene& scene = loaded->scene;
+  const int cameraNode = loaded->node;
+  const auto range = loaded->range;
+  const double duration = loaded->duration();
+  const auto& node = scene.nodes[static_cast<std::size_t>(cameraNode)];
+  const scene::Evaluator evaluator(scene);
   const std::size_t samples = std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil(duration * o.rate)) + 1);
   auto timeAt = [&](std::size_t n) { return range.start + duration * static_cast<double>(n) / static_cast<double>(samples - 1); };
 
@@ -280,13 +278,13 @@ Expected<FlythroughPoses> flyThroughPoses(const fs::path& dataset, const Flythro
       stretches.back().end = timeAt(n - 1);
       stretches.emplace_back().start = timeAt(n);
     }
-    stretches.back().points.emplace_back(evaluator.worldMatrix(*cameraNode, timeAt(n))[3]);
+    stretches.back().points.emplace_back(evaluator.worldMatrix(cameraNode, timeAt(n))[3]);
   }
   stretches.back().end = timeAt(samples - 1);
   for (Stretch& s : stretches) s.length = Polyline(s.points).length();
   std::stable_sort(stretches.begin(), stretches.end(), [](const Stretch& a, const Stretch& b) { return a.length > b.length; });
 
-  auto walls = render::StaticGeometry::create(*scene);  // built once for every stretch and width tried
+  auto walls = render::StaticGeometry::create(scene);  // built once for every stretch and width tried
   if (!walls) return std::unexpected(walls.error());
   const Flyer flyer(o, duration, samples, *walls);
   // The longest stretch whose flight is inside every ORCA range; where none is, the one closest.

@@ -95,6 +95,20 @@ Expected<std::vector<CameraPoseKey>> readPoseCsv(const fs::path& file, const Pos
   return keys;
 }
 
+Expected<AnimatedCamera> loadAnimatedCamera(const fs::path& dataset, const std::string& purpose) {
+  AnimatedCamera c;
+  auto scene = scene::loadScene(dataset);
+  if (!scene) return std::unexpected(scene.error());
+  c.scene = std::move(*scene);
+  auto node = scene::selectCameraNode(c.scene, std::nullopt);
+  if (!node) return std::unexpected(node.error());
+  if (*node < 0) return fail(ErrorCode::kInvalidData, "{}: no camera to {}", dataset.string(), purpose);
+  c.node = *node;
+  c.range = c.scene.timeRange();
+  if (!(c.duration() > 0)) return fail(ErrorCode::kInvalidData, "{}: no animation to {}", dataset.string(), purpose);
+  return c;
+}
+
 Expected<std::vector<CameraPoseKey>> readCameraRun(const fs::path& run) {
   std::error_code ec;
   if (fs::is_directory(run, ec)) return readCaptureRun(run);

@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "metrics/camera_motion.h"
+#include "scene/scene.h"
 
 namespace dynbench::camera {
 
@@ -35,6 +36,17 @@ Expected<std::vector<CameraPoseKey>> readPoseCsv(const std::filesystem::path& cs
 // Writes a CSV pose log readCameraRun reads (header line, one key a line, shortest round-trip
 // decimals), from a temporary file.
 Expected<void> writeCameraRunCsv(const std::filesystem::path& csv, const std::vector<CameraPoseKey>& keys);
+
+// A dataset whose first animated camera a camera tool reworks: the scene, that camera's node and
+// the animation's time range. An error names the dataset and says what the tool wanted to do
+// (`purpose`, e.g. "fly along") when it has no camera or no animation.
+struct AnimatedCamera {
+  scene::Scene scene;
+  int node = -1;
+  scene::Scene::TimeRange range;
+  double duration() const { return range.end - range.start; }
+};
+Expected<AnimatedCamera> loadAnimatedCamera(const std::filesystem::path& dataset, const std::string& purpose);
 
 struct MergeCameraOptions {
   std::filesystem::path dataset;  // .gltf with its .bin (as `convert` writes)

@@ -41,15 +41,13 @@ std::vector<double> averageOverTime(const std::vector<double>& times, const std:
 Expected<SlowedTurnsReport> makeSlowedTurnsDataset(const fs::path& dataset, const fs::path& output, const fs::path& csv,
                                                    const SlowedTurnsOptions& o) {
   if (!(o.window >= 0) || !(o.rate > 0)) return fail(ErrorCode::kUsage, "slowed turns: the window must be >= 0 s and the rate > 0");
-  auto scene = scene::loadScene(dataset);
-  if (!scene) return std::unexpected(scene.error());
-  auto cameraNode = scene::selectCameraNode(*scene, std::nullopt);
-  if (!cameraNode) return std::unexpected(cameraNode.error());
-  if (*cameraNode < 0) return fail(ErrorCode::kInvalidData, "{}: no camera to slow", dataset.string());
-  const auto range = scene->timeRange();
-  const double duration = range.end - range.start;
-  if (!(duration > 0)) return fail(ErrorCode::kInvalidData, "{}: no animation to slow", dataset.string());
-  const scene::Node& node = scene->nodes[static_cast<std::size_t>(*cameraNode)];
+  auto loaded = loadAnimatedCamera(dataset, "slow");
+  if (!loaded) return std::unexpected(loaded.error());
+  const scene::Scene& scene = loaded->scene;
+  const int cameraNode = loaded->node;
+  const auto range = loaded->range;
+  const double duration = loaded->duration();
+  const scene::Node& node = scene.nodes[static_cast<std::size_t>(cameraNode)];
 
   // Pose times: an even grid and both ends of every cut, so each jump stays a jump between keys.
   std::vector<double> times;
@@ -62,11 +60,11 @@ Expected<SlowedTurnsReport> makeSlowedTurnsDataset(const fs::path& dataset, cons
   // within 10 µs is one key (glTF key times are floats; a cut on the grid is the grid point)
   times.erase(std::unique(times.begin(), times.end(), [](double a, double b) { return std::abs(a - b) < 1e-5; }), times.end());
 
-  const scene::Evaluator evaluator(*scene);
+  const scene::Evaluator evaluator(scene);
   std::vector<glm::dvec3> positions;
   std::vector<double> yaw, pitch;
   for (double t : times) {
-    const glm::dmat4 world = evaluator.worldMatrix(*cameraNode, t);
+    const glm::dmat4 world = evaluator.worldMatrix(cameraNode, t);
     positions.emplace_back(world[3]);
     const EulerYawPitchRoll angles = eulerYawPitchRoll(decomposeRigid(world).rotation);
     const double y = angles.yaw, p = angles.pitch;
