@@ -13,7 +13,7 @@
 
 #include "render/path_tracer.h"
 #include "render/render_job.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/load.h"
 #include "scene/queries.h"
 

@@ -29,7 +29,7 @@
 #include "gltf_builder.h"
 #include "frames/frame_io.h"
 #include "render/render_job.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/load.h"
 #include "scene/queries.h"
 

@@ -15,7 +15,7 @@
 #include "gltf_builder.h"
 #include "metrics/camera_motion.h"
 #include "metrics/properties.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/load.h"
 
 namespace {

@@ -13,7 +13,7 @@
 #include "core/files.h"
 #include "gltf_builder.h"
 #include "run_cli.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/load.h"
 #include "scene/queries.h"
 

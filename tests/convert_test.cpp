@@ -17,7 +17,7 @@
 #include "gltf_builder.h"
 #include "external_tools.h"
 #include "run_cli.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/load.h"
 #include "scene/queries.h"
 

@@ -21,7 +21,7 @@
 #include "capture/cube2.h"
 #include "core/files.h"
 #include "core/image_io.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/load.h"
 #include "gltf_builder.h"
 #include "external_tools.h"

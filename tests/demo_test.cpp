@@ -17,7 +17,7 @@
 #include "suite/demo.h"
 #include "camera/flythrough.h"
 #include "render/raytracing_scene.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/load.h"
 #include "scene/queries.h"
 #include "gltf_builder.h"

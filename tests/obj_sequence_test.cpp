@@ -5,7 +5,7 @@
 
 #include "gltf_builder.h"
 #include "metrics/properties.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/load.h"
 
 namespace dynbench::scene {

@@ -24,7 +24,7 @@
 #include "core/files.h"
 #include "frames/feature_frame.h"
 #include "frames/frame_io.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/load.h"
 #include "suite/manifest.h"
 #include "gltf_builder.h"

@@ -15,7 +15,7 @@
 #include "gltf_builder.h"
 #include "render_scenes.h"
 #include "render/path_tracer.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/load.h"
 
 namespace dynbench::render {

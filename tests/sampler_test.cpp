@@ -5,7 +5,7 @@
 
 #include "core/math.h"
 #include "gltf_builder.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/load.h"
 
 namespace dynbench::scene {

@@ -12,7 +12,7 @@
 #include "core/files.h"
 #include "core/math.h"
 #include "render/raytracing_scene.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/load.h"
 #include "scene/queries.h"
 #include "report/reference.h"

@@ -14,7 +14,7 @@
 #include "convert/gltf_writer.h"
 #include "core/files.h"
 #include "core/math.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/load.h"
 #include "scene/queries.h"
 

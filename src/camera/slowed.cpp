@@ -10,7 +10,7 @@
 #include "camera/merge_camera.h"
 #include "core/files.h"
 #include "core/math.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/load.h"
 #include "scene/queries.h"
 

@@ -6,7 +6,7 @@
 
 #include "metrics/properties.h"
 #include "scene/queries.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 
 namespace dynbench::metrics {
 

@@ -16,7 +16,7 @@
 #include "core/runtime_files.h"
 #include "frames/frame_io.h"
 #include "render/backend.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 
 namespace dynbench::render {
 namespace {

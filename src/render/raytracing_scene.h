@@ -11,7 +11,7 @@
 
 #include "core/error.h"
 #include "render/camera.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 
 namespace dynbench::render {
 

@@ -14,7 +14,7 @@
 #include "render/backend.h"
 #include "scene/queries.h"
 #include "frames/frame_io.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/dataset_digest.h"
 
 namespace dynbench::render {

@@ -14,7 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "render/path_tracer.h"
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 #include "scene/scene.h"
 
 namespace dynbench::render {

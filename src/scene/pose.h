@@ -1,5 +1,5 @@
 #pragma once
-// Evaluation of a scene at any time t: animation sampling (glTF 2.0 Appendix C), local and world
+// The pose of a scene at any time t (scene::Evaluator): animation sampling (glTF 2.0 Appendix C), local and world
 // transforms, morph weights and visibility. All animations play together on one clock; when two
 // channels drive the same node property, the one listed later wins.
 #include <span>

@@ -1,4 +1,4 @@
-#include "scene/evaluate.h"
+#include "scene/pose.h"
 
 #include <algorithm>
 #include <cmath>
