@@ -249,6 +249,143 @@ std::string base64Encode(const std::string& bytes) {
   return out;
 }
 
+// Every run on the same axes: rotation per frame and its distribution, discard per frame, Table
+// 6.7 as bars (with the thesis's published rows when asked for), and the temporal methods' ꟻLIP per
+// frame.
+Expected<std::vector<Figure>> comparisonFigures(const std::vector<Run>& runs, const std::optional<Reference>& reference, const fs::path& assets) {
+  std::vector<Figure> comparison;
+  {
+    std::vector<ComparisonSeries> series;
+    for (const Run& r : runs) {
+      ComparisonSeries s;
+      s.name = r.name;
+      s.rotation = rotationSeries(r.cameraCsv);
+      s.discard = r.discard.frames;
+      s.mean = r.discard.mean;
+      series.push_back(std::move(s));
+    }
+    for (const auto& t : reference ? reference->tables : std::span<const ReferenceTable>{}) {
+      if (t.table != "6.7") continue;
+      for (const auto& row : t.rows) {
+        ComparisonSeries s;
+        s.name = row.dataset;
+        s.published = true;
+        discard::FramePercentages m;
+        for (std::size_t c = 0; c < discard::kTable67Columns.size() && c < row.cells.size(); ++c)
+          m.*discard::kTable67Columns[c].member = std::strtod(row.cells[c].c_str(), nullptr);
+        s.mean = m;
+        series.push_back(std::move(s));
+      }
+    }
+    auto written = writeComparisonPlots(series, assets, "all");
+    if (!written) return std::unexpected(written.error());
+    static const std::map<std::string, std::string> captions = {
+        {"all_rotation.png", "Geodesic change in camera rotation per frame, every dataset on one axis (cut frames left out)"},
+        {"all_cdf_rotation_cdf.png", "Cumulative distribution of the change in rotation per frame: the share of frames turning at most x degrees"},
+        {"all_discard.png", "Discarded pixels per frame pair, one panel per feature, every dataset on one axis (cut pairs left out)"},
+        {"all_table67.png", "Table 6.7 as bars: mean discard per feature; whiskers: 95 % intervals of the radiance columns"}};
+    for (const auto& png : *written) {
+      const auto caption = captions.find(png.filename().string());
+      comparison.push_back({caption != captions.end() ? caption->second : png.stem().string(), png, true});
+    }
+  }
+  // Temporal methods of every run on one axis, then per run (below) each method's worst frame.
+  {
+    std::vector<std::pair<std::string, std::vector<double>>> series;
+    for (const Run& r : runs)
+      for (const auto& m : r.scored()) {
+        std::vector<double> values;
+        for (const auto& f : m.scores->frames) values.push_back(f.flip);
+        series.emplace_back(fmt::format("{} {}{}", r.name, m.scores->name, std::string(m.input) == "still" ? " (still)" : ""), std::move(values));
+      }
+    if (!series.empty()) {
+      auto written = writeMethodsPlot(series, assets, "all");
+      if (!written) return std::unexpected(written.error());
+      comparison.push_back({"ꟻLIP per frame of every temporal method and dataset (lower is better)", assets / "all_methods_flip.png", true});
+    }
+  }
+
+  return comparison;
+}
+
+// One run's section (RUN is the k-th, counting from 0): Figures A.1 / A.2 (when a camera series is
+// there), the discard series, the video, thumbnails and masks, and each method's worst frame.
+Expected<RunFigures> runFigures(const Run& r, std::size_t k, const ReportOptions& options, const fs::path& assets) {
+  std::error_code ec;
+  const std::string stem = fmt::format("run{}", k + 1);
+  std::vector<Figure> list;
+  if (!r.cameraCsv.empty()) {
+    auto written = writeRotationPlotsFromCsv(r.cameraCsv, r.name, assets, stem);
+    if (!written) return std::unexpected(written.error());
+    list.push_back({"Figure A.1: change in pitch, yaw and roll per frame", assets / (stem + "_rotation_per_axis.png")});
+    list.push_back({"Figure A.2: geodesic change in rotation per frame", assets / (stem + "_rotation_geodesic.png")});
+  }
+  const auto& series = r.discard.frames;
+  if (!series.empty()) {
+    auto written = writeDiscardPlot(series, r.name, assets, stem);
+    if (!written) return std::unexpected(written.error());
+    list.push_back({"Discarded pixels per frame (Eq. 3.4)", assets / (stem + "_discard.png")});
+  }
+  // The video and thumbnails share one exposure, so that they neither flicker nor disagree, and
+  // say how many samples per pixel they show.
+  const int n = std::max(0, options.thumbnails);
+  std::optional<frames::PreviewToneMap> toneMap;
+  std::string sampling;
+  if (!r.frames.empty() && (n > 0 || options.videoFrames > 0)) {
+    auto map = clipToneMap(r.frames);
+    if (!map) return std::unexpected(map.error());
+    toneMap = *map;
+    auto note = samplingNote(r.frames);
+    if (!note) return std::unexpected(note.error());
+    sampling = *note;
+  }
+  if (toneMap && options.videoFrames > 0) {
+    VideoOptions videoOptions;
+    videoOptions.maxFrames = options.videoFrames;
+    auto video = writeRunVideo(r.frames, r.dir / "masks", *toneMap, assets / (stem + "_motion.webm"), videoOptions);
+    if (!video) return std::unexpected(video.error());
+    std::string caption = fmt::format("Frames {}-{} at {:g} fps ({} frames): direct + indirect radiance, tone-mapped", video->firstFrame,
+                                      video->lastFrame, video->fps, video->frames);
+    if (video->masks)
+      caption += fmt::format("; beside it, the discard mask of the pair ending at each frame ({}; grey: no pair, at the first frame or a camera cut)",
+                             kMaskLegend);
+    if (static_cast<std::size_t>(video->frames) < r.frames.size())
+      caption += fmt::format("; the first {} of the run's {} frames", video->frames, r.frames.size());
+    list.insert(list.begin(), {caption, video->file, true, *video});  // first: motion is the subject
+  }
+  for (const std::size_t f : evenlySpaced(r.frames.size(), n)) {
+    const auto& entry = r.frames[f];
+    auto frame = frames::readFrame(entry);
+    if (!frame) return std::unexpected(frame.error());
+    auto rgb = frames::previewImage(*frame, *toneMap);
+    const fs::path png = assets / fmt::format("{}_frame_{:05d}.png", stem, entry.frame);
+    if (auto ok = writeImage(png, FloatImage{frame->width, frame->height, 3, std::move(rgb), {}, {}, {}}); !ok) return std::unexpected(ok.error());
+    list.push_back({fmt::format("Frame {} (direct + indirect, tone-mapped)", entry.frame), png, false, std::nullopt, true});
+  }
+  for (const std::size_t f : evenlySpaced(r.masks.size(), n)) {
+    const fs::path& mask = r.masks[f];
+    const fs::path copy = assets / fmt::format("{}_{}", stem, mask.filename().string());
+    fs::copy_file(mask, copy, fs::copy_options::overwrite_existing, ec);
+    if (ec) return fail(ErrorCode::kIo, "{}: cannot copy: {}", mask.string(), ec.message());
+    list.push_back({fmt::format("Discard mask {} ({})", mask.stem().string(), kMaskLegend), copy,
+                    false, std::nullopt, true});
+  }
+  for (const auto& scored : r.scored()) {
+    const evaluate::MethodScores& m = *scored.scores;
+    const fs::path heat = r.dir / scored.folder / evaluate::methodFolder(m.name) / "flip_worst.png";
+    if (!fs::is_regular_file(heat, ec)) continue;
+    const fs::path copy = assets / fmt::format("{}_{}_{}_flip_worst.png", stem, scored.folder, evaluate::methodFolder(m.name));
+    fs::copy_file(heat, copy, fs::copy_options::overwrite_existing, ec);
+    if (ec) return fail(ErrorCode::kIo, "{}: cannot copy: {}", heat.string(), ec.message());
+    list.push_back({fmt::format("{}{}: ꟻLIP error of its worst frame, {} (magma: black 0, yellow 1)", m.name,
+                                *scored.input ? fmt::format(" ({} input)", scored.input) : "", m.worstFrame),
+                    copy, false, std::nullopt, true});
+  }
+  if (!sampling.empty())
+    sampling = fmt::format("Video and thumbnails: {}/frames, {}; one exposure for all of them.", r.dir.filename().string(), sampling);
+  return RunFigures{r.name, sampling, std::move(list)};
+}
+
 Expected<ReportFiles> writeReport(const ReportOptions& options) {
   if (options.runs.empty()) return fail(ErrorCode::kUsage, "report: name at least one RUN folder");
   // The published rows (--reference thesis): read once, for the tables and Table 6.7's bars.
@@ -275,136 +412,15 @@ Expected<ReportFiles> writeReport(const ReportOptions& options) {
   fs::create_directories(files.assets, ec);
   if (ec) return fail(ErrorCode::kIo, "{}: cannot create: {}", files.assets.string(), ec.message());
 
-  // Every run on the same axes: rotation per frame and its distribution, discard per frame, Table
-  // 6.7 as bars (with the thesis's published rows when asked for).
-  std::vector<Figure> comparison;
-  {
-    std::vector<ComparisonSeries> series;
-    for (const Run& r : runs) {
-      ComparisonSeries s;
-      s.name = r.name;
-      s.rotation = rotationSeries(r.cameraCsv);
-      s.discard = r.discard.frames;
-      s.mean = r.discard.mean;
-      series.push_back(std::move(s));
-    }
-    for (const auto& t : reference ? reference->tables : std::span<const ReferenceTable>{}) {
-      if (t.table != "6.7") continue;
-      for (const auto& row : t.rows) {
-        ComparisonSeries s;
-        s.name = row.dataset;
-        s.published = true;
-        discard::FramePercentages m;
-        for (std::size_t c = 0; c < discard::kTable67Columns.size() && c < row.cells.size(); ++c)
-          m.*discard::kTable67Columns[c].member = std::strtod(row.cells[c].c_str(), nullptr);
-        s.mean = m;
-        series.push_back(std::move(s));
-      }
-    }
-    auto written = writeComparisonPlots(series, files.assets, "all");
-    if (!written) return std::unexpected(written.error());
-    static const std::map<std::string, std::string> captions = {
-        {"all_rotation.png", "Geodesic change in camera rotation per frame, every dataset on one axis (cut frames left out)"},
-        {"all_cdf_rotation_cdf.png", "Cumulative distribution of the change in rotation per frame: the share of frames turning at most x degrees"},
-        {"all_discard.png", "Discarded pixels per frame pair, one panel per feature, every dataset on one axis (cut pairs left out)"},
-        {"all_table67.png", "Table 6.7 as bars: mean discard per feature; whiskers: 95 % intervals of the radiance columns"}};
-    for (const auto& png : *written) {
-      const auto caption = captions.find(png.filename().string());
-      comparison.push_back({caption != captions.end() ? caption->second : png.stem().string(), png, true});
-    }
-  }
-  // Temporal methods of every run on one axis, then per run (below) each method's worst frame.
-  {
-    std::vector<std::pair<std::string, std::vector<double>>> series;
-    for (const Run& r : runs)
-      for (const auto& m : r.scored()) {
-        std::vector<double> values;
-        for (const auto& f : m.scores->frames) values.push_back(f.flip);
-        series.emplace_back(fmt::format("{} {}{}", r.name, m.scores->name, std::string(m.input) == "still" ? " (still)" : ""), std::move(values));
-      }
-    if (!series.empty()) {
-      auto written = writeMethodsPlot(series, files.assets, "all");
-      if (!written) return std::unexpected(written.error());
-      comparison.push_back({"ꟻLIP per frame of every temporal method and dataset (lower is better)", files.assets / "all_methods_flip.png", true});
-    }
-  }
-
-  // Figures: per run, A.1 / A.2 (when a camera series is there), the discard series, thumbnails, masks.
+  auto comparisonOrError = comparisonFigures(runs, reference, files.assets);
+  if (!comparisonOrError) return std::unexpected(comparisonOrError.error());
+  const std::vector<Figure>& comparison = *comparisonOrError;
+  // Figures: per run.
   std::vector<RunFigures> figures;
   for (std::size_t k = 0; k < runs.size(); ++k) {
-    const Run& r = runs[k];
-    const std::string stem = fmt::format("run{}", k + 1);
-    std::vector<Figure> list;
-    if (!r.cameraCsv.empty()) {
-      auto written = writeRotationPlotsFromCsv(r.cameraCsv, r.name, files.assets, stem);
-      if (!written) return std::unexpected(written.error());
-      list.push_back({"Figure A.1: change in pitch, yaw and roll per frame", files.assets / (stem + "_rotation_per_axis.png")});
-      list.push_back({"Figure A.2: geodesic change in rotation per frame", files.assets / (stem + "_rotation_geodesic.png")});
-    }
-    const auto& series = r.discard.frames;
-    if (!series.empty()) {
-      auto written = writeDiscardPlot(series, r.name, files.assets, stem);
-      if (!written) return std::unexpected(written.error());
-      list.push_back({"Discarded pixels per frame (Eq. 3.4)", files.assets / (stem + "_discard.png")});
-    }
-    // The video and thumbnails share one exposure, so that they neither flicker nor disagree, and
-    // say how many samples per pixel they show.
-    const int n = std::max(0, options.thumbnails);
-    std::optional<frames::PreviewToneMap> toneMap;
-    std::string sampling;
-    if (!r.frames.empty() && (n > 0 || options.videoFrames > 0)) {
-      auto map = clipToneMap(r.frames);
-      if (!map) return std::unexpected(map.error());
-      toneMap = *map;
-      auto note = samplingNote(r.frames);
-      if (!note) return std::unexpected(note.error());
-      sampling = *note;
-    }
-    if (toneMap && options.videoFrames > 0) {
-      VideoOptions videoOptions;
-      videoOptions.maxFrames = options.videoFrames;
-      auto video = writeRunVideo(r.frames, r.dir / "masks", *toneMap, files.assets / (stem + "_motion.webm"), videoOptions);
-      if (!video) return std::unexpected(video.error());
-      std::string caption = fmt::format("Frames {}-{} at {:g} fps ({} frames): direct + indirect radiance, tone-mapped", video->firstFrame,
-                                        video->lastFrame, video->fps, video->frames);
-      if (video->masks)
-        caption += fmt::format("; beside it, the discard mask of the pair ending at each frame ({}; grey: no pair, at the first frame or a camera cut)",
-                               kMaskLegend);
-      if (static_cast<std::size_t>(video->frames) < r.frames.size())
-        caption += fmt::format("; the first {} of the run's {} frames", video->frames, r.frames.size());
-      list.insert(list.begin(), {caption, video->file, true, *video});  // first: motion is the subject
-    }
-    for (const std::size_t k : evenlySpaced(r.frames.size(), n)) {
-      const auto& entry = r.frames[k];
-      auto frame = frames::readFrame(entry);
-      if (!frame) return std::unexpected(frame.error());
-      auto rgb = frames::previewImage(*frame, *toneMap);
-      const fs::path png = files.assets / fmt::format("{}_frame_{:05d}.png", stem, entry.frame);
-      if (auto ok = writeImage(png, FloatImage{frame->width, frame->height, 3, std::move(rgb), {}, {}, {}}); !ok) return std::unexpected(ok.error());
-      list.push_back({fmt::format("Frame {} (direct + indirect, tone-mapped)", entry.frame), png, false, std::nullopt, true});
-    }
-    for (const std::size_t k : evenlySpaced(r.masks.size(), n)) {
-      const fs::path& mask = r.masks[k];
-      const fs::path copy = files.assets / fmt::format("{}_{}", stem, mask.filename().string());
-      fs::copy_file(mask, copy, fs::copy_options::overwrite_existing, ec);
-      if (ec) return fail(ErrorCode::kIo, "{}: cannot copy: {}", mask.string(), ec.message());
-      list.push_back({fmt::format("Discard mask {} ({})", mask.stem().string(), kMaskLegend), copy,
-                      false, std::nullopt, true});
-    }
-    for (const auto& scored : r.scored()) {
-      const evaluate::MethodScores& m = *scored.scores;
-      const fs::path heat = r.dir / scored.folder / evaluate::methodFolder(m.name) / "flip_worst.png";
-      if (!fs::is_regular_file(heat, ec)) continue;
-      const fs::path copy = files.assets / fmt::format("{}_{}_{}_flip_worst.png", stem, scored.folder, evaluate::methodFolder(m.name));
-      fs::copy_file(heat, copy, fs::copy_options::overwrite_existing, ec);
-      if (ec) return fail(ErrorCode::kIo, "{}: cannot copy: {}", heat.string(), ec.message());
-      list.push_back({fmt::format("{}{}: ꟻLIP error of its worst frame, {} (magma: black 0, yellow 1)", m.name,
-                                  *scored.input ? fmt::format(" ({} input)", scored.input) : "", m.worstFrame),
-                      copy, false, std::nullopt, true});
-    }
-    if (!sampling.empty())
-      sampling = fmt::format("Video and thumbnails: {}/frames, {}; one exposure for all of them.", r.dir.filename().string(), sampling);
-    figures.push_back({r.name, sampling, std::move(list)});
+    auto section = runFigures(runs[k], k, options, files.assets);
+    if (!section) return std::unexpected(section.error());
+    figures.push_back(std::move(*section));
   }
 
   auto allTables = tables(runs);
