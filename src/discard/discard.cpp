@@ -149,6 +149,50 @@ double pairsChange(const frames::ChangeEstimate& e, double tau, double& low, dou
   return exceedanceProbability(std::abs(e.mean), e.standardError, tau);
 }
 
+// The rows' sums added in row order, so that the total does not depend on the schedule.
+FrameSums addRows(const std::vector<FrameSums>& rows) {
+  FrameSums total;
+  for (const auto& row : rows) {
+    for (std::size_t b = 0; b < 5; ++b) total.count[b] += row.count[b];
+    total.directVariance += row.directVariance;
+    total.indirectVariance += row.indirectVariance;
+    total.directNoisy += row.directNoisy;
+    total.indirectNoisy += row.indirectNoisy;
+    for (std::size_t b = 0; b < 2; ++b) {
+      total.low[b] += row.low[b];
+      total.high[b] += row.high[b];
+    }
+  }
+  return total;
+}
+
+// Eq. (3.4) over the frame's n pixels, as percentages, with the radiance columns' intervals: a
+// 95 % sampling interval for the expected test, bounds for the pairs test.
+FramePercentages framePercentages(const FrameSums& total, std::size_t n, const FeatureFrame& current, Thresholds::RadianceTest test, bool pairs) {
+  const double scale = 100.0 / static_cast<double>(n);
+  FramePercentages p{current.frame, current.time, total.count[0] * scale, total.count[1] * scale, total.count[2] * scale, total.count[3] * scale,
+                     total.count[4] * scale, std::nullopt, std::nullopt};
+  if (test == Thresholds::RadianceTest::kExpected) {
+    // 95 %: the expected count +- 1.96 standard deviations of a sum of independent Bernoulli(p).
+    auto interval = [&](double percent, double countVariance) {
+      const double half = kZ95 * std::sqrt(countVariance) * scale;
+      return Interval{std::max(0.0, percent - half), std::min(100.0, percent + half)};
+    };
+    p.directInterval = interval(p.direct, total.directVariance);
+    p.indirectInterval = interval(p.indirect, total.indirectVariance);
+    p.directNoisy = total.directNoisy * scale;
+    p.indirectNoisy = total.indirectNoisy * scale;
+  } else if (pairs) {
+    // Bounds, not a sampling interval: the decided pixels as decided (each widened by its chance
+    // of a wrong decision), the undecided ones either way.
+    p.directInterval = Interval{std::max(0.0, total.low[0] * scale), std::min(100.0, total.high[0] * scale)};
+    p.indirectInterval = Interval{std::max(0.0, total.low[1] * scale), std::min(100.0, total.high[1] * scale)};
+    p.directNoisy = total.directNoisy * scale;
+    p.indirectNoisy = total.indirectNoisy * scale;
+  }
+  return p;
+}
+
 }  // namespace
 
 DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& previous, const Thresholds& t) {
@@ -278,40 +322,7 @@ DiscardResult discardFrame(const FeatureFrame& current, const FeatureFrame& prev
         if (bits & (1u << b)) row.count[static_cast<std::size_t>(b)] += 1.0;
     }
   });
-  FrameSums total;
-  for (const auto& row : rowSums) {
-    for (std::size_t b = 0; b < 5; ++b) total.count[b] += row.count[b];
-    total.directVariance += row.directVariance;
-    total.indirectVariance += row.indirectVariance;
-    total.directNoisy += row.directNoisy;
-    total.indirectNoisy += row.indirectNoisy;
-    for (std::size_t b = 0; b < 2; ++b) {
-      total.low[b] += row.low[b];
-      total.high[b] += row.high[b];
-    }
-  }
-  const double scale = 100.0 / static_cast<double>(n);  // Eq. (3.4), as a percentage
-  auto& p = result.percentages;
-  p = {current.frame, current.time, total.count[0] * scale, total.count[1] * scale, total.count[2] * scale, total.count[3] * scale,
-       total.count[4] * scale, std::nullopt, std::nullopt};
-  if (test == Test::kExpected) {
-    // 95 %: the expected count +- 1.96 standard deviations of a sum of independent Bernoulli(p).
-    auto interval = [&](double percent, double countVariance) {
-      const double half = kZ95 * std::sqrt(countVariance) * scale;
-      return Interval{std::max(0.0, percent - half), std::min(100.0, percent + half)};
-    };
-    p.directInterval = interval(p.direct, total.directVariance);
-    p.indirectInterval = interval(p.indirect, total.indirectVariance);
-    p.directNoisy = total.directNoisy * scale;
-    p.indirectNoisy = total.indirectNoisy * scale;
-  } else if (pairs) {
-    // Bounds, not a sampling interval: the decided pixels as decided (each widened by its chance
-    // of a wrong decision), the undecided ones either way.
-    p.directInterval = Interval{std::max(0.0, total.low[0] * scale), std::min(100.0, total.high[0] * scale)};
-    p.indirectInterval = Interval{std::max(0.0, total.low[1] * scale), std::min(100.0, total.high[1] * scale)};
-    p.directNoisy = total.directNoisy * scale;
-    p.indirectNoisy = total.indirectNoisy * scale;
-  }
+  result.percentages = framePercentages(addRows(rowSums), n, current, test, pairs);
   return result;
 }
 
