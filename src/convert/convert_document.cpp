@@ -69,24 +69,7 @@ void Converter::buildDocument() {
 
   for (auto& [id, t] : tracks_) {
     ++report_.capturables;
-    if (t.kind == Kind::kStaticModel) {
-      const int mesh = meshOfModel_[static_cast<std::size_t>(t.model)];
-      const auto& model = reader_->models()[static_cast<std::size_t>(t.model)];
-      json node = trs(translationOf(t.staticPose), rotationOf(t.staticPose));
-      node["name"] = fmt::format("static_{}_{}", t.id, model.path);
-      if (mesh >= 0 && model.joints.empty()) node["mesh"] = mesh;
-      t.node = addNode(node, staticObjects);
-      // A skinned model placed as a static one keeps its bind pose: a skin whose joints never move.
-      if (!model.joints.empty()) addSkin(t, mesh);
-      continue;
-    }
-    if (t.kind == Kind::kLight && !t.light.dynamic) {
-      json node = trs(t.light.position, glm::dquat(1, 0, 0, 0));
-      node["name"] = fmt::format("light_{}_{}", t.id, t.light.modelType);
-      t.node = addNode(node, staticObjects);
-      lightNodes(t, t.node);
-      continue;
-    }
+    if (placeStatic(t, staticObjects)) continue;
     if (!t.appeared) continue;
     // Dynamic capturables: node, key frames over their span, visibility keys.
     json node = {{"name", fmt::format("{}_{}", kindName(t.kind), t.id)}};
@@ -153,6 +136,28 @@ void Converter::buildDocument() {
   }
   report_.channels = channels.size();
   if (!channels.empty()) doc_["animations"] = {{{"name", "capture"}, {"samplers", samplers}, {"channels", channels}}};
+}
+
+bool Converter::placeStatic(Track& t, int staticObjects) {
+  if (t.kind == Kind::kStaticModel) {
+    const int mesh = meshOfModel_[static_cast<std::size_t>(t.model)];
+    const auto& model = reader_->models()[static_cast<std::size_t>(t.model)];
+    json node = trs(translationOf(t.staticPose), rotationOf(t.staticPose));
+    node["name"] = fmt::format("static_{}_{}", t.id, model.path);
+    if (mesh >= 0 && model.joints.empty()) node["mesh"] = mesh;
+    t.node = addNode(node, staticObjects);
+    // A skinned model placed as a static one keeps its bind pose: a skin whose joints never move.
+    if (!model.joints.empty()) addSkin(t, mesh);
+    return true;
+  }
+  if (t.kind == Kind::kLight && !t.light.dynamic) {
+    json node = trs(t.light.position, glm::dquat(1, 0, 0, 0));
+    node["name"] = fmt::format("light_{}_{}", t.id, t.light.modelType);
+    t.node = addNode(node, staticObjects);
+    lightNodes(t, t.node);
+    return true;
+  }
+  return false;
 }
 
 // Joint nodes in the bind pose under the capturable's node, the skin, and the skinned mesh node;

@@ -212,6 +212,9 @@ class Converter {
   void lightNodes(Track& t, int node);
 
   void buildDocument();
+  // A static model or a static light: its node under StaticObjects (no animation); false for any
+  // other capturable.
+  bool placeStatic(Track& t, int staticObjects);
 
   // Joint nodes in the bind pose under the capturable's node, the skin, and the skinned mesh node;
   // returns the joint nodes.
