@@ -10,6 +10,54 @@ namespace dynbench::capture {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// What a ModelMesh file declares as it goes, checked against what it holds at its end.
+struct Declared {
+  std::vector<std::size_t> vertices, triangles;   // per mesh (M records)
+  std::vector<std::vector<int>> influenceCounts;  // per mesh, per vertex: joints listed by `j`
+  std::set<int> bound, inverseBound;              // joints with a `b` record, with an `x` record
+};
+
+// The whole model against its declarations: a name, both poses of every joint, joints or key
+// frames, every mesh's per-vertex records as many as its vertices, its triangles as declared and
+// in range, every joint a vertex uses in the model. `where` is file:last line.
+void checkModel(const CapturedModel& model, const Declared& declared, const std::string& where) {
+  if (model.path.empty()) throw Failure{Error{ErrorCode::kInvalidData, where + ": no 'o' record naming the model"}};
+  if (declared.bound != declared.inverseBound) throw Failure{Error{ErrorCode::kInvalidData, where + ": every joint needs both a 'b' and an 'x' record"}};
+  if (model.keyFrames > 0 && !model.joints.empty())
+    throw Failure{Error{ErrorCode::kInvalidData, where + ": a model has joints or key frames ('K'), not both"}};
+  for (const auto& mesh : model.meshes) {
+    const std::size_t n = declared.vertices[static_cast<std::size_t>(mesh.id)];
+    auto check = [&](std::size_t count, const char* what, bool optional) {
+      if (count != n && !(optional && count == 0))
+        throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} declares {} vertices but has {} {} records", where, mesh.id, n, count, what)}};
+    };
+    check(mesh.positions.size(), "'p'", false);
+    check(mesh.normals.size(), "'n'", true);
+    check(mesh.uvs.size(), "'t'", true);
+    check(mesh.colors.size(), "'c'", true);
+    check(mesh.joints.size(), "'j'", true);
+    check(mesh.weights.size(), "'w'", true);
+    if (mesh.indices.size() != 3 * declared.triangles[static_cast<std::size_t>(mesh.id)])
+      throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} declares {} triangles but has {} 'i' records", where, mesh.id,
+                                                              declared.triangles[static_cast<std::size_t>(mesh.id)], mesh.indices.size() / 3)}};
+    for (std::size_t f = 0; f < mesh.keyPositions.size(); ++f) {
+      check(mesh.keyPositions[f].size(), fmt::format("'P' (key frame {})", f).c_str(), false);
+      if (!mesh.keyNormals.empty()) check(mesh.keyNormals[f].size(), fmt::format("'N' (key frame {})", f).c_str(), false);
+    }
+    for (std::uint32_t index : mesh.indices)
+      if (index >= n) throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} has a triangle using vertex {} of {}", where, mesh.id, index, n)}};
+    for (std::size_t v = 0; v < mesh.joints.size(); ++v)
+      for (int k = 0; k < declared.influenceCounts[static_cast<std::size_t>(mesh.id)][v]; ++k)
+        if (mesh.joints[v][k] >= model.joints.size())
+          throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} vertex {} uses joint {} but the model has {} joints", where,
+                                                                  mesh.id, v, mesh.joints[v][k], model.joints.size())}};
+  }
+}
+
+}  // namespace
+
 CapturedModel parseModelMesh(const fs::path& path) {
   const std::string file = path.string();
   LineSource source(path);
@@ -21,9 +69,7 @@ CapturedModel parseModelMesh(const fs::path& path) {
   if (!source.next(text, complete) || (text != kModelMeshVersionLine && text != kModelMeshVersion2Line && text != kModelMeshVersion1Line))
     throw Failure{Error{ErrorCode::kParse, fmt::format("{}:1: expected the version line '{}' (or '{}', '{}')", file, kModelMeshVersionLine,
                                                        kModelMeshVersion2Line, kModelMeshVersion1Line)}};
-  std::vector<std::size_t> declaredVertices, declaredTriangles;
-  std::vector<std::vector<int>> influenceCounts;  // per mesh, per vertex: joints listed by `j`
-  std::set<int> bound, inverseBound;
+  Declared declared;
   while (source.next(text, complete)) {
     if (isComment(text)) continue;
     const Line l(file, source.number(), text);
@@ -46,10 +92,10 @@ CapturedModel parseModelMesh(const fs::path& path) {
       CapturedMesh mesh;
       mesh.id = id;
       mesh.name = l.text(4);
-      declaredVertices.push_back(l.integer<std::size_t>(2, "vertex_count"));
-      declaredTriangles.push_back(l.integer<std::size_t>(3, "triangle_count"));
+      declared.vertices.push_back(l.integer<std::size_t>(2, "vertex_count"));
+      declared.triangles.push_back(l.integer<std::size_t>(3, "triangle_count"));
       model.meshes.push_back(std::move(mesh));
-      influenceCounts.emplace_back();
+      declared.influenceCounts.emplace_back();
     } else if (token == "p" || token == "n") {
       l.expectFields(4, "mesh_id:x:y:z");
       auto& mesh = meshAt(1);
@@ -61,7 +107,7 @@ CapturedModel parseModelMesh(const fs::path& path) {
       if (l.size() < 3 || l.size() > 6) l.fail(fmt::format("record '{}' needs a mesh_id and 1 to 4 values, got {} fields", token, l.size() - 1), ErrorCode::kParse);
       auto& mesh = meshAt(1);
       const int count = static_cast<int>(l.size()) - 2;
-      auto& counts = influenceCounts[static_cast<std::size_t>(mesh.id)];
+      auto& counts = declared.influenceCounts[static_cast<std::size_t>(mesh.id)];
       if (token == "j") {
         glm::u16vec4 j(0);
         for (int k = 0; k < count; ++k) j[k] = l.integer<std::uint16_t>(static_cast<std::size_t>(2 + k), "joint");
@@ -131,50 +177,19 @@ CapturedModel parseModelMesh(const fs::path& path) {
         joint.name = l.text(11);
         joint.bindPose = l.dualQuat(3);
         model.joints.push_back(std::move(joint));
-        bound.insert(id);
+        declared.bound.insert(id);
       } else {
         if (id < 0 || static_cast<std::size_t>(id) >= model.joints.size()) l.fail(fmt::format("inverse bind pose of joint {} before its bind pose", id));
         if (parent != model.joints[static_cast<std::size_t>(id)].parent) l.fail(fmt::format("joint {}: parent {} differs from the bind pose's", id, parent));
         model.joints[static_cast<std::size_t>(id)].inverseBindPose = l.dualQuat(3);
-        inverseBound.insert(id);
+        declared.inverseBound.insert(id);
       }
     } else {
       l.fail(fmt::format("unknown record '{}'; a ModelMesh file has o, M, p, n, t, c, j, w, i, a, g, f, r, e, E, m, b, x, K, P, N", token),
              ErrorCode::kParse);
     }
   }
-  const auto where = fmt::format("{}:{}", file, source.number());
-  if (model.path.empty()) throw Failure{Error{ErrorCode::kInvalidData, where + ": no 'o' record naming the model"}};
-  if (bound != inverseBound) throw Failure{Error{ErrorCode::kInvalidData, where + ": every joint needs both a 'b' and an 'x' record"}};
-  if (model.keyFrames > 0 && !model.joints.empty())
-    throw Failure{Error{ErrorCode::kInvalidData, where + ": a model has joints or key frames ('K'), not both"}};
-  for (const auto& mesh : model.meshes) {
-    const std::size_t n = declaredVertices[static_cast<std::size_t>(mesh.id)];
-    auto check = [&](std::size_t count, const char* what, bool optional) {
-      if (count != n && !(optional && count == 0))
-        throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} declares {} vertices but has {} {} records", where, mesh.id, n, count, what)}};
-    };
-    check(mesh.positions.size(), "'p'", false);
-    check(mesh.normals.size(), "'n'", true);
-    check(mesh.uvs.size(), "'t'", true);
-    check(mesh.colors.size(), "'c'", true);
-    check(mesh.joints.size(), "'j'", true);
-    check(mesh.weights.size(), "'w'", true);
-    if (mesh.indices.size() != 3 * declaredTriangles[static_cast<std::size_t>(mesh.id)])
-      throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} declares {} triangles but has {} 'i' records", where, mesh.id,
-                                                              declaredTriangles[static_cast<std::size_t>(mesh.id)], mesh.indices.size() / 3)}};
-    for (std::size_t f = 0; f < mesh.keyPositions.size(); ++f) {
-      check(mesh.keyPositions[f].size(), fmt::format("'P' (key frame {})", f).c_str(), false);
-      if (!mesh.keyNormals.empty()) check(mesh.keyNormals[f].size(), fmt::format("'N' (key frame {})", f).c_str(), false);
-    }
-    for (std::uint32_t index : mesh.indices)
-      if (index >= n) throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} has a triangle using vertex {} of {}", where, mesh.id, index, n)}};
-    for (std::size_t v = 0; v < mesh.joints.size(); ++v)
-      for (int k = 0; k < influenceCounts[static_cast<std::size_t>(mesh.id)][v]; ++k)
-        if (mesh.joints[v][k] >= model.joints.size())
-          throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} vertex {} uses joint {} but the model has {} joints", where,
-                                                                  mesh.id, v, mesh.joints[v][k], model.joints.size())}};
-  }
+  checkModel(model, declared, fmt::format("{}:{}", file, source.number()));
   return model;
 }
 
