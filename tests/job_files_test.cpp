@@ -10,6 +10,7 @@
 #include "capture/cube2_job.h"
 #include "core/files.h"
 #include "gltf_builder.h"
+#include "pipeline/dataset_run.h"
 #include "suite/demo.h"
 #include "render/render_job_json.h"
 #include "run_cli.h"
@@ -247,3 +248,31 @@ TEST(JobFiles, DemoJobRoundTripsEveryField) {
 
 }  // namespace
 }  // namespace dynbench
+
+namespace dynbench::pipeline {
+namespace {
+
+// Each method's input when a job names none for it: the one it is built for (the demo's case, as
+// every suite scores it), an entry overriding it, an unknown method jittered; the still input is
+// rendered only when some method takes it.
+TEST(JobFiles, AMethodWithoutAnInputGetsTheOneItIsBuiltFor) {
+  DatasetRunSettings s;
+  EXPECT_EQ(methodInput(s, "none"), "jittered");
+  EXPECT_EQ(methodInput(s, "taa"), "jittered");
+  EXPECT_EQ(methodInput(s, "accumulate"), "still");
+  EXPECT_EQ(methodInput(s, "svgf"), "still");
+  EXPECT_EQ(methodInput(s, "my_method.py"), "jittered");
+  EXPECT_TRUE(needsStillInput(s));  // the built-in four include accumulate and SVGF
+  EXPECT_EQ(s.floorFrames, kDefaultFloorFrames);
+  s.methodInputs["accumulate"] = "jittered";
+  EXPECT_EQ(methodInput(s, "accumulate"), "jittered");
+  s.methods = {"none", "taa", "accumulate"};
+  EXPECT_FALSE(needsStillInput(s));
+  s.methods.push_back("svgf");
+  EXPECT_TRUE(needsStillInput(s));
+  // The frame renders a dataset needs: the reference, both inputs and the floor's frames.
+  EXPECT_EQ(datasetFrameRenders(s), 3 * s.renderFrames + kDefaultFloorFrames);
+}
+
+}  // namespace
+}  // namespace dynbench::pipeline
