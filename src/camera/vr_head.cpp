@@ -82,7 +82,7 @@ Expected<VrCameraReport> writeVrCameraCsv(const fs::path& dataset, const fs::pat
 
   // Whether a static surface is nearer to p than `distance`: probes along the 26 directions of a
   // cube's faces, edges and corners (a ray-traced stand-in for a closest-point query; 0.99: the
-  // clamp above puts a head at the clearance exactly, which is clear).
+  // offset's clamp below puts a head at the clearance exactly, which is clear).
   auto nearerThan = [&](const glm::dvec3& p, double distance) {
     for (int x = -1; x <= 1; ++x)
       for (int y = -1; y <= 1; ++y)
