@@ -55,7 +55,7 @@ std::vector<OrcaCheck> orcaChecks(const metrics::CameraMotionSummary& m, double 
   const double half = 0.5;
   auto check = [](const char* measure, double value, const char* table, std::size_t column) {
     const OrcaRange r = orcaRange(table, column);
-    return OrcaCheck{measure, value, r.low, r.high};
+    return OrcaCheck{measure, value, r.low, r.high, table, column};
   };
   return {
       check("Table 6.4 position mean (m)", m.position.mean * metresPerUnit, "6.4", 0),
@@ -254,18 +254,31 @@ double totalDistance(const FlythroughReport& r) {
   return d;
 }
 
-}  // namespace
-
-Expected<FlythroughPoses> flyThroughPoses(const fs::path& dataset, const FlythroughOptions& o) {
+Expected<void> checkOptions(const FlythroughOptions& o) {
   if (!(o.speed > 0) || !(o.lookAhead > 0) || !(o.rate > 0) || !(o.frameRate > 0) || !(o.maxSmoothing >= 0) || !(o.metresPerUnit > 0) ||
       o.candidates < 1)
     return fail(ErrorCode::kUsage, "fly-through: speed, look-ahead, rates and metres per unit must be positive, candidates at least 1");
+  return {};
+}
+
+}  // namespace
+
+Expected<FlythroughPoses> flyThroughPoses(const fs::path& dataset, const FlythroughOptions& o) {
+  if (auto ok = checkOptions(o); !ok) return std::unexpected(ok.error());  // before any file is read
   auto loaded = loadAnimatedCamera(dataset, "fly along");
   if (!loaded) return std::unexpected(loaded.error());
-  const scene::Scene& scene = loaded->scene;
-  const int cameraNode = loaded->node;
-  const auto range = loaded->range;
-  const double duration = loaded->duration();
+  auto walls = render::StaticGeometry::create(loaded->scene);  // built once for every stretch and width tried
+  if (!walls) return std::unexpected(walls.error());
+  return flyThroughPoses(*loaded, *walls, dataset, o);
+}
+
+Expected<FlythroughPoses> flyThroughPoses(const AnimatedCamera& loaded, const render::StaticGeometry& walls, const fs::path& dataset,
+                                          const FlythroughOptions& o) {
+  if (auto ok = checkOptions(o); !ok) return std::unexpected(ok.error());
+  const scene::Scene& scene = loaded.scene;
+  const int cameraNode = loaded.node;
+  const auto range = loaded.range;
+  const double duration = loaded.duration();
   const auto& node = scene.nodes[static_cast<std::size_t>(cameraNode)];
   const scene::Evaluator evaluator(scene);
   const std::size_t samples = std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil(duration * o.rate)) + 1);
@@ -284,9 +297,7 @@ Expected<FlythroughPoses> flyThroughPoses(const fs::path& dataset, const Flythro
   for (Stretch& s : stretches) s.length = Polyline(s.points).length();
   std::stable_sort(stretches.begin(), stretches.end(), [](const Stretch& a, const Stretch& b) { return a.length > b.length; });
 
-  auto walls = render::StaticGeometry::create(scene);  // built once for every stretch and width tried
-  if (!walls) return std::unexpected(walls.error());
-  const Flyer flyer(o, duration, samples, *walls);
+  const Flyer flyer(o, duration, samples, walls);
   // The longest stretch whose flight is inside every ORCA range; where none is, the one closest.
   std::optional<Flight> best;
   int compared = 0;

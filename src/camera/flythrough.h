@@ -19,6 +19,10 @@
 #include "core/rates.h"
 #include "metrics/camera_motion.h"
 
+namespace dynbench::render {
+class StaticGeometry;
+}
+
 namespace dynbench::camera {
 
 // A column of the thesis's Tables 6.4-6.6 over its three ORCA rows (Bistro Interior, Bistro
@@ -36,6 +40,8 @@ OrcaRange orcaRange(const std::string& table, std::size_t column);
 struct OrcaCheck {
   std::string measure;  // e.g. "Table 6.6 yaw mean (°)"
   double value = 0, low = 0, high = 0;
+  std::string table;        // the thesis's table ("6.4", "6.5", "6.6") and column the measure is
+  std::size_t column = 0;   // (report/reference.h's cells): where another row's value stands
   bool inside() const { return value >= low - 5e-4 && value <= high + 5e-4; }  // the thesis prints 3 decimals
   // How far outside, relative to the range's width (0 inside).
   double distance() const;
@@ -86,6 +92,10 @@ struct FlythroughPoses {
   std::vector<CameraPoseKey> keys;
 };
 Expected<FlythroughPoses> flyThroughPoses(const std::filesystem::path& dataset, const FlythroughOptions& options = {});
+// The same over a dataset already loaded with its static geometry built (`dataset` names it in
+// errors): for a caller that needs both too, as the VR camera does.
+Expected<FlythroughPoses> flyThroughPoses(const AnimatedCamera& camera, const render::StaticGeometry& walls, const std::filesystem::path& dataset,
+                                          const FlythroughOptions& options);
 // Written as a merge-camera CSV pose log (time,x,y,z,qx,qy,qz,qw) at options.rate poses/s.
 Expected<FlythroughReport> writeFlythroughCsv(const std::filesystem::path& dataset, const std::filesystem::path& csv,
                                               const FlythroughOptions& options = {});

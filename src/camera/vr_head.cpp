@@ -55,7 +55,12 @@ Expected<VrCameraReport> writeVrCameraCsv(const fs::path& dataset, const fs::pat
   if (!trace) return std::unexpected(trace.error());
   auto digest = sha256File(o.trace);
   if (!digest) return std::unexpected(digest.error());
-  auto body = flyThroughPoses(dataset, o.body);
+  // One load and one build of the static geometry for the body's path and the head's clamp.
+  auto loaded = loadAnimatedCamera(dataset, "fly along");
+  if (!loaded) return std::unexpected(loaded.error());
+  auto walls = render::StaticGeometry::create(loaded->scene);
+  if (!walls) return std::unexpected(walls.error());
+  auto body = flyThroughPoses(*loaded, *walls, dataset, o.body);
   if (!body) return std::unexpected(body.error());
   const std::vector<CameraPoseKey>& keys = body->keys;
   const double duration = keys.back().time - keys.front().time;
@@ -64,10 +69,6 @@ Expected<VrCameraReport> writeVrCameraCsv(const fs::path& dataset, const fs::pat
     return fail(ErrorCode::kInvalidData, "{}: the trace covers {:.3f} s; the dataset needs {:.3f} s from {:.3f} s into it", o.trace.string(),
                 trace->back().time - trace->front().time, duration, o.traceStart);
 
-  auto scene = scene::loadScene(dataset);
-  if (!scene) return std::unexpected(scene.error());
-  auto walls = render::StaticGeometry::create(*scene);
-  if (!walls) return std::unexpected(walls.error());
 
   VrCameraReport report;
   report.body = body->report;

@@ -17,14 +17,12 @@ struct VrCameraCli {
   camera::VrCameraOptions options;
 };
 
-// The thesis's Eternal Valley VR cells of Tables 6.4-6.6, as printed ("-" when unreadable).
-std::vector<std::string> thesisVrRow(const std::string& table) {
-  auto reference = report::thesisReference();
-  if (reference)
-    for (const auto& t : reference->tables)
-      if (t.table == table)
-        for (const auto& row : t.rows)
-          if (row.dataset == "Eternal Valley VR") return row.cells;
+// The thesis's Eternal Valley VR row of `table` (6.4-6.6), its cells as printed (empty when absent).
+std::vector<std::string> thesisVrRow(const report::Reference& reference, const std::string& table) {
+  for (const auto& t : reference.tables)
+    if (t.table == table)
+      for (const auto& row : t.rows)
+        if (row.dataset == "Eternal Valley VR") return row.cells;
   return {};
 }
 
@@ -36,33 +34,14 @@ Expected<void> runVrCamera(VrCameraCli cli) {
   auto made = camera::makeVrCameraDataset(cli.dataset, output, csv, cli.options);
   if (!made) return std::unexpected(made.error());
   fmt::print("{}: {}\n", output.string(), camera::describe(made->report));
-  const metrics::CameraMotionSummary& m = made->motion;
-  const double u = cli.options.metresPerUnit;
-  struct Line {
-    const char* measure;
-    double value;
-    const char* table;
-    std::size_t column;
-  };
-  // Table 6.5 as the thesis prints it: half the rotation angle (Eq. 2.4 taken literally).
-  const Line lines[] = {
-      {"Table 6.4 position mean (m)", m.position.mean * u, "6.4", 0},
-      {"Table 6.4 position variance (m²)", m.position.variance * u * u, "6.4", 1},
-      {"Table 6.4 position max (m)", m.position.max * u, "6.4", 2},
-      {"Table 6.5 rotation mean (°, half angle)", m.rotation.mean / 2, "6.5", 0},
-      {"Table 6.5 rotation variance (half angle)", m.rotation.variance / 4, "6.5", 1},
-      {"Table 6.5 rotation max (°, half angle)", m.rotation.max / 2, "6.5", 2},
-      {"Table 6.6 pitch mean (°)", m.pitch.mean, "6.6", 0},
-      {"Table 6.6 pitch variance", m.pitch.variance, "6.6", 1},
-      {"Table 6.6 yaw mean (°)", m.yaw.mean, "6.6", 2},
-      {"Table 6.6 yaw variance", m.yaw.variance, "6.6", 3},
-      {"Table 6.6 roll mean (°)", m.roll.mean, "6.6", 4},
-      {"Table 6.6 roll variance", m.roll.variance, "6.6", 5},
-  };
+  auto reference = report::thesisReference();
+  if (!reference) return std::unexpected(reference.error());
+  // The measures as flythrough checks them against ORCA (positions in metres, Table 6.5 as the
+  // thesis's half angle), beside Eternal Valley VR's cells.
   fmt::print("{:<42} {:>10} {:>20}\n", "measure (the new dataset at --fps)", "value", "Eternal Valley VR");
-  for (const Line& l : lines) {
-    const auto row = thesisVrRow(l.table);
-    fmt::print("{:<42} {:>10.4f} {:>20}\n", l.measure, l.value, l.column < row.size() ? row[l.column] : "-");
+  for (const camera::OrcaCheck& c : camera::orcaChecks(made->motion, cli.options.metresPerUnit)) {
+    const auto row = thesisVrRow(*reference, c.table);
+    fmt::print("{:<42} {:>10.4f} {:>20}\n", c.measure, c.value, c.column < row.size() ? row[c.column] : "-");
   }
   if (!cli.json.empty())
     if (auto ok = writeFileAtomic(cli.json, jsonFileText(camera::vrCameraJson(*made, cli.dataset, output, csv, cli.options))); !ok)

@@ -124,10 +124,12 @@ Table discardTable(const std::vector<DiscardRow>& rows, const std::string& detai
   return t;
 }
 
+bool MethodsRow::withinFloor() const {
+  return scores.name != "none" && noneFlip && floor && scores.flip.count && evaluate::withinNoiseFloor(scores.flip.mean - *noneFlip, floor->mean);
+}
+
 bool MethodsRow::losesToNone() const {
-  if (scores.name == "none" || !noneFlip || scores.flip.count == 0) return false;
-  const double over = scores.flip.mean - *noneFlip;
-  return over > 0 && !(floor && evaluate::withinNoiseFloor(over, floor->mean));
+  return scores.name != "none" && noneFlip && scores.flip.count && scores.flip.mean > *noneFlip && !withinFloor();
 }
 
 Table temporalMethodsTable(const std::vector<MethodsRow>& rows) {
@@ -147,9 +149,8 @@ Table temporalMethodsTable(const std::vector<MethodsRow>& rows) {
       floorShown = r.dataset;
     }
     const auto& s = r.scores;
-    const bool within = s.name != "none" && r.noneFlip && r.floor && s.flip.count && evaluate::withinNoiseFloor(s.flip.mean - *r.noneFlip, r.floor->mean);
     const std::string ratio = r.noneFlip && *r.noneFlip > 0 && s.flip.count ? fmt::format("{:.3f}", s.flip.mean / *r.noneFlip) : "";
-    t.rows.push_back({r.dataset, s.name, r.input.empty() ? "—" : r.input, (within ? "≈ " : "") + cell(s.flip, 4), ratio, cell(s.psnr, 2),
+    t.rows.push_back({r.dataset, s.name, r.input.empty() ? "—" : r.input, (r.withinFloor() ? "≈ " : "") + cell(s.flip, 4), ratio, cell(s.psnr, 2),
                       cell(s.ssim, 4), cell(s.tPsnr, 2), cell(s.warpedErrorChange, 4), cell(s.historyUse, 3)});
   }
   return t;

@@ -39,6 +39,8 @@ struct MethodsRow {
   evaluate::MethodScores scores;
   std::optional<double> noneFlip;      // `none`'s mean ꟻLIP on the same input
   std::optional<evaluate::MeanWithError> floor;  // the dataset's reference noise floor (ꟻLIP)
+  // A method other than `none` whose difference with `none` is within the floor (≈).
+  bool withinFloor() const;
   // The ratio to `none` is above 1 and the difference is not within the floor.
   bool losesToNone() const;
 };
