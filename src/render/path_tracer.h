@@ -218,6 +218,10 @@ class PathTracer {
   // batch's BSDFs (then counts the lane). false when the path ends here. At a pixel's first hit,
   // which every path of the pixel shares, `first` holds its shading and ray origin, found once.
   struct FirstVertex;
+  // A frame's samples, in render's steps (path_tracer_frame.cpp), and a frame's radiance-change
+  // pairs, in renderChanges' (path_tracer_changes.cpp).
+  class FrameSampler;
+  class ChangeSampler;
   bool advance(PathState& path, int depth, const SurfaceHit& hit, const FirstVertex* first, PathScratch& scratch,
                std::size_t& lanes) const;
   // advance below the hit's emission: the punctual lights the tree selects, the light sample and

@@ -60,28 +60,107 @@ struct ChangeSums {
 
 }  // namespace
 
-void PathTracer::renderChanges(std::uint64_t frameIndex, const RenderCamera& camera, const RenderCamera& previousCamera, FrameBuffers& frame,
-                               RenderStatistics* statistics) const {
-  const std::size_t pixels = frame.pixelCount();
-  frame.directChange.assign(3 * pixels, 0.0f);
-  frame.indirectChange.assign(3 * pixels, 0.0f);
-  frame.changePairs.assign(pixels, 0.0f);
-  if (!previousRayTracing_ || pixels == 0) return;
-  const int width = camera.width(), height = camera.height();
-  // The thresholds on luminance: discard's (a fraction of the frame's mean luminance of each
-  // buffer, an RGB distance) over sqrt(3), the grey change's scale (frames/radiance_change.h).
-  auto imageLuminance = [](const std::vector<float>& rgb, std::size_t i) {
-    return luminance(glm::dvec3(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]));
-  };
-  const std::array<double, 2> tau{settings_.directThresholdFraction * frames::meanLuminance(frame.direct) / frames::kGreyDistance,
-                                  settings_.indirectThresholdFraction * frames::meanLuminance(frame.indirect) / frames::kGreyDistance};
-  const int cap = std::max(frames::kFirstPairs, settings_.maxPairs);
-  const double pixelSpread = std::atan(2.0 * std::tan(0.5 * camera.yfov()) / height);
-  const glm::dvec2 jitter = settings_.jitter ? frames::jitterOffset(static_cast<long>(frameIndex)) : glm::dvec2(0.0);
-  const std::uint64_t seed = settings_.seed ^ kPairStream;
-  const glm::dvec3 cameraNow = camera.position(), cameraBefore = previousCamera.position();
-  std::vector<ChangeSums> sums(pixels);
+// A frame's radiance-change pairs (renderChanges): each pixel's running sums, and per thread the
+// batch of samples whose two halves are traced together. renderChanges runs its steps in order:
+// the pixels in rounds, then the change buffers and the summary.
+class PathTracer::ChangeSampler {
+ public:
+  ChangeSampler(const PathTracer& tracer, std::uint64_t frameIndex, const RenderCamera& camera, const RenderCamera& previousCamera,
+                const FrameBuffers& frame)
+      : tracer_(tracer),
+        settings_(tracer.settings_),
+        frameIndex_(frameIndex),
+        camera_(camera),
+        frame_(frame),
+        width_(camera.width()),
+        // The thresholds on luminance: discard's (a fraction of the frame's mean luminance of each
+        // buffer, an RGB distance) over sqrt(3), the grey change's scale (frames/radiance_change.h).
+        tau_{settings_.directThresholdFraction * frames::meanLuminance(frame.direct) / frames::kGreyDistance,
+             settings_.indirectThresholdFraction * frames::meanLuminance(frame.indirect) / frames::kGreyDistance},
+        cap_(std::max(frames::kFirstPairs, settings_.maxPairs)),
+        pixelSpread_(std::atan(2.0 * std::tan(0.5 * camera.yfov()) / camera.height())),
+        jitter_(settings_.jitter ? frames::jitterOffset(static_cast<long>(frameIndex)) : glm::dvec2(0.0)),
+        seed_(settings_.seed ^ kPairStream),
+        cameraNow_(camera.position()),
+        cameraBefore_(previousCamera.position()),
+        batchSize_(std::max<std::size_t>(1, static_cast<std::size_t>(settings_.pathBatch) / 2)),
+        sums_(frame.pixelCount()),
+        batches_([spread = pixelSpread_] {
+          Batch b;
+          b.scratch.pixelSpread = spread;
+          return b;
+        }) {}
 
+  // Pixels in runs of 8, each in rounds: kFirstPairs pairs, then doubling while either buffer is
+  // undecided, up to the cap. A pixel's pairs depend on its own sums alone, so the result does not
+  // depend on the thread schedule.
+  void sampleInRounds() {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sums_.size(), 8), [&](const tbb::blocked_range<std::size_t>& run) {
+      Batch& b = batches_.local();
+      for (;;) {
+        b.samples.clear();
+        for (std::size_t pixel = run.begin(); pixel < run.end(); ++pixel) {
+          ChangeSums& sum = sums_[pixel];
+          if (sum.done) continue;
+          const int upTo = sum.attempted == 0 ? frames::kFirstPairs : std::min(cap_, 2 * sum.attempted);
+          for (int k = sum.attempted; k < upTo; ++k) b.samples.emplace_back(pixel, k);
+          sum.attempted = upTo;
+        }
+        if (b.samples.empty()) break;
+        for (std::size_t start = 0; start < b.samples.size(); start += batchSize_)
+          traceBatch(b, std::span(b.samples).subspan(start, std::min(batchSize_, b.samples.size() - start)));
+        for (std::size_t pixel = run.begin(); pixel < run.end(); ++pixel) {
+          ChangeSums& sum = sums_[pixel];
+          if (sum.done) continue;
+          const bool decided = frames::decideChange(estimate(sum, 0, pixel), tau_[0]) != frames::ChangeDecision::kUndecided &&
+                               frames::decideChange(estimate(sum, 1, pixel), tau_[1]) != frames::ChangeDecision::kUndecided;
+          // No pair after the first round: every sample's surface is new in this frame.
+          sum.done = decided || sum.attempted >= cap_ || sum.pairs == 0;
+        }
+      }
+    });
+  }
+
+  // The change buffers (mean, standard error, gathered light of each pixel) and pair counts, and
+  // the sampling summary's pair figures.
+  void write(FrameBuffers& frame) const {
+    long undecided = 0;
+    double totalPairs = 0.0;
+    int mostPairs = 0;
+    for (std::size_t pixel = 0; pixel < sums_.size(); ++pixel) {
+      const ChangeSums& sum = sums_[pixel];
+      std::array<frames::ChangeEstimate, 2> estimates{};
+      for (std::size_t b = 0; b < 2; ++b) {
+        const frames::ChangeEstimate e = estimates[b] = estimate(sum, b, pixel);
+        std::vector<float>& out = b == 0 ? frame.directChange : frame.indirectChange;
+        out[3 * pixel] = static_cast<float>(e.mean);
+        out[3 * pixel + 1] = static_cast<float>(e.standardError);
+        out[3 * pixel + 2] = static_cast<float>(e.gathered);
+      }
+      frame.changePairs[pixel] = static_cast<float>(sum.pairs);
+      totalPairs += sum.pairs;
+      mostPairs = std::max(mostPairs, sum.pairs);
+      if (sum.pairs > 0 && (frames::decideChange(estimates[0], tau_[0]) == frames::ChangeDecision::kUndecided ||
+                            frames::decideChange(estimates[1], tau_[1]) == frames::ChangeDecision::kUndecided))
+        ++undecided;
+    }
+    if (!frame.sampling) frame.sampling = frames::SamplingSummary{};
+    frame.sampling->pairCap = cap_;
+    frame.sampling->maxPairs = mostPairs;
+    frame.sampling->meanPairs = totalPairs / static_cast<double>(sums_.size());
+    frame.sampling->undecidedPixels = undecided;
+  }
+
+  // The threads' ray, shading-point and light counts.
+  void addCounts(RenderStatistics& statistics) const {
+    for (const Batch& b : batches_) {
+      statistics.rays += b.scratch.rays;
+      statistics.shadingPoints += b.scratch.shadingPoints;
+      statistics.punctualEvaluated += b.scratch.punctualEvaluated;
+    }
+  }
+
+ private:
   // Per thread: the path scratch, and a batch's samples with both halves' first vertices and paths.
   struct Batch {
     PathScratch scratch;
@@ -92,31 +171,65 @@ void PathTracer::renderChanges(std::uint64_t frameIndex, const RenderCamera& cam
     std::vector<PathState> pathsNow, pathsBefore;
     std::vector<std::size_t> traced;  // samples whose halves are traced (the others escaped or have no pair)
   };
-  tbb::enumerable_thread_specific<Batch> batches([&] {
-    Batch b;
-    b.scratch.pixelSpread = pixelSpread;
-    return b;
-  });
-  const std::size_t batchSize = std::max<std::size_t>(1, static_cast<std::size_t>(settings_.pathBatch) / 2);
+  // What both halves of one sample share: its key, this frame's hit, the view direction from this
+  // frame's camera, and the texture coordinates and level of detail of this frame's sample.
+  struct PairKey {
+    std::size_t pixel = 0;
+    int sample = 0;
+    const SurfaceHit* hitNow = nullptr;
+    glm::dvec3 woNow{0.0};
+    glm::dvec2 uv{0.0};
+    double lod = 0.0;
+  };
+
+  // A pixel's estimate in buffer b (0 direct, 1 indirect), floored by the frame's own luminance there.
+  frames::ChangeEstimate estimate(const ChangeSums& sum, std::size_t b, std::size_t pixel) const {
+    const std::vector<float>& rgb = b == 0 ? frame_.direct : frame_.indirect;
+    return sum.estimate(b, luminance(glm::dvec3(rgb[3 * pixel], rgb[3 * pixel + 1], rgb[3 * pixel + 2])));
+  }
 
   // One batch of samples: trace their camera rays in this frame, rebuild each hit in the previous
   // frame, trace both halves, add each pair to its pixel's sums.
-  auto trace = [&](Batch& b, std::span<const std::pair<std::size_t, int>> samples) {
+  void traceBatch(Batch& b, std::span<const std::pair<std::size_t, int>> samples) {
+    traceCameraRays(b, samples);
+    setUpPairs(b, samples);
+    if (b.traced.empty()) return;
+    b.scratch.pairLights = &tracer_.pairLights_;
+    b.scratch.scene = tracer_.rayTracing_.get();
+    b.scratch.lights = &tracer_.lights_;
+    b.scratch.pairHalf = 0;
+    tracer_.tracePaths(b.pathsNow, b.scratch, true);
+    b.scratch.scene = tracer_.previousRayTracing_.get();
+    b.scratch.lights = &tracer_.previousLights_;
+    b.scratch.pairHalf = 1;
+    tracer_.tracePaths(b.pathsBefore, b.scratch, true);
+    addPairs(b, samples);
+  }
+
+  // The samples' camera rays (offset by the pixel filter from the pair stream) and their hits in this frame.
+  void traceCameraRays(Batch& b, std::span<const std::pair<std::size_t, int>> samples) const {
     const std::size_t n = samples.size();
     b.rays.resize(n);
     b.hits.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const auto [pixel, sample] = samples[k];
+      const int px = static_cast<int>(pixel % static_cast<std::size_t>(width_)), py = static_cast<int>(pixel / static_cast<std::size_t>(width_));
+      Random rng = Random::vertex(seed_, frameIndex_, pixel, static_cast<std::uint64_t>(sample), 0);
+      const glm::dvec2 offset = tracer_.filter_.atCentre() ? glm::dvec2(0.0) : tracer_.filter_.offset(rng.uniform2());
+      b.rays[k] = camera_.ray(px + 0.5 + jitter_.x + offset.x, py + 0.5 + jitter_.y + offset.y);
+    }
+    tracer_.rayTracing_->intersect(b.rays, b.hits);
+    b.scratch.rays += n;
+  }
+
+  // Each sample's hit rebuilt in the previous frame and both halves' first vertices and paths set
+  // up (b.traced); an escaped sample adds its pair here (the environment, at infinity and
+  // unanimated: the same radiance in both frames), a surface absent from the previous frame none.
+  void setUpPairs(Batch& b, std::span<const std::pair<std::size_t, int>> samples) {
+    const std::size_t n = samples.size();
     b.previousHits.resize(n);
     b.now.resize(n);
     b.before.resize(n);
-    for (std::size_t k = 0; k < n; ++k) {
-      const auto [pixel, sample] = samples[k];
-      const int px = static_cast<int>(pixel % static_cast<std::size_t>(width)), py = static_cast<int>(pixel / static_cast<std::size_t>(width));
-      Random rng = Random::vertex(seed, frameIndex, pixel, static_cast<std::uint64_t>(sample), 0);
-      const glm::dvec2 offset = filter_.atCentre() ? glm::dvec2(0.0) : filter_.offset(rng.uniform2());
-      b.rays[k] = camera.ray(px + 0.5 + jitter.x + offset.x, py + 0.5 + jitter.y + offset.y);
-    }
-    rayTracing_->intersect(b.rays, b.hits);
-    b.scratch.rays += n;
     b.pathsNow.clear();
     b.pathsBefore.clear();
     b.traced.clear();
@@ -124,63 +237,60 @@ void PathTracer::renderChanges(std::uint64_t frameIndex, const RenderCamera& cam
       const auto [pixel, sample] = samples[k];
       const SurfaceHit& hit = b.hits[k];
       if (!hit.hit) {
-        // The environment, at infinity and unanimated: the same radiance in both frames.
-        const double y = environment_ ? luminance(environment_->radiance(b.rays[k].direction)) : 0.0;
-        sums[pixel].add({y, 0.0}, {y, 0.0}, {0.0, 0.0});
+        const double y = tracer_.environment_ ? luminance(tracer_.environment_->radiance(b.rays[k].direction)) : 0.0;
+        sums_[pixel].add({y, 0.0}, {y, 0.0}, {0.0, 0.0});
         continue;
       }
-      b.previousHits[k] = previousRayTracing_->surfaceAt(hit);
+      b.previousHits[k] = tracer_.previousRayTracing_->surfaceAt(hit);
       if (!b.previousHits[k].hit) continue;  // the surface is not in the previous frame: no pair
       // Both halves' first vertices alike: the view direction from each frame's camera to its
       // point, the texture level of detail of this frame's sample (a filtering choice of the
       // pixel, not a change of its lighting).
-      const glm::dvec2 uv = texCoord(hit);
-      const glm::dvec3 woNow = glm::normalize(cameraNow - hit.position);
-      const auto cornersNow = rayTracing_->trianglePositions(hit);
-      const double lod = textureLodAt(hit, cornersNow, -woNow, pixelSpread * hit.distance);
-      auto setUp = [&](FirstVertex& v, const SurfaceHit& h, const glm::dvec3& cameraPosition, const std::array<glm::dvec3, 3>& corners,
-                       std::vector<PathState>& paths) {
-        glm::dvec3 wo = glm::normalize(cameraPosition - h.position);
-        // A point the previous camera sees from behind (a silhouette turning away) is shaded from
-        // the side this frame sees, the view mirrored in its plane: which side a camera sees is the
-        // position column's business, not a change of lighting.
-        if (&h != &hit && (glm::dot(h.geometricNormal, wo) > 0) != (glm::dot(hit.geometricNormal, woNow) > 0))
-          wo -= 2.0 * glm::dot(wo, h.geometricNormal) * h.geometricNormal;
-        v.pixel = pixel;
-        v.ray = Ray{cameraPosition, -wo};
-        v.hit = &h;
-        shadeAt(h, wo, uv, corners, lod, v.shading);
-        v.origin = offsetOrigin(h.position, v.shading.geometricNormal);
-        PathState& p = paths.emplace_back();
-        p.first = &v;
-        p.ray = v.ray;
-        p.keyed = true;
-        p.keySeed = seed;
-        p.keyFrame = frameIndex;
-        p.keyPixel = pixel;
-        p.keySample = static_cast<std::uint64_t>(sample);
-        // Both halves' first bounces are sampled from this frame's view, carried into the previous
-        // surface's shading frame where it turned: the same lobe and direction wherever the surface
-        // did not move, so the rest of the path is the same (see renderChanges in path_tracer.h);
-        // both weigh it with the scalar BSDF (the batch's SIMD evaluation rounds differently).
-        p.sharedFirstBounce = true;
-        const glm::dvec3& nowNormal = b.now[k].shading.shadingNormal;
-        p.samplingView = v.shading.shadingNormal == nowNormal ? woNow : Frame(v.shading.shadingNormal).toWorld(Frame(nowNormal).toLocal(woNow));
-      };
-      setUp(b.now[k], hit, cameraNow, cornersNow, b.pathsNow);
-      setUp(b.before[k], b.previousHits[k], cameraBefore, previousRayTracing_->trianglePositions(b.previousHits[k]), b.pathsBefore);
+      PairKey key{pixel, sample, &hit, glm::normalize(cameraNow_ - hit.position), tracer_.texCoord(hit), 0.0};
+      const auto cornersNow = tracer_.rayTracing_->trianglePositions(hit);
+      key.lod = tracer_.textureLodAt(hit, cornersNow, -key.woNow, pixelSpread_ * hit.distance);
+      setUpHalf(key, hit, cameraNow_, cornersNow, nullptr, b.now[k], b.pathsNow);
+      setUpHalf(key, b.previousHits[k], cameraBefore_, tracer_.previousRayTracing_->trianglePositions(b.previousHits[k]), &b.now[k],
+                b.before[k], b.pathsBefore);
       b.traced.push_back(k);
     }
-    if (b.traced.empty()) return;
-    b.scratch.pairLights = &pairLights_;
-    b.scratch.scene = rayTracing_.get();
-    b.scratch.lights = &lights_;
-    b.scratch.pairHalf = 0;
-    tracePaths(b.pathsNow, b.scratch, true);
-    b.scratch.scene = previousRayTracing_.get();
-    b.scratch.lights = &previousLights_;
-    b.scratch.pairHalf = 1;
-    tracePaths(b.pathsBefore, b.scratch, true);
+  }
+
+  // One half's first vertex v at hit h seen from cameraPosition (corners: the triangle's world
+  // corners in that half's frame), and its path added to `paths`; nowHalf: this frame's half when
+  // v is the previous frame's, else nullptr.
+  void setUpHalf(const PairKey& key, const SurfaceHit& h, const glm::dvec3& cameraPosition, const std::array<glm::dvec3, 3>& corners,
+                 const FirstVertex* nowHalf, FirstVertex& v, std::vector<PathState>& paths) const {
+    glm::dvec3 wo = glm::normalize(cameraPosition - h.position);
+    // A point the previous camera sees from behind (a silhouette turning away) is shaded from
+    // the side this frame sees, the view mirrored in its plane: which side a camera sees is the
+    // position column's business, not a change of lighting.
+    if (nowHalf && (glm::dot(h.geometricNormal, wo) > 0) != (glm::dot(key.hitNow->geometricNormal, key.woNow) > 0))
+      wo -= 2.0 * glm::dot(wo, h.geometricNormal) * h.geometricNormal;
+    v.pixel = key.pixel;
+    v.ray = Ray{cameraPosition, -wo};
+    v.hit = &h;
+    tracer_.shadeAt(h, wo, key.uv, corners, key.lod, v.shading);
+    v.origin = offsetOrigin(h.position, v.shading.geometricNormal);
+    PathState& p = paths.emplace_back();
+    p.first = &v;
+    p.ray = v.ray;
+    p.keyed = true;
+    p.keySeed = seed_;
+    p.keyFrame = frameIndex_;
+    p.keyPixel = key.pixel;
+    p.keySample = static_cast<std::uint64_t>(key.sample);
+    // Both halves' first bounces are sampled from this frame's view, carried into the previous
+    // surface's shading frame where it turned: the same lobe and direction wherever the surface
+    // did not move, so the rest of the path is the same (see renderChanges in path_tracer.h);
+    // both weigh it with the scalar BSDF (the batch's SIMD evaluation rounds differently).
+    p.sharedFirstBounce = true;
+    const glm::dvec3& nowNormal = nowHalf ? nowHalf->shading.shadingNormal : v.shading.shadingNormal;
+    p.samplingView = v.shading.shadingNormal == nowNormal ? key.woNow : Frame(v.shading.shadingNormal).toWorld(Frame(nowNormal).toLocal(key.woNow));
+  }
+
+  // Each traced sample's pair added to its pixel's sums.
+  void addPairs(const Batch& b, std::span<const std::pair<std::size_t, int>> samples) {
     for (std::size_t j = 0; j < b.traced.size(); ++j) {
       const std::size_t k = b.traced[j];
       const PathSample& now = b.pathsNow[j].out;
@@ -190,69 +300,38 @@ void PathTracer::renderChanges(std::uint64_t frameIndex, const RenderCamera& cam
       const double gatheredDirect = std::abs(yNow - luminance(b.now[k].shading.material.emission)) +
                                     std::abs(yBefore - luminance(b.before[k].shading.material.emission));
       const double gatheredIndirect = std::abs(luminance(now.indirect)) + std::abs(luminance(before.indirect));
-      sums[samples[k].first].add({yNow, luminance(now.indirect)}, {yBefore, luminance(before.indirect)}, {gatheredDirect, gatheredIndirect});
+      sums_[samples[k].first].add({yNow, luminance(now.indirect)}, {yBefore, luminance(before.indirect)}, {gatheredDirect, gatheredIndirect});
     }
-  };
-
-  // Pixels in runs of 8, each in rounds: kFirstPairs pairs, then doubling while either buffer is
-  // undecided, up to the cap. A pixel's pairs depend on its own sums alone, so the result does not
-  // depend on the thread schedule.
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pixels, 8), [&](const tbb::blocked_range<std::size_t>& run) {
-    Batch& b = batches.local();
-    for (;;) {
-      b.samples.clear();
-      for (std::size_t pixel = run.begin(); pixel < run.end(); ++pixel) {
-        ChangeSums& sum = sums[pixel];
-        if (sum.done) continue;
-        const int upTo = sum.attempted == 0 ? frames::kFirstPairs : std::min(cap, 2 * sum.attempted);
-        for (int k = sum.attempted; k < upTo; ++k) b.samples.emplace_back(pixel, k);
-        sum.attempted = upTo;
-      }
-      if (b.samples.empty()) break;
-      for (std::size_t start = 0; start < b.samples.size(); start += batchSize)
-        trace(b, std::span(b.samples).subspan(start, std::min(batchSize, b.samples.size() - start)));
-      for (std::size_t pixel = run.begin(); pixel < run.end(); ++pixel) {
-        ChangeSums& sum = sums[pixel];
-        if (sum.done) continue;
-        const bool decided = frames::decideChange(sum.estimate(0, imageLuminance(frame.direct, pixel)), tau[0]) != frames::ChangeDecision::kUndecided &&
-                             frames::decideChange(sum.estimate(1, imageLuminance(frame.indirect, pixel)), tau[1]) != frames::ChangeDecision::kUndecided;
-        // No pair after the first round: every sample's surface is new in this frame.
-        sum.done = decided || sum.attempted >= cap || sum.pairs == 0;
-      }
-    }
-  });
-
-  long undecided = 0;
-  double totalPairs = 0.0;
-  int mostPairs = 0;
-  for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
-    const ChangeSums& sum = sums[pixel];
-    std::array<frames::ChangeEstimate, 2> estimates{};
-    for (std::size_t b = 0; b < 2; ++b) {
-      const frames::ChangeEstimate e = estimates[b] = sum.estimate(b, imageLuminance(b == 0 ? frame.direct : frame.indirect, pixel));
-      std::vector<float>& out = b == 0 ? frame.directChange : frame.indirectChange;
-      out[3 * pixel] = static_cast<float>(e.mean);
-      out[3 * pixel + 1] = static_cast<float>(e.standardError);
-      out[3 * pixel + 2] = static_cast<float>(e.gathered);
-    }
-    frame.changePairs[pixel] = static_cast<float>(sum.pairs);
-    totalPairs += sum.pairs;
-    mostPairs = std::max(mostPairs, sum.pairs);
-    if (sum.pairs > 0 && (frames::decideChange(estimates[0], tau[0]) == frames::ChangeDecision::kUndecided ||
-                          frames::decideChange(estimates[1], tau[1]) == frames::ChangeDecision::kUndecided))
-      ++undecided;
   }
-  if (!frame.sampling) frame.sampling = frames::SamplingSummary{};
-  frame.sampling->pairCap = cap;
-  frame.sampling->maxPairs = mostPairs;
-  frame.sampling->meanPairs = totalPairs / static_cast<double>(pixels);
-  frame.sampling->undecidedPixels = undecided;
-  if (statistics)
-    for (const Batch& b : batches) {
-      statistics->rays += b.scratch.rays;
-      statistics->shadingPoints += b.scratch.shadingPoints;
-      statistics->punctualEvaluated += b.scratch.punctualEvaluated;
-    }
+
+  const PathTracer& tracer_;
+  const RenderSettings& settings_;
+  const std::uint64_t frameIndex_;
+  const RenderCamera& camera_;
+  const FrameBuffers& frame_;
+  const int width_;
+  const std::array<double, 2> tau_;
+  const int cap_;
+  const double pixelSpread_;
+  const glm::dvec2 jitter_;
+  const std::uint64_t seed_;
+  const glm::dvec3 cameraNow_, cameraBefore_;
+  const std::size_t batchSize_;
+  std::vector<ChangeSums> sums_;
+  tbb::enumerable_thread_specific<Batch> batches_;
+};
+
+void PathTracer::renderChanges(std::uint64_t frameIndex, const RenderCamera& camera, const RenderCamera& previousCamera, FrameBuffers& frame,
+                               RenderStatistics* statistics) const {
+  const std::size_t pixels = frame.pixelCount();
+  frame.directChange.assign(3 * pixels, 0.0f);
+  frame.indirectChange.assign(3 * pixels, 0.0f);
+  frame.changePairs.assign(pixels, 0.0f);
+  if (!previousRayTracing_ || pixels == 0) return;
+  ChangeSampler sampler(*this, frameIndex, camera, previousCamera, frame);
+  sampler.sampleInRounds();
+  sampler.write(frame);
+  if (statistics) sampler.addCounts(*statistics);
 }
 
 }  // namespace dynbench::render
