@@ -345,19 +345,17 @@ void dynbench_scene_rendered(const refdef_t* view) {
   g_db.pending_game_frame = -1;
 }
 
-void dynbench_render_scene(const refdef_t* view) {
-  if (!g_db.active || (view->rdflags & RDF_NOWORLDMODEL) || !cg.snap) return;
-  ++g_db.pass;
-  /* How many frames the client takes to connect and load depends on the machine's load, and the
-   * client shares the C library's random numbers with the game and the bots (native modules in
-   * one process), so a match that ran while the client connected would differ from run to run.
-   * The client joins as a spectator (userinfo team s) of an empty level; at a fixed server time
-   * the adapter restarts the level (map_restart 0: the game module re-seeds from
-   * DYNBENCH_CAPTURE_SEED, the client stays connected, and the game module adds the bots of
-   * DYNBENCH_CAPTURE_BOTS in the same command pass): the match starts in the same engine frame,
-   * with the same random numbers, on every run. Recording starts at a fixed time after it. (Bots
-   * added from here, a frame after this module saw the restart, joined a frame apart from run to
-   * run; so does the moment the server starts answering `follow`.) */
+/* Before the match: whether recording has started. How many frames the client takes to connect
+ * and load depends on the machine's load, and the client shares the C library's random numbers
+ * with the game and the bots (native modules in one process), so a match that ran while the client
+ * connected would differ from run to run. The client joins as a spectator (userinfo team s) of an
+ * empty level; at a fixed server time the adapter restarts the level (map_restart 0: the game
+ * module re-seeds from DYNBENCH_CAPTURE_SEED, the client stays connected, and the game module adds
+ * the bots of DYNBENCH_CAPTURE_BOTS in the same command pass): the match starts in the same engine
+ * frame, with the same random numbers, on every run. Recording starts at a fixed time after it.
+ * (Bots added from here, a frame after this module saw the restart, joined a frame apart from run
+ * to run; so does the moment the server starts answering `follow`.) */
+static int match_started(void) {
   if (!g_db.restarted) {
     if (!g_db.connected_at) {
       g_db.connected_at = cg.snap->serverTime;
@@ -371,7 +369,7 @@ void dynbench_render_scene(const refdef_t* view) {
       trap_SendConsoleCommand("map_restart 0\n");
       g_db.restart_sent = 1;
     }
-    return;
+    return 0;
   }
   const int following = ensure_following();
   if (!g_db.started) {
@@ -381,59 +379,53 @@ void dynbench_render_scene(const refdef_t* view) {
         g_db.active = 0;
         trap_SendConsoleCommand("quit\n");
       }
-      return;
+      return 0;
     }
     g_db.started = 1;
     g_db.start_time = cg.time;
     g_db.window_start = trap_Milliseconds(); /* the machine's clock: this is the one place it is read */
     printf("dynbench-capture: level started at %d ms of server time, recording from %d\n", cgs.levelStartTime, cg.time);
   }
-  const playerState_t* ps = &cg.snap->ps;
-  /* --follow auto: the next bot once the followed one dies (the server switches the view) */
-  const int dead = ps->stats[STAT_HEALTH] <= 0 || ps->pm_type == PM_DEAD;
-  if (dead && !strcmp(g_db.follow, "auto") && g_db.next_sent_for_death != ps->clientNum + 1) {
-    trap_SendClientCommand("follownext");
-    g_db.next_sent_for_death = ps->clientNum + 1;
+  return 1;
+}
+
+/* A window played without recording (DYNBENCH_CAPTURE_RECORD=0, the overhead benchmark): counts
+ * the frame and quits after the last. */
+static void count_unrecorded_frame(void) {
+  printf("dynbench-capture: %d/%d frames\n", ++g_db.frame, g_db.total_frames);
+  if (g_db.frame >= g_db.total_frames) {
+    printf("dynbench-capture: window of %d frames took %d ms of wall time (not recorded)\n", g_db.frame, trap_Milliseconds() - g_db.window_start);
+    fflush(stdout);
+    g_db.active = 0;
+    trap_SendConsoleCommand("quit\n");
   }
-  if (!dead) g_db.next_sent_for_death = 0;
-  if (!g_db.record) {
-    printf("dynbench-capture: %d/%d frames\n", ++g_db.frame, g_db.total_frames);
-    if (g_db.frame >= g_db.total_frames) {
-      printf("dynbench-capture: window of %d frames took %d ms of wall time (not recorded)\n", g_db.frame, trap_Milliseconds() - g_db.window_start);
-      fflush(stdout);
-      g_db.active = 0;
-      trap_SendConsoleCommand("quit\n");
-    }
-    return;
-  }
-  dbc_session* s = g_db.session;
-  /* The capture's lens is set once, before the first frame. The view's field of view can change
-   * later (CG_CalcFov waves it while the followed player is under water, and zooms): the capture
-   * keeps the first, and says so once. */
+}
+
+/* The capture's lens is set once, before the first frame. The view's field of view can change
+ * later (CG_CalcFov waves it while the followed player is under water, and zooms): the capture
+ * keeps the first, and says so once. 0 on failure. */
+static int record_lens(dbc_session* s, const refdef_t* view) {
   if (!g_db.last_camera_width) {
     g_db.last_camera_width = view->width;
     g_db.last_camera_height = view->height;
     g_db.camera_fov = view->fov_y;
-    if (dbc_set_camera_settings(s, (float)view->width / (float)view->height, view->fov_y, 4.0f, 16384.0f) != DBC_OK) { db_fail("camera settings"); return; }
+    if (dbc_set_camera_settings(s, (float)view->width / (float)view->height, view->fov_y, 4.0f, 16384.0f) != DBC_OK) { db_fail("camera settings"); return 0; }
   } else if (!g_db.fov_change_reported && (view->width != g_db.last_camera_width || view->height != g_db.last_camera_height || view->fov_y != g_db.camera_fov)) {
     g_db.fov_change_reported = 1;
     fprintf(stderr, "dynbench-capture: note: the view's field of view changed at frame %d (%.3f to %.3f degrees, under water or zoomed); the capture keeps the first\n",
             g_db.frame, g_db.camera_fov, view->fov_y);
   }
-  /* models are recorded between frames: every drawn one first */
-  static char paths[MAX_PENDING][3 * MAX_QPATH];
-  static int key_frames[MAX_PENDING];
-  for (int i = 0; i < g_db.entity_count; ++i) {
-    if (!model_path_of(&g_db.entities[i].entity, paths[i], &key_frames[i])) paths[i][0] = 0;
-    if (!g_db.active) return;
-  }
-  if (dbc_frame_begin(s, (uint64_t)g_db.frame, (cg.time - g_db.start_time) / 1000.0) != DBC_OK) { db_fail("frame"); return; }
+  return 1;
+}
+
+/* The frame's camera, and a cut where the view jumped: another player followed, a respawn or a
+ * teleporter (the game toggles EF_TELEPORT_BIT when the view's origin jumps), or a jump the game
+ * did not mark. 0 on failure. */
+static int record_camera(dbc_session* s, const refdef_t* view, const playerState_t* ps, int dead) {
   float position[3], pitch, yaw, roll;
   to_capture(view->vieworg, position);
   camera_angles(view, &pitch, &yaw, &roll);
-  if (dbc_camera(s, g_db.camera_id, position, pitch, yaw, roll) != DBC_OK) { db_fail("camera"); return; }
-  /* cuts: another player followed, a respawn or a teleporter (the game toggles EF_TELEPORT_BIT
-   * when the view's origin jumps), or a jump the game did not mark */
+  if (dbc_camera(s, g_db.camera_id, position, pitch, yaw, roll) != DBC_OK) { db_fail("camera"); return 0; }
   const int teleport = ps->eFlags & EF_TELEPORT_BIT;
   if (g_db.have_last) {
     const float dx = position[0] - g_db.last_position[0], dy = position[1] - g_db.last_position[1], dz = position[2] - g_db.last_position[2];
@@ -441,26 +433,34 @@ void dynbench_render_scene(const refdef_t* view) {
     if (ps->clientNum != g_db.last_client) reason = "switch";
     else if (teleport != g_db.last_teleport) reason = g_db.last_dead ? "respawn" : "teleport";
     else if (dx * dx + dy * dy + dz * dz > 64.0f * 64.0f) reason = "teleport";
-    if (reason && dbc_camera_cut(s, g_db.camera_id, reason) != DBC_OK) { db_fail("camera cut"); return; }
+    if (reason && dbc_camera_cut(s, g_db.camera_id, reason) != DBC_OK) { db_fail("camera cut"); return 0; }
   }
   g_db.have_last = 1;
   g_db.last_client = ps->clientNum;
   g_db.last_teleport = teleport;
   g_db.last_dead = dead;
   memcpy(g_db.last_position, position, sizeof(position));
+  return 1;
+}
 
-  if (g_db.frame == 0) {
-    const dbc_dual_quat identity_pose = {0, 0, 0, 1, 0, 0, 0, 0};
-    if (dbc_static_model(s, dbc_new_id(s), g_db.world_path, identity_pose) != DBC_OK) { db_fail("world"); return; }
-    for (int i = 0; i < g_db.static_light_count; ++i) {
-      const float* light = g_db.static_lights[i];
-      if (dbc_light(s, dbc_new_id(s), light, light + 3, light[6], (dbc_light_falloff)(int)light[7], DBC_LIGHT_POINT, 0,
-                    g_db.have_map_lights ? "maplight" : "surfacelight") != DBC_OK) {
-        db_fail("surface light");
-        return;
-      }
+/* The first frame's world model and the map's static lights. 0 on failure. */
+static int record_world(dbc_session* s) {
+  const dbc_dual_quat identity_pose = {0, 0, 0, 1, 0, 0, 0, 0};
+  if (dbc_static_model(s, dbc_new_id(s), g_db.world_path, identity_pose) != DBC_OK) { db_fail("world"); return 0; }
+  for (int i = 0; i < g_db.static_light_count; ++i) {
+    const float* light = g_db.static_lights[i];
+    if (dbc_light(s, dbc_new_id(s), light, light + 3, light[6], (dbc_light_falloff)(int)light[7], DBC_LIGHT_POINT, 0,
+                  g_db.have_map_lights ? "maplight" : "surfacelight") != DBC_OK) {
+      db_fail("surface light");
+      return 0;
     }
   }
+  return 1;
+}
+
+/* The frame's drawn models (paths and key-frame counts found before the frame began) with their
+ * poses and key frames, and its dynamic lights. 0 on failure. */
+static int record_entities(dbc_session* s, char paths[][3 * MAX_QPATH], const int* key_frames) {
   for (int i = 0; i < g_db.entity_count && g_db.active; ++i) {
     const pending_entity_t* p = &g_db.entities[i];
     const char* path = paths[i];
@@ -468,11 +468,11 @@ void dynbench_render_scene(const refdef_t* view) {
     if (!path[0]) continue;
     int fresh;
     const uint64_t id = identity(p->slot, p->serial, p->entity.hModel, p->entity.customSkin, p->occurrence, &fresh);
-    if (dbc_model(s, id, path, pose_of(&p->entity)) != DBC_OK) { db_fail("model transform"); return; }
+    if (dbc_model(s, id, path, pose_of(&p->entity)) != DBC_OK) { db_fail("model transform"); return 0; }
     if (frames > 1) {
       const uint32_t from = (uint32_t)(p->entity.oldframe % frames), to = (uint32_t)(p->entity.frame % frames);
       const float fraction = fminf(1.0f, fmaxf(0.0f, 1.0f - p->entity.backlerp));
-      if (dbc_vertex_frames(s, id, path, from, to, fraction) != DBC_OK) { db_fail("key frames"); return; }
+      if (dbc_vertex_frames(s, id, path, from, to, fraction) != DBC_OK) { db_fail("key frames"); return 0; }
     }
   }
   for (int i = 0; i < g_db.light_count; ++i) {
@@ -483,9 +483,14 @@ void dynbench_render_scene(const refdef_t* view) {
     to_capture(l->origin, at);
     const char* type = l->entity_type == ET_MISSILE ? "missile" : l->entity_type == ET_PLAYER ? "flash" : l->entity_type == -2 ? "explosion" : "effect";
     /* the renderer's dynamic light reaches `intensity` units and fades towards it */
-    if (dbc_light(s, id, at, l->rgb, l->intensity, DBC_FALLOFF_QUADRATIC, DBC_LIGHT_POINT, 1, type) != DBC_OK) { db_fail("light"); return; }
+    if (dbc_light(s, id, at, l->rgb, l->intensity, DBC_FALLOFF_QUADRATIC, DBC_LIGHT_POINT, 1, type) != DBC_OK) { db_fail("light"); return 0; }
   }
-  if (dbc_frame_end(s) != DBC_OK) { db_fail("frame end"); return; }
+  return 1;
+}
+
+/* After a recorded frame: the game frame to keep, progress, and after the last frame the capture
+ * closed and the game quit. */
+static void finish_frame(dbc_session* s) {
   if (strstr(g_db.game_frames, va(",%d,", g_db.frame))) g_db.pending_game_frame = g_db.frame;
   ++g_db.frame;
   printf("dynbench-capture: %d/%d frames\n", g_db.frame, g_db.total_frames);
@@ -499,6 +504,39 @@ void dynbench_render_scene(const refdef_t* view) {
     fflush(stdout);
     trap_SendConsoleCommand("quit\n");
   }
+}
+
+void dynbench_render_scene(const refdef_t* view) {
+  if (!g_db.active || (view->rdflags & RDF_NOWORLDMODEL) || !cg.snap) return;
+  ++g_db.pass;
+  if (!match_started()) return;
+  const playerState_t* ps = &cg.snap->ps;
+  /* --follow auto: the next bot once the followed one dies (the server switches the view) */
+  const int dead = ps->stats[STAT_HEALTH] <= 0 || ps->pm_type == PM_DEAD;
+  if (dead && !strcmp(g_db.follow, "auto") && g_db.next_sent_for_death != ps->clientNum + 1) {
+    trap_SendClientCommand("follownext");
+    g_db.next_sent_for_death = ps->clientNum + 1;
+  }
+  if (!dead) g_db.next_sent_for_death = 0;
+  if (!g_db.record) {
+    count_unrecorded_frame();
+    return;
+  }
+  dbc_session* s = g_db.session;
+  if (!record_lens(s, view)) return;
+  /* models are recorded between frames: every drawn one first */
+  static char paths[MAX_PENDING][3 * MAX_QPATH];
+  static int key_frames[MAX_PENDING];
+  for (int i = 0; i < g_db.entity_count; ++i) {
+    if (!model_path_of(&g_db.entities[i].entity, paths[i], &key_frames[i])) paths[i][0] = 0;
+    if (!g_db.active) return;
+  }
+  if (dbc_frame_begin(s, (uint64_t)g_db.frame, (cg.time - g_db.start_time) / 1000.0) != DBC_OK) { db_fail("frame"); return; }
+  if (!record_camera(s, view, ps, dead)) return;
+  if (g_db.frame == 0 && !record_world(s)) return;
+  if (!record_entities(s, paths, key_frames)) return;
+  if (dbc_frame_end(s) != DBC_OK) { db_fail("frame end"); return; }
+  finish_frame(s);
 }
 
 int dynbench_frame_time(int server_time) {
