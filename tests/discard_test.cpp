@@ -550,6 +550,11 @@ TEST(DiscardCli, ASubPixelPanOverAFineTextureDiscardsNothingWhenRadianceIsFilter
                                         dataset.string(), frames.string(), filtered ? "blackman-harris" : "centre"),
                             dir);
     ASSERT_EQ(r.status, 0) << r.err;
+    // No indirect light at all (a floor alone, no environment): the indirect buffer's threshold is
+    // 0, and its black pixels are unchanged after their first pairs, not undecided up to the cap.
+    const auto sampling = nlohmann::json::parse(test::slurp(frames / "frame_00001.json"))["sampling"];
+    EXPECT_EQ(sampling["undecided_pixels"], 0) << sampling;
+    EXPECT_LT(sampling["max_pairs"].get<int>(), sampling["pair_cap"].get<int>()) << sampling;
     const auto d = dynbench(fmt::format("discard {} --json {}", frames.string(), (dir / "d.json").string()), dir);
     ASSERT_EQ(d.status, 0) << d.err;
     const auto j = nlohmann::json::parse(test::slurp(dir / "d.json"));

@@ -33,6 +33,13 @@ TEST(RadianceChange, TheDecisionRuleAtKnownEstimates) {
   EXPECT_EQ(decideChange({0.0, 0.0, 2.0, 4}, tau), ChangeDecision::kUndecided);   // 1.5
   EXPECT_EQ(decideChange({0.0, 0.0, 2.0, 8}, tau), ChangeDecision::kUnchanged);   // 0.75
   EXPECT_EQ(decideChange({0.0, 0.0, 0.0, 4}, tau), ChangeDecision::kUnchanged);   // nothing a path gathered could differ
+  // A buffer black over the whole frame has tau 0: a black pixel (no light gathered, every D 0)
+  // is unchanged at once, a pixel whose paths gathered light is not (it could have changed by any
+  // amount), and any change at all is one.
+  EXPECT_EQ(decideChange({0.0, 0.0, 0.0, 4}, 0.0), ChangeDecision::kUnchanged);
+  EXPECT_EQ(decideChange({0.0, 0.0, 1e-9, 4096}, 0.0), ChangeDecision::kUndecided);
+  EXPECT_EQ(decideChange({1e-6, 0.0, 1e-6, 4}, 0.0), ChangeDecision::kChanged);
+  EXPECT_EQ(decideChange({0.0, 0.0, 0.0, 1}, 0.0), ChangeDecision::kUndecided);  // one pair is still too few
   // Every pair the same non-zero change: exact.
   EXPECT_EQ(decideChange({1.2, 0.0, 3.0, 4}, tau), ChangeDecision::kChanged);
   EXPECT_EQ(decideChange({5.0, 0.0, 5.0, 1}, tau), ChangeDecision::kUndecided);  // one pair has no spread to judge by

@@ -71,13 +71,17 @@ inline double unseenChangeBound(const ChangeEstimate& e) {
 // With at least two pairs: changed when |d| - tau > z s; unchanged when |d| + z s < tau, and where every D was exactly the
 // same (s = 0: nothing on any path changed, or everything by the same amount) only when the
 // unseen-change bound is below tau too; else undecided (more pairs, or counted as uncertain).
-// tau is the threshold on luminance (discard's RGB threshold / sqrt(3)).
+// tau is the threshold on luminance (discard's RGB threshold / sqrt(3)). A bound of exactly 0
+// (every D 0 and no light gathered on any path: a black pixel) is unchanged under any tau, also
+// 0: a buffer black over the whole frame has a relative threshold of 0, and its every pixel stayed
+// undecided up to the pair cap (4096 pairs a pixel for nothing).
 inline ChangeDecision decideChange(const ChangeEstimate& e, double tau) {
   if (e.pairs < 2) return ChangeDecision::kUndecided;  // no spread to judge by
   const double d = std::abs(e.mean), s = e.standardError;
   if (d - tau > kChangeZ * s) return ChangeDecision::kChanged;
   const double unseen = s > 0 ? 0.0 : unseenChangeBound(e);
-  if (d + kChangeZ * s + unseen < tau) return ChangeDecision::kUnchanged;
+  const double bound = d + kChangeZ * s + unseen;
+  if (bound < tau || bound == 0.0) return ChangeDecision::kUnchanged;
   return ChangeDecision::kUndecided;
 }
 
