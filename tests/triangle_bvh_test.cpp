@@ -158,6 +158,44 @@ TEST(TriangleBvh, AgreesWithEmbreeOnARandomSoup) {
   EXPECT_LE(a.occludedDisagree, a.rays / 2000);
 }
 
+// The shadow cache (occluded with lastBlocker) answers exactly as the plain test: rays side by side
+// towards one light through a random soup, the cache carried from ray to ray; it is used (some
+// rays are answered by the cached triangle) and a blocked ray leaves a triangle that blocks it.
+TEST(TriangleBvh, TheShadowCacheAnswersAsThePlainTest) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-10.0, 10.0), small(-1.5, 1.5);
+  std::vector<BvhTriangle> soup;
+  for (int i = 0; i < 2000; ++i) {
+    const glm::dvec3 c(u(rng), u(rng), u(rng));
+    soup.push_back(triangle(c + glm::dvec3(small(rng), small(rng), small(rng)), c + glm::dvec3(small(rng), small(rng), small(rng)),
+                            c + glm::dvec3(small(rng), small(rng), small(rng))));
+  }
+  const TriangleBvh bvh(soup);
+  const glm::dvec3 light(0.3, 11.0, -0.2);
+  std::uint32_t lastBlocker = TriangleBvh::kNoBlocker;
+  int blocked = 0, cacheAnswered = 0;
+  for (int row = 0; row < 100; ++row)
+    for (int column = 0; column < 100; ++column) {
+      const glm::dvec3 from(-10.0 + 0.2 * column, -11.0, -10.0 + 0.2 * row);
+      const glm::dvec3 d = light - from;
+      const double length = glm::length(d);
+      const std::uint32_t before = lastBlocker;
+      const bool plain = bvh.occluded(from, d / length, 1e-6, length - 1e-6);
+      const bool cached = bvh.occluded(from, d / length, 1e-6, length - 1e-6, lastBlocker);
+      ASSERT_EQ(cached, plain) << row << " " << column;
+      if (!plain) continue;
+      ++blocked;
+      cacheAnswered += lastBlocker == before;
+      ASSERT_NE(lastBlocker, TriangleBvh::kNoBlocker);
+    }
+  EXPECT_GT(blocked, 1000);
+  EXPECT_LT(blocked, 10000);
+  EXPECT_GT(cacheAnswered, blocked / 4) << "neighbouring rays are often blocked by the same triangle";
+  // A stale or unknown cache entry changes nothing.
+  std::uint32_t stale = 12345678;
+  EXPECT_FALSE(bvh.occluded({0, 50, 0}, {0, 1, 0}, 0.0, 10.0, stale));
+}
+
 TEST(OpenArena, TheFitsTracerAgreesWithEmbreeOnAMap) {
   DYNBENCH_NEEDS(test::missingOpenArena());
   auto files = GameFiles::open("/usr/lib/openarena/baseoa");

@@ -22,10 +22,15 @@ struct Occluders {
   // Surfaces nearer `from` than `inhibit` are passed through (q3map2's inhibitRadius: a grid
   // point's traces ignore what lies within half a grid step of it).
   bool visible(const glm::dvec3& from, const glm::dvec3& to, double inhibit = 0.0) const {
+    std::uint32_t noCache = TriangleBvh::kNoBlocker;
+    return visible(from, to, inhibit, noCache);
+  }
+  // The same with a shadow cache (TriangleBvh::occluded): for the rays of one light, in order.
+  bool visible(const glm::dvec3& from, const glm::dvec3& to, double inhibit, std::uint32_t& lastBlocker) const {
     const glm::dvec3 d = to - from;
     const double length = glm::length(d);
     if (length <= inhibit + 1e-6) return true;
-    return !solid.occluded(from + inhibit * (d / length), d / length, kTraceMargin, length - inhibit - kTraceMargin);
+    return !solid.occluded(from + inhibit * (d / length), d / length, kTraceMargin, length - inhibit - kTraceMargin, lastBlocker);
   }
   // Whether a ray from `from` towards `direction` reaches the sky (or leaves the map).
   bool seesSky(const glm::dvec3& from, const glm::dvec3& direction, double inhibit = 0.0) const {

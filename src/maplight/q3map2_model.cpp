@@ -203,13 +203,14 @@ Column candidateColumn(const glm::dvec3& position, const std::vector<Sample>& sa
   light.position = position;
   light.value = 1.0;
   light.range = range;
+  std::uint32_t lastBlocker = TriangleBvh::kNoBlocker;  // neighbouring texels' rays are often blocked alike
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const Sample& s = samples[i];
     const glm::dvec3 normal = receivingNormal(s, position);
     const double add = lightContribution(light, s.position, normal) * directedShare(s, normal);
     // below 1/4 of a byte for the brightest entity lights q3map2 maps use (V ~ 1000): nothing
     if (add * 1000.0 < 0.25) continue;
-    if (!occluders.visible(s.position, position, s.inhibit)) continue;
+    if (!occluders.visible(s.position, position, s.inhibit, lastBlocker)) continue;
     c.rows.push_back(static_cast<std::uint32_t>(i));
     c.values.push_back(static_cast<float>(add));
     c.norm2 += add * add;

@@ -162,6 +162,23 @@ std::uint32_t TriangleBvh::build(std::vector<std::uint32_t>& order, std::size_t 
 
 // Möller and Trumbore (1997), "Fast, minimum storage ray-triangle intersection", in double; a hit
 // where u >= 0, v >= 0, u + v <= 1 and tMin <= t <= tMax, either side.
+bool TriangleBvh::crosses(std::uint32_t k, const glm::dvec3& origin, const glm::dvec3& direction, double tMin, double tMax, double& u, double& v,
+                          double& t) const {
+  const Prepared& p = prepared_[k];
+  const glm::dvec3 pv = glm::cross(direction, p.e2);
+  const double det = glm::dot(p.e1, pv);
+  if (det == 0.0) return false;  // parallel to the plane, or a degenerate triangle
+  const double inv = 1.0 / det;
+  const glm::dvec3 tv = origin - p.p0;
+  u = glm::dot(tv, pv) * inv;
+  if (u < 0.0 || u > 1.0) return false;
+  const glm::dvec3 qv = glm::cross(tv, p.e1);
+  v = glm::dot(direction, qv) * inv;
+  if (v < 0.0 || u + v > 1.0) return false;
+  t = glm::dot(p.e2, qv) * inv;
+  return !(t < tMin || t > tMax);  // (so written, a NaN distance counts as a crossing, as it always has)
+}
+
 template <bool kAnyHit>
 bool TriangleBvh::trace(const glm::dvec3& origin, const glm::dvec3& direction, double tMin, double tMax, double& distance, std::uint32_t& triangle,
                         double& u, double& v) const {
@@ -195,20 +212,12 @@ bool TriangleBvh::trace(const glm::dvec3& origin, const glm::dvec3& direction, d
       continue;
     }
     for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
-      const Prepared& p = prepared_[k];
-      const glm::dvec3 pv = glm::cross(direction, p.e2);
-      const double det = glm::dot(p.e1, pv);
-      if (det == 0.0) continue;  // parallel to the plane, or a degenerate triangle
-      const double inv = 1.0 / det;
-      const glm::dvec3 tv = origin - p.p0;
-      const double uu = glm::dot(tv, pv) * inv;
-      if (uu < 0.0 || uu > 1.0) continue;
-      const glm::dvec3 qv = glm::cross(tv, p.e1);
-      const double vv = glm::dot(direction, qv) * inv;
-      if (vv < 0.0 || uu + vv > 1.0) continue;
-      const double t = glm::dot(p.e2, qv) * inv;
-      if (t < tMin || t > reach) continue;
-      if constexpr (kAnyHit) return true;
+      double uu = 0.0, vv = 0.0, t = 0.0;
+      if (!crosses(k, origin, direction, tMin, reach, uu, vv, t)) continue;
+      if constexpr (kAnyHit) {
+        triangle = k;
+        return true;
+      }
       // Two surfaces at the same distance (a wall's two coincident faces): the one facing the ray,
       // where Embree keeps whichever its traversal meets first.
       if (found && t >= best - tieTolerance(best) && !(facesRay(k, uu, vv, direction) && !facesRay(triangle, u, v, direction))) continue;
@@ -239,6 +248,15 @@ bool TriangleBvh::occluded(const glm::dvec3& origin, const glm::dvec3& direction
   double distance = 0.0, u = 0.0, v = 0.0;
   std::uint32_t triangle = 0;
   return trace<true>(origin, direction, tMin, tMax, distance, triangle, u, v);
+}
+
+bool TriangleBvh::occluded(const glm::dvec3& origin, const glm::dvec3& direction, double tMin, double tMax, std::uint32_t& lastBlocker) const {
+  double distance = 0.0, u = 0.0, v = 0.0, t = 0.0;
+  if (lastBlocker < prepared_.size() && crosses(lastBlocker, origin, direction, tMin, tMax, u, v, t)) return true;
+  std::uint32_t triangle = kNoBlocker;
+  const bool blocked = trace<true>(origin, direction, tMin, tMax, distance, triangle, u, v);
+  if (blocked) lastBlocker = triangle;
+  return blocked;
 }
 
 BvhHit TriangleBvh::intersect(const glm::dvec3& origin, const glm::dvec3& direction, double tMin) const {

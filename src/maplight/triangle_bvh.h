@@ -39,6 +39,13 @@ class TriangleBvh {
   // Whether some triangle (either side) crosses the ray at a distance in [tMin, tMax]. A tMin above
   // 0 keeps a ray that starts on a surface (within rounding) from being blocked by it.
   bool occluded(const glm::dvec3& origin, const glm::dvec3& direction, double tMin, double tMax) const;
+  // The same, trying first the triangle that blocked the caller's previous ray (`lastBlocker`,
+  // kNoBlocker at first; set to this ray's blocker when it is blocked): a shadow cache for rays
+  // that run side by side, as a candidate light's rays to neighbouring texels do. The answer is
+  // the same bits as without it (any crossing triangle blocks, and the triangle test is the one
+  // the traversal runs); only the work differs.
+  static constexpr std::uint32_t kNoBlocker = 0xffffffffu;
+  bool occluded(const glm::dvec3& origin, const glm::dvec3& direction, double tMin, double tMax, std::uint32_t& lastBlocker) const;
   // The nearest triangle the ray crosses at a distance of at least tMin; of two at the same
   // distance (within 1e-9 relative), the one whose shading normal faces the ray.
   BvhHit intersect(const glm::dvec3& origin, const glm::dvec3& direction, double tMin) const;
@@ -58,6 +65,10 @@ class TriangleBvh {
   };
   std::uint32_t build(std::vector<std::uint32_t>& order, std::size_t begin, std::size_t end, const std::vector<glm::dvec3>& centroids,
                       const std::vector<BvhTriangle>& triangles, std::size_t depth);
+  // Whether the ray crosses prepared triangle k at a distance in [tMin, tMax] (Möller-Trumbore),
+  // with the crossing's barycentrics and distance.
+  bool crosses(std::uint32_t k, const glm::dvec3& origin, const glm::dvec3& direction, double tMin, double tMax, double& u, double& v,
+               double& t) const;
   glm::dvec3 shadingNormal(std::uint32_t triangle, double u, double v) const;
   bool facesRay(std::uint32_t triangle, double u, double v, const glm::dvec3& direction) const;
   template <bool kAnyHit>
