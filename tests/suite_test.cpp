@@ -730,16 +730,19 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
 
   // The same suite as two halves on two folders (another machine's, say), the records brought
   // together and assembled with nothing rendered: suite.json and suite.md byte for byte the
-  // one-shot run's. (The captures are copied to spare the game; each half renders its own frames.)
+  // one-shot run's. (The captures and frames are copied to spare the game and the renders: each
+  // half makes its datasets, measures and records; the kills below render everything again.)
   {
     const fs::path a = dir / "half-a", b = dir / "half-b";
     for (const fs::path& half : {a, b}) {
       fs::create_directories(half);
       fs::copy(out / "captures", half / "captures", fs::copy_options::recursive);
+      fs::copy(out / "runs", half / "runs", fs::copy_options::recursive);
     }
     const auto first = dynbench(fmt::format("suite {} -o {} --only fps-1-bot,fps-1-flythrough,fps-1-slowed", kSmoke.string(), a.string()), dir);
     ASSERT_EQ(first.status, 0) << first.err << first.out;
     EXPECT_NE(first.out.find("3 of 6 datasets still without one"), std::string::npos) << first.out;
+    EXPECT_NE(first.out.find("rendered 0 frames"), std::string::npos) << "the copied frames are reused: " << first.out;
     EXPECT_FALSE(fs::exists(a / "suite.json"));
     const auto second = dynbench(fmt::format("suite {} -o {} --only fps-2-bot --only fps-2-flythrough,fps-2-slowed", kSmoke.string(), b.string()), dir);
     ASSERT_EQ(second.status, 0) << second.err << second.out;
