@@ -23,6 +23,7 @@
 #include "gltf_builder.h"
 #include "external_tools.h"
 #include "run_cli.h"
+#include "shared_run.h"
 
 namespace dynbench {
 namespace {
@@ -190,8 +191,12 @@ TEST(Demo, WholeChainOnAShortMatch) {
   DYNBENCH_NEEDS(test::missingCube2());
   DYNBENCH_NEEDS(test::missingFfmpeg());
   const fs::path dir = test::freshDir("demo_chain");
-  const auto r = dynbench(fmt::format("demo -o {} --seconds 3 --bots 4 --res 32x18 --spp 1 --max-spp 32 --render-frames 12 --bounces 1", (dir / "demo").string()), dir);
+  // Shared with Slurm.DemoAsAChainOfJobsGivesTheLocalDemosTables (shared_run.h), copied here to
+  // resume in.
+  const auto shared = test::sharedRun("demo", "demo -o {out} --seconds 3 --bots 4 --res 32x18 --spp 1 --max-spp 32 --render-frames 12 --bounces 1");
+  const auto& r = shared.run;
   ASSERT_EQ(r.status, 0) << r.err << r.out;
+  test::copyOf(shared, dir / "demo");
   EXPECT_NE(r.out.find("report: "), std::string::npos) << r.out;
   const std::string md = test::slurp(dir / "demo" / "report.md");
   EXPECT_NE(md.find("| colos_bot "), std::string::npos);

@@ -23,6 +23,7 @@
 #include "gltf_builder.h"
 #include "pipeline/cluster_jobs.h"
 #include "run_cli.h"
+#include "shared_run.h"
 
 namespace dynbench {
 namespace {
@@ -311,8 +312,9 @@ TEST_F(Slurm, DemoAsAChainOfJobsGivesTheLocalDemosTables) {
   EXPECT_EQ(job["width"], 32);
   EXPECT_EQ(job["frames"], 12);
   EXPECT_EQ(job["max_spp"], 32);
-  r = dynbench(fmt::format("demo -o {} {}", (dir / "local").string(), options), dir);
-  ASSERT_EQ(r.status, 0) << r.err;
+  // The local demo is Demo.WholeChainOnAShortMatch's (shared_run.h: made once for both).
+  const auto localRun = test::sharedRun("demo", "demo -o {out} " + options);
+  ASSERT_EQ(localRun.run.status, 0) << localRun.run.err;
   // The same tables, every cell (the figures' file names aside).
   auto tables = [](const std::string& md) {
     std::string rows;
@@ -321,7 +323,7 @@ TEST_F(Slurm, DemoAsAChainOfJobsGivesTheLocalDemosTables) {
       if (line.starts_with("|") || line.starts_with("Table")) rows += line + "\n";
     return rows;
   };
-  const std::string local = tables(test::slurp(dir / "local" / "report.md"));
+  const std::string local = tables(test::slurp(localRun.output / "report.md"));
   EXPECT_GT(std::count(local.begin(), local.end(), '\n'), 30);
   EXPECT_EQ(local, tables(test::slurp(dir / "cluster" / "report.md")));
 }
@@ -338,11 +340,12 @@ TEST_F(Slurm, SuiteAsAChainOfJobsGivesTheLocalSuitesNumbers) {
   std::smatch m;
   ASSERT_TRUE(std::regex_search(r.out, m, std::regex("Slurm jobs: datasets (\\d+) .*render (\\d+) \\(4 tasks.*suite (\\d+) "))) << r.out;
   EXPECT_NE(test::slurp(dir / "cluster" / "slurm" / "render.sbatch").find("#SBATCH --array=0-3\n"), std::string::npos);
-  r = dynbench(fmt::format("suite {} -o {}", smoke.string(), (dir / "local").string()), dir);
-  ASSERT_EQ(r.status, 0) << r.err;
+  // The local run is Suite.SmokeSuite...'s (shared_run.h: made once for both).
+  const auto localRun = test::sharedRun("smoke-suite", fmt::format("suite {} -o {{out}}", smoke.string()));
+  ASSERT_EQ(localRun.run.status, 0) << localRun.run.err;
   // The same numbers and the same frames, byte for byte: the renders are seeded, whoever runs them.
   // (Sidecars name the dataset's absolute path, so only the images are compared.)
-  const auto local = nlohmann::json::parse(test::slurp(dir / "local" / "suite.json"));
+  const auto local = nlohmann::json::parse(test::slurp(localRun.output / "suite.json"));
   const auto cluster = nlohmann::json::parse(test::slurp(dir / "cluster" / "suite.json"));
   EXPECT_EQ(local["datasets"], cluster["datasets"]);
   EXPECT_EQ(local["validity"], cluster["validity"]);

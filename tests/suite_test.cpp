@@ -25,6 +25,7 @@
 #include "gltf_builder.h"
 #include "other_machine.h"
 #include "run_cli.h"
+#include "shared_run.h"
 #include "scene/dataset_digest.h"
 
 namespace dynbench {
@@ -538,8 +539,12 @@ TEST(Suite, SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught) {
   DYNBENCH_NEEDS(test::missingCube2());
   const fs::path dir = test::freshDir("suite_smoke");
   const fs::path out = dir / "smoke";
-  const auto r = dynbench(fmt::format("suite {} -o {}", kSmoke.string(), out.string()), dir);
+  // The one-shot run, shared with Slurm.SuiteAsAChainOfJobsGivesTheLocalSuitesNumbers (shared_run.h),
+  // copied here to resume, lock and verify in.
+  const auto shared = test::sharedRun("smoke-suite", fmt::format("suite {} -o {{out}}", kSmoke.string()));
+  const auto& r = shared.run;
   ASSERT_EQ(r.status, 0) << r.err << r.out;
+  test::copyOf(shared, out);
   const auto doc = nlohmann::json::parse(test::slurp(out / "suite.json"));
   EXPECT_EQ(doc["dynbench_suite_results"], 3);
   EXPECT_EQ(doc["manifest"], nlohmann::json::parse(test::slurp(kSmoke)));
