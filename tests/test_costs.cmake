@@ -10,13 +10,12 @@
 # for it here (checked), and if(TEST) is always false in a file ctest reads.
 set(dynbench_test_costs
   OpenArena.StrippedLightsAreFittedToTheLightmaps=225
-  Demo.WholeChainOnAShortMatch=172
+  Demo.WholeChainOnAShortMatch=130
   Slurm.SuiteAsAChainOfJobsGivesTheLocalSuitesNumbers=129
-  DiscardCli.ASubPixelPanOverAFineTextureDiscardsNothingWhenRadianceIsFiltered=127
   Suite.SmokeSuiteRunsResumesAndVerifiesAndAnEditedFrameIsCaught=119
   Cube2.SeededMatchIsDeterministicAndConverts=101
   Slurm.ASignalledTaskRequeuesAndACancelledOneIsReportedAndRerun=95
-  Slurm.DemoAsAChainOfJobsGivesTheLocalDemosTables=74
+  Slurm.DemoAsAChainOfJobsGivesTheLocalDemosTables=55
   Cube2.SecondMapsLavaAndWaterConvertValidateAndAgreeWithTheGame=55
   OpenArena.AnEmulatedMatchIsTheSameOnEveryHost=50
   Cube2.TheGamesOwnFramesAgreeWithTheDatasetsRenderOfThem=46
