@@ -408,24 +408,14 @@ TEST(OpenArena, MapLightColoursAreRecordedLinear) {
 
 TEST(OpenArena, BadOptionsFailClearly) {
   const auto dir = test::freshDir("openarena_bad");
-  auto r = dynbench(fmt::format("capture openarena -o {} --fps 30", (dir / "a").string()), dir);
-  EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_NE(r.err.find("divisor of 1000"), std::string::npos) << r.err;
+  EXPECT_TRUE(test::refuses(fmt::format("capture openarena -o {} --fps 30", (dir / "a").string()), dir, 2, "divisor of 1000"));
   EXPECT_FALSE(fs::exists(dir / "a")) << "nothing is made for a match that cannot be played";
-  r = dynbench(fmt::format("capture openarena -o {} --map 'oa dm1'", (dir / "b").string()), dir);
-  EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_NE(r.err.find("expected a map name"), std::string::npos) << r.err;
-  r = dynbench(fmt::format("capture openarena -o {} --follow someone", (dir / "c").string()), dir);
-  EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_NE(r.err.find("--follow 'someone'"), std::string::npos) << r.err;
-  r = dynbench(fmt::format("capture openarena -o {} --seconds 1 --game-frames 49", (dir / "g").string()), dir);
-  EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_NE(r.err.find("--game-frames: frame 49"), std::string::npos) << r.err;
-  r = dynbench(fmt::format("capture openarena -o {} --game-cpu arm", (dir / "i").string()), dir);
-  EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_NE(r.err.find("--game-cpu 'arm': expected emulated or host"), std::string::npos) << r.err;
+  EXPECT_TRUE(test::refuses(fmt::format("capture openarena -o {} --map 'oa dm1'", (dir / "b").string()), dir, 2, "expected a map name"));
+  EXPECT_TRUE(test::refuses(fmt::format("capture openarena -o {} --follow someone", (dir / "c").string()), dir, 2, "--follow 'someone'"));
+  EXPECT_TRUE(test::refuses(fmt::format("capture openarena -o {} --seconds 1 --game-frames 49", (dir / "g").string()), dir, 2, "--game-frames: frame 49"));
+  EXPECT_TRUE(test::refuses(fmt::format("capture openarena -o {} --game-cpu arm", (dir / "i").string()), dir, 2, "--game-cpu 'arm': expected emulated or host"));
   EXPECT_FALSE(fs::exists(dir / "i"));
-  r = dynbench(fmt::format("capture openarena -o {} --bots 17", (dir / "d").string()), dir);
+  auto r = dynbench(fmt::format("capture openarena -o {} --bots 17", (dir / "d").string()), dir);
   EXPECT_EQ(r.status, 2) << r.err;
   r = dynbench(fmt::format("capture openarena -o {} --modules {}", (dir / "e").string(), dir.string()), dir);
   EXPECT_NE(r.status, 0);

@@ -81,4 +81,15 @@ inline Run dynbench(const std::string& args, const std::filesystem::path& dir) {
   return r;
 }
 
+namespace test {
+// Whether dynbench refuses `args`: exits with `status` and says `message` on stderr (for
+// EXPECT_TRUE, which then reports the command, its status and its stderr).
+inline testing::AssertionResult refuses(const std::string& args, const std::filesystem::path& dir, int status, const std::string& message) {
+  const Run r = dynbench(args, dir);
+  if (r.status != status) return testing::AssertionFailure() << "dynbench " << args << " exited " << r.status << ", not " << status << ":\n" << r.err;
+  if (r.err.find(message) == std::string::npos) return testing::AssertionFailure() << "dynbench " << args << " did not say '" << message << "':\n" << r.err;
+  return testing::AssertionSuccess();
+}
+}  // namespace test
+
 }  // namespace dynbench

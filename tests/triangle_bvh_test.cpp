@@ -141,15 +141,21 @@ Agreement compareWithEmbree(const std::vector<BvhTriangle>& triangles, const glm
   return a;
 }
 
-TEST(TriangleBvh, AgreesWithEmbreeOnARandomSoup) {
-  std::mt19937 rng(5);
+// `count` triangles of up to 3 units across, centred in the cube [-10, 10]^3.
+std::vector<BvhTriangle> randomSoup(unsigned seed, int count) {
+  std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-10.0, 10.0), small(-1.5, 1.5);
   std::vector<BvhTriangle> soup;
-  for (int i = 0; i < 3000; ++i) {
+  for (int i = 0; i < count; ++i) {
     const glm::dvec3 c(u(rng), u(rng), u(rng));
     soup.push_back(triangle(c + glm::dvec3(small(rng), small(rng), small(rng)), c + glm::dvec3(small(rng), small(rng), small(rng)),
                             c + glm::dvec3(small(rng), small(rng), small(rng))));
   }
+  return soup;
+}
+
+TEST(TriangleBvh, AgreesWithEmbreeOnARandomSoup) {
+  const std::vector<BvhTriangle> soup = randomSoup(5, 3000);
   const Agreement a = compareWithEmbree(soup, glm::dvec3(-12), glm::dvec3(12), 40000);
   EXPECT_EQ(a.rays, 40000u);
   // measured: 0 of 40,000 each (2026-11-28)
@@ -162,15 +168,7 @@ TEST(TriangleBvh, AgreesWithEmbreeOnARandomSoup) {
 // towards one light through a random soup, the cache carried from ray to ray; it is used (some
 // rays are answered by the cached triangle) and a blocked ray leaves a triangle that blocks it.
 TEST(TriangleBvh, TheShadowCacheAnswersAsThePlainTest) {
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> u(-10.0, 10.0), small(-1.5, 1.5);
-  std::vector<BvhTriangle> soup;
-  for (int i = 0; i < 2000; ++i) {
-    const glm::dvec3 c(u(rng), u(rng), u(rng));
-    soup.push_back(triangle(c + glm::dvec3(small(rng), small(rng), small(rng)), c + glm::dvec3(small(rng), small(rng), small(rng)),
-                            c + glm::dvec3(small(rng), small(rng), small(rng))));
-  }
-  const TriangleBvh bvh(soup);
+  const TriangleBvh bvh(randomSoup(11, 2000));
   const glm::dvec3 light(0.3, 11.0, -0.2);
   std::uint32_t lastBlocker = TriangleBvh::kNoBlocker;
   int blocked = 0, cacheAnswered = 0;
