@@ -3,7 +3,7 @@
 // demo (Demo.WholeChainOnAShortMatch checks it; Slurm.DemoAsAChainOfJobs compares its Slurm twin
 // with it) and the local smoke suite (Suite.SmokeSuite... and Slurm.SuiteAsAChainOfJobs). The first
 // test to ask makes it, under an exclusive lock (flock), in a folder keyed by the arguments and by
-// the executable's size and modification time (a rebuilt dynbench makes it anew); the others wait
+// the executable's path, size and modification time (a rebuilt dynbench makes it anew); the others wait
 // for the lock and read it. Each of the two was made twice per test run before (about 110 s of
 // CPU on a 2-core AMD EPYC). A test reads the folder and never writes into it: one that edits or
 // resumes copies it first (copyOf).
@@ -34,7 +34,7 @@ inline SharedRun sharedRun(const std::string& name, const std::string& arguments
   namespace fs = std::filesystem;
   const fs::path exe(DYNBENCH_EXE);
   const auto stamp = fs::last_write_time(exe).time_since_epoch().count();
-  const std::size_t key = std::hash<std::string>{}(fmt::format("{}\n{}\n{}", arguments, fs::file_size(exe), stamp));
+  const std::size_t key = std::hash<std::string>{}(fmt::format("{}\n{}\n{}\n{}", arguments, exe.string(), fs::file_size(exe), stamp));
   const fs::path root = fs::temp_directory_path() / "dynbench-shared-runs";
   fs::create_directories(root);
   const fs::path folder = root / fmt::format("{}-{:016x}", name, key);
