@@ -66,7 +66,7 @@ struct ChangeSums {
 class PathTracer::ChangeSampler {
  public:
   ChangeSampler(const PathTracer& tracer, std::uint64_t frameIndex, const RenderCamera& camera, const RenderCamera& previousCamera,
-                const FrameBuffers& frame)
+                FrameBuffers& frame)
       : tracer_(tracer),
         settings_(tracer.settings_),
         frameIndex_(frameIndex),
@@ -121,9 +121,10 @@ class PathTracer::ChangeSampler {
     });
   }
 
-  // The change buffers (mean, standard error, gathered light of each pixel) and pair counts, and
-  // the sampling summary's pair figures.
-  void write(FrameBuffers& frame) const {
+  // The change buffers (mean, standard error, gathered light of each pixel) and pair counts of the
+  // frame, and its sampling summary's pair figures.
+  void write() const {
+    FrameBuffers& frame = frame_;
     long undecided = 0;
     double totalPairs = 0.0;
     int mostPairs = 0;
@@ -308,7 +309,7 @@ class PathTracer::ChangeSampler {
   const RenderSettings& settings_;
   const std::uint64_t frameIndex_;
   const RenderCamera& camera_;
-  const FrameBuffers& frame_;
+  FrameBuffers& frame_;  // its images give the thresholds; write() fills its change buffers
   const int width_;
   const std::array<double, 2> tau_;
   const int cap_;
@@ -330,7 +331,7 @@ void PathTracer::renderChanges(std::uint64_t frameIndex, const RenderCamera& cam
   if (!previousRayTracing_ || pixels == 0) return;
   ChangeSampler sampler(*this, frameIndex, camera, previousCamera, frame);
   sampler.sampleInRounds();
-  sampler.write(frame);
+  sampler.write();
   if (statistics) sampler.addCounts(*statistics);
 }
 
