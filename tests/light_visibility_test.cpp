@@ -2,6 +2,7 @@
 // a closed wall falls to the defensive share of its importance once learned, the image is the one
 // of evaluating every light (unbiased), with less noise than the tree's own selection, and the
 // same bytes at one and two threads and on every run.
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 
@@ -75,12 +76,12 @@ TEST(LightVisibility, ALightBehindAClosedWallFallsToTheDefensiveShare) {
   for (double x = -4.5; x < -0.4; x += 0.25)
     for (double z = -4.5; z < 4.6; z += 0.25) points.push_back({{x, 0.0, z}, {0, 1, 0}});
   LightVisibility visibility;
-  int traced = 0;
+  std::atomic<int> traced = 0;  // learn() calls back from TBB's threads
   visibility.learn(lights, points, 0.5, [&](const LightVisibility::Point& p, const LightSample& s) {
     ++traced;
     return !(*rt)->occluded(p.position + 1e-4 * p.normal, s.direction, s.distance * (1 - 1e-4));
   });
-  EXPECT_EQ(traced, 2 * static_cast<int>(points.size())) << "every point sees both lights in reach";
+  EXPECT_EQ(traced.load(), 2 * static_cast<int>(points.size())) << "every point sees both lights in reach";
   EXPECT_GT(visibility.cellCount(), 50u);
   const glm::dvec3 p(-2.0, 0.0, 0.5), n(0, 1, 0);
   const float* factors = visibility.factors(p, n);
