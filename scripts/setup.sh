@@ -1,9 +1,22 @@
 #!/usr/bin/env bash
-# Installs everything dynbench needs on Debian bookworm (run as root, or with sudo available).
+# Installs what dynbench needs on Debian bookworm (run as root, or with sudo available).
+#   bash scripts/setup.sh         what the main job needs: the build, its libraries, Cube 2 (the
+#                                 demo's game), ffmpeg and gnuplot (the report)
+#   bash scripts/setup.sh --all   everything: the above, and what the test suite and the other
+#                                 engines use (Blender, Chromium, Slurm, clang, OpenArena, qemu,
+#                                 the glTF validator)
 # Idempotent: when every package is already installed it only checks and returns.
 set -euo pipefail
 
-# Keep this list in step with ../shared/ARCHITECTURE.md §4 and CONTRIBUTING.md.
+all=0
+for arg in "$@"; do
+  case "$arg" in
+    --all) all=1 ;;
+    *) echo "setup: unknown option '$arg' (expected --all or nothing)" >&2; exit 2 ;;
+  esac
+done
+
+# Keep these lists in step with ../shared/ARCHITECTURE.md §4 and CONTRIBUTING.md.
 packages=(
   # build
   build-essential cmake ninja-build pkg-config git
@@ -15,41 +28,46 @@ packages=(
   libcli11-dev libfmt-dev libspdlog-dev
   # SHA-256 of a suite's datasets and frames (core/checksum.cpp)
   libssl-dev
-  # tests and benchmarks
+  # tests and benchmarks: small header packages that configuring the build needs
   libgtest-dev libgmock-dev googletest libbenchmark-dev zlib1g-dev
   # plots
   gnuplot-nox
-  # test data: FBX / DAE models with skeletons, cameras and lights
-  assimp-testmodels
-  # Blender: `render --engine cycles` (the thesis's renderer) and the tests that check dynbench's
-  # datasets with Blender's glTF importer and its P/N buffers against Cycles
-  blender python3-numpy
   # the magma colour map of FLIP heatmaps, read from matplotlib's tables at build time
   # (tools/colormap/magma_header.py)
   python3-matplotlib
-  # the Python module (docs/python.md): pybind11 with its nlohmann::json bridge; its tests run
-  # pytest and compare frames with OpenImageIO's own Python binding
-  pybind11-dev pybind11-json-dev python3-dev python3-pytest python3-openimageio
-  # headless Chromium: the tests open `dynbench report`'s HTML in a real browser
-  chromium
+  # the Python module (docs/python.md): pybind11 with its nlohmann::json bridge
+  pybind11-dev pybind11-json-dev python3-dev
   # ffmpeg: `dynbench report` encodes each run's video (VP9 WebM) with it
   ffmpeg
-  # Slurm and munge: `--slurm` job arrays, tried and tested on a single-node cluster on localhost
-  # (scripts/slurm-local.sh; docs/cluster.md)
-  slurm-wlm munge
-  # fuzzing the readers of untrusted input (the `fuzz` preset, CONTRIBUTING.md): clang 16 and its
-  # libFuzzer runtime
-  clang-16 libclang-rt-16-dev
-  # Cube 2: Sauerbraten (`dynbench capture cube2`): the engine's build needs, its game data, and
-  # a virtual X server with Mesa's software OpenGL to run it headless
+  # Cube 2: Sauerbraten (`dynbench capture cube2`, the demo's game): the engine's build needs, its
+  # game data, and a virtual X server with Mesa's software OpenGL to run it headless
   libsdl2-dev libsdl2-image-dev libsdl2-mixer-dev libenet-dev libgl-dev cube2-data xvfb xauth
   libgl1-mesa-dri
-  # OpenArena (`dynbench capture openarena`): Debian's ioquake3 engine and the game's data; its
-  # game code is rebuilt from the source package with the capture hooks (below); qemu-user runs
-  # the engine on an emulated CPU, so that a seed plays the same match on every host
-  # (integrations/openarena/README.md, "Across CPUs")
-  openarena qemu-user
 )
+if ((all)); then
+  packages+=(
+    # test data: FBX / DAE models with skeletons, cameras and lights
+    assimp-testmodels
+    # Blender: `render --engine cycles` (the thesis's renderer) and the tests that check dynbench's
+    # datasets with Blender's glTF importer and its P/N buffers against Cycles
+    blender python3-numpy
+    # the Python module's tests run pytest and compare frames with OpenImageIO's own Python binding
+    python3-pytest python3-openimageio
+    # headless Chromium: the tests open `dynbench report`'s HTML in a real browser
+    chromium
+    # Slurm and munge: `--slurm` job arrays, tried and tested on a single-node cluster on localhost
+    # (scripts/slurm-local.sh; docs/cluster.md)
+    slurm-wlm munge
+    # fuzzing the readers of untrusted input (the `fuzz` preset, CONTRIBUTING.md): clang 16 and its
+    # libFuzzer runtime
+    clang-16 libclang-rt-16-dev
+    # OpenArena (`dynbench capture openarena`): Debian's ioquake3 engine and the game's data; its
+    # game code is rebuilt from the source package with the capture hooks (below); qemu-user runs
+    # the engine on an emulated CPU, so that a seed plays the same match on every host
+    # (integrations/openarena/README.md, "Across CPUs")
+    openarena qemu-user
+  )
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -66,25 +84,6 @@ if ((${#missing[@]})); then
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 else
   echo "setup: all ${#packages[@]} Debian packages present"
-fi
-
-# The Khronos glTF validator (npm), which the tests run on every dataset dynbench writes.
-# Node.js comes from Debian when the machine has none.
-if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
-  echo "setup: installing nodejs and npm"
-  SUDO=""
-  [[ $(id -u) -eq 0 ]] || SUDO="sudo"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends nodejs npm
-fi
-here=$(cd "$(dirname "$0")/.." && pwd)
-validator="$here/tools/gltf-validator"
-if [[ ! -f "$validator/node_modules/gltf-validator/package.json" ]] ||
-   ! grep -q '"version": "2.0.0-dev.3.10"' "$validator/node_modules/gltf-validator/package.json"; then
-  echo "setup: installing the Khronos glTF validator (npm ci)"
-  (cd "$validator" && npm ci --no-audit --no-fund --loglevel=error)
-else
-  echo "setup: glTF validator present"
 fi
 
 # Game source code from Debian's source packages, fetched once into caches that the CMake build
@@ -121,4 +120,25 @@ SOURCES
   echo "setup: $name source in $cache"
 }
 fetch_source cube2 "cube2=0.0.20201227+dfsg-2" cube2_0.0.20201227+dfsg.orig.tar.xz
+((all)) || exit 0
 fetch_source openarena "openarena=0.8.8+dfsg-6" openarena_0.8.8+dfsg.orig.tar.xz
+
+# The Khronos glTF validator (npm), which the tests run on every dataset dynbench writes.
+# Node.js comes from Debian when the machine has none.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  echo "setup: installing nodejs and npm"
+  SUDO=""
+  [[ $(id -u) -eq 0 ]] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends nodejs npm
+fi
+here=$(cd "$(dirname "$0")/.." && pwd)
+validator="$here/tools/gltf-validator"
+if [[ ! -f "$validator/node_modules/gltf-validator/package.json" ]] ||
+   ! grep -q '"version": "2.0.0-dev.3.10"' "$validator/node_modules/gltf-validator/package.json"; then
+  echo "setup: installing the Khronos glTF validator (npm ci)"
+  (cd "$validator" && npm ci --no-audit --no-fund --loglevel=error)
+else
+  echo "setup: glTF validator present"
+fi
+

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# A single-node Slurm on this machine, from Debian's slurm-wlm and munge (scripts/setup.sh installs
+# A single-node Slurm on this machine, from Debian's slurm-wlm and munge (scripts/setup.sh --all installs
 # them), for trying `dynbench ... --slurm` and for the tests. Nothing outside its folder changes:
 # its own munge key and socket, a generated slurm.conf, non-default ports, state and logs, all
 # under $DYNBENCH_SLURM_DIR (default /tmp/dynbench-slurm).
@@ -26,7 +26,7 @@ die() { echo "slurm-local: $*" >&2; exit 1; }
 need() {
   for program in munged slurmctld slurmd sinfo scontrol sbatch; do
     command -v "$program" >/dev/null || [[ -x /usr/sbin/$program ]] ||
-      die "$program is missing: install Debian's slurm-wlm and munge (scripts/setup.sh does)"
+      die "$program is missing: install Debian's slurm-wlm and munge (scripts/setup.sh --all does)"
   done
 }
 

@@ -19,23 +19,23 @@ inline bool onPath(const char* program) {
 }
 
 inline std::string missingBlender() {
-  return onPath("blender") ? "" : "Blender is not installed (Debian packages blender and python3-numpy; scripts/setup.sh)";
+  return onPath("blender") ? "" : "Blender is not installed (Debian packages blender and python3-numpy; scripts/setup.sh --all)";
 }
 inline std::string missingChromium() {
-  return onPath("chromium") ? "" : "Chromium is not installed (Debian package chromium; scripts/setup.sh)";
+  return onPath("chromium") ? "" : "Chromium is not installed (Debian package chromium; scripts/setup.sh --all)";
 }
 inline std::string missingFfmpeg() {
   return onPath("ffmpeg") ? "" : "ffmpeg is not installed (Debian package ffmpeg; scripts/setup.sh)";
 }
 inline std::string missingSlurm() {
   for (const char* program : {"/usr/sbin/slurmctld", "/usr/sbin/slurmd", "/usr/sbin/munged"})
-    if (!std::filesystem::exists(program)) return "Slurm is not installed (Debian packages slurm-wlm and munge; scripts/setup.sh)";
-  return onPath("sbatch") ? "" : "sbatch is not on PATH (Debian package slurm-client; scripts/setup.sh)";
+    if (!std::filesystem::exists(program)) return "Slurm is not installed (Debian packages slurm-wlm and munge; scripts/setup.sh --all)";
+  return onPath("sbatch") ? "" : "sbatch is not on PATH (Debian package slurm-client; scripts/setup.sh --all)";
 }
 inline std::string missingGltfValidator() {
-  if (!onPath("node")) return "node is not installed (Debian package nodejs; scripts/setup.sh)";
+  if (!onPath("node")) return "node is not installed (Debian package nodejs; scripts/setup.sh --all)";
   const auto validator = std::filesystem::path(DYNBENCH_SOURCE_DIR) / "tools/gltf-validator/node_modules/gltf-validator";
-  return std::filesystem::exists(validator) ? "" : "the Khronos glTF validator is not installed (scripts/setup.sh runs npm ci)";
+  return std::filesystem::exists(validator) ? "" : "the Khronos glTF validator is not installed (scripts/setup.sh --all runs npm ci)";
 }
 inline std::string missingCube2() {
   if (!capture::findCube2Client({})) return "the Cube 2 client is not built (scripts/setup.sh, then cmake --build)";
@@ -45,9 +45,9 @@ inline std::string missingCube2() {
 }
 
 inline std::string missingOpenArena() {
-  if (!capture::findOpenArenaModules({})) return "OpenArena's game modules are not built (scripts/setup.sh, then cmake --build)";
+  if (!capture::findOpenArenaModules({})) return "OpenArena's game modules are not built (scripts/setup.sh --all, then cmake --build)";
   if (!std::filesystem::exists("/usr/lib/ioquake3/ioquake3") || !std::filesystem::exists("/usr/lib/openarena/baseoa"))
-    return "Debian's openarena is not installed (scripts/setup.sh)";
+    return "Debian's openarena is not installed (scripts/setup.sh --all)";
   if (!onPath("Xvfb")) return "Xvfb is not installed (Debian package xvfb)";
   return {};
 }
@@ -55,7 +55,7 @@ inline std::string missingOpenArena() {
 // OpenArena's default, --game-cpu emulated, runs the engine under qemu-x86_64.
 inline std::string missingEmulatedOpenArena() {
   if (auto missing = missingOpenArena(); !missing.empty()) return missing;
-  return onPath("qemu-x86_64") ? "" : "qemu-x86_64 is not installed (Debian package qemu-user; scripts/setup.sh)";
+  return onPath("qemu-x86_64") ? "" : "qemu-x86_64 is not installed (Debian package qemu-user; scripts/setup.sh --all)";
 }
 
 inline bool requireAll() {

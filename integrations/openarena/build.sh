@@ -21,7 +21,7 @@ build_dir=$(cd "$build_dir" && pwd)
 # scripts/setup.sh fetches the tarball (apt-get source) into this cache; this script never touches apt.
 cache=${DYNBENCH_OPENARENA_CACHE:-/var/cache/dynbench/openarena}
 if [[ ! -f "$build_dir/$orig" ]]; then
-  [[ -f "$cache/$orig" ]] || { echo "openarena: $cache/$orig missing: run scripts/setup.sh (it fetches the game code)" >&2; exit 1; }
+  [[ -f "$cache/$orig" ]] || { echo "openarena: $cache/$orig missing: run scripts/setup.sh --all (it fetches the game code)" >&2; exit 1; }
   cp "$cache/$orig" "$build_dir/$orig"
 fi
 

@@ -86,8 +86,9 @@ Expected<fs::path> findOpenArenaModules(const fs::path& requested) {
                                               "lib/dynbench/openarena", DYNBENCH_OPENARENA_MODULES_BUILD_PATH}))
     if (isModuleFolder(c)) return c;
   return fail(ErrorCode::kExternalTool,
-              "OpenArena's game modules with dynbench's capture hooks are not built: run scripts/setup.sh, then cmake --build "
-              "(target openarena_modules), or pass --modules DIR");
+              "OpenArena's game modules with dynbench's capture hooks are not built: run scripts/setup.sh --all (it installs "
+              "OpenArena and fetches its game code), then cmake --build build/release --target openarena_modules, or pass "
+              "--modules DIR");
 }
 
 namespace {
@@ -156,13 +157,13 @@ Expected<void> checkOpenArenaOptions(const OpenArenaOptions& o) {
   auto modules = findOpenArenaModules(o.modules);
   if (!modules) return std::unexpected(modules.error());
   if (!isExecutable(o.engine))
-    return fail(ErrorCode::kExternalTool, "{}: not an executable: install Debian's openarena (scripts/setup.sh does)", o.engine.string());
+    return fail(ErrorCode::kExternalTool, "{}: not an executable: install Debian's openarena (scripts/setup.sh --all does)", o.engine.string());
   std::error_code ec;
   if (!fs::is_directory(o.data / "baseoa", ec))
-    return fail(ErrorCode::kExternalTool, "{}: missing: install Debian's openarena (scripts/setup.sh does)", (o.data / "baseoa").string());
+    return fail(ErrorCode::kExternalTool, "{}: missing: install Debian's openarena (scripts/setup.sh --all does)", (o.data / "baseoa").string());
   if (!o.window && findOnPath("Xvfb").empty()) return fail(ErrorCode::kExternalTool, "Xvfb is missing: install Debian's xvfb (scripts/setup.sh does)");
   if (o.gameCpu == GameCpu::kEmulated && findOnPath(kQemu).empty())
-    return fail(ErrorCode::kExternalTool, "{} is missing: install Debian's qemu-user (scripts/setup.sh does), or pass --game-cpu host", kQemu);
+    return fail(ErrorCode::kExternalTool, "{} is missing: install Debian's qemu-user (scripts/setup.sh --all does), or pass --game-cpu host", kQemu);
   if (fs::exists(o.output / "Capture.txt", ec))
     return fail(ErrorCode::kUsage, "{}: already holds a capture; choose an empty folder", o.output.string());
   return {};

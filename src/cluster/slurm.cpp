@@ -34,7 +34,7 @@ Expected<Output> slurmCommand(std::vector<std::string> argv) {
   };
   auto run = runProcess(p);
   if (!run)
-    return fail(ErrorCode::kExternalTool, "{}: {}; --slurm needs Slurm's commands (Debian: slurm-client, or slurm-wlm as scripts/setup.sh installs)",
+    return fail(ErrorCode::kExternalTool, "{}: {}; --slurm needs Slurm's commands (Debian: slurm-client, or slurm-wlm as scripts/setup.sh --all installs)",
                 p.argv.front(), run.error().message);
   out.status = run->exitStatus;
   return out;
