@@ -188,70 +188,210 @@ Expected<std::unique_ptr<CaptureReader>> CaptureReader::open(const fs::path& dir
   return reader;
 }
 
+namespace {
+
+// The records inside a frame (docs/capture-format.md's table), one handler each, checked against
+// the capturables and models seen before: a capturable keeps its kind and model for the whole
+// capture, and joints and key frames follow their model's transform in the same frame.
+class FrameRecords {
+ public:
+  FrameRecords(CaptureReader::Impl& impl, const CaptureReader& reader, CaptureFrame& frame, const Line& l)
+      : impl_(impl), reader_(reader), frame_(frame), l_(l) {}
+
+  void camera() {
+    const CameraRecord c = cameraRecord(l_);
+    claim(c.id, Kind::kCamera, -1);
+    frame_.cameras.push_back(c);
+  }
+
+  void cut() {
+    CameraCutRecord c = cutRecord(l_);
+    if (std::none_of(frame_.cameras.begin(), frame_.cameras.end(), [&](const CameraRecord& r) { return r.id == c.id; }))
+      l_.fail(fmt::format("cut of camera {}, which has no camera transform ('t') earlier in this frame", c.id));
+    frame_.cuts.push_back(std::move(c));
+  }
+
+  void staticModel() { frame_.staticModels.push_back(modelRecord(Kind::kStaticModel)); }
+
+  void model() {
+    ModelRecord r = modelRecord(Kind::kModel);
+    impl_.modelsThisFrame.insert(r.id);
+    frame_.models.push_back(std::move(r));
+  }
+
+  void joints() {
+    if (l_.size() < 4) l_.fail("record 'j' needs id:joint_count:8 numbers per joint:model_path", ErrorCode::kParse);
+    JointsRecord r;
+    r.id = l_.integer<std::uint64_t>(1, "id");
+    const auto count = l_.integer<std::size_t>(2, "joint_count");
+    if (l_.size() != 4 + 8 * count)
+      l_.fail(fmt::format("record 'j' with {} joints needs {} fields, got {}", count, 3 + 8 * count, l_.size() - 1), ErrorCode::kParse);
+    r.model = modelAt(3 + 8 * count);
+    const auto& model = reader_.models()[static_cast<std::size_t>(r.model)];
+    if (count != model.joints.size())
+      l_.fail(fmt::format("{} joints for model '{}', which has {} joints", count, model.path, model.joints.size()));
+    followsItsTransform(r.id, r.model, "joints");
+    r.joints.reserve(count);
+    for (std::size_t k = 0; k < count; ++k) r.joints.push_back(l_.dualQuat(3 + 8 * k));
+    frame_.joints.push_back(std::move(r));
+  }
+
+  void vertexFrames() {
+    l_.expectFields(5, "id:from:to:fraction:model_path");
+    VertexFramesRecord r;
+    r.id = l_.integer<std::uint64_t>(1, "id");
+    r.from = l_.integer<std::uint32_t>(2, "from"), r.to = l_.integer<std::uint32_t>(3, "to");
+    r.fraction = l_.real(4, "fraction");
+    r.model = modelAt(5);
+    const auto& model = reader_.models()[static_cast<std::size_t>(r.model)];
+    if (model.keyFrames == 0) l_.fail(fmt::format("key frames of model '{}', which has none ('K' records)", model.path));
+    if (r.from >= model.keyFrames || r.to >= model.keyFrames)
+      l_.fail(fmt::format("key frames {} and {} of model '{}', which has {}", r.from, r.to, model.path, model.keyFrames));
+    if (!(r.fraction >= 0 && r.fraction <= 1)) l_.fail(fmt::format("fraction {} is not in [0, 1]", r.fraction));
+    followsItsTransform(r.id, r.model, "key frames");
+    frame_.vertexFrames.push_back(r);
+  }
+
+  void light() {
+    LightRecord r = lightRecord(l_);
+    claim(r.id, Kind::kLight, -1);
+    frame_.lights.push_back(std::move(r));
+  }
+
+  void cameraSettings() { frame_.cameraSettings = capture::cameraSettings(l_); }
+
+ private:
+  // A 'p' (static) or 'm' (moving) model's transform.
+  ModelRecord modelRecord(Kind kind) {
+    l_.expectFields(10, "id:rx:ry:rz:rw:dx:dy:dz:dw:model_path");
+    ModelRecord r;
+    r.id = l_.integer<std::uint64_t>(1, "id");
+    r.pose = l_.dualQuat(2);
+    r.model = modelAt(10);
+    claim(r.id, kind, r.model);
+    return r;
+  }
+
+  // Joints ('j') and key frames ('v') animate a model whose transform ('m') came earlier in the
+  // frame, and name the model that transform names.
+  void followsItsTransform(std::uint64_t id, int model, std::string_view what) {
+    if (!impl_.modelsThisFrame.contains(id))
+      l_.fail(fmt::format("{} of capturable {}, which has no model transform ('m') earlier in this frame", what, id));
+    if (impl_.capturables.at(id).second != model)
+      l_.fail(fmt::format("{} of capturable {} name model '{}', its transform another", what, id,
+                          reader_.models()[static_cast<std::size_t>(model)].path));
+  }
+
+  void claim(std::uint64_t id, Kind kind, int model) {
+    auto [it, inserted] = impl_.capturables.emplace(id, std::make_pair(kind, model));
+    if (!inserted && it->second != std::make_pair(kind, model))
+      l_.fail(fmt::format("capturable {} was a {}{}; it cannot become a {}{}", id, capturableKindName(it->second.first), ofModel(it->second.second),
+                          capturableKindName(kind), ofModel(model)));
+  }
+
+  std::string ofModel(int model) const {
+    return model >= 0 ? " of '" + reader_.models()[static_cast<std::size_t>(model)].path + "'" : "";
+  }
+
+  int modelAt(std::size_t field) const {
+    const std::string path = l_.text(field);
+    const int index = reader_.modelIndex(path);
+    if (index < 0) l_.fail(fmt::format("unknown model '{}': no file in {} declares it", path, kModelsFolder));
+    return index;
+  }
+
+  CaptureReader::Impl& impl_;
+  const CaptureReader& reader_;
+  CaptureFrame& frame_;
+  const Line& l_;
+};
+
+struct FrameRecordEntry {
+  std::string_view token;
+  void (FrameRecords::*read)();
+};
+constexpr FrameRecordEntry kFrameRecords[] = {
+    {"t", &FrameRecords::camera},      {"c", &FrameRecords::cut},          {"p", &FrameRecords::staticModel},
+    {"m", &FrameRecords::model},       {"j", &FrameRecords::joints},       {"v", &FrameRecords::vertexFrames},
+    {"l", &FrameRecords::light},       {"C", &FrameRecords::cameraSettings},
+};
+
+// The tokens of kFrameRecords and the end record, as an error message lists them: "t, c, ... or e".
+std::string expectedFrameTokens() {
+  std::string list;
+  for (const FrameRecordEntry& e : kFrameRecords) list += std::string(e.token) + ", ";
+  return list.substr(0, list.size() - 2) + " or e";
+}
+
+}  // namespace
+
+// The next line that is not a comment: false at the end of the file (or at a last line cut
+// short), with the warning the end deserves.
+bool CaptureReader::nextLine(std::string& line, std::size_t& number, bool inFrame, const CaptureFrame& frame) {
+  Impl& impl = *impl_;
+  while (true) {
+    bool complete = true;
+    if (impl.pending) {
+      line = std::move(*impl.pending);
+      number = impl.pendingLine;
+      impl.pending.reset();
+    } else if (impl.source.next(line, complete)) {
+      number = impl.source.number();
+    } else {
+      if (inFrame)
+        warnings_.push_back(
+            fmt::format("{}:{}: frame {} has no end record (the capture was cut short); it is dropped", impl.file, frame.line, frame.number));
+      else if (!closed_)
+        warnings_.push_back(fmt::format("{}: no closing record: the capture was not closed (host stopped early?)", impl.file));
+      return false;
+    }
+    if (isComment(line)) continue;
+    if (!complete) {
+      warnings_.push_back(fmt::format("{}:{}: the capture ends in the middle of a line{}", impl.file, number,
+                                      inFrame ? fmt::format("; frame {} is dropped", frame.number) : std::string()));
+      return false;
+    }
+    return true;
+  }
+}
+
+// Between frames: the closing 'z' record, or the 'f' record that opens the next frame.
+void CaptureReader::startFrame(const Line& l, CaptureFrame& frame) {
+  Impl& impl = *impl_;
+  const auto token = l.token();
+  if (token == "z") {
+    l.expectFields(1, "frame_count");
+    closed_ = true;
+    return;
+  }
+  if (token != "f") l.fail(fmt::format("record '{}' outside a frame; expected 'f' (frame) or 'z' (end of capture)", token));
+  l.expectFields(2, "frame_number:time");
+  frame.number = l.integer<std::uint64_t>(1, "frame_number");
+  frame.time = l.real(2, "time");
+  frame.line = l.number();
+  if (impl.anyFrame && frame.number <= impl.lastFrame)
+    l.fail(fmt::format("frame {} after frame {}; frame numbers must increase", frame.number, impl.lastFrame));
+  if (impl.anyFrame && frame.time < impl.lastTime)
+    l.fail(fmt::format("frame time {} after {}; time must not go back", frame.time, impl.lastTime));
+  impl.modelsThisFrame.clear();
+}
+
 Expected<bool> CaptureReader::next(CaptureFrame& frame) {
   Impl& impl = *impl_;
   frame.clear();
   try {
     bool inFrame = false;
-    bool complete = true;
     std::string line;
     std::size_t number = 0;
-    while (true) {
-      if (impl.pending) {
-        line = std::move(*impl.pending);
-        number = impl.pendingLine;
-        impl.pending.reset();
-      } else if (impl.source.next(line, complete)) {
-        number = impl.source.number();
-      } else {
-        if (inFrame)
-          warnings_.push_back(fmt::format("{}:{}: frame {} has no end record (the capture was cut short); it is dropped", impl.file,
-                                          frame.line, frame.number));
-        else if (!closed_)
-          warnings_.push_back(fmt::format("{}: no closing record: the capture was not closed (host stopped early?)", impl.file));
-        return false;
-      }
-      if (isComment(line)) continue;
+    while (nextLine(line, number, inFrame, frame)) {
       const Line l(impl.file, number, line);
-      if (!complete) {
-        warnings_.push_back(fmt::format("{}:{}: the capture ends in the middle of a line{}", impl.file, number,
-                                        inFrame ? fmt::format("; frame {} is dropped", frame.number) : std::string()));
-        return false;
-      }
       const auto token = l.token();
       if (closed_) l.fail("a record after the closing 'z' record");
       if (!inFrame) {
-        if (token == "z") {
-          l.expectFields(1, "frame_count");
-          closed_ = true;
-          continue;
-        }
-        if (token != "f") l.fail(fmt::format("record '{}' outside a frame; expected 'f' (frame) or 'z' (end of capture)", token));
-        l.expectFields(2, "frame_number:time");
-        frame.number = l.integer<std::uint64_t>(1, "frame_number");
-        frame.time = l.real(2, "time");
-        frame.line = number;
-        if (impl.anyFrame && frame.number <= impl.lastFrame)
-          l.fail(fmt::format("frame {} after frame {}; frame numbers must increase", frame.number, impl.lastFrame));
-        if (impl.anyFrame && frame.time < impl.lastTime)
-          l.fail(fmt::format("frame time {} after {}; time must not go back", frame.time, impl.lastTime));
-        impl.modelsThisFrame.clear();
-        inFrame = true;
+        startFrame(l, frame);
+        inFrame = !closed_;
         continue;
       }
-      auto claim = [&](std::uint64_t id, Kind kind, int model) {
-        auto [it, inserted] = impl.capturables.emplace(id, std::make_pair(kind, model));
-        if (!inserted && it->second != std::make_pair(kind, model))
-          l.fail(fmt::format("capturable {} was a {}{}; it cannot become a {}{}", id, capturableKindName(it->second.first),
-                             it->second.second >= 0 ? " of '" + models_[static_cast<std::size_t>(it->second.second)].path + "'" : "",
-                             capturableKindName(kind), model >= 0 ? " of '" + models_[static_cast<std::size_t>(model)].path + "'" : ""));
-      };
-      auto modelAt = [&](std::size_t field) {
-        const std::string path = l.text(field);
-        const int index = modelIndex(path);
-        if (index < 0) l.fail(fmt::format("unknown model '{}': no file in {} declares it", path, kModelsFolder));
-        return index;
-      };
       if (token == "e") {
         l.expectFields(1, "frame_number");
         if (l.integer<std::uint64_t>(1, "frame_number") != frame.number)
@@ -260,71 +400,16 @@ Expected<bool> CaptureReader::next(CaptureFrame& frame) {
         impl.lastFrame = frame.number;
         impl.lastTime = frame.time;
         return true;
-      } else if (token == "f") {
-        l.fail(fmt::format("frame starts before frame {} (line {}) ended", frame.number, frame.line));
-      } else if (token == "t") {
-        const CameraRecord c = cameraRecord(l);
-        claim(c.id, Kind::kCamera, -1);
-        frame.cameras.push_back(c);
-      } else if (token == "c") {
-        CameraCutRecord c = cutRecord(l);
-        if (std::none_of(frame.cameras.begin(), frame.cameras.end(), [&](const CameraRecord& r) { return r.id == c.id; }))
-          l.fail(fmt::format("cut of camera {}, which has no camera transform ('t') earlier in this frame", c.id));
-        frame.cuts.push_back(std::move(c));
-      } else if (token == "p" || token == "m") {
-        l.expectFields(10, "id:rx:ry:rz:rw:dx:dy:dz:dw:model_path");
-        ModelRecord r;
-        r.id = l.integer<std::uint64_t>(1, "id");
-        r.pose = l.dualQuat(2);
-        r.model = modelAt(10);
-        claim(r.id, token == "p" ? Kind::kStaticModel : Kind::kModel, r.model);
-        if (token == "m") impl.modelsThisFrame.insert(r.id);
-        (token == "p" ? frame.staticModels : frame.models).push_back(std::move(r));
-      } else if (token == "j") {
-        if (l.size() < 4) l.fail("record 'j' needs id:joint_count:8 numbers per joint:model_path", ErrorCode::kParse);
-        JointsRecord r;
-        r.id = l.integer<std::uint64_t>(1, "id");
-        const auto count = l.integer<std::size_t>(2, "joint_count");
-        if (l.size() != 4 + 8 * count)
-          l.fail(fmt::format("record 'j' with {} joints needs {} fields, got {}", count, 3 + 8 * count, l.size() - 1), ErrorCode::kParse);
-        r.model = modelAt(3 + 8 * count);
-        const auto& model = models_[static_cast<std::size_t>(r.model)];
-        if (count != model.joints.size())
-          l.fail(fmt::format("{} joints for model '{}', which has {} joints", count, model.path, model.joints.size()));
-        if (!impl.modelsThisFrame.contains(r.id))
-          l.fail(fmt::format("joints of capturable {}, which has no model transform ('m') earlier in this frame", r.id));
-        if (impl.capturables.at(r.id).second != r.model)
-          l.fail(fmt::format("joints of capturable {} name model '{}', its transform another", r.id, model.path));
-        r.joints.reserve(count);
-        for (std::size_t k = 0; k < count; ++k) r.joints.push_back(l.dualQuat(3 + 8 * k));
-        frame.joints.push_back(std::move(r));
-      } else if (token == "v") {
-        l.expectFields(5, "id:from:to:fraction:model_path");
-        VertexFramesRecord r;
-        r.id = l.integer<std::uint64_t>(1, "id");
-        r.from = l.integer<std::uint32_t>(2, "from"), r.to = l.integer<std::uint32_t>(3, "to");
-        r.fraction = l.real(4, "fraction");
-        r.model = modelAt(5);
-        const auto& model = models_[static_cast<std::size_t>(r.model)];
-        if (model.keyFrames == 0) l.fail(fmt::format("key frames of model '{}', which has none ('K' records)", model.path));
-        if (r.from >= model.keyFrames || r.to >= model.keyFrames)
-          l.fail(fmt::format("key frames {} and {} of model '{}', which has {}", r.from, r.to, model.path, model.keyFrames));
-        if (!(r.fraction >= 0 && r.fraction <= 1)) l.fail(fmt::format("fraction {} is not in [0, 1]", r.fraction));
-        if (!impl.modelsThisFrame.contains(r.id))
-          l.fail(fmt::format("key frames of capturable {}, which has no model transform ('m') earlier in this frame", r.id));
-        if (impl.capturables.at(r.id).second != r.model)
-          l.fail(fmt::format("key frames of capturable {} name model '{}', its transform another", r.id, model.path));
-        frame.vertexFrames.push_back(r);
-      } else if (token == "l") {
-        LightRecord r = lightRecord(l);
-        claim(r.id, Kind::kLight, -1);
-        frame.lights.push_back(std::move(r));
-      } else if (token == "C") {
-        frame.cameraSettings = cameraSettings(l);
-      } else {
-        l.fail(fmt::format("unknown record '{}' in a frame; expected t, c, p, m, j, v, l, C or e", token), ErrorCode::kParse);
       }
+      if (token == "f") l.fail(fmt::format("frame starts before frame {} (line {}) ended", frame.number, frame.line));
+      const auto entry = std::find_if(std::begin(kFrameRecords), std::end(kFrameRecords),
+                                      [&](const FrameRecordEntry& e) { return e.token == token; });
+      if (entry == std::end(kFrameRecords))
+        l.fail(fmt::format("unknown record '{}' in a frame; expected {}", token, expectedFrameTokens()), ErrorCode::kParse);
+      FrameRecords records(impl, *this, frame, l);
+      (records.*(entry->read))();
     }
+    return false;
   } catch (const Failure& f) {
     return std::unexpected(f.error);
   }

@@ -137,6 +137,8 @@ struct CaptureFrame {
   void clear();
 };
 
+class Line;  // capture/record_lexer.h
+
 class CaptureReader {
  public:
   // Reads every ModelMesh file and Capture.txt's records up to the first frame.
@@ -157,6 +159,8 @@ class CaptureReader {
 
  private:
   CaptureReader();
+  bool nextLine(std::string& line, std::size_t& number, bool inFrame, const CaptureFrame& frame);
+  void startFrame(const Line& l, CaptureFrame& frame);
   CaptureSettings settings_;
   std::vector<CapturedModel> models_;
   std::map<std::string, int> modelByPath_;
