@@ -81,7 +81,11 @@ if ((${#missing[@]})); then
   [[ $(id -u) -eq 0 ]] || SUDO="sudo"
   export DEBIAN_FRONTEND=noninteractive
   $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+  # --force-unsafe-io: dpkg skips its fsync after every file it unpacks, which was most of a fresh
+  # machine's setup (dpkg unpacked and configured 677 packages in 277 of setup's 292 s on a 2-core
+  # AMD EPYC; Debian's own container images set the same). A machine that loses power mid-install
+  # may keep a half-written file; apt-get install --reinstall mends it.
+  $SUDO apt-get install -y -qq --no-install-recommends -o Dpkg::Options::=--force-unsafe-io "${missing[@]}"
 else
   echo "setup: all ${#packages[@]} Debian packages present"
 fi

@@ -88,7 +88,7 @@ TEST(OpenArena, SeededMatchesOnTwoMapsAreByteIdentical) {
   const auto dir = test::freshDir("openarena_identical");
   // oa_dm1 with its fitted lights (fitted once, then read from the cache by run b); oa_dm3 with the
   // adapter's own approximation: its fit takes 38 s, and the fit's own determinism, across machines
-  // too, is OpenArena.StrippedLightsAreFittedToTheLightmaps's.
+  // too, is OpenArena.AFitIsTheSameBytesOnAnotherMachineAndUnjudged's.
   for (const auto& [map, seed, lights] : {std::tuple<std::string, int, std::string>{"oa_dm1", 3, "fit"}, {"oa_dm3", 5, "none"}}) {
     for (const char* run : {"a", "b"}) {
       std::optional<test::OtherMachine> other;  // run b as another machine would (other_machine.h)
