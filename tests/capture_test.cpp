@@ -433,5 +433,30 @@ TEST(BadCapture, BrokenModelMeshFile) {
   expectCaptureError(dir, ErrorCode::kInvalidData, {file.filename().string(), "triangles"});
 }
 
+// A model file checked against its own declarations at its end (checkModel): each broken one names
+// the file, its last line and what disagrees.
+TEST(BadCapture, ModelMeshDeclarationsAreChecked) {
+  const std::vector<std::pair<std::string, std::string>> edits = {
+      {"i:0:0:1:2\n", "i:0:0:1:7\n"},  // a vertex beyond the three declared
+      {"p:0:1:0:0\n", ""},              // two positions for three vertices
+      {"o:mapmodel/crate%3A1\n", ""},    // no name
+  };
+  const std::vector<std::string> expected = {"mesh 0 has a triangle using vertex 7 of 3", "mesh 0 declares 3 vertices but has 2 'p' records",
+                                             "no 'o' record naming the model"};
+  for (std::size_t k = 0; k < edits.size(); ++k) {
+    const auto dir = writeCapture(fmt::format("bad_modelmesh_{}", k));
+    fs::path file;
+    for (const auto& e : fs::directory_iterator(dir / "models"))
+      if (test::slurp(e.path()).find("o:mapmodel/crate%3A1\n") != std::string::npos) file = e.path();
+    ASSERT_FALSE(file.empty()) << "the crate's model file";
+    std::string text = test::slurp(file);
+    const auto at = text.find(edits[k].first);
+    ASSERT_NE(at, std::string::npos) << edits[k].first;
+    text.replace(at, edits[k].first.size(), edits[k].second);
+    std::ofstream(file, std::ios::trunc) << text;
+    expectCaptureError(dir, ErrorCode::kInvalidData, {file.filename().string() + ":", expected[k]});
+  }
+}
+
 }  // namespace
 }  // namespace dynbench::capture

@@ -22,38 +22,38 @@ struct Declared {
 // The whole model against its declarations: a name, both poses of every joint, joints or key
 // frames, every mesh's per-vertex records as many as its vertices, its triangles as declared and
 // in range, every joint a vertex uses in the model. `where` is file:last line.
-void checkModel(const CapturedModel& model, const Declared& declared, const std::string& where) {
-  if (model.path.empty()) throw Failure{Error{ErrorCode::kInvalidData, where + ": no 'o' record naming the model"}};
-  if (declared.bound != declared.inverseBound) throw Failure{Error{ErrorCode::kInvalidData, where + ": every joint needs both a 'b' and an 'x' record"}};
-  if (model.keyFrames > 0 && !model.joints.empty())
-    throw Failure{Error{ErrorCode::kInvalidData, where + ": a model has joints or key frames ('K'), not both"}};
+Expected<void> checkModel(const CapturedModel& model, const Declared& declared, const std::string& where) {
+  const auto invalid = [&](const std::string& what) { return std::unexpected(Error{ErrorCode::kInvalidData, where + ": " + what}); };
+  if (model.path.empty()) return invalid("no 'o' record naming the model");
+  if (declared.bound != declared.inverseBound) return invalid("every joint needs both a 'b' and an 'x' record");
+  if (model.keyFrames > 0 && !model.joints.empty()) return invalid("a model has joints or key frames ('K'), not both");
   for (const auto& mesh : model.meshes) {
     const std::size_t n = declared.vertices[static_cast<std::size_t>(mesh.id)];
-    auto check = [&](std::size_t count, const char* what, bool optional) {
-      if (count != n && !(optional && count == 0))
-        throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} declares {} vertices but has {} {} records", where, mesh.id, n, count, what)}};
+    // Each per-vertex record as many as the vertices (an optional one may be absent altogether).
+    const auto vertexRecords = [&](std::size_t count, const std::string& what, bool optional) -> Expected<void> {
+      if (count == n || (optional && count == 0)) return {};
+      return invalid(fmt::format("mesh {} declares {} vertices but has {} {} records", mesh.id, n, count, what));
     };
-    check(mesh.positions.size(), "'p'", false);
-    check(mesh.normals.size(), "'n'", true);
-    check(mesh.uvs.size(), "'t'", true);
-    check(mesh.colors.size(), "'c'", true);
-    check(mesh.joints.size(), "'j'", true);
-    check(mesh.weights.size(), "'w'", true);
-    if (mesh.indices.size() != 3 * declared.triangles[static_cast<std::size_t>(mesh.id)])
-      throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} declares {} triangles but has {} 'i' records", where, mesh.id,
-                                                              declared.triangles[static_cast<std::size_t>(mesh.id)], mesh.indices.size() / 3)}};
+    for (const auto& [count, what, optional] : {std::tuple{mesh.positions.size(), "'p'", false}, {mesh.normals.size(), "'n'", true},
+                                                {mesh.uvs.size(), "'t'", true}, {mesh.colors.size(), "'c'", true},
+                                                {mesh.joints.size(), "'j'", true}, {mesh.weights.size(), "'w'", true}})
+      if (auto ok = vertexRecords(count, what, optional); !ok) return ok;
+    const std::size_t triangles = declared.triangles[static_cast<std::size_t>(mesh.id)];
+    if (mesh.indices.size() != 3 * triangles)
+      return invalid(fmt::format("mesh {} declares {} triangles but has {} 'i' records", mesh.id, triangles, mesh.indices.size() / 3));
     for (std::size_t f = 0; f < mesh.keyPositions.size(); ++f) {
-      check(mesh.keyPositions[f].size(), fmt::format("'P' (key frame {})", f).c_str(), false);
-      if (!mesh.keyNormals.empty()) check(mesh.keyNormals[f].size(), fmt::format("'N' (key frame {})", f).c_str(), false);
+      if (auto ok = vertexRecords(mesh.keyPositions[f].size(), fmt::format("'P' (key frame {})", f), false); !ok) return ok;
+      if (mesh.keyNormals.empty()) continue;
+      if (auto ok = vertexRecords(mesh.keyNormals[f].size(), fmt::format("'N' (key frame {})", f), false); !ok) return ok;
     }
     for (std::uint32_t index : mesh.indices)
-      if (index >= n) throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} has a triangle using vertex {} of {}", where, mesh.id, index, n)}};
+      if (index >= n) return invalid(fmt::format("mesh {} has a triangle using vertex {} of {}", mesh.id, index, n));
     for (std::size_t v = 0; v < mesh.joints.size(); ++v)
       for (int k = 0; k < declared.influenceCounts[static_cast<std::size_t>(mesh.id)][v]; ++k)
         if (mesh.joints[v][k] >= model.joints.size())
-          throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: mesh {} vertex {} uses joint {} but the model has {} joints", where,
-                                                                  mesh.id, v, mesh.joints[v][k], model.joints.size())}};
+          return invalid(fmt::format("mesh {} vertex {} uses joint {} but the model has {} joints", mesh.id, v, mesh.joints[v][k], model.joints.size()));
   }
+  return {};
 }
 
 }  // namespace
@@ -189,7 +189,7 @@ CapturedModel parseModelMesh(const fs::path& path) {
              ErrorCode::kParse);
     }
   }
-  checkModel(model, declared, fmt::format("{}:{}", file, source.number()));
+  if (auto ok = checkModel(model, declared, fmt::format("{}:{}", file, source.number())); !ok) raise(ok.error());
   return model;
 }
 
