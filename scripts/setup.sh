@@ -134,7 +134,7 @@ if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
   SUDO=""
   [[ $(id -u) -eq 0 ]] || SUDO="sudo"
   $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends nodejs npm
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends -o Dpkg::Options::=--force-unsafe-io nodejs npm
 fi
 here=$(cd "$(dirname "$0")/.." && pwd)
 validator="$here/tools/gltf-validator"
