@@ -190,44 +190,41 @@ Expected<MergeCameraReport> mergeCamera(const MergeCameraOptions& options) {
   std::error_code ec;
   fs::copy_file(bin, tmpBin, fs::copy_options::overwrite_existing, ec);
   if (ec) return fail(ErrorCode::kIo, "{}: cannot copy to {}: {}", bin.string(), tmpBin.string(), ec.message());
-  std::uint64_t binBytes = 0;
-  try {
-    BinaryBuffer buffer(tmpBin, BinaryBuffer::Mode::kAppend);
-    const int input = addDataAccessor(doc, buffer, times, kFloat, "SCALAR", 0, json::array({times.front()}), json::array({times.back()}));
-    const std::map<std::string, int> outputs{{"translation", addDataAccessor(doc, buffer, translations, kFloat, "VEC3")},
-                                             {"rotation", addDataAccessor(doc, buffer, rotations, kFloat, "VEC4")}};
-    buffer.finish();
-    binBytes = buffer.size();
-    // Repoint the camera's translation and rotation samplers; add channels where there were none.
-    if (!doc.contains("animations") || doc["animations"].empty())
-      doc["animations"] = {{{"name", "camera"}, {"samplers", json::array()}, {"channels", json::array()}}};
-    std::set<std::string> done;
-    for (auto& animation : doc["animations"])
-      for (auto& channel : animation["channels"]) {
-        const auto& target = channel["target"];
-        if (!target.contains("node") || target["node"] != *node) continue;
-        const std::string path = target.value("path", "");
-        if (!outputs.contains(path)) continue;
-        // A sampler may be shared with another node; it must not change under it: give this channel its own.
-        animation["samplers"].push_back({{"input", input}, {"output", outputs.at(path)}, {"interpolation", "LINEAR"}});
-        channel["sampler"] = animation["samplers"].size() - 1;
-        done.insert(path);
-      }
-    for (const auto& [path, output] : outputs) {
-      if (done.contains(path)) continue;
-      auto& animation = doc["animations"][0];
-      animation["samplers"].push_back({{"input", input}, {"output", output}, {"interpolation", "LINEAR"}});
-      animation["channels"].push_back({{"sampler", animation["samplers"].size() - 1}, {"target", {{"node", *node}, {"path", path}}}});
-    }
-    // The old camera's cuts were jumps of its motion, which the run replaces: they go with it.
-    auto& cameraNode = doc["nodes"][static_cast<std::size_t>(*node)];
-    if (!options.keepCuts && cameraNode.contains("extras") && cameraNode["extras"].is_object()) {
-      cameraNode["extras"].erase("dynbench_camera_cuts");
-      if (cameraNode["extras"].empty()) cameraNode.erase("extras");
-    }
-  } catch (const Failure& f) {
+  BinaryBuffer buffer(tmpBin, BinaryBuffer::Mode::kAppend);
+  const int input = addDataAccessor(doc, buffer, times, kFloat, "SCALAR", 0, json::array({times.front()}), json::array({times.back()}));
+  const std::map<std::string, int> outputs{{"translation", addDataAccessor(doc, buffer, translations, kFloat, "VEC3")},
+                                           {"rotation", addDataAccessor(doc, buffer, rotations, kFloat, "VEC4")}};
+  if (auto ok = buffer.finish(); !ok) {
     fs::remove(tmpBin, ec);
-    return std::unexpected(f.error);
+    return std::unexpected(ok.error());
+  }
+  const std::uint64_t binBytes = buffer.size();
+  // Repoint the camera's translation and rotation samplers; add channels where there were none.
+  if (!doc.contains("animations") || doc["animations"].empty())
+    doc["animations"] = {{{"name", "camera"}, {"samplers", json::array()}, {"channels", json::array()}}};
+  std::set<std::string> done;
+  for (auto& animation : doc["animations"])
+    for (auto& channel : animation["channels"]) {
+      const auto& target = channel["target"];
+      if (!target.contains("node") || target["node"] != *node) continue;
+      const std::string path = target.value("path", "");
+      if (!outputs.contains(path)) continue;
+      // A sampler may be shared with another node; it must not change under it: give this channel its own.
+      animation["samplers"].push_back({{"input", input}, {"output", outputs.at(path)}, {"interpolation", "LINEAR"}});
+      channel["sampler"] = animation["samplers"].size() - 1;
+      done.insert(path);
+    }
+  for (const auto& [path, output] : outputs) {
+    if (done.contains(path)) continue;
+    auto& animation = doc["animations"][0];
+    animation["samplers"].push_back({{"input", input}, {"output", output}, {"interpolation", "LINEAR"}});
+    animation["channels"].push_back({{"sampler", animation["samplers"].size() - 1}, {"target", {{"node", *node}, {"path", path}}}});
+  }
+  // The old camera's cuts were jumps of its motion, which the run replaces: they go with it.
+  auto& cameraNode = doc["nodes"][static_cast<std::size_t>(*node)];
+  if (!options.keepCuts && cameraNode.contains("extras") && cameraNode["extras"].is_object()) {
+    cameraNode["extras"].erase("dynbench_camera_cuts");
+    if (cameraNode["extras"].empty()) cameraNode.erase("extras");
   }
   auto written = writeDataset(std::move(doc), tmpBin, binBytes, options.output, false);
   if (!written) return std::unexpected(written.error());

@@ -5,49 +5,46 @@
 namespace dynbench::convert {
 namespace detail {
 
-ConvertReport Converter::run() {
+Expected<ConvertReport> Converter::run() {
   auto opened = CaptureReader::open(options_.capture);
-  if (!opened) throw Failure{Error{opened.error().code, opened.error().message}};
+  if (!opened) return std::unexpected(opened.error());
   reader_ = std::move(*opened);
   const fs::path out = options_.output;
   stem_ = out.stem().string();
   outDir_ = out.has_parent_path() ? out.parent_path() : fs::path(".");
   std::error_code ec;
   fs::create_directories(outDir_, ec);
-  if (ec) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: cannot create folder: {}", outDir_.string(), ec.message())}};
+  if (ec) return fail(ErrorCode::kIo, "{}: cannot create folder: {}", outDir_.string(), ec.message());
 
-  passOne();
-  calibrateLighting();
-  if (times_.empty()) throw Failure{Error{ErrorCode::kInvalidData, fmt::format("{}: the capture has no complete frame", options_.capture.string())}};
+  if (auto ok = passOne(); !ok) return std::unexpected(ok.error());
+  if (auto ok = calibrateLighting(); !ok) return std::unexpected(ok.error());
+  if (times_.empty()) return fail(ErrorCode::kInvalidData, "{}: the capture has no complete frame", options_.capture.string());
   binPath_ = temporarySibling(outDir_ / (stem_ + ".bin"));
-  try {
-    {
-      BinaryBuffer bin(binPath_);
-      bin_ = &bin;
-      buildDocument();
-      passTwo();
-      bin.finish();
-      report_.binBytes = bin.size();
-      bin_ = nullptr;
-    }
-    writeOutputs();
-  } catch (...) {
-    std::error_code ec;
+  auto written = writeBufferAndDocument();
+  if (!written) {
     fs::remove(binPath_, ec);  // no half-written buffer left behind
-    throw;
+    return std::unexpected(written.error());
   }
   report_.warnings.insert(report_.warnings.begin(), reader_->warnings().begin(), reader_->warnings().end());
   return report_;
 }
 
+Expected<void> Converter::writeBufferAndDocument() {
+  {
+    BinaryBuffer bin(binPath_);
+    bin_ = &bin;
+    auto built = buildDocument();
+    if (built) built = passTwo();
+    bin_ = nullptr;
+    if (auto finished = bin.finish(); built && !finished) built = std::unexpected(finished.error());
+    if (!built) return built;
+    report_.binBytes = bin.size();
+  }
+  return writeOutputs();
+}
+
 }  // namespace detail
 
-Expected<ConvertReport> convertCapture(const ConvertOptions& options) {
-  try {
-    return detail::Converter(options).run();
-  } catch (const Failure& f) {
-    return std::unexpected(f.error);
-  }
-}
+Expected<ConvertReport> convertCapture(const ConvertOptions& options) { return detail::Converter(options).run(); }
 
 }  // namespace dynbench::convert

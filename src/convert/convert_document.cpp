@@ -2,7 +2,7 @@
 
 namespace dynbench::convert::detail {
 
-void Converter::buildDocument() {
+Expected<void> Converter::buildDocument() {
   doc_ = {{"asset", {{"version", "2.0"}, {"generator", fmt::format("dynbench {} convert", kVersion)}}},
           {"scene", 0},
           {"scenes", {{{"name", "capture"}, {"nodes", {0}}}}},
@@ -14,7 +14,7 @@ void Converter::buildDocument() {
   const int world = addNode({{"name", "WorldOrigo"}}, -1);
   const int staticObjects = addNode({{"name", "StaticObjects"}}, world);
   const int dynamicObjects = addNode({{"name", "DynamicObjects"}}, world);
-  buildMeshes();
+  if (auto ok = buildMeshes(); !ok) return ok;
 
   // The map geometry: a model whose path is the map's name, placed at the map offset.
   const auto& settings = reader_->settings();
@@ -136,6 +136,7 @@ void Converter::buildDocument() {
   }
   report_.channels = channels.size();
   if (!channels.empty()) doc_["animations"] = {{{"name", "capture"}, {"samplers", samplers}, {"channels", channels}}};
+  return {};
 }
 
 bool Converter::placeStatic(Track& t, int staticObjects) {

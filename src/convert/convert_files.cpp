@@ -28,28 +28,28 @@ std::string Converter::datasetReadme() const {
 }
 
 // The environment image beside the dataset and the root extension that names it (docs/dataset.md).
-json Converter::environment() {
+Expected<json> Converter::environment() {
   json ext = {{"projection", "equirectangular"}, {"units", "cd/m2"}, {"intensity", 1.0}};
   fs::path target;
   if (options_.environment) {
     std::string ext2 = options_.environment->extension().string();
     std::transform(ext2.begin(), ext2.end(), ext2.begin(), [](unsigned char c) { return std::tolower(c); });
     if (ext2 != ".hdr" && ext2 != ".exr")
-      throw Failure{Error{ErrorCode::kUsage, fmt::format("--env {}: expected an .hdr or .exr image", options_.environment->string())}};
+      return fail(ErrorCode::kUsage, "--env {}: expected an .hdr or .exr image", options_.environment->string());
     auto header = readImageHeader(*options_.environment);
-    if (!header) throw Failure{Error{header.error().code, header.error().message}};
+    if (!header) return std::unexpected(header.error());
     if (header->width != 2 * header->height)
       report_.warnings.push_back(fmt::format("--env {}: {}x{} is not 2:1; is it equirectangular?", options_.environment->string(),
                                              header->width, header->height));
     target = outDir_ / (stem_ + "_environment" + ext2);
     std::error_code ec;
     fs::copy_file(*options_.environment, target, fs::copy_options::overwrite_existing, ec);
-    if (ec) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: cannot copy the environment: {}", target.string(), ec.message())}};
+    if (ec) return fail(ErrorCode::kIo, "{}: cannot copy the environment: {}", target.string(), ec.message());
     ext["source"] = options_.environment->filename().string();
   } else {
     const SkyImage& sky = *sky_;
     target = outDir_ / (stem_ + "_sky.hdr");
-    if (auto ok = writeImage(target, FloatImage{sky.width, sky.height, 3, sky.rgb, {}, {}, {}}); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
+    if (auto ok = writeImage(target, FloatImage{sky.width, sky.height, 3, sky.rgb, {}, {}, {}}); !ok) return std::unexpected(ok.error());
     ext["source"] = "dynbench Preetham sky";
     ext["sky"] = {{"model", !skyParameters_.dome ? (skyParameters_.sunDisc ? "ESRA sun disc alone, no sky dome" : "black: no sky dome, no sun")
                             : skyParameters_.sunDisc ? "Preetham 1999 + ESRA sun"
@@ -65,9 +65,11 @@ json Converter::environment() {
   return ext;
 }
 
-void Converter::writeOutputs() {
+Expected<void> Converter::writeOutputs() {
   json document = doc_;
-  document["extensions"]["DYNBENCH_environment"] = environment();
+  auto environmentExtension = environment();
+  if (!environmentExtension) return std::unexpected(environmentExtension.error());
+  document["extensions"]["DYNBENCH_environment"] = std::move(*environmentExtension);
   if (!lights_.empty()) document["extensions"]["KHR_lights_punctual"] = {{"lights", lights_}};
   std::vector<std::string> used{"DYNBENCH_environment"};
   if (!lights_.empty()) used.push_back("KHR_lights_punctual");
@@ -84,10 +86,11 @@ void Converter::writeOutputs() {
   report_.frames = times_.size();
 
   const fs::path readme = outDir_ / (stem_ + ".README.md");
-  if (auto ok = writeFileAtomic(readme, datasetReadme()); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
+  if (auto ok = writeFileAtomic(readme, datasetReadme()); !ok) return std::unexpected(ok.error());
   report_.written.push_back(readme);
   auto written = writeDataset(std::move(document), binPath_, report_.binBytes, options_.output, options_.glb);
-  if (!written) throw Failure{written.error()};
+  if (!written) return std::unexpected(written.error());
   report_.written.insert(report_.written.end(), written->begin(), written->end());
+  return {};
 }
 }  // namespace dynbench::convert::detail

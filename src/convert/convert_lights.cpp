@@ -13,7 +13,7 @@ namespace {
 double fluxFactor(LightFalloff falloff) { return falloff == LightFalloff::kQuadratic ? 1.0 / 6.0 : 5.0 / 48.0; }
 }  // namespace
 
-void Converter::calibrateLighting() {
+Expected<void> Converter::calibrateLighting() {
   const auto& lighting = reader_->settings().lighting;
   skyParameters_ = options_.sky;
   if (options_.sunFromCapture && lighting) {
@@ -48,7 +48,7 @@ void Converter::calibrateLighting() {
     } else {
       auto image = readImage(*options_.environment);
       if (!image || image->channels < 3)
-        throw Failure{Error{ErrorCode::kInvalidData, fmt::format("--env {}: cannot read it as an RGB image", options_.environment->string())}};
+        return fail(ErrorCode::kInvalidData, "--env {}: cannot read it as an RGB image", options_.environment->string());
       std::vector<float> rgb(static_cast<std::size_t>(image->width) * image->height * 3);
       for (std::size_t i = 0; i < rgb.size() / 3; ++i)
         for (int c = 0; c < 3; ++c) rgb[3 * i + c] = image->pixels[i * static_cast<std::size_t>(image->channels) + c];
@@ -74,6 +74,7 @@ void Converter::calibrateLighting() {
     sky_ = preethamSky(skyParameters_);
     calibration_["sky_dome"] = "none: the engine's sky gives no light but its sun (no sky light, no ambient)";
   }
+  return {};
 }
 
 std::pair<glm::dvec3, double> Converter::lightColorIntensity(const glm::dvec3& capturedColor, double range, LightFalloff falloff,

@@ -4,7 +4,7 @@
 
 namespace dynbench::convert::detail {
 
-int Converter::image(const std::string& texture) {
+Expected<int> Converter::image(const std::string& texture) {
   if (texture.empty()) return -1;
   if (auto it = imageByTexture_.find(texture); it != imageByTexture_.end()) return it->second;
   int index = -1;
@@ -30,10 +30,10 @@ int Converter::image(const std::string& texture) {
     std::error_code ec;
     fs::create_directories(target.parent_path(), ec);
     if (pixels) {
-      if (auto ok = writeImage(target, *pixels); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
+      if (auto ok = writeImage(target, *pixels); !ok) return std::unexpected(ok.error());
     } else {
       fs::copy_file(source, target, fs::copy_options::overwrite_existing, ec);
-      if (ec) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: cannot copy texture: {}", target.string(), ec.message())}};
+      if (ec) return fail(ErrorCode::kIo, "{}: cannot copy texture: {}", target.string(), ec.message());
     }
     report_.written.push_back(target);
     index = addTexture(relative.generic_string(), ext == ".jpg" || ext == ".jpeg" ? "image/jpeg" : "image/png");
@@ -66,20 +66,20 @@ int Converter::addTexture(const std::string& relativeUri, const std::string& mim
   return static_cast<int>(doc_["textures"].size()) - 1;
 }
 
-Converter::DerivedTexture Converter::derivedTexture(const std::string& texture, const std::string& suffix, const FloatImage& image) {
+Expected<Converter::DerivedTexture> Converter::derivedTexture(const std::string& texture, const std::string& suffix, const FloatImage& image) {
   const std::string relative = (fs::path(texture).parent_path() / (fs::path(texture).stem().string() + suffix + ".png")).generic_string();
   const fs::path target = outDir_ / (stem_ + "_textures") / relative;
   std::error_code ec;
   fs::create_directories(target.parent_path(), ec);
-  if (auto ok = writeImage(target, image); !ok) throw Failure{Error{ok.error().code, ok.error().message}};
+  if (auto ok = writeImage(target, image); !ok) return std::unexpected(ok.error());
   report_.written.push_back(target);
-  return {addTexture(relative, "image/png"), target};
+  return DerivedTexture{addTexture(relative, "image/png"), target};
 }
 
 // The mask map turned into a glTF metallic-roughness texture (docs/dataset.md): Cube 2 masks hold
 // specular intensity in R and the environment-map (chrome) mask in B, so roughness (G) = 1 - 0.8 R
 // and metallic (B) = B. Returns -1 when the mask cannot be read.
-int Converter::metallicRoughnessFromMask(const std::string& mask) {
+Expected<int> Converter::metallicRoughnessFromMask(const std::string& mask) {
   if (mask.empty()) return -1;
   if (auto it = maskTextures_.find(mask); it != maskTextures_.end()) return it->second;
   int index = -1;
@@ -98,7 +98,9 @@ int Converter::metallicRoughnessFromMask(const std::string& mask) {
         mr.pixels[p * 3 + 1] = 1.0f - 0.8f * specular;  // G: roughness
         mr.pixels[p * 3 + 2] = chrome;                  // B: metallic
       }
-      index = derivedTexture(mask, "_metallic_roughness", mr).texture;
+      auto derived = derivedTexture(mask, "_metallic_roughness", mr);
+      if (!derived) return std::unexpected(derived.error());
+      index = derived->texture;
     }
   }
   maskTextures_[mask] = index;
@@ -119,7 +121,7 @@ bool blended(const CapturedMesh& mesh) {
 // mean channel by channel kept the mean but not the hue: oa_ctf2's red flame, whose light image is
 // orange, rendered magenta where its texels have a little green and blue. The level map keeps the
 // map's pattern and the light's colour.
-std::optional<Converter::EmissionLevelMap> Converter::emissionLevelMap(const std::string& texture) {
+Expected<std::optional<Converter::EmissionLevelMap>> Converter::emissionLevelMap(const std::string& texture) {
   if (auto it = emissionLevelMaps_.find(texture); it != emissionLevelMaps_.end()) return it->second;
   std::optional<EmissionLevelMap> result;
   if (const fs::path source = textureSource(texture); !source.empty()) {
@@ -136,13 +138,14 @@ std::optional<Converter::EmissionLevelMap> Converter::emissionLevelMap(const std
         const auto encoded = static_cast<float>(linearToSrgb(y));  // sRGB-encoded, as glTF stores emissive textures
         for (std::size_t c = 0; c < 3; ++c) level.pixels[i * 3 + c] = encoded;
       }
-      const DerivedTexture derived = derivedTexture(texture, "_emission_level", level);
+      auto derived = derivedTexture(texture, "_emission_level", level);
+      if (!derived) return std::unexpected(derived.error());
       // the mean of the bytes written, decoded as the renderer decodes them
-      auto written = readImage(derived.file);
-      if (!written) throw Failure{Error{written.error().code, written.error().message}};
+      auto written = readImage(derived->file);
+      if (!written) return std::unexpected(written.error());
       double sum = 0.0;
       for (std::size_t i = 0; i < n; ++i) sum += srgbToLinear<double>(written->pixels[i * static_cast<std::size_t>(written->channels)]);
-      result = EmissionLevelMap{derived.texture, sum / static_cast<double>(n)};
+      result = EmissionLevelMap{derived->texture, sum / static_cast<double>(n)};
     }
   }
   if (!result) report_.warnings.push_back(fmt::format("emission map '{}' cannot be read; its surface gives off its mean emission evenly", texture));
@@ -153,7 +156,7 @@ std::optional<Converter::EmissionLevelMap> Converter::emissionLevelMap(const std
 // Material per distinct set of maps and factors (docs/dataset.md): base colour from the texture
 // map times the captured factor; metallic and roughness from the captured values, else from the
 // mask map, else dielectric with roughness 0.8; emission in cd/m2.
-int Converter::material(const CapturedMesh& mesh) {
+Expected<int> Converter::material(const CapturedMesh& mesh) {
   const bool blend = blended(mesh);
   const auto& c = mesh.baseColor;
   const std::string key = fmt::format("{}\n{}\n{}\n{} {} {} {}\n{}\n{} {} {}\n{}\n{}", mesh.texture, mesh.maskTexture, mesh.emissionTexture, c.r, c.g,
@@ -162,13 +165,17 @@ int Converter::material(const CapturedMesh& mesh) {
   if (auto it = materialByMaps_.find(key); it != materialByMaps_.end()) return it->second;
   json m = {{"name", mesh.texture.empty() ? "untextured" : fs::path(mesh.texture).stem().string()},
             {"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.8}}}};
-  if (int t = image(mesh.texture); t >= 0) m["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", t}};
+  const auto baseColor = image(mesh.texture);
+  if (!baseColor) return std::unexpected(baseColor.error());
+  if (*baseColor >= 0) m["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", *baseColor}};
   if (c != glm::vec4(1.0f)) m["pbrMetallicRoughness"]["baseColorFactor"] = {c.r, c.g, c.b, c.a};
+  const auto fromMask = mesh.metallicRoughness ? Expected<int>(-1) : metallicRoughnessFromMask(mesh.maskTexture);
+  if (!fromMask) return std::unexpected(fromMask.error());
   if (mesh.metallicRoughness) {
     m["pbrMetallicRoughness"]["metallicFactor"] = mesh.metallicRoughness->x;
     m["pbrMetallicRoughness"]["roughnessFactor"] = mesh.metallicRoughness->y;
-  } else if (int t = metallicRoughnessFromMask(mesh.maskTexture); t >= 0) {
-    m["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", t}};
+  } else if (*fromMask >= 0) {
+    m["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", *fromMask}};
     m["pbrMetallicRoughness"]["metallicFactor"] = 1.0;
     m["pbrMetallicRoughness"]["roughnessFactor"] = 1.0;
     m["extras"] = {{"dynbench_mask_map", mesh.maskTexture}};
@@ -182,13 +189,19 @@ int Converter::material(const CapturedMesh& mesh) {
     // The capture's emission is the surface's mean (record m): in the light's colour, times the
     // map's level over its mean, the surface gives off the light the capture says. A map without
     // light (mean 0) leaves the surface dark.
-    if (const auto level = emissionLevelMap(mesh.emissionTexture)) {
-      emission = level->mean > 1e-6 ? emission / static_cast<float>(level->mean) : glm::vec3(0.0f);
-      emissionTexture = level->texture;
+    const auto level = emissionLevelMap(mesh.emissionTexture);
+    if (!level) return std::unexpected(level.error());
+    if (*level) {
+      emission = (*level)->mean > 1e-6 ? emission / static_cast<float>((*level)->mean) : glm::vec3(0.0f);
+      emissionTexture = (*level)->texture;
     }
   }
   if (const float peak = std::max({emission.r, emission.g, emission.b}); peak > 0) {
-    if (!mesh.emissionTextureMeanOne) emissionTexture = image(mesh.emissionTexture);
+    if (!mesh.emissionTextureMeanOne) {
+      const auto emissive = image(mesh.emissionTexture);
+      if (!emissive) return std::unexpected(emissive.error());
+      emissionTexture = *emissive;
+    }
     const glm::vec3 factor = emission / peak;
     m["emissiveFactor"] = {factor.r, factor.g, factor.b};
     m["extensions"]["KHR_materials_emissive_strength"] = {{"emissiveStrength", luxPerUnit_ * peak / kPi}};
@@ -241,7 +254,7 @@ json Converter::morphTargets(const CapturedModel& model, const CapturedMesh& mes
   return targets;
 }
 
-void Converter::buildMeshes() {
+Expected<void> Converter::buildMeshes() {
   for (const auto& model : reader_->models()) {
     json primitives = json::array();
     for (const auto& mesh : model.meshes) {
@@ -288,9 +301,11 @@ void Converter::buildMeshes() {
         attributes["JOINTS_0"] = dataAccessor(joints, kUnsignedShort, "VEC4", kArrayBuffer);
         attributes["WEIGHTS_0"] = dataAccessor(weights, kFloat, "VEC4", kArrayBuffer);
       }
+      const auto materialIndex = material(mesh);
+      if (!materialIndex) return std::unexpected(materialIndex.error());
       json primitive = {{"attributes", attributes},
                         {"indices", dataAccessor(mesh.indices, kUnsignedInt, "SCALAR", kElementArrayBuffer)},
-                        {"material", material(mesh)}};
+                        {"material", *materialIndex}};
       if (model.keyFrames > 0) primitive["targets"] = morphTargets(model, mesh);
       primitives.push_back(std::move(primitive));
     }
@@ -320,5 +335,6 @@ void Converter::buildMeshes() {
       ibmOfModel_[static_cast<int>(meshOfModel_.size()) - 1] = dataAccessor(matrices, kFloat, "MAT4", 0);
     }
   }
+  return {};
 }
 }  // namespace dynbench::convert::detail

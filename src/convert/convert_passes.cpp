@@ -73,7 +73,7 @@ void Converter::scanFrame(const CaptureFrame& frame, std::size_t i, Key&& key) {
   endFrame(i, key);
 }
 
-void Converter::passOne() {
+Expected<void> Converter::passOne() {
   CaptureFrame frame;
   std::size_t i = 0;
   auto count = [](Track& t, std::size_t frame, bool) {
@@ -82,7 +82,7 @@ void Converter::passOne() {
   };
   while (true) {
     auto more = reader_->next(frame);
-    if (!more) throw Failure{Error{more.error().code, more.error().message}};
+    if (!more) return std::unexpected(more.error());
     if (!*more) break;
     if (frame.cameraSettings && !cameraChanged_) {
       cameraChanged_ = true;
@@ -99,14 +99,14 @@ void Converter::passOne() {
   // Times must strictly increase for glTF samplers; equal capture times (a paused game) cannot be keyed.
   for (std::size_t k = 1; k < n; ++k)
     if (!(times_[k] > times_[k - 1]))
-      throw Failure{Error{ErrorCode::kInvalidData,
-                         fmt::format("{}: frames {} and {} have the same time {} s (as float); glTF key times must increase",
-                                     options_.capture.string(), k - 1, k, times_[k])}};
+      return fail(ErrorCode::kInvalidData, "{}: frames {} and {} have the same time {} s (as float); glTF key times must increase",
+                  options_.capture.string(), k - 1, k, times_[k]);
+  return {};
 }
 
-void Converter::passTwo() {
+Expected<void> Converter::passTwo() {
   auto opened = CaptureReader::open(options_.capture);
-  if (!opened) throw Failure{Error{opened.error().code, opened.error().message}};
+  if (!opened) return std::unexpected(opened.error());
   auto reader = std::move(*opened);
   for (auto& [id, t] : tracks_) {
     t.appeared = t.visible = false;
@@ -137,8 +137,8 @@ void Converter::passTwo() {
   CaptureFrame frame;
   for (std::size_t i = 0; i < times_.size(); ++i) {
     auto more = reader->next(frame);
-    if (!more) throw Failure{Error{more.error().code, more.error().message}};
-    if (!*more) throw Failure{Error{ErrorCode::kIo, fmt::format("{}: the capture changed while it was converted", options_.capture.string())}};
+    if (!more) return std::unexpected(more.error());
+    if (!*more) return fail(ErrorCode::kIo, "{}: the capture changed while it was converted", options_.capture.string());
     // Held values follow this frame's records.
     for (const auto& c : frame.cameras) {
       Track& t = tracks_.at(c.id);
@@ -227,5 +227,6 @@ void Converter::passTwo() {
     for (auto& w : t.jointTranslation) w.flush();
     for (auto& w : t.jointRotation) w.flush();
   }
+  return {};
 }
 }  // namespace dynbench::convert::detail

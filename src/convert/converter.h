@@ -105,7 +105,7 @@ class Converter {
  public:
   explicit Converter(const ConvertOptions& options) : options_(options) {}
 
-  ConvertReport run();
+  Expected<ConvertReport> run();
 
  private:
   // ---- pass 1: spans and visibility key counts ------------------------------------------------
@@ -123,7 +123,7 @@ class Converter {
   template <typename Key>
   void scanFrame(const CaptureFrame& frame, std::size_t i, Key&& key);
 
-  void passOne();
+  Expected<void> passOne();
 
   // ---- the document --------------------------------------------------------------------------
 
@@ -152,7 +152,7 @@ class Converter {
     return n;
   }
 
-  int image(const std::string& texture);
+  Expected<int> image(const std::string& texture);
 
   // A texture's file under the data root, or empty (with a warning) when it cannot be used.
   fs::path textureSource(const std::string& texture);
@@ -163,7 +163,7 @@ class Converter {
     int texture = -1;  // glTF texture index
     double mean = 0.0; // mean linear level
   };
-  std::optional<EmissionLevelMap> emissionLevelMap(const std::string& texture);
+  Expected<std::optional<EmissionLevelMap>> emissionLevelMap(const std::string& texture);
 
   int addTexture(const std::string& relativeUri, const std::string& mime);
   // An image made from a capture texture, written beside the dataset's copies as
@@ -172,19 +172,19 @@ class Converter {
     int texture = -1;
     fs::path file;
   };
-  DerivedTexture derivedTexture(const std::string& texture, const std::string& suffix, const FloatImage& image);
+  Expected<DerivedTexture> derivedTexture(const std::string& texture, const std::string& suffix, const FloatImage& image);
 
   // The mask map turned into a glTF metallic-roughness texture (docs/dataset.md): Cube 2 masks hold
   // specular intensity in R and the environment-map (chrome) mask in B, so roughness (G) = 1 - 0.8 R
   // and metallic (B) = B. Returns -1 when the mask cannot be read.
-  int metallicRoughnessFromMask(const std::string& mask);
+  Expected<int> metallicRoughnessFromMask(const std::string& mask);
 
   // Material per distinct maps and factors (docs/dataset.md): base colour from the texture map;
   // metallic and roughness from the mask map, or dielectric with roughness 0.8 without one.
-  int material(const CapturedMesh& mesh);
+  Expected<int> material(const CapturedMesh& mesh);
 
   json morphTargets(const CapturedModel& model, const CapturedMesh& mesh);
-  void buildMeshes();
+  Expected<void> buildMeshes();
 
   // KHR_lights_punctual colour (the captured colour over its largest channel) and intensity of a
   // captured light under the light rules; `share` divides it between a ring's lights. A light with
@@ -204,14 +204,14 @@ class Converter {
 
   // The generated sky (when there is no --env) and the illuminance of the engine's full light,
   // from the map's lighting: computed before any light is written.
-  void calibrateLighting();
+  Expected<void> calibrateLighting();
 
   int lightDefinition(const LightRecord& l, double share);
 
   // A light capturable: one light, or (ring rule) six around its node.
   void lightNodes(Track& t, int node);
 
-  void buildDocument();
+  Expected<void> buildDocument();
   // A static model or a static light: its node under StaticObjects (no animation); false for any
   // other capturable.
   bool placeStatic(Track& t, int staticObjects);
@@ -225,16 +225,19 @@ class Converter {
 
   // ---- pass 2: key frames ----------------------------------------------------------------------
 
-  void passTwo();
+  Expected<void> passTwo();
 
   // ---- files -----------------------------------------------------------------------------------
 
   std::string datasetReadme() const;
 
   // The environment image beside the dataset and the root extension that names it (docs/dataset.md).
-  json environment();
+  Expected<json> environment();
 
-  void writeOutputs();
+  Expected<void> writeOutputs();
+
+  // The buffer (buildDocument, passTwo) and then the files; on an error the caller removes the buffer.
+  Expected<void> writeBufferAndDocument();
 
   const ConvertOptions& options_;
   std::unique_ptr<CaptureReader> reader_;

@@ -28,11 +28,14 @@ std::string uriPath(const std::string& path) {
 
 BinaryBuffer::BinaryBuffer(const fs::path& path, Mode mode) : path_(path) {
   fd_ = ::open(path.c_str(), mode == Mode::kCreate ? (O_RDWR | O_CREAT | O_TRUNC) : O_RDWR, 0644);
-  if (fd_ < 0) raise(ErrorCode::kIo, "{}: cannot {}: {}", path.string(), mode == Mode::kCreate ? "create" : "open", std::strerror(errno));
+  if (fd_ < 0) {
+    keepFirstError("{}: cannot {}: {}", path.string(), mode == Mode::kCreate ? "create" : "open", std::strerror(errno));
+    return;
+  }
   if (mode == Mode::kAppend) {
     const off_t end = ::lseek(fd_, 0, SEEK_END);
-    if (end < 0) raise(ErrorCode::kIo, "{}: cannot size: {}", path.string(), std::strerror(errno));
-    size_ = static_cast<std::uint64_t>(end);
+    if (end < 0) keepFirstError("{}: cannot size: {}", path.string(), std::strerror(errno));
+    else size_ = static_cast<std::uint64_t>(end);
   }
 }
 
@@ -48,12 +51,14 @@ std::uint64_t BinaryBuffer::allocate(std::uint64_t bytes) {
 }
 
 void BinaryBuffer::write(std::uint64_t offset, const void* data, std::size_t bytes) {
+  if (error_) return;
   const char* p = static_cast<const char*>(data);
   while (bytes > 0) {
     const ssize_t n = ::pwrite(fd_, p, bytes, static_cast<off_t>(offset));
     if (n < 0) {
       if (errno == EINTR) continue;
-      raise(ErrorCode::kIo, "{}: write failed: {}", path_.string(), std::strerror(errno));
+      keepFirstError("{}: write failed: {}", path_.string(), std::strerror(errno));
+      return;
     }
     p += n;
     offset += static_cast<std::uint64_t>(n);
@@ -61,9 +66,11 @@ void BinaryBuffer::write(std::uint64_t offset, const void* data, std::size_t byt
   }
 }
 
-void BinaryBuffer::finish() {
+Expected<void> BinaryBuffer::finish() {
   size_ = (size_ + 3) & ~std::uint64_t{3};
-  if (::ftruncate(fd_, static_cast<off_t>(size_)) != 0) raise(ErrorCode::kIo, "{}: cannot size: {}", path_.string(), std::strerror(errno));
+  if (!error_ && ::ftruncate(fd_, static_cast<off_t>(size_)) != 0) keepFirstError("{}: cannot size: {}", path_.string(), std::strerror(errno));
+  if (error_) return std::unexpected(*error_);
+  return {};
 }
 
 void RegionWriter::flush() {

@@ -1,10 +1,11 @@
 #pragma once
 // Writing glTF 2.0 (the one place that does): the binary buffer, buffer views and accessors,
 // URI encoding, and the finished dataset as .gltf + .bin or one .glb. Used by convert (a whole
-// dataset from a capture) and merge-camera (keys appended to an existing dataset). Buffer and file
-// errors are thrown as Failure (core/error.h) by BinaryBuffer; the free functions return them.
+// dataset from a capture) and merge-camera (keys appended to an existing dataset). Errors are
+// returned: BinaryBuffer keeps its first one and returns it from finish(), as a stream does.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -25,6 +26,10 @@ std::string uriPath(const std::string& path);
 
 // The binary buffer on disk: regions are allocated first (4-byte aligned, glTF §3.6.2.4), then
 // filled in any order with pwrite. kAppend keeps an existing file's bytes and allocates after them.
+// Why a sticky error rather than one per write: the writes come from deep in a dataset's building
+// (every accessor, every animated value's region), and a failed one (a full disk) spoils the whole
+// file anyway. The first error is kept, later writes are skipped, and finish() returns it; nothing
+// is taken as written until finish() succeeds.
 class BinaryBuffer {
  public:
   enum class Mode { kCreate, kAppend };
@@ -35,14 +40,20 @@ class BinaryBuffer {
 
   std::uint64_t allocate(std::uint64_t bytes);
   void write(std::uint64_t offset, const void* data, std::size_t bytes);
-  // Pads the file to its allocated (4-byte aligned) size.
-  void finish();
+  // Pads the file to its allocated (4-byte aligned) size; the first error of the buffer's life
+  // (opening, a write, sizing), if any.
+  [[nodiscard]] Expected<void> finish();
   std::uint64_t size() const { return size_; }
 
  private:
+  template <typename... Args>
+  void keepFirstError(fmt::format_string<Args...> format, Args&&... args) {
+    if (!error_) error_ = Error{ErrorCode::kIo, fmt::format(format, std::forward<Args>(args)...)};
+  }
   std::filesystem::path path_;
   int fd_ = -1;
   std::uint64_t size_ = 0;
+  std::optional<Error> error_;
 };
 
 // Fills one region front to back through a small buffer, so that a long capture costs a few

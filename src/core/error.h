@@ -34,10 +34,14 @@ template <typename... Args>
   return std::unexpected(Error{code, fmt::format(format, std::forward<Args>(args)...)});
 }
 
-// Readers and writers whose many nested helpers would each have to pass an Expected up (the glTF
-// reader, the capture reader, convert) may throw the one exception type, Failure, and turn it back
-// into an Expected at their library function's boundary. Nothing else is thrown on purpose, and
-// no exception leaves the library (the CLI's main catches any that does, as an internal error).
+// The two lexer-based readers (the glTF loader's JSON walk, scene/load_gltf.cpp, and the capture's
+// record lexer, capture/record_lexer.h) throw the one exception type, Failure, from the field
+// accessors every record parser calls (a number, a field count, a JSON pointer), and turn it back
+// into an Expected at their library function's boundary: with an Expected from each accessor, each
+// of nearly 300 field reads would need its own check, and a parser that forgot one would read on
+// from a default. Everything else returns Expected (convert and the writers did throw until
+// 2026-11-29). Nothing else is thrown on purpose, and no exception leaves the library (the CLI's
+// main catches any that does, as an internal error).
 struct Failure {
   Error error;
 };
