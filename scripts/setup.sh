@@ -16,6 +16,9 @@ for arg in "$@"; do
   esac
 done
 
+SUDO=""
+[[ $(id -u) -eq 0 ]] || SUDO="sudo"
+
 # Keep these lists in step with ../shared/ARCHITECTURE.md §4 and CONTRIBUTING.md.
 packages=(
   # build
@@ -77,8 +80,6 @@ done
 
 if ((${#missing[@]})); then
   echo "setup: installing ${missing[*]}"
-  SUDO=""
-  [[ $(id -u) -eq 0 ]] || SUDO="sudo"
   export DEBIAN_FRONTEND=noninteractive
   $SUDO apt-get update -qq
   # --force-unsafe-io: dpkg skips its fsync after every file it unpacks, which was most of a fresh
@@ -100,8 +101,6 @@ fetch_source() {  # NAME PACKAGE=VERSION ORIG_TARBALL
     echo "setup: $name source present"
     return
   fi
-  local SUDO=""
-  [[ $(id -u) -eq 0 ]] || SUDO="sudo"
   if ! grep -rqs "^Types: deb-src\|^deb-src" /etc/apt/sources.list /etc/apt/sources.list.d/; then
     echo "setup: adding a deb-src entry for bookworm (game source packages)"
     $SUDO tee /etc/apt/sources.list.d/dynbench-src.sources >/dev/null <<'SOURCES'
@@ -131,8 +130,6 @@ fetch_source openarena "openarena=0.8.8+dfsg-6" openarena_0.8.8+dfsg.orig.tar.xz
 # Node.js comes from Debian when the machine has none.
 if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
   echo "setup: installing nodejs and npm"
-  SUDO=""
-  [[ $(id -u) -eq 0 ]] || SUDO="sudo"
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends -o Dpkg::Options::=--force-unsafe-io nodejs npm
 fi

@@ -427,7 +427,6 @@ TEST(OpenArena, FittedLightsReproduceTheLightmapsAndTheLightGrid) {
   EXPECT_GE(dm2->report.gridCorrelation, 0.70);
   EXPECT_GT(dm2->report.gridCorrelation, dm2->report.gridKnownCorrelation + 0.2);
   EXPECT_FALSE(dm2->report.gridFitted) << "no floor: the lightmaps alone are fitted";
-
 }
 
 TEST(OpenArena, HiddenLightsAreFoundAgain) {
@@ -449,7 +448,6 @@ TEST(OpenArena, HiddenLightsAreFoundAgain) {
   EXPECT_GT(recovered->report.shownLightValue, 0.5 * recovered->report.hiddenLightValue);
   EXPECT_GT(recovered->report.recoveredShownShare, recovered->report.recoveredShare);
   EXPECT_EQ(recovered->report.gridPoints, 0u) << "the floor raises every grid point's ambient too";
-
 }
 
 TEST(OpenArena, AFitIsTheSameBytesOnAnotherMachineAndUnjudged) {

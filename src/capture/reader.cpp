@@ -355,14 +355,14 @@ bool CaptureReader::nextLine(std::string& line, std::size_t& number, bool inFram
   }
 }
 
-// Between frames: the closing 'z' record, or the 'f' record that opens the next frame.
-void CaptureReader::startFrame(const Line& l, CaptureFrame& frame) {
+// Between frames: the closing 'z' record (false), or the 'f' record that opens the next frame (true).
+bool CaptureReader::startFrame(const Line& l, CaptureFrame& frame) {
   Impl& impl = *impl_;
   const auto token = l.token();
   if (token == "z") {
     l.expectFields(1, "frame_count");
     closed_ = true;
-    return;
+    return false;
   }
   if (token != "f") l.fail(fmt::format("record '{}' outside a frame; expected 'f' (frame) or 'z' (end of capture)", token));
   l.expectFields(2, "frame_number:time");
@@ -374,6 +374,7 @@ void CaptureReader::startFrame(const Line& l, CaptureFrame& frame) {
   if (impl.anyFrame && frame.time < impl.lastTime)
     l.fail(fmt::format("frame time {} after {}; time must not go back", frame.time, impl.lastTime));
   impl.modelsThisFrame.clear();
+  return true;
 }
 
 Expected<bool> CaptureReader::next(CaptureFrame& frame) {
@@ -388,8 +389,7 @@ Expected<bool> CaptureReader::next(CaptureFrame& frame) {
       const auto token = l.token();
       if (closed_) l.fail("a record after the closing 'z' record");
       if (!inFrame) {
-        startFrame(l, frame);
-        inFrame = !closed_;
+        inFrame = startFrame(l, frame);
         continue;
       }
       if (token == "e") {

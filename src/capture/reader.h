@@ -160,7 +160,7 @@ class CaptureReader {
  private:
   CaptureReader();
   bool nextLine(std::string& line, std::size_t& number, bool inFrame, const CaptureFrame& frame);
-  void startFrame(const Line& l, CaptureFrame& frame);
+  bool startFrame(const Line& l, CaptureFrame& frame);
   CaptureSettings settings_;
   std::vector<CapturedModel> models_;
   std::map<std::string, int> modelByPath_;

@@ -35,8 +35,8 @@ Expected<void> Converter::writeBufferAndDocument() {
     bin_ = &bin;
     auto built = buildDocument();
     if (built) built = passTwo();
+    if (built) built = bin.finish();
     bin_ = nullptr;
-    if (auto finished = bin.finish(); built && !finished) built = std::unexpected(finished.error());
     if (!built) return built;
     report_.binBytes = bin.size();
   }

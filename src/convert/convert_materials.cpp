@@ -169,16 +169,18 @@ Expected<int> Converter::material(const CapturedMesh& mesh) {
   if (!baseColor) return std::unexpected(baseColor.error());
   if (*baseColor >= 0) m["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", *baseColor}};
   if (c != glm::vec4(1.0f)) m["pbrMetallicRoughness"]["baseColorFactor"] = {c.r, c.g, c.b, c.a};
-  const auto fromMask = mesh.metallicRoughness ? Expected<int>(-1) : metallicRoughnessFromMask(mesh.maskTexture);
-  if (!fromMask) return std::unexpected(fromMask.error());
   if (mesh.metallicRoughness) {
     m["pbrMetallicRoughness"]["metallicFactor"] = mesh.metallicRoughness->x;
     m["pbrMetallicRoughness"]["roughnessFactor"] = mesh.metallicRoughness->y;
-  } else if (*fromMask >= 0) {
-    m["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", *fromMask}};
-    m["pbrMetallicRoughness"]["metallicFactor"] = 1.0;
-    m["pbrMetallicRoughness"]["roughnessFactor"] = 1.0;
-    m["extras"] = {{"dynbench_mask_map", mesh.maskTexture}};
+  } else {
+    const auto fromMask = metallicRoughnessFromMask(mesh.maskTexture);
+    if (!fromMask) return std::unexpected(fromMask.error());
+    if (*fromMask >= 0) {
+      m["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {{"index", *fromMask}};
+      m["pbrMetallicRoughness"]["metallicFactor"] = 1.0;
+      m["pbrMetallicRoughness"]["roughnessFactor"] = 1.0;
+      m["extras"] = {{"dynbench_mask_map", mesh.maskTexture}};
+    }
   }
   // Emission e in the lights' units shows as bright as a white Lambertian surface under the
   // engine's full light, E_u lux: radiance E_u e / pi cd/m2. glTF keeps emissiveFactor within

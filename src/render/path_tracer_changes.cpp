@@ -123,7 +123,7 @@ class PathTracer::ChangeSampler {
 
   // The change buffers (mean, standard error, gathered light of each pixel) and pair counts of the
   // frame, and its sampling summary's pair figures.
-  void write() const {
+  void write() {
     FrameBuffers& frame = frame_;
     long undecided = 0;
     double totalPairs = 0.0;
