@@ -10,8 +10,10 @@ namespace dynbench::test {
 
 namespace fs = std::filesystem;
 
+fs::path scratchRoot() { return fs::temp_directory_path() / ("dynbench_test_" + std::to_string(::getpid())); }
+
 fs::path freshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("dynbench_test_" + std::to_string(::getpid())) / name;
+  const fs::path dir = scratchRoot() / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

@@ -12,6 +12,10 @@
 namespace dynbench::test {
 
 // A fresh empty folder under the system temp dir, unique per test.
+// This process's scratch folder, $TMPDIR/dynbench_test_PID (test_main.cpp removes it once the
+// process's tests have passed).
+std::filesystem::path scratchRoot();
+// An empty folder `name` in it.
 std::filesystem::path freshDir(const std::string& name);
 
 std::string base64(const std::string& bytes);

@@ -11,9 +11,12 @@
 #include <unistd.h>
 
 #include <fcntl.h>
+#include <algorithm>
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <system_error>
+#include <vector>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -28,6 +31,26 @@ struct SharedRun {
   std::filesystem::path output;  // the run's output folder (its `{out}`)
   Run run;                       // its exit status, stdout and stderr
 };
+
+// Every rebuild of dynbench makes its own shared runs (about 200 MB each): before making one, the
+// runs of the same name from earlier builds are removed, but for the newest other (a second build
+// tree, e.g. the debug preset's, keeps its own) and any another process holds locked.
+inline void pruneOlderRuns(const std::filesystem::path& root, const std::string& name, const std::filesystem::path& keep) {
+  namespace fs = std::filesystem;
+  std::vector<fs::directory_entry> older;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(root, ec))
+    if (entry.is_directory() && entry.path().filename().string().starts_with(name + "-") && entry.path() != keep) older.push_back(entry);
+  std::sort(older.begin(), older.end(), [](const auto& a, const auto& b) { return a.last_write_time() > b.last_write_time(); });
+  for (std::size_t i = 1; i < older.size(); ++i) {
+    const std::string lockPath = older[i].path().string() + ".lock";
+    const int lock = ::open(lockPath.c_str(), O_RDWR);
+    if (lock < 0) continue;
+    // The empty lock file stays: a process that opened it a moment ago keeps a lock on that file.
+    if (::flock(lock, LOCK_EX | LOCK_NB) == 0) fs::remove_all(older[i].path(), ec);
+    ::close(lock);
+  }
+}
 
 // `arguments` names the output folder `{out}`: e.g. "suite smoke.json -o {out}".
 inline SharedRun sharedRun(const std::string& name, const std::string& arguments) {
@@ -48,6 +71,7 @@ inline SharedRun sharedRun(const std::string& name, const std::string& arguments
   // run.json, written last and atomically, says the run is whole: a run cut short is made again.
   const fs::path result = folder / "run.json";
   if (!fs::exists(result)) {
+    pruneOlderRuns(root, name, folder);
     fs::remove_all(folder);
     fs::create_directories(folder);
     std::string command = arguments;

@@ -1,5 +1,7 @@
 #include "convert/converter.h"
 
+#include "core/files.h"
+
 namespace dynbench::convert::detail {
 
 std::string Converter::datasetReadme() const {
@@ -32,8 +34,7 @@ Expected<json> Converter::environment() {
   json ext = {{"projection", "equirectangular"}, {"units", "cd/m2"}, {"intensity", 1.0}};
   fs::path target;
   if (options_.environment) {
-    std::string ext2 = options_.environment->extension().string();
-    std::transform(ext2.begin(), ext2.end(), ext2.begin(), [](unsigned char c) { return std::tolower(c); });
+    const std::string ext2 = lowercaseExtension(*options_.environment);
     if (ext2 != ".hdr" && ext2 != ".exr")
       return fail(ErrorCode::kUsage, "--env {}: expected an .hdr or .exr image", options_.environment->string());
     auto header = readImageHeader(*options_.environment);

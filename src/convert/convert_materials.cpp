@@ -2,14 +2,15 @@
 
 #include <optional>
 
+#include "core/files.h"
+
 namespace dynbench::convert::detail {
 
 Expected<int> Converter::image(const std::string& texture) {
   if (texture.empty()) return -1;
   if (auto it = imageByTexture_.find(texture); it != imageByTexture_.end()) return it->second;
   int index = -1;
-  std::string ext = fs::path(texture).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = lowercaseExtension(texture);
   // glTF's images are PNG or JPEG, copied as they are; another format OpenImageIO reads (id Tech
   // 3's TGA) is rewritten as PNG beside them, its 8-bit values unchanged (read as float, written 8-bit).
   const bool copied = ext == ".png" || ext == ".jpg" || ext == ".jpeg";

@@ -76,6 +76,15 @@ Expected<std::uint64_t> fileSize(const std::filesystem::path& path) {
   return static_cast<std::uint64_t>(size);
 }
 
+std::string asciiLowercase(std::string text) {
+  // Not std::tolower, whose result depends on the C locale.
+  for (char& c : text)
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return text;
+}
+
+std::string lowercaseExtension(const std::filesystem::path& path) { return asciiLowercase(path.extension().string()); }
+
 bool isExecutable(const std::filesystem::path& path) { return ::access(path.c_str(), X_OK) == 0; }
 
 std::filesystem::path findOnPath(const std::string& name) {

@@ -27,6 +27,12 @@ std::filesystem::path temporarySibling(const std::filesystem::path& path);
 Expected<void> commitTemporary(const std::filesystem::path& temporary,
                                const std::filesystem::path& path);
 
+// `text` with A-Z as a-z and every other byte kept: for names the formats compare without case,
+// in ASCII (file extensions; id Tech 3's paths, shader names and entity values).
+std::string asciiLowercase(std::string text);
+// The extension of `path` (with its dot), in lower case: ".gltf" for "Map.GLTF".
+std::string lowercaseExtension(const std::filesystem::path& path);
+
 // True when `path` names a file this process may execute.
 bool isExecutable(const std::filesystem::path& path);
 // `name` looked up in $PATH (as a shell would); empty when it is not there.

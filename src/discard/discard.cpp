@@ -19,8 +19,6 @@ namespace {
 
 using namespace reprojection;
 
-glm::dvec3 at3(const std::vector<float>& b, std::size_t i) { return {b[3 * i], b[3 * i + 1], b[3 * i + 2]}; }
-
 }  // namespace
 
 namespace {

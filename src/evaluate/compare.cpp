@@ -17,8 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 bool isHdrFile(const fs::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lowercaseExtension(path);
   return ext == ".exr" || ext == ".hdr";
 }
 

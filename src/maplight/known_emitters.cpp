@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include "core/files.h"
+
 namespace dynbench::maplight {
 
 namespace {
@@ -110,8 +112,7 @@ std::vector<MapLight> entityLights(const Bsp& bsp) {
   std::vector<MapLight> lights;
   for (std::size_t i = 0; i < bsp.entities.size(); ++i) {
     const BspEntity& e = bsp.entities[i];
-    std::string classname = entityValue(e, "classname");
-    std::transform(classname.begin(), classname.end(), classname.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const std::string classname = asciiLowercase(entityValue(e, "classname"));
     if (!classname.starts_with("light") || classname.starts_with("lightjunior")) continue;
     if (entityValue(e, "noradiosity") == "1") continue;
     MapLight l;

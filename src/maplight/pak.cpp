@@ -5,6 +5,8 @@
 
 #include <zip.h>
 
+#include "core/files.h"
+
 namespace dynbench::maplight {
 
 struct GameFiles::Archive {
@@ -14,13 +16,6 @@ struct GameFiles::Archive {
     if (zip) zip_discard(zip);
   }
 };
-
-namespace {
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
-}  // namespace
 
 GameFiles::~GameFiles() = default;
 GameFiles::GameFiles(GameFiles&&) noexcept = default;
@@ -32,7 +27,7 @@ Expected<GameFiles> GameFiles::open(const std::filesystem::path& baseFolder) {
     return fail(ErrorCode::kIo, "{}: not a folder (expected the game's base folder with its .pk3 archives)", baseFolder.string());
   std::vector<std::filesystem::path> paks;
   for (const auto& entry : std::filesystem::directory_iterator(baseFolder, ec))
-    if (lower(entry.path().extension().string()) == ".pk3") paks.push_back(entry.path());
+    if (lowercaseExtension(entry.path()) == ".pk3") paks.push_back(entry.path());
   if (paks.empty()) return fail(ErrorCode::kIo, "{}: no .pk3 archives in it", baseFolder.string());
   std::sort(paks.begin(), paks.end());
   GameFiles files;
@@ -52,21 +47,21 @@ Expected<GameFiles> GameFiles::open(const std::filesystem::path& baseFolder) {
     const zip_int64_t count = zip_get_num_entries(zip, 0);
     for (zip_int64_t i = 0; i < count; ++i)
       if (const char* name = zip_get_name(zip, static_cast<zip_uint64_t>(i), 0))
-        files.entries_[lower(name)] = {files.archives_.size(), i};
+        files.entries_[asciiLowercase(name)] = {files.archives_.size(), i};
     files.archives_.push_back(std::move(archive));
   }
   return files;
 }
 
-bool GameFiles::contains(const std::string& path) const { return entries_.contains(lower(path)); }
+bool GameFiles::contains(const std::string& path) const { return entries_.contains(asciiLowercase(path)); }
 
 std::string GameFiles::archiveOf(const std::string& path) const {
-  const auto found = entries_.find(lower(path));
+  const auto found = entries_.find(asciiLowercase(path));
   return found == entries_.end() ? std::string() : archives_[found->second.first]->path.filename().string();
 }
 
 Expected<std::string> GameFiles::read(const std::string& path) const {
-  const auto found = entries_.find(lower(path));
+  const auto found = entries_.find(asciiLowercase(path));
   if (found == entries_.end()) return fail(ErrorCode::kIo, "{}: not in the game's archives", path);
   const Archive& archive = *archives_[found->second.first];
   const auto index = static_cast<zip_uint64_t>(found->second.second);
@@ -85,7 +80,7 @@ Expected<std::string> GameFiles::read(const std::string& path) const {
 }
 
 std::vector<std::string> GameFiles::list(const std::string& folder, const std::string& suffix) const {
-  const std::string prefix = lower(folder), end = lower(suffix);
+  const std::string prefix = asciiLowercase(folder), end = asciiLowercase(suffix);
   std::vector<std::string> paths;
   for (auto it = entries_.lower_bound(prefix); it != entries_.end() && it->first.starts_with(prefix); ++it)
     if (it->first.size() >= end.size() && it->first.ends_with(end)) paths.push_back(it->first);

@@ -8,15 +8,12 @@
 #include <numbers>
 #include <unistd.h>
 
+#include "core/files.h"
 #include "core/image_io.h"
 
 namespace dynbench::maplight {
 
 namespace {
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
 
 // id Tech 3's script tokens: words, quoted strings, braces; // and /* */ comments; tokens keep
 // their line so that a keyword's arguments end at the line's end.
@@ -92,7 +89,7 @@ Expected<void> ShaderScripts::add(const std::string& text, const std::string& fi
       std::vector<std::string> args;
       std::size_t j = i + 1;
       while (j < tokens.size() && tokens[j].line == t.line && tokens[j].text != "{" && tokens[j].text != "}") args.push_back(tokens[j++].text);
-      const std::string key = lower(t.text);
+      const std::string key = asciiLowercase(t.text);
       if (depth == 1) {
         if (key == "q3map_surfacelight" && !args.empty()) shader.surfaceLight = number(args[0]);
         else if (key == "q3map_lightrgb" && args.size() >= 3) {
@@ -114,7 +111,7 @@ Expected<void> ShaderScripts::add(const std::string& text, const std::string& fi
           shader.skyLight = number(args[0]);
           shader.skyLightIterations = static_cast<int>(number(args[1]));
         } else if (key == "cull" && !args.empty()) {
-          const std::string mode = lower(args[0]);
+          const std::string mode = asciiLowercase(args[0]);
           shader.twoSided = mode == "none" || mode == "disable" || mode == "twosided";
         } else if (key == "q3map_lightsubdivide" && !args.empty()) {
           shader.lightSubdivide = number(args[0]);
@@ -122,7 +119,7 @@ Expected<void> ShaderScripts::add(const std::string& text, const std::string& fi
           shader.backsplashFraction = number(args[0]) * 0.01;
           shader.backsplashDistance = number(args[1]);
         } else if (key == "surfaceparm" && !args.empty()) {
-          const std::string parm = lower(args[0]);
+          const std::string parm = asciiLowercase(args[0]);
           shader.sky = shader.sky || parm == "sky";
           shader.translucent = shader.translucent || parm == "trans";
           shader.noDraw = shader.noDraw || parm == "nodraw";
@@ -133,7 +130,7 @@ Expected<void> ShaderScripts::add(const std::string& text, const std::string& fi
       i = j;
     }
     if (depth > 0) return fail(ErrorCode::kParse, "{}:{}: shader '{}' is not closed (expected '}}')", file, nameLine, shader.name);
-    const std::string key = lower(shader.name);
+    const std::string key = asciiLowercase(shader.name);
     if (byName_.emplace(key, shaders_.size()).second) shaders_.push_back(std::move(shader));
   }
   return {};
@@ -150,7 +147,7 @@ Expected<ShaderScripts> ShaderScripts::read(const GameFiles& files) {
 }
 
 const ShaderLighting* ShaderScripts::find(const std::string& name) const {
-  const auto it = byName_.find(lower(name));
+  const auto it = byName_.find(asciiLowercase(name));
   return it != byName_.end() ? &shaders_[it->second] : nullptr;
 }
 

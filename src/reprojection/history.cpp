@@ -3,12 +3,6 @@
 #include <cmath>
 
 namespace dynbench::reprojection {
-namespace {
-
-glm::dvec3 at3(const std::vector<float>& b, std::size_t i) { return {b[3 * i], b[3 * i + 1], b[3 * i + 2]}; }
-
-}  // namespace
-
 bool onTangentPlane(const glm::dvec3& p, const glm::dvec3& n, const glm::dvec3& q, double viewDepth, const SurfaceThresholds& t) {
   return std::abs(glm::dot(n, q - p)) <= t.position * std::abs(viewDepth);
 }

@@ -8,8 +8,6 @@
 namespace dynbench::reprojection {
 namespace {
 
-glm::dvec3 at3(const std::vector<float>& b, std::size_t i) { return {b[3 * i], b[3 * i + 1], b[3 * i + 2]}; }
-
 // Sum of weight x value over a set of taps (bilinear or cubic).
 template <typename Taps>
 glm::dvec3 weightedSum3(const std::vector<float>& buffer, const Taps& taps) {

@@ -35,6 +35,10 @@ inline BilinearTaps bilinearTaps(double x, double y, int width, int height, std:
   return BilinearTaps{{index(x0, y0), index(x1, y0), index(x0, y1), index(x1, y1)},
                       {(1 - tx) * (1 - ty), tx * (1 - ty), (1 - tx) * ty, tx * ty}};
 }
+// Pixel `index`'s value in a buffer of three interleaved channels (P, N, radiance).
+inline glm::dvec3 at3(const std::vector<float>& buffer, std::size_t index) {
+  return {buffer[3 * index], buffer[3 * index + 1], buffer[3 * index + 2]};
+}
 glm::dvec3 sample3(const std::vector<float>& buffer, const BilinearTaps& taps);
 double sample1(const std::vector<float>& buffer, const BilinearTaps& taps);
 // The Catmull-Rom cubic's 4 x 4 taps around continuous pixel coordinates (x, y) (Keys' a = -0.5,

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "core/files.h"
 #include "core/checksum.h"
 #include "core/json_fields.h"
 #include "scene/load.h"
@@ -14,8 +15,7 @@ namespace fs = std::filesystem;
 
 Expected<std::string> datasetDigest(const fs::path& dataset) {
   std::error_code ec;
-  std::string extension = dataset.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string extension = lowercaseExtension(dataset);
   if (extension != ".gltf") {
     // One file (GLB, a file assimp reads) or an OBJ sequence: the files the loader reads.
     std::vector<std::string> files;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "core/files.h"
+
 namespace dynbench::scene {
 
 Expected<Scene> loadScene(const std::filesystem::path& path, const LoadOptions& options) {
@@ -12,8 +14,7 @@ Expected<Scene> loadScene(const std::filesystem::path& path, const LoadOptions& 
   std::error_code ec;
   if (!std::filesystem::exists(path, ec))
     return fail(ErrorCode::kIo, "{}: no such file or folder", path.string());
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = lowercaseExtension(path);
   if (ext == ".gltf" || ext == ".glb") return loadGltf(path);
   return loadWithAssimp(path);
 }

@@ -70,9 +70,9 @@ MaterialWorkflow detectWorkflow(const aiMaterial& material) {
   bool rawGlossiness = false, rawMetalRough = false;
   int useGlossiness = -1;
   for (unsigned i = 0; i < material.mNumProperties; ++i) {
-    std::string key = material.mProperties[i]->mKey.C_Str();
-    if (!key.starts_with("$raw.")) continue;
-    std::transform(key.begin(), key.end(), key.begin(), [](unsigned char c) { return std::tolower(c); });
+    const std::string rawKey = material.mProperties[i]->mKey.C_Str();
+    if (!rawKey.starts_with("$raw.")) continue;
+    const std::string key = asciiLowercase(rawKey);
     if (key.ends_with("|useglossiness")) material.Get(material.mProperties[i]->mKey.C_Str(), 0, 0, useGlossiness);
     else if (key.ends_with("|glossiness")) rawGlossiness = true;
     else if (key.ends_with("|roughness") || key.ends_with("|metalness") || key.ends_with("|metallic")) rawMetalRough = true;

@@ -10,6 +10,8 @@
 
 #include "scene/load.h"
 
+#include "core/files.h"
+
 namespace dynbench::scene {
 namespace {
 
@@ -40,9 +42,7 @@ bool naturalLess(const std::string& a, const std::string& b) {
 }
 
 bool isObj(const fs::path& p) {
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext == ".obj";
+  return lowercaseExtension(p) == ".obj";
 }
 
 }  // namespace
