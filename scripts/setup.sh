@@ -36,8 +36,11 @@ packages=(
   # plots
   gnuplot-nox
   # the magma colour map of FLIP heatmaps, read from matplotlib's tables at build time
-  # (tools/colormap/magma_header.py)
-  python3-matplotlib
+  # (tools/colormap/magma_header.py). python3-munkres meets matplotlib's python3-fonttools, which
+  # needs "python3-scipy | python3-munkres": named here, it keeps SciPy out, and with it pythran,
+  # Boost's headers and OpenBLAS (about 20,000 of a fresh setup's 65,000 files; nothing of
+  # dynbench imports SciPy)
+  python3-matplotlib python3-munkres
   # the Python module (docs/python.md): pybind11 with its nlohmann::json bridge
   pybind11-dev pybind11-json-dev python3-dev
   # ffmpeg: `dynbench report` encodes each run's video (VP9 WebM) with it
