@@ -20,7 +20,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kOrbit = fs::path(DYNBENCH_SOURCE_DIR) / "examples" / "orbit" / "orbit.gltf";
 
 // Every key of `changed` but `version` holds another value than in `defaults`: a round trip of
 // `changed` then covers every field (a field the reader forgot would come back as its default).

@@ -23,7 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kOrbit = fs::path(DYNBENCH_SOURCE_DIR) / "examples" / "orbit" / "orbit.gltf";
 
 nlohmann::json readJson(const fs::path& p) {
   auto text = readWholeFile(p);

@@ -19,7 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kOrbit = fs::path(DYNBENCH_SOURCE_DIR) / "examples" / "orbit" / "orbit.gltf";
 
 void makeRun(const fs::path& run, const std::string& frames, const std::string& sampling = "--spp 2 --pairs --max-pairs 16") {
   for (const auto& args : {fmt::format("stats {} --json {} --series {}", kOrbit.string(), (run / "stats.json").string(), run.string()),

@@ -14,6 +14,9 @@
 
 namespace dynbench {
 
+// The small CC0 example scene (examples/orbit, made by examples/make_orbit.py) the CLI tests render.
+inline const std::filesystem::path kOrbit = std::filesystem::path(DYNBENCH_SOURCE_DIR) / "examples" / "orbit" / "orbit.gltf";
+
 namespace test {
 // A whole file's text; a missing or unreadable file is a test failure (and "" is returned), so a
 // test never dereferences an empty result.

@@ -31,7 +31,6 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
-const fs::path kOrbit = fs::path(DYNBENCH_SOURCE_DIR) / "examples" / "orbit" / "orbit.gltf";
 const fs::path kSlurmLocal = fs::path(DYNBENCH_SOURCE_DIR) / "scripts" / "slurm-local.sh";
 
 std::string shell(const std::string& command) {
