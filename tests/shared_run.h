@@ -16,6 +16,7 @@
 #include <functional>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -37,17 +38,21 @@ struct SharedRun {
 // tree, e.g. the debug preset's, keeps its own) and any another process holds locked.
 inline void pruneOlderRuns(const std::filesystem::path& root, const std::string& name, const std::filesystem::path& keep) {
   namespace fs = std::filesystem;
-  std::vector<fs::directory_entry> older;
+  // Each folder's time read once, without throwing: another test process may remove one meanwhile.
+  std::vector<std::pair<fs::file_time_type, fs::path>> older;
   std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(root, ec))
-    if (entry.is_directory() && entry.path().filename().string().starts_with(name + "-") && entry.path() != keep) older.push_back(entry);
-  std::sort(older.begin(), older.end(), [](const auto& a, const auto& b) { return a.last_write_time() > b.last_write_time(); });
+  for (const auto& entry : fs::directory_iterator(root, ec)) {
+    if (!entry.is_directory(ec) || !entry.path().filename().string().starts_with(name + "-") || entry.path() == keep) continue;
+    const auto time = fs::last_write_time(entry.path(), ec);
+    if (!ec) older.emplace_back(time, entry.path());
+  }
+  std::sort(older.begin(), older.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
   for (std::size_t i = 1; i < older.size(); ++i) {
-    const std::string lockPath = older[i].path().string() + ".lock";
+    const std::string lockPath = older[i].second.string() + ".lock";
     const int lock = ::open(lockPath.c_str(), O_RDWR);
     if (lock < 0) continue;
     // The empty lock file stays: a process that opened it a moment ago keeps a lock on that file.
-    if (::flock(lock, LOCK_EX | LOCK_NB) == 0) fs::remove_all(older[i].path(), ec);
+    if (::flock(lock, LOCK_EX | LOCK_NB) == 0) fs::remove_all(older[i].second, ec);
     ::close(lock);
   }
 }

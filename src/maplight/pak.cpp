@@ -1,7 +1,6 @@
 #include "maplight/pak.h"
 
 #include <algorithm>
-#include <cctype>
 
 #include <zip.h>
 

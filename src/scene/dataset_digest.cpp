@@ -4,8 +4,8 @@
 
 #include <fmt/format.h>
 
-#include "core/files.h"
 #include "core/checksum.h"
+#include "core/files.h"
 #include "core/json_fields.h"
 #include "scene/load.h"
 

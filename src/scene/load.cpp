@@ -1,7 +1,5 @@
 #include "scene/load.h"
 
-#include <algorithm>
-
 #include "core/files.h"
 
 namespace dynbench::scene {

@@ -8,9 +8,8 @@
 #include <cctype>
 #include <fnmatch.h>
 
-#include "scene/load.h"
-
 #include "core/files.h"
+#include "scene/load.h"
 
 namespace dynbench::scene {
 namespace {
