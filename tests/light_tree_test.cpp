@@ -2,6 +2,7 @@
 // light (checked exactly, by enumerating every path down the tree, and by sampling), no light that
 // can give light ever left out, none that cannot ever selected, and an exact sum (probability 1
 // each) where no more lights than the budget can reach the point.
+#include <bit>
 #include <cmath>
 #include <map>
 #include <random>
@@ -152,6 +153,51 @@ TEST(LightTree, ANodeOutOfRangeOrBehindThePlaneHasNoImportanceAndOthersHaveSome)
   leaf.count = 1;
   const double d = std::sqrt(2.0 * 2.0 + 1.0), cosine = 2.0 / d, window = 1.0 - std::pow(d / 4.0, 4);
   EXPECT_NEAR(LightTree::importance(leaf, {1, 0, 0}, {0, 1, 0}), 8 * cosine * window / (d * d), 1e-12);
+}
+
+// The two-lane importance is importance() itself, bit for bit (a reference's bytes depend on it):
+// over many nodes, points and normals, including points inside and on the boxes, lights that
+// coincide (boxes of no extent), unbounded ranges, normals along an axis (facing exactly zero)
+// and points at a range's edge.
+TEST(LightTree, BothChildrensImportanceAtOnceIsTheScalarOneBitForBit) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> pick(0, 5);
+  for (int trial = 0; trial < 20; ++trial) {
+    auto lights = randomLights(40 + trial, 100 + static_cast<std::uint32_t>(trial));
+    lights.push_back(lights[3]);  // two lights at one place
+    lights.push_back(lights[4]);
+    LightTree tree;
+    tree.build(lights);
+    const auto nodes = tree.nodes();
+    for (int k = 0; k < 400; ++k) {
+      glm::dvec3 p{10 * unit(rng), 10 * unit(rng), 10 * unit(rng)};
+      const auto a = static_cast<std::uint32_t>(rng() % nodes.size()), b = static_cast<std::uint32_t>(rng() % nodes.size());
+      switch (pick(rng)) {
+        case 0: p = 0.5 * (nodes[a].lower + nodes[a].upper); break;  // the box's centre
+        case 1: p = nodes[a].lower; break;                            // its corner
+        case 2: p.x = nodes[b].upper.x; break;                        // on a face's plane
+        default: break;
+      }
+      glm::dvec3 n = glm::normalize(glm::dvec3{unit(rng), unit(rng), unit(rng)});
+      if (k % 7 == 0) n = {0, k % 2 ? 1.0 : -1.0, 0};
+      double both[2];
+      tree.importancePair(a, b, p, n, both);
+      const double ia = LightTree::importance(nodes[a], p, n), ib = LightTree::importance(nodes[b], p, n);
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(both[0]), std::bit_cast<std::uint64_t>(ia)) << "node " << a << ": " << both[0] << " against " << ia;
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(both[1]), std::bit_cast<std::uint64_t>(ib)) << "node " << b << ": " << both[1] << " against " << ib;
+    }
+  }
+  // At a light's range exactly: importance zero both ways.
+  LightTree tree;
+  const std::vector<LightTree::Light> one = {{{0, 2, 0}, 5.0, 2.0}, {{0, 3, 0}, 5.0, 0.0}};
+  tree.build(one);
+  double both[2];
+  tree.importancePair(1, 2, {0, 0, 0}, {0, 1, 0}, both);
+  EXPECT_EQ(both[0], LightTree::importance(tree.nodes()[1], {0, 0, 0}, {0, 1, 0}));
+  EXPECT_EQ(both[1], LightTree::importance(tree.nodes()[2], {0, 0, 0}, {0, 1, 0}));
+  EXPECT_EQ(std::min(both[0], both[1]), 0.0);
+  EXPECT_GT(std::max(both[0], both[1]), 0.0);
 }
 
 }  // namespace

@@ -6,6 +6,10 @@
 #include <limits>
 #include <numeric>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace dynbench::render {
 
 namespace {
@@ -16,12 +20,20 @@ double boundedRange(double range) { return range > 0 && std::isfinite(range) ? r
 
 void LightTree::build(std::span<const Light> lights) {
   nodes_.clear();
+  boxes_.clear();
   lightCount_ = lights.size();
   if (lights.empty()) return;
   nodes_.reserve(2 * lights.size());
   std::vector<std::uint32_t> order(lights.size());
   std::iota(order.begin(), order.end(), 0u);
   buildRange(order, lights, 0, order.size());
+  boxes_.resize(nodes_.size());
+  for (std::size_t n = 0; n < nodes_.size(); ++n) {
+    Box& box = boxes_[n];
+    box.centre = 0.5 * (nodes_[n].lower + nodes_[n].upper);
+    box.half = 0.5 * (nodes_[n].upper - nodes_[n].lower);
+    box.radius2 = glm::dot(box.half, box.half);
+  }
 }
 
 // Top-down, split at the median of the longest axis of the lights' positions: the lights of a node
@@ -98,6 +110,71 @@ double LightTree::importance(const Node& node, const glm::dvec3& p, const glm::d
   return node.power * cosBound * window / std::max({distance2, radius2, 1e-18});
 }
 
+#if defined(__SSE2__)
+namespace {
+// Two lanes of doubles: importance()'s arithmetic, operation for operation (SSE2's additions,
+// multiplications, divisions and square roots round as the scalar ones do, and nothing here fuses
+// a multiply-add), so each lane holds exactly the scalar result.
+struct Lanes {
+  __m128d v;
+  static Lanes of(double a, double b) { return {_mm_set_pd(b, a)}; }
+  static Lanes all(double x) { return {_mm_set1_pd(x)}; }
+  friend Lanes operator+(Lanes a, Lanes b) { return {_mm_add_pd(a.v, b.v)}; }
+  friend Lanes operator-(Lanes a, Lanes b) { return {_mm_sub_pd(a.v, b.v)}; }
+  friend Lanes operator*(Lanes a, Lanes b) { return {_mm_mul_pd(a.v, b.v)}; }
+  friend Lanes operator/(Lanes a, Lanes b) { return {_mm_div_pd(a.v, b.v)}; }
+};
+Lanes sqrt(Lanes a) { return {_mm_sqrt_pd(a.v)}; }
+// std::max(a, b) = b > a ? b : a and std::min(a, b) = b < a ? b : a, even for signed zeros (no
+// NaN reaches a lane whose result is kept); maxpd(x, y) = x > y ? x : y, minpd likewise.
+Lanes max(Lanes a, Lanes b) { return {_mm_max_pd(b.v, a.v)}; }
+Lanes min(Lanes a, Lanes b) { return {_mm_min_pd(b.v, a.v)}; }
+// cond ? a : b, lane by lane (cond from a comparison: all bits set or none).
+Lanes choose(__m128d cond, Lanes a, Lanes b) { return {_mm_or_pd(_mm_and_pd(cond, a.v), _mm_andnot_pd(cond, b.v))}; }
+
+struct Lanes3 {
+  Lanes x, y, z;
+};
+Lanes3 of(const glm::dvec3& a, const glm::dvec3& b) { return {Lanes::of(a.x, b.x), Lanes::of(a.y, b.y), Lanes::of(a.z, b.z)}; }
+Lanes3 all(const glm::dvec3& a) { return {Lanes::all(a.x), Lanes::all(a.y), Lanes::all(a.z)}; }
+Lanes3 operator-(const Lanes3& a, const Lanes3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+// glm::dot's order: (x + y) + z.
+Lanes dot(const Lanes3& a, const Lanes3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+}  // namespace
+#endif
+
+void LightTree::importancePair(std::uint32_t a, std::uint32_t b, const glm::dvec3& p, const glm::dvec3& n, double out[2]) const {
+#if defined(__SSE2__)
+  const Node &na = nodes_[a], &nb = nodes_[b];
+  const Box &ba = boxes_[a], &bb = boxes_[b];
+  const Lanes3 point = all(p), normal = all(n);
+  const Lanes3 toCentre = of(ba.centre, bb.centre) - point, half = of(ba.half, bb.half);
+  const Lanes3 absNormal = {Lanes::all(std::abs(n.x)), Lanes::all(std::abs(n.y)), Lanes::all(std::abs(n.z))};
+  const Lanes facing = dot(toCentre, normal) + dot(half, absNormal);
+  // The window: an infinite range gives r2 = 0 and window 1, as importance()'s skipped branch does.
+  const Lanes3 lower = of(na.lower, nb.lower), upper = of(na.upper, nb.upper);
+  const Lanes3 nearest = {min(max(point.x, lower.x), upper.x), min(max(point.y, lower.y), upper.y), min(max(point.z, lower.z), upper.z)};
+  const Lanes3 gap = nearest - point;
+  const Lanes range = Lanes::of(na.range, nb.range);
+  const Lanes r2 = dot(gap, gap) / (range * range);
+  const Lanes window = Lanes::all(1.0) - r2 * r2;
+  const Lanes radius2 = Lanes::of(ba.radius2, bb.radius2);
+  const Lanes distance2 = dot(toCentre, toCentre);
+  const Lanes distance = sqrt(distance2);
+  const Lanes cosN = dot(toCentre, normal) / distance;
+  const Lanes sinB2 = radius2 / distance2, cosB = sqrt(Lanes::all(1.0) - sinB2);
+  const Lanes bound = cosN * cosB + sqrt(max(Lanes::all(0.0), Lanes::all(1.0) - cosN * cosN)) * sqrt(sinB2);
+  const __m128d narrower = _mm_and_pd(_mm_cmpgt_pd(distance2.v, radius2.v), _mm_cmplt_pd(cosN.v, cosB.v));
+  const Lanes cosBound = max(choose(narrower, bound, Lanes::all(1.0)), Lanes::all(1e-6));
+  const Lanes value = Lanes::of(na.power, nb.power) * cosBound * window / max(max(distance2, radius2), Lanes::all(1e-18));
+  const __m128d gives = _mm_and_pd(_mm_cmpgt_pd(facing.v, _mm_setzero_pd()), _mm_cmplt_pd(r2.v, _mm_set1_pd(1.0)));
+  _mm_storeu_pd(out, choose(gives, value, Lanes::all(0.0)).v);
+#else
+  out[0] = importance(nodes_[a], p, n);
+  out[1] = importance(nodes_[b], p, n);
+#endif
+}
+
 void LightTree::sumOverNodes(std::span<const double> perLight, std::span<double> perNode) const {
   // Depth first with the first child after its parent: children come after their parent, so a
   // pass from the last node back sums each node's children into it.
@@ -105,12 +182,21 @@ void LightTree::sumOverNodes(std::span<const double> perLight, std::span<double>
     perNode[n] = nodes_[n].count == 1 ? perLight[nodes_[n].first] : perNode[n + 1] + perNode[nodes_[n].first];
 }
 
-bool LightTree::descend(std::uint32_t n, const glm::dvec3& point, const glm::dvec3& normal, double u, Selected& out, const float* factors) const {
+bool LightTree::descend(std::uint32_t n, const glm::dvec3& point, const glm::dvec3& normal, double u, Selected& out, const float* factors,
+                        const double* firstImportances) const {
   double probability = 1.0;
   while (nodes_[n].count > 1) {
     const std::uint32_t a = n + 1, b = nodes_[n].first;
-    double ia = importance(nodes_[a], point, normal), ib = importance(nodes_[b], point, normal);
-    if (factors) ia *= factors[a], ib *= factors[b];
+    double ia, ib;
+    if (firstImportances) {  // the first level's, already weighed by select()
+      ia = firstImportances[0], ib = firstImportances[1];
+      firstImportances = nullptr;
+    } else {
+      double both[2];
+      importancePair(a, b, point, normal, both);
+      ia = both[0], ib = both[1];
+      if (factors) ia *= factors[a], ib *= factors[b];
+    }
     const double total = ia + ib;
     if (!(total > 0)) return false;  // neither child can light the point
     const double pa = ia / total;
@@ -146,16 +232,26 @@ void LightTree::select(const glm::dvec3& point, const glm::dvec3& normal, double
   cut[0] = 0;
   weight[0] = rootImportance;
   size = 1;
+  // When the budget stops the split, the children's importances of the node it would have split,
+  // which the walk down from that node needs first (the same numbers, not computed twice).
+  int stoppedAt = -1;
+  double stopped[2];
   while (true) {
     int best = -1;
     for (int k = 0; k < size; ++k)
       if (nodes_[cut[k]].count > 1 && (best < 0 || weight[k] > weight[best])) best = k;
     if (best < 0) break;  // only single lights left
     const std::uint32_t n = cut[best], a = n + 1, b = nodes_[n].first;
-    double ia = importance(nodes_[a], point, normal), ib = importance(nodes_[b], point, normal);
+    double both[2];
+    importancePair(a, b, point, normal, both);
+    double ia = both[0], ib = both[1];
     if (factors) ia *= factors[a], ib *= factors[b];
     const int children = (ia > 0) + (ib > 0);
-    if (size - 1 + children > budget) break;
+    if (size - 1 + children > budget) {
+      stoppedAt = best;
+      stopped[0] = ia, stopped[1] = ib;
+      break;
+    }
     // Replace the node with its children that can light the point.
     cut[best] = cut[size - 1];
     weight[best] = weight[size - 1];
@@ -165,7 +261,7 @@ void LightTree::select(const glm::dvec3& point, const glm::dvec3& normal, double
   }
   for (int k = 0; k < size; ++k) {
     Selected s;
-    if (descend(cut[k], point, normal, u, s, factors)) selected.push_back(s);
+    if (descend(cut[k], point, normal, u, s, factors, k == stoppedAt ? stopped : nullptr)) selected.push_back(s);
   }
 }
 

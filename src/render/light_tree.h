@@ -79,15 +79,28 @@ class LightTree {
     std::uint32_t count = 0;            // lights below
   };
   static double importance(const Node& node, const glm::dvec3& point, const glm::dvec3& normal);
+  std::span<const Node> nodes() const { return nodes_; }
+  // importance() of two nodes (by index) at once, the same numbers bit for bit: the walks down and
+  // the cut weigh both children of a node each step, and two lanes of SSE2 give both in about the
+  // time of one (its square roots and divisions are the cost). Exposed for tests.
+  void importancePair(std::uint32_t a, std::uint32_t b, const glm::dvec3& point, const glm::dvec3& normal, double out[2]) const;
 
  private:
+  // What importance() derives from a node's bounds, computed once at build() the same way.
+  struct Box {
+    glm::dvec3 centre{0.0}, half{0.0};
+    double radius2 = 0.0;  // dot(half, half)
+  };
   std::vector<Node> nodes_;  // depth first: an interior node's first child follows it
+  std::vector<Box> boxes_;   // one per node
   std::size_t lightCount_ = 0;
 
   std::uint32_t buildRange(std::vector<std::uint32_t>& order, std::span<const Light> lights, std::size_t begin, std::size_t end);
   // From node `n`, one light chosen by importance (times `factors`, if given); probability
   // multiplied into *probability. Returns false when no light below can light the point.
-  bool descend(std::uint32_t n, const glm::dvec3& point, const glm::dvec3& normal, double u, Selected& out, const float* factors) const;
+  // `firstImportances` (optional): node n's children's importances (times factors), if known.
+  bool descend(std::uint32_t n, const glm::dvec3& point, const glm::dvec3& normal, double u, Selected& out, const float* factors,
+               const double* firstImportances = nullptr) const;
 };
 
 }  // namespace dynbench::render

@@ -1,6 +1,7 @@
 #include "render/light_visibility.h"
 
 #include <cmath>
+#include <unordered_map>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -19,7 +20,7 @@ struct Seen {
 
 std::uint64_t LightVisibility::key(const glm::dvec3& point, const glm::dvec3& normal, int level) const {
   // 19 bits a coordinate: cells 2^19 apart share a key, which costs only the quality of the factors
-  const double size = std::ldexp(cellSize_, level);
+  const double size = levelSizes_[static_cast<std::size_t>(level)];
   const auto cell = [&](double v) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v / size))) & 0x7FFFFu; };
   const glm::dvec3 a = glm::abs(normal);
   const int axis = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
@@ -27,11 +28,23 @@ std::uint64_t LightVisibility::key(const glm::dvec3& point, const glm::dvec3& no
   return cell(point.x) | cell(point.y) << 19 | cell(point.z) << 38 | facing << 57 | static_cast<std::uint64_t>(level) << 60;
 }
 
+std::int64_t LightVisibility::find(std::uint64_t key) const {
+  if (cellCount_ == 0) return -1;
+  const std::size_t mask = slotKeys_.size() - 1;
+  for (std::size_t slot = (key * 0x9E3779B97F4A7C15ull) >> slotShift_;; slot = (slot + 1) & mask) {
+    if (slotKeys_[slot] == key) return slotCells_[slot];
+    if (slotKeys_[slot] == kNoKey) return -1;
+  }
+}
+
 void LightVisibility::learn(const LightSet& lights, std::span<const Point> points, double cellSize, const Visible& visible) {
-  cells_.clear();
+  slotKeys_.clear();
+  slotCells_.clear();
+  cellCount_ = 0;
   points_.clear();
   factors_.clear();
   cellSize_ = cellSize;
+  for (int level = 0; level < kLevels; ++level) levelSizes_[static_cast<std::size_t>(level)] = std::ldexp(cellSize, level);
   const LightTree& tree = lights.punctualTree();
   nodes_ = tree.nodeCount();
   if (tree.empty() || points.empty() || !(cellSize > 0)) return;
@@ -53,12 +66,28 @@ void LightVisibility::learn(const LightSet& lights, std::span<const Point> point
   // Cells numbered in the order of their first point (each point's levels in turn); each cell's
   // points in their order.
   std::vector<std::vector<std::uint32_t>> members;
-  for (std::size_t i = 0; i < points.size(); ++i)
-    for (int level = 0; level < kLevels; ++level) {
-      const auto [it, inserted] = cells_.try_emplace(key(points[i].position, points[i].normal, level), static_cast<std::uint32_t>(members.size()));
-      if (inserted) members.emplace_back();
-      members[it->second].push_back(static_cast<std::uint32_t>(i));
+  {
+    std::unordered_map<std::uint64_t, std::uint32_t> cells;  // cell key -> index
+    for (std::size_t i = 0; i < points.size(); ++i)
+      for (int level = 0; level < kLevels; ++level) {
+        const auto [it, inserted] = cells.try_emplace(key(points[i].position, points[i].normal, level), static_cast<std::uint32_t>(members.size()));
+        if (inserted) members.emplace_back();
+        members[it->second].push_back(static_cast<std::uint32_t>(i));
+      }
+    int bits = 1;
+    while ((std::size_t{1} << bits) < 2 * cells.size()) ++bits;
+    slotShift_ = 64 - bits;
+    slotKeys_.assign(std::size_t{1} << bits, kNoKey);
+    slotCells_.assign(std::size_t{1} << bits, 0);
+    const std::size_t mask = slotKeys_.size() - 1;
+    for (const auto& [cellKey, cell] : cells) {
+      std::size_t slot = (cellKey * 0x9E3779B97F4A7C15ull) >> slotShift_;
+      while (slotKeys_[slot] != kNoKey) slot = (slot + 1) & mask;
+      slotKeys_[slot] = cellKey;
+      slotCells_[slot] = cell;
     }
+    cellCount_ = cells.size();
+  }
   points_.resize(members.size());
   for (std::size_t c = 0; c < members.size(); ++c) points_[c] = static_cast<std::uint32_t>(members[c].size());
   factors_.assign(members.size() * nodes_, 1.0f);
@@ -83,13 +112,13 @@ void LightVisibility::learn(const LightSet& lights, std::span<const Point> point
 }
 
 const float* LightVisibility::factors(const glm::dvec3& point, const glm::dvec3& normal) const {
-  if (cells_.empty()) return nullptr;
+  if (cellCount_ == 0) return nullptr;
   const float* coarse = nullptr;
   for (int level = 0; level < kLevels; ++level) {
-    const auto it = cells_.find(key(point, normal, level));
-    if (it == cells_.end()) continue;
-    const float* f = &factors_[static_cast<std::size_t>(it->second) * nodes_];
-    if (points_[it->second] >= kMinPoints) return f;
+    const std::int64_t cell = find(key(point, normal, level));
+    if (cell < 0) continue;
+    const float* f = &factors_[static_cast<std::size_t>(cell) * nodes_];
+    if (points_[static_cast<std::size_t>(cell)] >= kMinPoints) return f;
     coarse = f;
   }
   return coarse;

@@ -23,10 +23,10 @@
 // rays through a lattice of pixel centres and one cosine bounce each, from a stream of their own),
 // their shadow rays are traced in parallel into per-point slots, and the sums are made cell by cell
 // in point order, so the factors do not depend on threads or their schedule.
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <span>
-#include <unordered_map>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -58,14 +58,26 @@ class LightVisibility {
   // The node factors (LightTree::select's) of the cell holding a shading point, or nullptr where
   // no pilot point fell in it (the tree's own importance).
   const float* factors(const glm::dvec3& point, const glm::dvec3& normal) const;
-  bool empty() const { return cells_.empty(); }
-  std::size_t cellCount() const { return cells_.size(); }
+  bool empty() const { return cellCount_ == 0; }
+  std::size_t cellCount() const { return cellCount_; }
 
  private:
   std::uint64_t key(const glm::dvec3& point, const glm::dvec3& normal, int level) const;
+  // The cell index of `key`, or -1. Every shading point looks up to kLevels cells, so the table is
+  // flat: std::unordered_map's lookups (a division by its prime bucket count, then a node in its
+  // own allocation) were 5 % of a reference frame's time, and no library the project already
+  // depends on has a flat map (Boost's and Abseil's are not installed).
+  std::int64_t find(std::uint64_t key) const;
   double cellSize_ = 1.0;
+  std::array<double, kLevels> levelSizes_{};  // cellSize_ * 2^level
   std::size_t nodes_ = 0;
-  std::unordered_map<std::uint64_t, std::uint32_t> cells_;  // cell key -> index
+  // Open addressing with linear probing from the key's Fibonacci hash; kNoKey marks an empty
+  // slot (no key has its top bit set); at most half the slots are used.
+  static constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
+  std::vector<std::uint64_t> slotKeys_;
+  std::vector<std::uint32_t> slotCells_;
+  int slotShift_ = 64;  // 64 - log2(slot count)
+  std::size_t cellCount_ = 0;
   std::vector<std::uint32_t> points_;                       // pilot points in cell c
   std::vector<float> factors_;                              // cell c's node n at c * nodes_ + n
 };
