@@ -194,6 +194,30 @@ TEST(TriangleBvh, TheShadowCacheAnswersAsThePlainTest) {
   EXPECT_FALSE(bvh.occluded({0, 50, 0}, {0, 1, 0}, 0.0, 10.0, stale));
 }
 
+// occluded()'s two-lane traversal answers as the one-box-at-a-time one, ray for ray: random
+// segments of every length through a soup, from its triangles' own corners (rays that start on a
+// surface) and along the axes (direction components of zero, the huge reciprocal).
+TEST(TriangleBvh, TwoBoxesAtOnceAnswerAsOneAtATime) {
+  const std::vector<BvhTriangle> soup = randomSoup(17, 3000);
+  const TriangleBvh bvh(soup);
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-12.0, 12.0), length(0.01, 40.0);
+  std::normal_distribution<double> normal;
+  int blocked = 0;
+  for (int i = 0; i < 60000; ++i) {
+    glm::dvec3 o(u(rng), u(rng), u(rng));
+    if (i % 3 == 0) o = soup[rng() % soup.size()].position[rng() % 3];
+    glm::dvec3 d = glm::normalize(glm::dvec3(normal(rng), normal(rng), normal(rng)));
+    if (i % 5 == 0) d = glm::dvec3(0.0), d[i % 3] = i % 2 ? 1.0 : -1.0;
+    const double tMin = i % 3 == 0 ? 1e-6 : 0.0, tMax = length(rng);
+    const bool plain = bvh.occludedOneBoxAtATime(o, d, tMin, tMax);
+    ASSERT_EQ(bvh.occluded(o, d, tMin, tMax), plain) << "ray " << i;
+    blocked += plain;
+  }
+  EXPECT_GT(blocked, 10000);
+  EXPECT_LT(blocked, 50000);
+}
+
 TEST(OpenArena, TheFitsTracerAgreesWithEmbreeOnAMap) {
   DYNBENCH_NEEDS(test::missingOpenArena());
   auto files = GameFiles::open("/usr/lib/openarena/baseoa");
@@ -212,6 +236,22 @@ TEST(OpenArena, TheFitsTracerAgreesWithEmbreeOnAMap) {
   EXPECT_LE(a.hitDisagree, a.rays / 2000);
   EXPECT_LE(a.distanceDisagree, a.rays / 2000);
   EXPECT_LE(a.occludedDisagree, a.rays / 2000);
+  // and its two-lane shadow traversal answers as the one-box-at-a-time one on the map's rooms,
+  // between points of its surfaces (the fit's rays run from texel to light)
+  const TriangleBvh bvh(triangles);
+  std::mt19937 rng(5);
+  int blocked = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const BvhTriangle &from = triangles[rng() % triangles.size()], &to = triangles[rng() % triangles.size()];
+    const glm::dvec3 a = (from.position[0] + from.position[1] + from.position[2]) / 3.0, b = (to.position[0] + to.position[1] + to.position[2]) / 3.0;
+    const double distance = glm::length(b - a);
+    if (!(distance > 0.1)) continue;
+    const glm::dvec3 d = (b - a) / distance;
+    const bool plain = bvh.occludedOneBoxAtATime(a, d, 0.01, distance - 0.01);
+    ASSERT_EQ(bvh.occluded(a, d, 0.01, distance - 0.01), plain) << "ray " << i;
+    blocked += plain;
+  }
+  EXPECT_GT(blocked, 5000);
 }
 
 // The instructions whose results the x86 manuals leave to the implementation: the reciprocal and

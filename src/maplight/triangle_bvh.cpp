@@ -8,6 +8,10 @@
 
 #include <glm/geometric.hpp>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace dynbench::maplight {
 
 namespace {
@@ -244,17 +248,77 @@ bool TriangleBvh::facesRay(std::uint32_t triangle, double u, double v, const glm
   return glm::dot(shadingNormal(triangle, u, v), direction) < 0.0;
 }
 
+bool TriangleBvh::anyHit(const glm::dvec3& origin, const glm::dvec3& direction, double tMin, double tMax, std::uint32_t& triangle) const {
+#if defined(__SSE2__)
+  if (nodes_.empty()) return false;
+  const glm::dvec3 inverse(reciprocal(direction.x), reciprocal(direction.y), reciprocal(direction.z));
+  // The slab test of trace() on two boxes, a lane each: bit 0 where a's box is met in [tMin, tMax],
+  // bit 1 where b's is. std::min(x, y) is minpd(y, x) and std::max(x, y) is maxpd(y, x), and
+  // nothing here is NaN (the reciprocals are finite), so each lane's numbers are trace()'s.
+  const auto boxes = [&](const Node& a, const Node& b) {
+    __m128d t0 = _mm_set1_pd(tMin), t1 = _mm_set1_pd(tMax);
+    for (int axis = 0; axis < 3; ++axis) {
+      const __m128d o = _mm_set1_pd(origin[axis]), inv = _mm_set1_pd(inverse[axis]);
+      const __m128d near = _mm_mul_pd(_mm_sub_pd(_mm_set_pd(b.lo[axis], a.lo[axis]), o), inv);
+      const __m128d far = _mm_mul_pd(_mm_sub_pd(_mm_set_pd(b.hi[axis], a.hi[axis]), o), inv);
+      // trace(): if (near > far) swap, so near becomes std::min(near, far), far std::max(far, near)
+      const __m128d entry = _mm_min_pd(far, near), exit = _mm_max_pd(near, far);
+      t0 = _mm_max_pd(entry, t0);  // std::max(t0, entry)
+      t1 = _mm_min_pd(exit, t1);   // std::min(t1, exit)
+    }
+    return _mm_movemask_pd(_mm_cmple_pd(t0, t1));  // not (t0 > t1): met
+  };
+  if (!(boxes(nodes_[0], nodes_[0]) & 1)) return false;
+  std::uint32_t stack[kStackDepth];
+  std::size_t top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const std::uint32_t index = stack[--top];
+    const Node& node = nodes_[index];  // its box is met
+    if (node.count == 0) {
+      const std::uint32_t first = index + 1, second = node.first;
+      const int met = boxes(nodes_[first], nodes_[second]);
+      // the child nearer the ray's origin along the split axis is taken first (pushed last)
+      if (direction[node.axis] < 0.0) {
+        if (met & 1) stack[top++] = first;
+        if (met & 2) stack[top++] = second;
+      } else {
+        if (met & 2) stack[top++] = second;
+        if (met & 1) stack[top++] = first;
+      }
+      continue;
+    }
+    for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+      double u = 0.0, v = 0.0, t = 0.0;
+      if (crosses(k, origin, direction, tMin, tMax, u, v, t)) {
+        triangle = k;
+        return true;
+      }
+    }
+  }
+  return false;
+#else
+  double distance = 0.0, u = 0.0, v = 0.0;
+  return trace<true>(origin, direction, tMin, tMax, distance, triangle, u, v);
+#endif
+}
+
 bool TriangleBvh::occluded(const glm::dvec3& origin, const glm::dvec3& direction, double tMin, double tMax) const {
+  std::uint32_t triangle = 0;
+  return anyHit(origin, direction, tMin, tMax, triangle);
+}
+
+bool TriangleBvh::occludedOneBoxAtATime(const glm::dvec3& origin, const glm::dvec3& direction, double tMin, double tMax) const {
   double distance = 0.0, u = 0.0, v = 0.0;
   std::uint32_t triangle = 0;
   return trace<true>(origin, direction, tMin, tMax, distance, triangle, u, v);
 }
 
 bool TriangleBvh::occluded(const glm::dvec3& origin, const glm::dvec3& direction, double tMin, double tMax, std::uint32_t& lastBlocker) const {
-  double distance = 0.0, u = 0.0, v = 0.0, t = 0.0;
+  double u = 0.0, v = 0.0, t = 0.0;
   if (lastBlocker < prepared_.size() && crosses(lastBlocker, origin, direction, tMin, tMax, u, v, t)) return true;
   std::uint32_t triangle = kNoBlocker;
-  const bool blocked = trace<true>(origin, direction, tMin, tMax, distance, triangle, u, v);
+  const bool blocked = anyHit(origin, direction, tMin, tMax, triangle);
   if (blocked) lastBlocker = triangle;
   return blocked;
 }

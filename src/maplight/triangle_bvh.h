@@ -46,6 +46,9 @@ class TriangleBvh {
   // the traversal runs); only the work differs.
   static constexpr std::uint32_t kNoBlocker = 0xffffffffu;
   bool occluded(const glm::dvec3& origin, const glm::dvec3& direction, double tMin, double tMax, std::uint32_t& lastBlocker) const;
+  // occluded() as it was before its two-lane traversal, one node's box at a time: the same answer
+  // for every ray (tests compare the two).
+  bool occludedOneBoxAtATime(const glm::dvec3& origin, const glm::dvec3& direction, double tMin, double tMax) const;
   // The nearest triangle the ray crosses at a distance of at least tMin; of two at the same
   // distance (within 1e-9 relative), the one whose shading normal faces the ray.
   BvhHit intersect(const glm::dvec3& origin, const glm::dvec3& direction, double tMin) const;
@@ -71,6 +74,11 @@ class TriangleBvh {
                double& t) const;
   glm::dvec3 shadingNormal(std::uint32_t triangle, double u, double v) const;
   bool facesRay(std::uint32_t triangle, double u, double v, const glm::dvec3& direction) const;
+  // Whether any triangle crosses the ray in [tMin, tMax], with one that does. A node's two
+  // children's boxes are tested at once in two SSE2 lanes, each lane the slab test trace() makes
+  // operation for operation, so the same boxes are culled and the answer is trace<true>'s; only the
+  // order in which leaves are visited (and so which blocker is reported) may differ.
+  bool anyHit(const glm::dvec3& origin, const glm::dvec3& direction, double tMin, double tMax, std::uint32_t& triangle) const;
   template <bool kAnyHit>
   bool trace(const glm::dvec3& origin, const glm::dvec3& direction, double tMin, double tMax, double& distance, std::uint32_t& triangle,
              double& u, double& v) const;
