@@ -53,6 +53,10 @@ PixelFilter::PixelFilter(const PixelFilterSpec& spec) : spec_(spec) {
   }
   const double total = cdf_.back();
   for (double& c : cdf_) c /= total;
+  guide_.resize(kGuideCells + 1);
+  for (int b = 0; b <= kGuideCells; ++b)
+    guide_[static_cast<std::size_t>(b)] = static_cast<std::uint32_t>(
+        std::upper_bound(cdf_.begin(), cdf_.end(), static_cast<double>(b) / kGuideCells) - cdf_.begin());
 }
 
 double PixelFilter::weight(double v) const {
@@ -76,7 +80,8 @@ double PixelFilter::sample1D(double u) const {
     case PixelFilterType::kBlackmanHarris: break;
   }
   // The cell whose CDF range holds u, then linear within it.
-  const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);
+  const auto cell = static_cast<std::size_t>(std::clamp(std::floor(u * kGuideCells), 0.0, kGuideCells - 1.0));
+  const auto it = std::upper_bound(cdf_.begin() + guide_[cell], cdf_.begin() + guide_[cell + 1], u);
   const auto i = static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(it - cdf_.begin(), 1, kTable));
   const double lo = cdf_[i - 1], hi = cdf_[i];
   const double t = hi > lo ? (u - lo) / (hi - lo) : 0.5;

@@ -14,6 +14,7 @@
 //                               s = 2 pi (v / (2w) + 1/2), on [-w, w]
 // Width as Cycles' `filter_width` means it: Cycles' table doubles a Blackman-Harris width before
 // evaluating the window, so its default 1.5 px reaches 1.5 px from the centre on each side.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,13 @@ class PixelFilter {
   // it by binary search and linear interpolation, i.e. samples the piecewise-linear CDF exactly
   // (its density is the filter averaged over each of the kTable cells).
   std::vector<double> cdf_;
+  // guide_[b] = the binary search's answer for u = b / kGuideCells (b = 0 .. kGuideCells): the
+  // answer for any u in [b, b + 1) / kGuideCells lies between guide_[b] and guide_[b + 1], so the
+  // search runs over those few cells instead of all of them, with the same result (the CDF is
+  // monotone; b / kGuideCells is exact for a power of two). Found by `perf`: the 12-step search
+  // over 4,097 cells was 2.6 % of a demo frame.
+  static constexpr int kGuideCells = 256;
+  std::vector<std::uint32_t> guide_;
 };
 
 }  // namespace dynbench::render
