@@ -81,8 +81,9 @@ class LightTree {
   static double importance(const Node& node, const glm::dvec3& point, const glm::dvec3& normal);
   std::span<const Node> nodes() const { return nodes_; }
   // importance() of two nodes (by index) at once, the same numbers bit for bit: the walks down and
-  // the cut weigh both children of a node each step, and two lanes of SSE2 give both in about the
-  // time of one (its square roots and divisions are the cost). Exposed for tests.
+  // the cut weigh both children of a node each step, and two lanes of SSE2 overlap the two chains
+  // of square roots and divisions that are its cost (importance's share of a demo frame 10.9 %
+  // as two calls, 9.1 % as one pair, `perf`). Exposed for tests.
   void importancePair(std::uint32_t a, std::uint32_t b, const glm::dvec3& point, const glm::dvec3& normal, double out[2]) const;
 
  private:
