@@ -29,9 +29,9 @@ std::uint64_t LightVisibility::key(const glm::dvec3& point, const glm::dvec3& no
 }
 
 std::int64_t LightVisibility::find(std::uint64_t key) const {
-  if (cellCount_ == 0) return -1;
+  if (slotKeys_.empty()) return -1;
   const std::size_t mask = slotKeys_.size() - 1;
-  for (std::size_t slot = (key * 0x9E3779B97F4A7C15ull) >> slotShift_;; slot = (slot + 1) & mask) {
+  for (std::size_t slot = firstSlot(key);; slot = (slot + 1) & mask) {
     if (slotKeys_[slot] == key) return slotCells_[slot];
     if (slotKeys_[slot] == kNoKey) return -1;
   }
@@ -40,7 +40,6 @@ std::int64_t LightVisibility::find(std::uint64_t key) const {
 void LightVisibility::learn(const LightSet& lights, std::span<const Point> points, double cellSize, const Visible& visible) {
   slotKeys_.clear();
   slotCells_.clear();
-  cellCount_ = 0;
   points_.clear();
   factors_.clear();
   cellSize_ = cellSize;
@@ -81,12 +80,11 @@ void LightVisibility::learn(const LightSet& lights, std::span<const Point> point
     slotCells_.assign(std::size_t{1} << bits, 0);
     const std::size_t mask = slotKeys_.size() - 1;
     for (const auto& [cellKey, cell] : cells) {
-      std::size_t slot = (cellKey * 0x9E3779B97F4A7C15ull) >> slotShift_;
+      std::size_t slot = firstSlot(cellKey);
       while (slotKeys_[slot] != kNoKey) slot = (slot + 1) & mask;
       slotKeys_[slot] = cellKey;
       slotCells_[slot] = cell;
     }
-    cellCount_ = cells.size();
   }
   points_.resize(members.size());
   for (std::size_t c = 0; c < members.size(); ++c) points_[c] = static_cast<std::uint32_t>(members[c].size());
@@ -112,7 +110,7 @@ void LightVisibility::learn(const LightSet& lights, std::span<const Point> point
 }
 
 const float* LightVisibility::factors(const glm::dvec3& point, const glm::dvec3& normal) const {
-  if (cellCount_ == 0) return nullptr;
+  if (points_.empty()) return nullptr;
   const float* coarse = nullptr;
   for (int level = 0; level < kLevels; ++level) {
     const std::int64_t cell = find(key(point, normal, level));

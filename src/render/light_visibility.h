@@ -58,8 +58,8 @@ class LightVisibility {
   // The node factors (LightTree::select's) of the cell holding a shading point, or nullptr where
   // no pilot point fell in it (the tree's own importance).
   const float* factors(const glm::dvec3& point, const glm::dvec3& normal) const;
-  bool empty() const { return cellCount_ == 0; }
-  std::size_t cellCount() const { return cellCount_; }
+  bool empty() const { return points_.empty(); }
+  std::size_t cellCount() const { return points_.size(); }
 
  private:
   std::uint64_t key(const glm::dvec3& point, const glm::dvec3& normal, int level) const;
@@ -68,6 +68,7 @@ class LightVisibility {
   // own allocation) were 5 % of a reference frame's time, and no library the project already
   // depends on has a flat map (Boost's and Abseil's are not installed).
   std::int64_t find(std::uint64_t key) const;
+  std::size_t firstSlot(std::uint64_t key) const { return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> slotShift_); }
   double cellSize_ = 1.0;
   std::array<double, kLevels> levelSizes_{};  // cellSize_ * 2^level
   std::size_t nodes_ = 0;
@@ -76,8 +77,7 @@ class LightVisibility {
   static constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
   std::vector<std::uint64_t> slotKeys_;
   std::vector<std::uint32_t> slotCells_;
-  int slotShift_ = 64;  // 64 - log2(slot count)
-  std::size_t cellCount_ = 0;
+  int slotShift_ = 63;  // 64 - log2(slot count)
   std::vector<std::uint32_t> points_;                       // pilot points in cell c
   std::vector<float> factors_;                              // cell c's node n at c * nodes_ + n
 };
