@@ -6,7 +6,10 @@
 #include <cstring>
 #include <fstream>
 #include <system_error>
+#include <utility>
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 namespace dynbench {
@@ -99,5 +102,48 @@ std::filesystem::path findOnPath(const std::string& name) {
   return {};
 }
 
+
+namespace {
+
+Expected<int> openLockFile(const std::filesystem::path& file) {
+  const int fd = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) return fail(ErrorCode::kIo, "{}: cannot open the lock file: {}", file.string(), std::strerror(errno));
+  return fd;
+}
+
+}  // namespace
+
+Expected<FileLock> FileLock::wait(const std::filesystem::path& file) {
+  auto fd = openLockFile(file);
+  if (!fd) return std::unexpected(fd.error());
+  int status = 0;
+  while ((status = ::flock(*fd, LOCK_EX)) != 0 && errno == EINTR) {}
+  if (status != 0) {
+    const int error = errno;
+    ::close(*fd);
+    return fail(ErrorCode::kIo, "{}: cannot lock: {}", file.string(), std::strerror(error));
+  }
+  return FileLock(*fd);
+}
+
+Expected<std::optional<FileLock>> FileLock::tryTake(const std::filesystem::path& file) {
+  auto fd = openLockFile(file);
+  if (!fd) return std::unexpected(fd.error());
+  if (::flock(*fd, LOCK_EX | LOCK_NB) == 0) return std::optional<FileLock>(FileLock(*fd));
+  const int error = errno;
+  ::close(*fd);
+  if (error == EWOULDBLOCK) return std::optional<FileLock>();
+  return fail(ErrorCode::kIo, "{}: cannot lock: {}", file.string(), std::strerror(error));
+}
+
+void FileLock::note(std::string_view text) const {
+  if (::ftruncate(descriptor_, 0) != 0 || ::pwrite(descriptor_, text.data(), text.size(), 0) < 0) {}  // a courtesy only
+}
+
+FileLock::FileLock(FileLock&& other) noexcept : descriptor_(std::exchange(other.descriptor_, -1)) {}
+
+FileLock::~FileLock() {
+  if (descriptor_ >= 0) ::close(descriptor_);
+}
 
 }  // namespace dynbench

@@ -3,6 +3,7 @@
 // interrupted run never leaves a half-written output that looks complete.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -32,6 +33,27 @@ Expected<void> commitTemporary(const std::filesystem::path& temporary,
 std::string asciiLowercase(std::string text);
 // The extension of `path` (with its dot), in lower case: ".gltf" for "Map.GLTF".
 std::string lowercaseExtension(const std::filesystem::path& path);
+
+// An advisory lock (flock(2)) on a file, held until the object goes or the process ends, however
+// it ends (a SIGKILL too: the kernel drops it with the descriptor). Each FileLock opens the file
+// anew, so two exclude each other in one process as in two.
+class FileLock {
+ public:
+  // Waits until no other process holds `file` (created if missing; its folder must exist).
+  static Expected<FileLock> wait(const std::filesystem::path& file);
+  // The lock if no other process holds it, std::nullopt if one does.
+  static Expected<std::optional<FileLock>> tryTake(const std::filesystem::path& file);
+  // Replaces the file's contents with `text` (who holds it, for another process's message).
+  void note(std::string_view text) const;
+
+  FileLock(FileLock&& other) noexcept;
+  FileLock& operator=(FileLock&&) = delete;
+  ~FileLock();
+
+ private:
+  explicit FileLock(int descriptor) : descriptor_(descriptor) {}
+  int descriptor_ = -1;
+};
 
 // True when `path` names a file this process may execute.
 bool isExecutable(const std::filesystem::path& path);

@@ -3,6 +3,7 @@
 #include <cstdlib>
 
 #include "core/checksum.h"
+#include "core/files.h"
 
 namespace dynbench::maplight {
 
@@ -23,12 +24,17 @@ Expected<std::filesystem::path> cachedAdapterLights(const std::filesystem::path&
   const auto file = cacheFolder / fmt::format("{}-{}-v{}.txt", map, sha256Text(*bytes).substr(0, 16), kFitVersion);
   std::error_code ec;
   if (std::filesystem::is_regular_file(file, ec)) return file;
+  std::filesystem::create_directories(cacheFolder, ec);
+  if (ec) return fail(ErrorCode::kIo, "{}: cannot create the map-light cache folder: {}", cacheFolder.string(), ec.message());
+  // One fit per map at a time: a second process that needs the same map (two captures of it, Slurm
+  // tasks on one node) waits for the first's file instead of fitting it again beside it.
+  const auto lock = FileLock::wait(std::filesystem::path(file).concat(".lock"));
+  if (!lock) return std::unexpected(lock.error());
+  if (std::filesystem::is_regular_file(file, ec)) return file;
   MapLightFitOptions options;
   options.judgeOnHeldOut = false;  // the file holds the lights alone
   auto lighting = fitMapLighting(*files, map, options, progress);
   if (!lighting) return std::unexpected(lighting.error());
-  std::filesystem::create_directories(cacheFolder, ec);
-  if (ec) return fail(ErrorCode::kIo, "{}: cannot create the map-light cache folder: {}", cacheFolder.string(), ec.message());
   if (auto written = writeAdapterLights(file, *lighting); !written) return std::unexpected(written.error());
   return file;
 }

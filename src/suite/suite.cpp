@@ -6,12 +6,8 @@
 #include <set>
 #include <utility>
 
-#include <fcntl.h>
-#include <sys/file.h>
 #include <sys/resource.h>
 #include <unistd.h>
-#include <cerrno>
-#include <cstring>
 
 #include <fmt/format.h>
 
@@ -223,37 +219,21 @@ Expected<std::vector<PreparedDataset>> prepareDatasets(const Manifest& manifest,
   return prepared;
 }
 
-// One `suite` at a time in a folder: an advisory lock on DIR/.suite.lock (flock(2)), released when
-// the process ends however it ends. Render tasks (--part render) take none: a Slurm array runs many
-// at once in one folder, each on frames of its own.
-class FolderLock {
- public:
-  static Expected<FolderLock> take(const fs::path& root) {
-    const fs::path file = root / ".suite.lock";
-    const int fd = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd < 0) return fail(ErrorCode::kIo, "{}: cannot open: {}", file.string(), std::strerror(errno));
-    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
-      std::string holder(32, '\0');
-      const auto n = ::pread(fd, holder.data(), holder.size(), 0);
-      holder.resize(n > 0 ? static_cast<std::size_t>(n) : 0);
-      ::close(fd);
-      return fail(ErrorCode::kIo, "{}: another `dynbench suite` is running in this folder (process {} holds {}); wait for it, or use another folder",
-                  root.string(), holder.empty() ? std::string("?") : holder, file.string());
-    }
-    const std::string pid = std::to_string(::getpid());
-    if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, pid.data(), pid.size(), 0) < 0) {}  // who holds it, for the message above only
-    return FolderLock(fd);
+// One `suite` at a time in a folder: an advisory lock on DIR/.suite.lock, released when the
+// process ends however it ends. Render tasks (--part render) take none: a Slurm array runs many at
+// once in one folder, each on frames of its own.
+Expected<FileLock> lockFolder(const fs::path& root) {
+  const fs::path file = root / ".suite.lock";
+  auto lock = FileLock::tryTake(file);
+  if (!lock) return std::unexpected(lock.error());
+  if (!*lock) {
+    const auto holder = readWholeFile(file);
+    return fail(ErrorCode::kIo, "{}: another `dynbench suite` is running in this folder (process {} holds {}); wait for it, or use another folder",
+                root.string(), holder && !holder->empty() ? *holder : std::string("?"), file.string());
   }
-  FolderLock(FolderLock&& o) noexcept : fd_(std::exchange(o.fd_, -1)) {}
-  FolderLock& operator=(FolderLock&&) = delete;
-  ~FolderLock() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-
- private:
-  explicit FolderLock(int fd) : fd_(fd) {}
-  int fd_ = -1;
-};
+  (*lock)->note(std::to_string(::getpid()));  // who holds it, for the message above
+  return std::move(**lock);
+}
 
 // The bytes of every file under `folder`.
 std::uintmax_t folderBytes(const fs::path& folder) {
@@ -373,7 +353,7 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
     if (auto ok = pipeline::renderTask(jobs, options.renderTask, options.framesPerTask, "the suite", log); !ok) return std::unexpected(ok.error());
     return outcome;
   }
-  auto lock = FolderLock::take(root);
+  auto lock = lockFolder(root);
   if (!lock) return std::unexpected(lock.error());
   if (options.part == SuitePart::kDatasets) {
     if (auto prepared = prepareDatasets(*manifest, {}, root, settings.fps, log); !prepared) return std::unexpected(prepared.error());
