@@ -102,7 +102,6 @@ std::filesystem::path findOnPath(const std::string& name) {
   return {};
 }
 
-
 namespace {
 
 Expected<int> openLockFile(const std::filesystem::path& file) {
