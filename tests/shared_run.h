@@ -7,10 +7,6 @@
 // for the lock and read it. Each of the two was made twice per test run before (about 110 s of
 // CPU on a 2-core AMD EPYC). A test reads the folder and never writes into it: one that edits or
 // resumes copies it first (copyOf).
-#include <sys/file.h>
-#include <unistd.h>
-
-#include <fcntl.h>
 #include <algorithm>
 #include <filesystem>
 #include <functional>
@@ -48,12 +44,11 @@ inline void pruneOlderRuns(const std::filesystem::path& root, const std::string&
   }
   std::sort(older.begin(), older.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
   for (std::size_t i = 1; i < older.size(); ++i) {
-    const std::string lockPath = older[i].second.string() + ".lock";
-    const int lock = ::open(lockPath.c_str(), O_RDWR);
-    if (lock < 0) continue;
+    const fs::path lockPath = older[i].second.string() + ".lock";
+    if (!fs::exists(lockPath, ec)) continue;
     // The empty lock file stays: a process that opened it a moment ago keeps a lock on that file.
-    if (::flock(lock, LOCK_EX | LOCK_NB) == 0) fs::remove_all(older[i].second, ec);
-    ::close(lock);
+    const auto lock = FileLock::tryTake(lockPath);
+    if (lock && *lock) fs::remove_all(older[i].second, ec);
   }
 }
 
@@ -67,10 +62,9 @@ inline SharedRun sharedRun(const std::string& name, const std::string& arguments
   fs::create_directories(root);
   const fs::path folder = root / fmt::format("{}-{:016x}", name, key);
   SharedRun shared{folder / "out", {}};
-  const int lock = ::open((folder.string() + ".lock").c_str(), O_CREAT | O_RDWR, 0644);
-  if (lock < 0 || ::flock(lock, LOCK_EX) != 0) {
-    ADD_FAILURE() << folder << ".lock: cannot lock";
-    if (lock >= 0) ::close(lock);
+  const auto lock = FileLock::wait(folder.string() + ".lock");
+  if (!lock) {
+    ADD_FAILURE() << lock.error().message;
     return shared;
   }
   // run.json, written last and atomically, says the run is whole: a run cut short is made again.
@@ -91,9 +85,7 @@ inline SharedRun sharedRun(const std::string& name, const std::string& arguments
     shared.run.out = record["out"];
     shared.run.err = record["err"];
   }
-  ::flock(lock, LOCK_UN);
-  ::close(lock);
-  return shared;
+  return shared;  // the lock goes with `lock`
 }
 
 // A copy of a shared run's output to edit or resume in, with its files' times (which decide what
