@@ -16,6 +16,7 @@
 #include "frames/frame_io.h"
 #include "gltf_builder.h"
 #include "render/backend.h"
+#include "render/render_job_json.h"
 #include "run_cli.h"
 
 namespace dynbench {
@@ -106,6 +107,88 @@ TEST(RenderCli, WritesTheContractAndResumes) {
   EXPECT_NE(r.out.find("3 frame(s) rendered, 0 already complete"), std::string::npos) << r.out;
   for (const auto& entry : fs::directory_iterator(out))
     EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+}
+
+// A mesh hidden at rest that appears in frame 1 and morphs until frame 2 onto itself: 96 pairs of
+// quads, each pair's two quads (one facing the camera, one tilted towards the light) 2 units apart
+// where it appears and coincident from frame 2 on, so that which of the two a ray reports is
+// decided by the order Embree's BVH visits them. Embree builds a moving mesh's BVH where it is
+// first enabled and refits it after (raytracing_scene.cpp), so that order depends on where the
+// stepping through the frames began.
+fs::path writeCoincidingQuads(const fs::path& dir) {
+  test::GltfBuilder b;
+  std::vector<float> positions, normals, moved;
+  std::vector<std::uint32_t> indices;
+  for (int pair = 0; pair < 96; ++pair) {
+    const float x = -1.2f + 0.2f * static_cast<float>(pair % 12), y = -0.7f + 0.2f * static_cast<float>(pair / 12);
+    for (int side = 0; side < 2; ++side) {
+      const auto base = static_cast<std::uint32_t>(positions.size() / 3);
+      for (const auto& [dx, dy] : {std::pair{0.f, 0.f}, {0.2f, 0.f}, {0.2f, 0.2f}, {0.f, 0.2f}}) {
+        positions.insert(positions.end(), {x + dx + 2.0f * static_cast<float>(side), y + dy, -3.0f});
+        moved.insert(moved.end(), {-2.0f * static_cast<float>(side), 0.f, 0.f});
+        if (side == 0) normals.insert(normals.end(), {0.f, 0.f, 1.f});
+        else normals.insert(normals.end(), {0.6f, 0.f, 0.8f});
+      }
+      indices.insert(indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    }
+  }
+  nlohmann::json prim = {{"attributes", {{"POSITION", b.accessor(positions, "VEC3")}, {"NORMAL", b.accessor(normals, "VEC3")}}},
+                         {"indices", b.indices(indices)},
+                         {"targets", {{{"POSITION", b.accessor(moved, "VEC3")}}}}};
+  b.doc["meshes"] = {{{"primitives", nlohmann::json::array({prim})}, {"weights", {0.0}}}};
+  const int quads = b.node({{"mesh", 0}, {"scale", {0.0, 0.0, 0.0}}});
+  b.channel(quads, "scale", {0.0f, 1.0f / 24}, {0, 0, 0, 1, 1, 1}, "STEP");
+  b.channel(quads, "weights", {1.0f / 24, 2.0f / 24, 6.0f / 24}, {0.0f, 1.0f, 1.0f});
+  b.node({{"camera", b.perspectiveCamera(1.0)}});
+  b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  b.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "directional"}, {"intensity", 3.0}}};
+  b.node({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}, {"rotation", {0.0, 0.38268343, 0.0, 0.92387953}}});
+  return b.write(dir, "quads");
+}
+
+// A resumed job steps through the frames it skips, so the frame it renders is the same bytes as
+// the whole job's (frame-level resume and the suite's records rest on it); so does a job over part
+// of a range told to step from the range's first frame (what a Slurm render task is).
+TEST(RenderCli, AResumedJobStepsThroughTheFramesItSkips) {
+  const auto dir = test::freshDir("render_history");
+  const fs::path dataset = writeCoincidingQuads(dir);
+  const std::string options = "--res 96x54 --spp 1 --env-constant 0 --threads 2 --frames 0:5";
+  auto r = dynbench(fmt::format("render {} -o {} {}", dataset.string(), (dir / "whole").string(), options), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  // Started at frame 5, the mesh's BVH is built where it lies from frame 2 on: another order.
+  r = dynbench(fmt::format("render {} -o {} --res 96x54 --spp 1 --env-constant 0 --threads 2 --frames 5", dataset.string(), (dir / "alone").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto bytes = [](const fs::path& file) { return readWholeFile(file).value_or(""); };
+  const fs::path frame5 = fs::path("frame_00005.exr");
+  ASSERT_FALSE(bytes(dir / "whole" / frame5).empty());
+  EXPECT_TRUE(bytes(dir / "whole" / frame5) != bytes(dir / "alone" / frame5)) << "the scene no longer tells where the stepping began";
+  // Resumed with frames 3 and 5 missing: the same bytes as the whole job's.
+  fs::copy(dir / "whole", dir / "resumed");
+  for (const char* f : {"frame_00003.exr", "frame_00003.json", "frame_00005.exr", "frame_00005.json"}) fs::remove(dir / "resumed" / f);
+  r = dynbench(fmt::format("render {} -o {} {}", dataset.string(), (dir / "resumed").string(), options), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("2 frame(s) rendered, 4 already complete"), std::string::npos) << r.out;
+  for (const char* f : {"frame_00003.exr", "frame_00005.exr"}) EXPECT_TRUE(bytes(dir / "whole" / f) == bytes(dir / "resumed" / f)) << f;
+  // A part of the job's range, as a Slurm task runs it (`render --job FILE --frames PART`): stepped
+  // from the file's first frame, the whole job's bytes.
+  render::RenderJob job;
+  job.dataset = dataset;
+  job.settings.width = 96;
+  job.settings.height = 54;
+  job.settings.samplesPerPixel = 1;
+  job.threads = 2;
+  job.frames = {0, 5, 1};
+  for (const char* name : {"whole", "part"}) {
+    job.output = dir / "job" / name;
+    ASSERT_TRUE(render::writeRenderJob(job, dir / (std::string(name) + ".json")));
+  }
+  r = dynbench(fmt::format("render --job {}", (dir / "whole.json").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = dynbench(fmt::format("render --job {} --frames 4:5", (dir / "part.json").string()), dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("2 frame(s) rendered, 0 already complete"), std::string::npos) << r.out;
+  for (const char* f : {"frame_00004.exr", "frame_00005.exr"})
+    EXPECT_TRUE(bytes(dir / "job" / "whole" / f) == bytes(dir / "job" / "part" / f)) << f;
 }
 
 // Frames are written while the next one renders: a frame that cannot be written still stops the

@@ -64,7 +64,9 @@ Expected<void> renderOnSlurm(const render::RenderJob& job, const cluster::Option
 
 Expected<void> renderJob(const render::RenderJob& job);
 
-// The job of `render --job FILE [--frames A:B] [--threads N]`: the file's, with this run's frames and threads.
+// The job of `render --job FILE [--frames A:B] [--threads N]`: the file's, with this run's frames and
+// threads. The frames are a part of the file's (a Slurm task's chunk): the scene is stepped from the
+// file's first frame, so that they are the whole job's bytes (RenderJob::stepFrom).
 Expected<render::RenderJob> jobFromFile(const RenderCli& cli) {
   if (auto ok = nothingBesideJob(cli.jobFile, cli.givenWithJob, "--frames, --threads"); !ok) return std::unexpected(ok.error());
   auto job = render::readRenderJob(cli.jobFile);
@@ -72,6 +74,7 @@ Expected<render::RenderJob> jobFromFile(const RenderCli& cli) {
   if (!cli.frames.empty()) {
     auto range = render::parseFrameRange(cli.frames);
     if (!range) return std::unexpected(range.error());
+    job->stepFrom = job->frames.first;
     job->frames = *range;
   }
   if (cli.threadsGiven) job->threads = cli.job.threads;

@@ -299,6 +299,7 @@ Expected<void> renderTask(const std::vector<DatasetJob>& datasets, int task, int
     std::size_t j = i;
     while (j + 1 < last && items[j + 1].first.job.output == items[i].first.job.output) ++j;
     RenderStage chunk = items[i].first;
+    chunk.job.stepFrom = chunk.job.frames.first;  // the whole range's stepping, so the whole job's bytes
     chunk.job.frames.first = items[i].second;
     chunk.job.frames.last = items[j].second;
     auto rendered = runRender(chunk);

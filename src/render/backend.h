@@ -15,9 +15,18 @@
 
 namespace dynbench::render {
 
+// A frame the job steps the scene through without rendering it: (its time, its previous frame's).
+struct SceneStep {
+  double time = 0.0, previousTime = 0.0;
+};
+
 struct FrameRequest {
   long frame = 0;
   FrameCameras cameras;
+  // The frames of the job's stepping (RenderJob::stepFrom) before this one that are not rendered
+  // (already complete, or before the part this job renders), in order: a backend whose scene keeps
+  // state from frame to frame sets it to each before this frame, as if it had rendered them.
+  std::vector<SceneStep> stepsBefore;
 };
 
 // Receives each finished frame, in request order, one call at a time; an error stops the backend.

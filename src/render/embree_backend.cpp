@@ -29,6 +29,13 @@ class EmbreeBackend final : public RenderBackend {
     };
     for (std::size_t i = 0; i < requests.size(); ++i) {
       const FrameRequest& request = requests[i];
+      // The frames stepped through unrendered first: the path tracer's scene keeps state between
+      // frames (RenderJob::stepFrom).
+      for (const SceneStep& step : request.stepsBefore)
+        if (auto ok = tracer_->setTime(step.time, step.previousTime); !ok) {
+          (void)finishWriting();
+          return ok;
+        }
       if (auto ok = tracer_->setTime(request.cameras.time, request.cameras.previousTime); !ok) {
         (void)finishWriting();
         return ok;

@@ -174,11 +174,25 @@ Expected<RenderSummary> renderDataset(const scene::Scene& scene, const RenderJob
   std::vector<FrameRequest> requests;
   std::set<long> cuts;
   const scene::Evaluator evaluator(scene);
-  for (long f : todo) {
+  // Every frame from where the stepping begins to the last one rendered, in order; those not
+  // rendered are steps before the next that is (RenderJob::stepFrom).
+  std::vector<long> stepping;
+  if (job.stepFrom)
+    for (long f = *job.stepFrom; f < frames->front(); f += std::max<long>(1, job.frames.step)) stepping.push_back(f);
+  stepping.insert(stepping.end(), frames->begin(), frames->end());
+  const std::set<long> rendering(todo.begin(), todo.end());
+  std::vector<SceneStep> steps;
+  for (long f : stepping) {
+    if (f > todo.back()) break;
     auto cameras = frameCameras(evaluator, *cameraNode, job, f);
     if (!cameras) return std::unexpected(cameras.error());
+    if (!rendering.contains(f)) {
+      steps.push_back({cameras->time, cameras->previousTime});
+      continue;
+    }
     if (cameras->cut) cuts.insert(f);
-    requests.push_back({f, std::move(*cameras)});
+    requests.push_back({f, std::move(*cameras), std::move(steps)});
+    steps.clear();
   }
   const auto started = std::chrono::steady_clock::now();
   // --threads holds for the whole job: loading (textures decode in parallel), rendering and

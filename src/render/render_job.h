@@ -33,6 +33,13 @@ struct RenderJob {
   std::string engine = "embree";  // a backend name (render/backend.h)
   double fps = kDefaultFrameRate;
   FrameRange frames;
+  // The frame the scene is stepped from: every frame of the range from here (at its step) is set in
+  // turn before the first frame rendered, those already complete too. The scene keeps state from
+  // frame to frame (a moving mesh's BVH is built where it first appears and refitted after,
+  // raytracing_scene.cpp), so a frame's bytes depend on where the stepping began; this makes a
+  // resumed job, and a Slurm task that renders part of a range from its first frame, give the
+  // whole job's bytes. Unset: the range's first frame.
+  std::optional<long> stepFrom;
   std::optional<std::string> camera;
   // The animation played (index or name), when the scene was reduced to one with
   // scene::keepOnlyAnimation; recorded so that frames of another animation are not reused.
