@@ -28,6 +28,16 @@ TEST(Checksum, Sha256OfFilesMatchesThePublishedVectors) {
   EXPECT_NE(missing.error().message.find("nope"), std::string::npos);
 }
 
+// A digest fed in parts is the digest of the whole; the stream ends with its digest.
+TEST(Checksum, Sha256StreamFedInPartsMatchesThePublishedVector) {
+  Sha256Stream sha;
+  sha.update("a", 1);
+  sha.update("bc", 2);
+  EXPECT_EQ(sha.hex(), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(sha.hex(), "");
+  EXPECT_EQ(sha256Text("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+}
+
 TEST(Checksum, ListingDigestIsSha256sumsListingDigested) {
   EXPECT_EQ(sha256Text("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
   const auto dir = test::freshDir("checksum_listing");

@@ -4,13 +4,21 @@
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
 
+#include <xmmintrin.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <set>
 #include <sstream>
 #include <string>
 
+#include "core/checksum.h"
 #include "core/machine.h"
 #include "core/simd.h"
+#include "render/cpu_estimates.h"
 
 namespace dynbench::core {
 namespace {
@@ -30,7 +38,7 @@ TEST(Simd, HighwayDispatchStopsAtAvx2) {
 // __builtin_cpu_supports that machineInfo asks), and its CPU and vendor are /proc/cpuinfo's.
 TEST(Machine, IsaLevelAgreesWithTheKernelsFlags) {
   std::ifstream in("/proc/cpuinfo");
-  std::string line, model, vendor;
+  std::string line, model, vendor, family, modelNumber, stepping;
   std::set<std::string> flags;
   while (std::getline(in, line)) {
     const auto colon = line.find(':');
@@ -43,6 +51,9 @@ TEST(Machine, IsaLevelAgreesWithTheKernelsFlags) {
     }
     if (key == "model" && line.starts_with("model name") && model.empty()) model = value;
     if (key == "vendor_id" && vendor.empty()) vendor = value;
+    if (line.starts_with("cpu family") && family.empty()) family = value;
+    if (key == "model" && !line.starts_with("model name") && modelNumber.empty()) modelNumber = value;
+    if (key == "stepping" && stepping.empty()) stepping = value;
   }
   ASSERT_FALSE(flags.empty()) << "/proc/cpuinfo has no flags";
   const auto all = [&](std::initializer_list<const char*> names) {
@@ -57,6 +68,45 @@ TEST(Machine, IsaLevelAgreesWithTheKernelsFlags) {
   EXPECT_EQ(m.cpu, model);
   EXPECT_EQ(m.vendor, vendor);
   EXPECT_GE(m.threads, 1);
+  ASSERT_FALSE(family.empty());
+  EXPECT_EQ(m.family, std::stoi(family));
+  EXPECT_EQ(m.model, std::stoi(modelNumber));
+  EXPECT_EQ(m.stepping, std::stoi(stepping));
+  EXPECT_TRUE(m.reciprocalEstimates.empty());  // render's to fill (render/cpu_estimates.h)
+}
+
+// The fingerprint of the CPU's reciprocal estimates (render/cpu_estimates.h) is the SHA-256 of RCPPS over [1, 2) and RSQRTPS
+// over [1, 4), recomputed here one float at a time (RCPSS, RSQRTSS) into one buffer; each estimate
+// is within the SDM's bound (relative error at most 1.5 x 2^-12); and the assumption that lets
+// those inputs stand for all holds on this CPU: the estimate of x 2^k is that of x scaled.
+TEST(Machine, ReciprocalEstimatesFingerprintTheCpusTables) {
+  const auto rcp = [](float x) { return _mm_cvtss_f32(_mm_rcp_ss(_mm_set_ss(x))); };
+  const auto rsqrt = [](float x) { return _mm_cvtss_f32(_mm_rsqrt_ss(_mm_set_ss(x))); };
+  const auto fromBits = [](std::uint32_t bits) { return std::bit_cast<float>(bits); };
+  std::string bytes;
+  bytes.reserve((0x800000u + 0x1000000u) * 4);
+  double worst = 0;
+  std::size_t unscaled = 0;
+  for (int squareRoot = 0; squareRoot < 2; ++squareRoot) {
+    const std::uint32_t last = squareRoot ? 0x40800000u : 0x40000000u;
+    for (std::uint32_t bits = 0x3f800000u; bits < last; ++bits) {
+      const float x = fromBits(bits), e = squareRoot ? rsqrt(x) : rcp(x);
+      const std::uint32_t out = std::bit_cast<std::uint32_t>(e);
+      bytes.append(reinterpret_cast<const char*>(&out), 4);
+      worst = std::max(worst, std::abs(squareRoot ? double(e) * std::sqrt(double(x)) - 1.0 : double(e) * x - 1.0));
+      if (bits % 4099 != 0) continue;  // the scaling, on a sample of 2,000-odd inputs
+      for (const int k : {-20, -3, 4, 30}) {
+        const float scaled = std::ldexp(x, squareRoot ? 2 * k : k);
+        const float expected = std::ldexp(e, -k);
+        unscaled += (squareRoot ? rsqrt(scaled) : rcp(scaled)) != expected;
+      }
+    }
+  }
+  EXPECT_EQ(render::reciprocalEstimates(), sha256Text(bytes));
+  EXPECT_EQ(render::reciprocalEstimates().size(), 64u);
+  EXPECT_LE(worst, 1.5 * std::ldexp(1.0, -12));
+  EXPECT_GT(worst, 0.0);  // estimates, not exact results
+  EXPECT_EQ(unscaled, 0u);
 }
 
 }  // namespace

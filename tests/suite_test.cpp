@@ -371,10 +371,10 @@ TEST(Suite, ARecordMadeAgainAgreesToTheTablesDigitsAndATenthOfTheFloor) {
     return *read;
   };
   const suite::SuiteRecord recorded = make("recorded.json", [](nlohmann::json&) {});
-  const auto differences = [&](const std::function<void(nlohmann::json&)>& edit, bool sameVendor = true) {
-    return suite::compareRecords(recorded, make("remade.json", edit), sameVendor).differences;
+  const auto differences = [&](const std::function<void(nlohmann::json&)>& edit) {
+    return suite::compareRecords(recorded, make("remade.json", edit)).differences;
   };
-  const auto same = suite::compareRecords(recorded, recorded, true);
+  const auto same = suite::compareRecords(recorded, recorded);
   EXPECT_TRUE(same.differences.empty());
   EXPECT_EQ(same.files, 1u);
   EXPECT_TRUE(same.filesCompared);
@@ -396,15 +396,52 @@ TEST(Suite, ARecordMadeAgainAgreesToTheTablesDigitsAndATenthOfTheFloor) {
       << score[0];
   EXPECT_EQ(differences([](nlohmann::json& r) { r["result"]["errors"]["taa"]["flip_ratio_to_none"] = 0.508; }).size(), 1u);
   EXPECT_EQ(differences([](nlohmann::json& r) { r["result"]["window"]["first"] = 31; }).size(), 1u);
-  // Frame digests: compared on one vendor, not across vendors (said so instead).
+  // Frame digests: compared on one vendor, not across vendors (said so instead), where the record
+  // names no fingerprint of its CPU's reciprocal estimates (records made before they carried one).
   const auto otherFrame = [](nlohmann::json& r) { r["files"]["runs/fps-2-bot/frames/frame_00030.exr"] = std::string(64, 'b'); };
-  ASSERT_EQ(differences(otherFrame).size(), 1u);
-  EXPECT_NE(differences(otherFrame)[0].find("/files/runs/fps-2-bot/frames/frame_00030.exr: recorded aaaaaaaaaaaa…, remade bbbbbbbbbbbb… (SHA-256)"),
+  const auto withFingerprint = [](const std::string& estimates) {
+    return [estimates](nlohmann::json& r) {
+      r["machine"]["family"] = 25;
+      r["machine"]["model"] = 17;
+      r["machine"]["reciprocal_estimates"] = estimates;
+    };
+  };
+  const auto both = [](auto first, auto second) {
+    return [first, second](nlohmann::json& r) {
+      first(r);
+      second(r);
+    };
+  };
+  const auto oneVendor = suite::compareRecords(recorded, make("remade.json", both(withFingerprint("1234"), otherFrame)));
+  ASSERT_EQ(oneVendor.differences.size(), 1u);
+  EXPECT_NE(oneVendor.differences[0].find("/files/runs/fps-2-bot/frames/frame_00030.exr: recorded aaaaaaaaaaaa…, remade bbbbbbbbbbbb… (SHA-256)"),
             std::string::npos);
-  const auto acrossVendors = suite::compareRecords(recorded, make("remade.json", otherFrame), false);
+  EXPECT_TRUE(oneVendor.filesCompared);
+  // ... and says that the frames may differ because the record cannot tell how its CPU estimated.
+  EXPECT_NE(oneVendor.filesNote.find("the record names no fingerprint of its CPU's reciprocal estimates (family and model not recorded; "
+                                     "this machine family 25 model 17)"),
+            std::string::npos)
+      << oneVendor.filesNote;
+  const auto oneVendorEqual = suite::compareRecords(recorded, make("remade.json", withFingerprint("1234")));
+  EXPECT_TRUE(oneVendorEqual.differences.empty());
+  EXPECT_TRUE(oneVendorEqual.filesNote.empty()) << oneVendorEqual.filesNote;
+  const auto acrossVendors = suite::compareRecords(recorded, make("remade.json", both(otherFrame, [](nlohmann::json& r) { r["machine"]["vendor"] = "GenuineIntel"; })));
   EXPECT_TRUE(acrossVendors.differences.empty());
   EXPECT_FALSE(acrossVendors.filesCompared);
   EXPECT_NE(acrossVendors.filesNote.find("not compared across CPU vendors"), std::string::npos);
+  // Where both name one: compared where the fingerprints are equal, whatever the CPUs' names...
+  const suite::SuiteRecord fingerprinted = make("fingerprinted.json", withFingerprint("1234"));
+  const auto equalEstimates = suite::compareRecords(fingerprinted, make("remade.json", both(withFingerprint("1234"), otherFrame)));
+  EXPECT_EQ(equalEstimates.differences.size(), 1u);
+  EXPECT_TRUE(equalEstimates.filesCompared);
+  EXPECT_TRUE(equalEstimates.filesNote.empty()) << equalEstimates.filesNote;
+  // ... and not where they differ, even on one vendor.
+  const auto otherEstimates = suite::compareRecords(fingerprinted, make("remade.json", both(withFingerprint("5678"), otherFrame)));
+  EXPECT_TRUE(otherEstimates.differences.empty());
+  EXPECT_FALSE(otherEstimates.filesCompared);
+  EXPECT_NE(otherEstimates.filesNote.find("whose reciprocal estimates differ from this machine's (A, family 25 model 17: fingerprint 1234 against 5678)"),
+            std::string::npos)
+      << otherEstimates.filesNote;
 }
 
 // --sample's choice: K of the records, the same for a seed on every machine (mt19937_64's sequence

@@ -10,34 +10,35 @@
 
 namespace dynbench {
 
-namespace {
-
-// One SHA-256 in progress (OpenSSL's EVP interface).
-class Sha256 {
- public:
-  Sha256() : context_(EVP_MD_CTX_new(), EVP_MD_CTX_free) { ok_ = context_ && EVP_DigestInit_ex(context_.get(), EVP_sha256(), nullptr) == 1; }
-  void update(const void* bytes, std::size_t size) { ok_ = ok_ && EVP_DigestUpdate(context_.get(), bytes, size) == 1; }
-  // The digest as hex, or empty when OpenSSL failed on the way.
-  std::string hex() {
-    std::array<unsigned char, EVP_MAX_MD_SIZE> digest;
-    unsigned int length = 0;
-    if (!ok_ || EVP_DigestFinal_ex(context_.get(), digest.data(), &length) != 1) return {};
-    std::string out;
-    for (unsigned int i = 0; i < length; ++i) out += fmt::format("{:02x}", digest[i]);
-    return out;
-  }
-
- private:
-  std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> context_;
-  bool ok_ = false;
+struct Sha256Stream::State {
+  std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> context{EVP_MD_CTX_new(), EVP_MD_CTX_free};
+  bool ok = false;
 };
 
-}  // namespace
+Sha256Stream::Sha256Stream() : state_(std::make_unique<State>()) {
+  state_->ok = state_->context && EVP_DigestInit_ex(state_->context.get(), EVP_sha256(), nullptr) == 1;
+}
+
+Sha256Stream::~Sha256Stream() = default;
+
+void Sha256Stream::update(const void* bytes, std::size_t size) {
+  state_->ok = state_->ok && EVP_DigestUpdate(state_->context.get(), bytes, size) == 1;
+}
+
+std::string Sha256Stream::hex() {
+  std::array<unsigned char, EVP_MAX_MD_SIZE> digest;
+  unsigned int length = 0;
+  if (!state_->ok || EVP_DigestFinal_ex(state_->context.get(), digest.data(), &length) != 1) return {};
+  state_->ok = false;
+  std::string out;
+  for (unsigned int i = 0; i < length; ++i) out += fmt::format("{:02x}", digest[i]);
+  return out;
+}
 
 Expected<std::string> sha256File(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return fail(ErrorCode::kIo, "{}: cannot read", path.string());
-  Sha256 sha;
+  Sha256Stream sha;
   std::array<char, 1 << 16> buffer;
   while (in) {
     in.read(buffer.data(), buffer.size());
@@ -50,7 +51,7 @@ Expected<std::string> sha256File(const std::filesystem::path& path) {
 }
 
 std::string sha256Text(std::string_view bytes) {
-  Sha256 sha;
+  Sha256Stream sha;
   sha.update(bytes.data(), bytes.size());
   return sha.hex();
 }

@@ -1,7 +1,9 @@
 #pragma once
 // SHA-256 of files, for the suite's record of every dataset and frame (`suite verify`). OpenSSL's
 // libcrypto (Debian libssl-dev) computes it; this is the one place dynbench talks to it.
+#include <cstddef>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -9,6 +11,22 @@
 #include "core/error.h"
 
 namespace dynbench {
+
+// One SHA-256 fed in parts (OpenSSL's EVP interface), for data too large to hold at once.
+class Sha256Stream {
+ public:
+  Sha256Stream();
+  ~Sha256Stream();
+  Sha256Stream(const Sha256Stream&) = delete;
+  Sha256Stream& operator=(const Sha256Stream&) = delete;
+  void update(const void* bytes, std::size_t size);
+  // The digest as 64 lower-case hex digits; empty when OpenSSL failed on the way. Ends the stream.
+  std::string hex();
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 // The file's SHA-256 as 64 lower-case hex digits; an error names the file.
 Expected<std::string> sha256File(const std::filesystem::path& path);

@@ -1,7 +1,9 @@
 #include "core/machine.h"
 
 #include <fstream>
+#include <string>
 #include <thread>
+
 
 namespace dynbench::core {
 
@@ -33,6 +35,13 @@ std::string isaLevel() {
   return v4 ? "x86-64-v4" : v3 ? "x86-64-v3" : v2 ? "x86-64-v2" : "x86-64";
 }
 
+int cpuinfoNumber(const std::string& key) {
+  const std::string value = cpuinfoValue(key);
+  if (value.empty() || value.find_first_not_of("0123456789") != std::string::npos) return -1;
+  return std::stoi(value);
+}
+
+
 }  // namespace
 
 MachineInfo machineInfo() {
@@ -43,6 +52,9 @@ MachineInfo machineInfo() {
   if (m.vendor.empty()) m.vendor = "unknown";
   m.isa = isaLevel();
   m.threads = static_cast<int>(std::thread::hardware_concurrency());
+  m.family = cpuinfoNumber("cpu family");
+  m.model = cpuinfoNumber("model");
+  m.stepping = cpuinfoNumber("stepping");
   return m;
 }
 

@@ -24,6 +24,7 @@
 #include "capture/reader.h"
 #include "report/plots.h"
 #include "report/stats_output.h"
+#include "render/cpu_estimates.h"
 #include "scene/load.h"
 #include "scene/dataset_digest.h"
 
@@ -383,7 +384,8 @@ Expected<SuiteOutcome> runSuite(const SuiteOptions& options, const pipeline::Run
   if (!todo.empty()) {
     auto prepared = prepareDatasets(*manifest, todo, root, settings.fps, log);
     if (!prepared) return std::unexpected(prepared.error());
-    const core::MachineInfo machine = core::machineInfo();
+    core::MachineInfo machine = core::machineInfo();
+    machine.reciprocalEstimates = render::reciprocalEstimates();
     // Progress: datasets made, and the time left at the mean time of those this run rendered (a
     // dataset whose frames were complete is re-read in seconds; it would make the estimate a guess).
     const auto start = std::chrono::steady_clock::now();

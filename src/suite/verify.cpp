@@ -8,7 +8,6 @@
 
 #include "core/checksum.h"
 #include "core/files.h"
-#include "core/machine.h"
 #include "core/json_fields.h"
 #include "pipeline/stages.h"
 #include "suite/manifest.h"
@@ -131,7 +130,7 @@ Expected<VerifyOutcome> verifySuite(const fs::path& root, const pipeline::RunLog
   return out;
 }
 
-RecordComparison compareRecords(const SuiteRecord& recorded, const SuiteRecord& remade, bool sameVendor) {
+RecordComparison compareRecords(const SuiteRecord& recorded, const SuiteRecord& remade) {
   RecordComparison out;
   out.dataset = recorded.dataset;
   const std::string file = recorded.file.string();
@@ -193,14 +192,29 @@ RecordComparison compareRecords(const SuiteRecord& recorded, const SuiteRecord& 
       }
     }
   }
-  // The files, where both records' frames come from one CPU vendor's instructions (docs/suite.md).
-  const std::string vendorA = recorded.document["machine"].value("vendor", ""), vendorB = remade.document["machine"].value("vendor", "");
-  if (!sameVendor) {
+  // The files, where both machines can give the same bytes (docs/suite.md, "Records").
+  const nlohmann::json &machineA = recorded.document["machine"], &machineB = remade.document["machine"];
+  const std::string estimatesA = machineA.value("reciprocal_estimates", ""), estimatesB = machineB.value("reciprocal_estimates", "");
+  const std::string vendorA = machineA.value("vendor", ""), vendorB = machineB.value("vendor", "");
+  const auto model = [](const nlohmann::json& m) {
+    return m.value("family", -1) < 0 ? std::string("family and model not recorded")
+                                     : fmt::format("family {} model {}", m.value("family", -1), m.value("model", -1));
+  };
+  const bool byEstimates = !estimatesA.empty() && !estimatesB.empty();
+  if (byEstimates && estimatesA != estimatesB) {
+    out.filesNote = fmt::format("the record was made on {} ({}), whose reciprocal estimates differ from this machine's ({}, {}: fingerprint {} against {}): "
+                                "frame digests are not compared",
+                                machineA.value("cpu", "?"), model(machineA), machineB.value("cpu", "?"), model(machineB), estimatesA.substr(0, 12),
+                                estimatesB.substr(0, 12));
+    return out;
+  }
+  if (!byEstimates && vendorA != vendorB) {
     out.filesNote = fmt::format("the record was made on {} ({}), this machine is {} ({}): frame digests are not compared across CPU vendors",
-                                recorded.document["machine"].value("cpu", "?"), vendorA, remade.document["machine"].value("cpu", "?"), vendorB);
+                                machineA.value("cpu", "?"), vendorA, machineB.value("cpu", "?"), vendorB);
     return out;
   }
   out.filesCompared = true;
+  const std::size_t numbersDiffering = out.differences.size();
   for (const auto& [path, sum] : recorded.files) {
     ++out.files;
     const auto now = remade.files.find(path);
@@ -212,6 +226,11 @@ RecordComparison compareRecords(const SuiteRecord& recorded, const SuiteRecord& 
       ++out.files;
       differs("/files/" + path, "no such file", sum.substr(0, 12) + "…", "");
     }
+  if (!byEstimates && out.differences.size() > numbersDiffering)
+    out.filesNote = fmt::format("compared because both CPUs are {}, but the record names no fingerprint of its CPU's reciprocal estimates ({}; "
+                                "this machine {}): the frames that differ may come from a CPU that estimates otherwise, or from a job of a build "
+                                "before 2026-11-30 resumed at them (it began the scene's stepping there, docs/suite.md)",
+                                vendorA, model(machineA), model(machineB));
   return out;
 }
 
@@ -242,8 +261,7 @@ Expected<RecordComparison> verifyRecord(const fs::path& file, const fs::path& wo
   if (!run) return std::unexpected(run.error());
   auto remade = readRecord(recordPath(work, recorded->dataset), *manifest);
   if (!remade) return std::unexpected(remade.error());
-  const std::string vendor = recorded->document["machine"].value("vendor", "");
-  return compareRecords(*recorded, *remade, !vendor.empty() && vendor == core::machineInfo().vendor);
+  return compareRecords(*recorded, *remade);
 }
 
 std::vector<fs::path> sampleRecords(std::vector<fs::path> records, std::size_t k, std::uint64_t seed) {

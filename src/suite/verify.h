@@ -22,16 +22,18 @@ Expected<VerifyOutcome> verifySuite(const std::filesystem::path& dir, const pipe
 struct RecordComparison {
   std::string dataset;
   std::size_t numbers = 0, files = 0;    // compared
-  bool filesCompared = false;            // the frame digests: only where both were made on one CPU vendor
-  std::string filesNote;                 // why they were not
+  bool filesCompared = false;            // the frame digests: only where both CPUs can give the same bytes
+  std::string filesNote;                 // why they were not, or what a difference among them may mean
   std::vector<std::string> differences;  // "FILE: POINTER: recorded A, remade B (...)"
 };
 // Compares a remade record with the recorded one: the window, the pins' digests and the camera and
 // Table 6.7 measures to the digits suite.md shows them (3 decimals); every method's ꟻLIP, its
 // difference from `none`'s and the noise floor within a tenth of the recorded floor, the ratio to
-// `none` within what that allows it (0.1 floor (1 + ratio) / none's ꟻLIP); and, where
-// `sameVendor`, the SHA-256 of every recorded file.
-RecordComparison compareRecords(const SuiteRecord& recorded, const SuiteRecord& remade, bool sameVendor);
+// `none` within what that allows it (0.1 floor (1 + ratio) / none's ꟻLIP); and the SHA-256 of every
+// recorded file where the two records' machines can give the same bytes: the same fingerprint of the
+// CPU's reciprocal estimates (core::reciprocalEstimates), or, where the recorded one names none
+// (records made before 2026-11-30), the same CPU vendor.
+RecordComparison compareRecords(const SuiteRecord& recorded, const SuiteRecord& remade);
 
 // Makes the dataset of the record `file` again from nothing (capture, convert, camera, renders,
 // discard, evaluate) in the fresh folder `work` (emptied first), from the manifest the record
