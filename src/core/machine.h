@@ -23,5 +23,4 @@ struct MachineInfo {
 
 MachineInfo machineInfo();
 
-
 }  // namespace dynbench::core

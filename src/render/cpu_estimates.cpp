@@ -2,11 +2,10 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <cstring>
 #include <vector>
 
 #if defined(__x86_64__) || defined(__i386__)
-#include <xmmintrin.h>
+#include <emmintrin.h>
 #endif
 
 #include "core/checksum.h"
@@ -21,11 +20,11 @@ void hashEstimates(Sha256Stream& sha, std::uint32_t first, std::uint32_t last, b
   std::vector<std::uint32_t> out(1u << 16);
   for (std::uint32_t chunk = first; chunk < last; chunk += static_cast<std::uint32_t>(out.size())) {
     const std::uint32_t count = std::min<std::uint32_t>(static_cast<std::uint32_t>(out.size()), last - chunk);
-    for (std::uint32_t i = 0; i < count; i += 4) {
-      alignas(16) std::uint32_t bits[4] = {chunk + i, chunk + i + 1, chunk + i + 2, chunk + i + 3};
-      const __m128 x = _mm_load_ps(reinterpret_cast<const float*>(bits));
-      _mm_store_ps(reinterpret_cast<float*>(bits), squareRoot ? _mm_rsqrt_ps(x) : _mm_rcp_ps(x));
-      std::memcpy(out.data() + i, bits, sizeof bits);
+    for (std::uint32_t i = 0; i < count; i += 4) {  // count is a multiple of 4: both ranges are of 2^16s
+      const std::uint32_t b = chunk + i;
+      const auto lane = [b](std::uint32_t k) { return static_cast<int>(b + k); };
+      const __m128 x = _mm_castsi128_ps(_mm_setr_epi32(lane(0), lane(1), lane(2), lane(3)));
+      _mm_storeu_ps(reinterpret_cast<float*>(out.data() + i), squareRoot ? _mm_rsqrt_ps(x) : _mm_rcp_ps(x));
     }
     sha.update(out.data(), count * sizeof(std::uint32_t));
   }
