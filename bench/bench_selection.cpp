@@ -1,8 +1,10 @@
 // References at a suite's budget with one light selection or another (run by hand; not part of the
 // test suite; issue 68's comparison):
 //   build/release/bench/bench_selection --frames A:B [--res WxH] [--spp N] [--max-spp N] [--tolerance T]
-//                                       [--bounces N] [--max-pairs N] DATASET:SELECTION [DATASET:SELECTION ...]
-// SELECTION is `tree` (the light tree's importance alone) or `learned` (render/light_visibility.h).
+//                                       [--bounces N] [--max-pairs N] DATASET:SELECTION[@K] [DATASET:SELECTION[@K] ...]
+// SELECTION is `tree` (the light tree's importance alone) or `learned` (render/light_visibility.h);
+// K is RenderSettings::everyLightUpTo (every light in reach where at most K reach; 0: always
+// sample lights_per_point, as before), by default render's.
 // Defaults: v2's budget (320x180, 16 to 128 paths, tolerance 0.5, 2 bounces, pairs up to 64 a pixel). For each
 // configuration, in one run: the converged reference of the frames as a suite renders it (seed 1,
 // with its radiance-change pairs), then the same frames with seed 3 and no pairs (the suite's floor
@@ -32,6 +34,7 @@ namespace {
 struct Configuration {
   fs::path dataset;
   bool learned = true;
+  int everyLightUpTo = render::kEveryLightUpTo;
 };
 
 render::RenderSummary renderOrExit(const render::RenderJob& job) {
@@ -73,12 +76,20 @@ int main(int argc, char** argv) {
     else {
       const std::string arg = argv[i];
       const auto colon = arg.rfind(':');
-      const auto learned = colon == std::string::npos ? std::nullopt : render::parseLightSelection(arg.substr(colon + 1));
+      std::string selection = colon == std::string::npos ? std::string() : arg.substr(colon + 1);
+      int everyLightUpTo = render::kEveryLightUpTo;
+      if (const auto at = selection.find('@'); at != std::string::npos) {
+        char* end = nullptr;
+        everyLightUpTo = static_cast<int>(std::strtol(selection.c_str() + at + 1, &end, 10));
+        if (*end != '\0' || everyLightUpTo < 0) selection.clear();
+        else selection.resize(at);
+      }
+      const auto learned = render::parseLightSelection(selection);
       if (!learned) {
-        std::fprintf(stderr, "bench_selection: %s: expected DATASET:tree or DATASET:learned\n", arg.c_str());
+        std::fprintf(stderr, "bench_selection: %s: expected DATASET:tree or DATASET:learned, optionally with @K (K >= 0)\n", arg.c_str());
         return 2;
       }
-      configurations.push_back({arg.substr(0, colon), *learned});
+      configurations.push_back({arg.substr(0, colon), *learned, everyLightUpTo});
     }
   }
   if (!framesGiven || configurations.empty()) {
@@ -97,6 +108,7 @@ int main(int argc, char** argv) {
     render::RenderJob reference = job;
     reference.dataset = configurations[c].dataset;
     reference.settings.learnedLightSelection = configurations[c].learned;
+    reference.settings.everyLightUpTo = configurations[c].everyLightUpTo;
     reference.settings.seed = 1;
     reference.settings.pairs = true;
     reference.output = work / fmt::format("{}_reference", c);
@@ -113,11 +125,11 @@ int main(int argc, char** argv) {
     const double perFrame = (a.seconds - a.loadSeconds) / static_cast<double>(frames);
     const double efficiency = 1.0 / (noise->mean * noise->mean * perFrame);
     if (c == 0) firstEfficiency = efficiency;
-    const std::string name = fmt::format("{}:{}", configurations[c].dataset.filename().string() == "bot.gltf"
+    const std::string name = fmt::format("{}:{}@{}", configurations[c].dataset.filename().string() == "bot.gltf"
                                                       ? configurations[c].dataset.parent_path().filename().string()
                                                       : configurations[c].dataset.filename().string(),
-                                         render::lightSelectionName(configurations[c].learned));
-    fmt::print("{:<44} {:>8.2f} {:>9.2f} {:>7.1f}% {:>7.1f} {:>9.4f} {:>8.4f} {:>9.2f}x\n", name.substr(0, 44), perFrame,
+                                         render::lightSelectionName(configurations[c].learned), configurations[c].everyLightUpTo);
+    fmt::print("{:<44} {:>8.2f} {:>9.2f} {:>7.1f}% {:>7.1f} {:>9.4f} {:>8.4f} {:>9.2f}x\n", name.size() > 44 ? name.substr(name.size() - 44) : name, perFrame,
                (b.seconds - b.loadSeconds) / static_cast<double>(frames), 100.0 * static_cast<double>(a.cappedPixels) / static_cast<double>(a.pixels),
                static_cast<double>(a.cameraSamples) / static_cast<double>(a.pixels), noise->mean, 1.96 * noise->standardError, efficiency / firstEfficiency);
   }

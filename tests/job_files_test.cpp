@@ -57,6 +57,7 @@ render::RenderJob everyRenderField() {
   s.pairs = true;
   s.maxPairs = 96;
   s.lightsPerPoint = 0;
+  s.everyLightUpTo = 5;
   s.learnedLightSelection = false;
   s.directThresholdFraction = 0.2;
   s.indirectThresholdFraction = 0.3;

@@ -2,6 +2,7 @@
 // light (checked exactly, by enumerating every path down the tree, and by sampling), no light that
 // can give light ever left out, none that cannot ever selected, and an exact sum (probability 1
 // each) where no more lights than the budget can reach the point.
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <map>
@@ -153,6 +154,139 @@ TEST(LightTree, ANodeOutOfRangeOrBehindThePlaneHasNoImportanceAndOthersHaveSome)
   leaf.count = 1;
   const double d = std::sqrt(2.0 * 2.0 + 1.0), cosine = 2.0 / d, window = 1.0 - std::pow(d / 4.0, 4);
   EXPECT_NEAR(LightTree::importance(leaf, {1, 0, 0}, {0, 1, 0}), 8 * cosine * window / (d * d), 1e-12);
+}
+
+// select() as light_tree.h states it, one walk at a time with the scalar importance(): the cut
+// (split the most important interior node while the budget holds its children that can light the
+// point), then from each node of the cut a walk down by the children's importances (times the
+// factors), remapping u at each step. The tree's own select() interleaves its walks and chooses a
+// child without a branch; it must select exactly these lights with exactly these probabilities.
+std::vector<LightTree::Selected> selectOneWalkAtATime(const LightTree& tree, const glm::dvec3& p, const glm::dvec3& n, double u, int budget,
+                                                      const float* factors) {
+  const auto nodes = tree.nodes();
+  auto weigh = [&](std::uint32_t k) { return LightTree::importance(nodes[k], p, n) * (factors ? factors[k] : 1.0); };
+  std::vector<LightTree::Selected> selected;
+  if (!(weigh(0) > 0)) return selected;
+  std::vector<std::pair<std::uint32_t, double>> cut = {{0u, weigh(0)}};
+  while (true) {
+    int best = -1;
+    for (int k = 0; k < static_cast<int>(cut.size()); ++k)
+      if (nodes[cut[k].first].count > 1 && (best < 0 || cut[k].second > cut[best].second)) best = k;
+    if (best < 0) break;
+    const std::uint32_t a = cut[best].first + 1, b = nodes[cut[best].first].first;
+    const double ia = weigh(a), ib = weigh(b);
+    if (static_cast<int>(cut.size()) - 1 + (ia > 0) + (ib > 0) > budget) break;
+    cut[best] = cut.back();
+    cut.pop_back();
+    if (ia > 0) cut.push_back({a, ia});
+    if (ib > 0) cut.push_back({b, ib});
+  }
+  for (const auto& [start, weight] : cut) {
+    std::uint32_t k = start;
+    double v = u, probability = 1.0;
+    bool found = true;
+    while (nodes[k].count > 1) {
+      const std::uint32_t a = k + 1, b = nodes[k].first;
+      const double ia = weigh(a), ib = weigh(b);
+      if (!(ia + ib > 0)) {
+        found = false;
+        break;
+      }
+      const double pa = ia / (ia + ib);
+      if (v < pa) {
+        v = std::min(v / pa, 1.0 - 0x1p-53), probability *= pa, k = a;
+      } else {
+        v = std::min((v - pa) / (1.0 - pa), 1.0 - 0x1p-53), probability *= 1.0 - pa, k = b;
+      }
+    }
+    if (found && probability > 0) selected.push_back({nodes[k].first, probability});
+  }
+  return selected;
+}
+
+TEST(LightTree, TheInterleavedWalksSelectWhatOneWalkAtATimeSelectsBitForBit) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> coordinate(-12.0, 12.0), uniform(0.0, 1.0);
+  std::uniform_real_distribution<float> factor(0.1f, 1.0f);
+  int compared = 0, several = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    auto lights = randomLights(50 + 40 * trial, 200 + static_cast<std::uint32_t>(trial));
+    lights.push_back(lights[5]);  // coincident lights
+    LightTree tree;
+    tree.build(lights);
+    std::vector<float> factors(tree.nodeCount());
+    for (float& f : factors) f = factor(rng);
+    std::vector<LightTree::Selected> selected;
+    for (int k = 0; k < 300; ++k) {
+      const glm::dvec3 p(coordinate(rng), coordinate(rng), coordinate(rng));
+      const glm::dvec3 n = k % 5 == 0 ? glm::dvec3(0, 1, 0) : glm::normalize(glm::dvec3(coordinate(rng), coordinate(rng), coordinate(rng)));
+      const double u = k % 11 == 0 ? 0.0 : uniform(rng);
+      const int budget = 1 + k % 8;
+      const float* weights = k % 2 ? factors.data() : nullptr;
+      tree.select(p, n, u, budget, selected, weights);
+      const auto expected = selectOneWalkAtATime(tree, p, n, u, budget, weights);
+      ASSERT_EQ(selected.size(), expected.size()) << "trial " << trial << " point " << k;
+      for (std::size_t s = 0; s < expected.size(); ++s) {
+        EXPECT_EQ(selected[s].light, expected[s].light) << "trial " << trial << " point " << k << " walk " << s;
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(selected[s].probability), std::bit_cast<std::uint64_t>(expected[s].probability))
+            << "trial " << trial << " point " << k << " walk " << s;
+      }
+      ++compared;
+      several += expected.size() > 1;
+    }
+  }
+  EXPECT_EQ(compared, 3600);
+  EXPECT_GT(several, 1000);  // most selections walk from several nodes at once
+}
+
+// reachingLights: every light that can light the point (in front of its plane, within its range)
+// and none other, in the tree's order, or false where more than the limit can; and select() with
+// everyLightUpTo takes exactly those, each with probability 1, where there are few enough, and
+// otherwise selects exactly as without it.
+TEST(LightTree, EveryLightInReachIsTakenExactlyWhereFewReach) {
+  const auto lights = randomLights(400, 31);
+  LightTree tree;
+  tree.build(lights);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> coordinate(-14.0, 14.0), uniform(0.0, 1.0);
+  int few = 0, many = 0;
+  std::vector<LightTree::Selected> reaching, selected, sampled;
+  for (int k = 0; k < 400; ++k) {
+    const glm::dvec3 p(coordinate(rng), coordinate(rng), coordinate(rng));
+    const glm::dvec3 n = glm::normalize(glm::dvec3(coordinate(rng), coordinate(rng), coordinate(rng)));
+    std::vector<std::uint32_t> expected;
+    for (std::uint32_t l = 0; l < lights.size(); ++l)
+      if (canLight(lights[l], p, n)) expected.push_back(l);
+    ASSERT_TRUE(tree.reachingLights(p, n, 1000, reaching));
+    std::vector<std::uint32_t> found;
+    for (const auto& s : reaching) {
+      EXPECT_EQ(s.probability, 1.0);
+      found.push_back(s.light);
+    }
+    std::sort(found.begin(), found.end());
+    ASSERT_EQ(found, expected) << "point " << k;
+    const int count = static_cast<int>(expected.size());
+    if (count > 0) EXPECT_FALSE(tree.reachingLights(p, n, count - 1, reaching)) << "one more than the limit";
+    EXPECT_TRUE(tree.reachingLights(p, n, count, reaching));
+    const double u = uniform(rng);
+    const int limit = 24;
+    tree.select(p, n, u, 4, selected, nullptr, limit);
+    if (count <= limit) {
+      ++few;
+      ASSERT_EQ(selected.size(), expected.size());
+      for (const auto& s : selected) EXPECT_EQ(s.probability, 1.0);
+    } else {
+      ++many;
+      tree.select(p, n, u, 4, sampled);
+      ASSERT_EQ(selected.size(), sampled.size());
+      for (std::size_t s = 0; s < sampled.size(); ++s) {
+        EXPECT_EQ(selected[s].light, sampled[s].light);
+        EXPECT_EQ(selected[s].probability, sampled[s].probability);
+      }
+    }
+  }
+  EXPECT_GT(few, 40);
+  EXPECT_GT(many, 40);
 }
 
 // The two-lane importance is importance() itself, bit for bit (a reference's bytes depend on it):

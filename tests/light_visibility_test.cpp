@@ -1,7 +1,9 @@
-// The learned light selection (render/light_visibility.h) against what it promises: a light behind
-// a closed wall falls to the defensive share of its importance once learned, the image is the one
-// of evaluating every light (unbiased), with less noise than the tree's own selection, and the
-// same bytes at one and two threads and on every run.
+// The learned light selection (render/light_visibility.h) against what it promises: the lights
+// seen arriving are summed, a light behind a closed wall falls to the defensive share among the
+// others, the estimate is the sum over every light (unbiased, also where the pilot was wrong), the
+// image is the one of evaluating every light, with less noise than the tree's own selection, and
+// the same bytes at one and two threads and on every run.
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -29,7 +31,8 @@ struct WallScene {
   std::vector<glm::dvec3> lights;  // positions, front ones first
 };
 
-WallScene wallScene(int front, int behind, const std::string& name) {
+// `extra`: more lights (position, range) after those.
+WallScene wallScene(int front, int behind, const std::string& name, const std::vector<std::pair<glm::dvec3, double>>& extra = {}) {
   WallScene w;
   test::GltfBuilder b;
   const int grey = addMaterial(b, glm::dvec3(0.6), 0.0, 1.0, true);
@@ -45,69 +48,89 @@ WallScene wallScene(int front, int behind, const std::string& name) {
     b.node({{"translation", {at.x, at.y, at.z}}, {"extensions", {{"KHR_lights_punctual", {{"light", k}}}}}});
     w.lights.push_back(at);
   }
+  for (std::size_t e = 0; e < extra.size(); ++e) {
+    const auto& [at, range] = extra[e];
+    lights.push_back({{"type", "point"}, {"intensity", 5.0}, {"range", range}});
+    b.node({{"translation", {at.x, at.y, at.z}}, {"extensions", {{"KHR_lights_punctual", {{"light", front + behind + static_cast<int>(e)}}}}}});
+    w.lights.push_back(at);
+  }
   b.doc["extensionsUsed"] = {"KHR_lights_punctual", "KHR_materials_specular"};
   w.scene = load(b, name);
   return w;
 }
 
-// A leaf's importance as the tree computes it (LightTree::importance of a one-light node).
-double leafImportance(const glm::dvec3& light, double power, double range, const glm::dvec3& p, const glm::dvec3& n) {
-  LightTree::Node node;
-  node.lower = node.upper = light;
-  node.power = power;
-  node.range = range;
-  node.count = 1;
-  return LightTree::importance(node, p, n);
-}
-
-// Two lights, one in front of the wall, one behind it: learned from points of the front floor, the
-// one behind keeps exactly the defensive share of its importance there, the one in front all of
-// it, so that with one light a point the probability of picking the one behind is
-// s i_B / (i_A + s i_B) (it was i_B / (i_A + i_B) by the tree alone), measured over a fine grid of u.
-TEST(LightVisibility, ALightBehindAClosedWallFallsToTheDefensiveShare) {
-  const WallScene w = wallScene(1, 1, "visibility_two_lights");
+// Three lights and what the cell of a point on the front floor learns of each, from pilot points
+// of the front floor away from the wall (x < -2): light A in front is seen (its shadow rays
+// arrived), so its leaf's factor is 0 and it is summed; light B behind the wall reached those
+// points unoccluded by range and orientation but never arrived, so it keeps the defensive share s;
+// light D in front near the wall, whose short range reaches no pilot point, is unknown and keeps
+// 1. At a point near the wall that D does light (the pilot was wrong about it there), the
+// estimate must still be the sum over every light: over a fine grid of u (the selection is a
+// deterministic function of u), the mean of sum f(l) / p(l) over the selected lights equals the
+// sum of f(l) over all lights, f the light's unshadowed irradiance times its true visibility.
+TEST(LightVisibility, SeenLightsAreSummedAndTheOthersSampledWithoutBias) {
+  WallScene w = wallScene(1, 1, "visibility_three_lights", {{{-0.7, 1.5, 0.2}, 1.6}});
   auto rt = RayTracingScene::create(w.scene);
   ASSERT_TRUE(rt) << rt.error().message;
   ASSERT_TRUE((*rt)->update(0.0));
   LightSet lights;
   ASSERT_TRUE(lights.build(w.scene, **rt, nullptr, 5.0, [](int, int, unsigned, glm::dvec2) { return glm::dvec3(0.0); }));
-  ASSERT_EQ(lights.punctualCount(), 2u);
+  ASSERT_EQ(lights.punctualCount(), 3u);  // A, B, D in the builder's order
   std::vector<LightVisibility::Point> points;
-  for (double x = -4.5; x < -0.4; x += 0.25)
+  for (double x = -4.5; x < -2.0; x += 0.25)
     for (double z = -4.5; z < 4.6; z += 0.25) points.push_back({{x, 0.0, z}, {0, 1, 0}});
+  auto visible = [&](const glm::dvec3& at, const glm::dvec3& normal, const LightSample& sample) {
+    return !(*rt)->occluded(at + 1e-4 * normal, sample.direction, sample.distance * (1 - 1e-4));
+  };
   LightVisibility visibility;
-  std::atomic<int> traced = 0;  // learn() calls back from TBB's threads
-  visibility.learn(lights, points, 0.5, [&](const LightVisibility::Point& p, const LightSample& s) {
-    ++traced;
-    return !(*rt)->occluded(p.position + 1e-4 * p.normal, s.direction, s.distance * (1 - 1e-4));
-  });
-  EXPECT_EQ(traced.load(), 2 * static_cast<int>(points.size())) << "every point sees both lights in reach";
-  EXPECT_GT(visibility.cellCount(), 50u);
-  const glm::dvec3 p(-2.0, 0.0, 0.5), n(0, 1, 0);
-  const float* factors = visibility.factors(p, n);
-  ASSERT_NE(factors, nullptr);
-  EXPECT_EQ(visibility.factors({-2.0, 0.0, 0.5}, {0, -1, 0}), nullptr) << "the other side of the floor learned nothing";
-  EXPECT_EQ(visibility.factors({2.0, 0.0, 0.5}, n), nullptr) << "nor the floor behind the wall";
-  // light 0 in front, light 1 behind (the builder's order); power = luminance of intensity (white)
-  const double iA = leafImportance(w.lights[0], 3.0, 30.0, p, n), iB = leafImportance(w.lights[1], 4.0, 30.0, p, n);
-  const double s = LightVisibility::kDefensiveShare;
-  for (const bool learned : {false, true}) {
-    const int grid = 1 << 16;
-    int behind = 0;
-    std::vector<LightTree::Selected> selected;
-    double reported = 0;
-    for (int k = 0; k < grid; ++k) {
-      lights.selectPunctual(p, n, (k + 0.5) / grid, 1, selected, learned ? factors : nullptr);
-      ASSERT_EQ(selected.size(), 1u);
-      if (selected[0].light == 1) {
-        ++behind;
-        reported = selected[0].probability;
-      }
-    }
-    const double expected = learned ? s * iB / (iA + s * iB) : iB / (iA + iB);
-    EXPECT_NEAR(static_cast<double>(behind) / grid, expected, 2.0 / grid) << "learned " << learned;
-    EXPECT_NEAR(reported, expected, 1e-6 * expected) << "learned " << learned;  // the factors are floats
+  visibility.learn(lights, points, 0.5, [&](const LightVisibility::Point& p, const LightSample& sample) { return visible(p.position, p.normal, sample); });
+  const glm::dvec3 p(-1.0, 0.0, 0.2), n(0, 1, 0);
+  const LightVisibility::Cell cell = visibility.cell(p, n);
+  ASSERT_NE(cell.factors, nullptr) << "a coarser cell holds pilot points";
+  // The tree's light of each punctual light, and its leaf.
+  const LightTree& tree = lights.punctualTree();
+  std::array<std::uint32_t, 3> leaf{};
+  for (std::uint32_t node = 0; node < tree.nodeCount(); ++node)
+    if (tree.nodes()[node].count == 1) leaf[lights.treeLight(tree.nodes()[node].first)] = node;
+  std::array<std::uint32_t, 3> treeIndex{};
+  for (std::uint32_t k = 0; k < 3; ++k) treeIndex[lights.treeLight(k)] = k;
+  EXPECT_EQ(cell.factors[leaf[0]], 0.0f) << "A is seen: summed, never sampled";
+  EXPECT_EQ(cell.factors[leaf[1]], static_cast<float>(LightVisibility::kDefensiveShare)) << "B is occluded";
+  EXPECT_EQ(cell.factors[leaf[2]], 1.0f) << "D is unknown";
+  ASSERT_EQ(cell.seen.size(), 1u);
+  EXPECT_EQ(cell.seen[0], treeIndex[0]);
+  EXPECT_EQ(cell.typicalReaching, 2u) << "A and B reach the pilot points";
+
+  // f(l) for each light at p: what the integrator adds for it with probability 1.
+  std::array<double, 3> f{};
+  double exact = 0;
+  LightSample sample;
+  for (std::size_t l = 0; l < 3; ++l) {
+    if (lights.samplePunctual(l, p, sample) && visible(p, n, sample)) f[l] = luminance(sample.radiance) * std::max(0.0, glm::dot(n, sample.direction));
+    exact += f[l];
   }
+  ASSERT_GT(f[0], 0.0);
+  EXPECT_EQ(f[1], 0.0) << "B is behind the wall";
+  ASSERT_GT(f[2], 0.0) << "D lights the point";
+  const int grid = 1 << 16;
+  double mean = 0;
+  std::array<int, 3> picked{};
+  std::vector<LightTree::Selected> selected;
+  for (int k = 0; k < grid; ++k) {
+    lights.selectPunctual(p, n, (k + 0.5) / grid, kUnseenLightsPerPoint, selected, cell.factors, 0, cell.seen);
+    double estimate = 0;
+    for (const auto& s : selected) {
+      ++picked[s.light];
+      if (s.light == 0) EXPECT_EQ(s.probability, 1.0);
+      estimate += f[s.light] / s.probability;
+    }
+    mean += estimate / grid;
+  }
+  EXPECT_EQ(picked[0], grid) << "A at every u";
+  EXPECT_EQ(picked[1] + picked[2], grid) << "one of the others at every u";
+  EXPECT_GT(picked[2], picked[1]) << "the unknown light before the occluded one";
+  EXPECT_GT(picked[1], 0) << "the occluded light keeps its defensive share";
+  EXPECT_NEAR(mean, exact, 1e-3 * exact) << "unbiased";
 }
 
 // Twelve lights in front of the wall and twelve behind it, one light a shading point: the learned

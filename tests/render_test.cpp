@@ -280,10 +280,13 @@ void addRoom(test::GltfBuilder& b, double half, int material) {
 }
 
 TEST(Render, ARoomLitByAHundredPointLightsRendersAsEvaluatingEveryLight) {
-  // 100 point lights of varied intensity and colour, half of them with a range, in a closed room:
-  // the light tree (4 lights per shading point) must render, within its noise, the image of
-  // evaluating every light at every point (lightsPerPoint 0, without the tree; exact for direct
-  // light), direct and indirect; and it must evaluate far fewer lights to do it.
+  // 100 point lights of varied intensity and colour, half of them with a range, in a closed room
+  // with a sphere on its floor: the light tree alone (4 lights per shading point, nothing learned,
+  // never every light in reach) and the default selection (every light in reach where at most 16
+  // reach, the lights learned to arrive summed at the first vertex and one other sampled) must
+  // render, within their noise, the image of evaluating every light at every point (lightsPerPoint
+  // 0, without the tree; exact for direct light), direct and indirect; the tree must evaluate far
+  // fewer lights to do it.
   test::GltfBuilder b;
   const int wall = addMaterial(b, {0.7, 0.6, 0.5}, 0.0, 0.7, false);
   addRoom(b, 5.0, wall);
@@ -299,46 +302,53 @@ TEST(Render, ARoomLitByAHundredPointLightsRendersAsEvaluatingEveryLight) {
   b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
   const scene::Scene s = load(b, "hundred_lights");
   const RenderCamera cam = lookCamera({0, 3.5, 4.5}, {0, -0.6, -1}, 80.0, 48, 32);
-  RenderSettings tree, every;
-  tree.samplesPerPixel = every.samplesPerPixel = 64;
-  tree.bounces = every.bounces = 1;
-  tree.useEnvironment = every.useEnvironment = false;
+  RenderSettings tree, learned, every;
+  tree.samplesPerPixel = learned.samplesPerPixel = every.samplesPerPixel = 64;
+  tree.bounces = learned.bounces = every.bounces = 1;
+  tree.useEnvironment = learned.useEnvironment = every.useEnvironment = false;
   tree.lightsPerPoint = 4;
+  tree.learnedLightSelection = false;
+  tree.everyLightUpTo = 0;
   every.lightsPerPoint = 0;
   every.seed = 2;
+  learned.seed = 3;
+  ASSERT_TRUE(learned.learnedLightSelection && learned.everyLightUpTo == kEveryLightUpTo && learned.lightsPerPoint == 4) << "the defaults";
   // At the pixel centres, so that evaluating every light is exact (no pixel filter's noise).
-  tree.pixelFilter = every.pixelFilter = {PixelFilterType::kCentre, 0.0};
-  auto tt = tracerFor(s, tree), te = tracerFor(s, every);
-  ASSERT_TRUE(tt && te);
+  tree.pixelFilter = learned.pixelFilter = every.pixelFilter = {PixelFilterType::kCentre, 0.0};
+  auto tt = tracerFor(s, tree), tl = tracerFor(s, learned), te = tracerFor(s, every);
+  ASSERT_TRUE(tt && tl && te);
   ASSERT_TRUE(tt->setTime(0, 0));
+  ASSERT_TRUE(tl->setTime(0, 0));
   ASSERT_TRUE(te->setTime(0, 0));
-  RenderStatistics st, se;
-  const FrameBuffers ft = tt->render(0, cam, cam, nullptr, &st), fe = te->render(0, cam, cam, nullptr, &se);
-  for (const bool direct : {true, false}) {
-    const auto& bt = direct ? ft.direct : ft.indirect;
-    const auto& be = direct ? fe.direct : fe.indirect;
-    const auto& vt = direct ? ft.directVariance : ft.indirectVariance;
-    const auto& ve = direct ? fe.directVariance : fe.indirectVariance;
-    double worst = 0, sumT = 0, sumE = 0;
-    for (int by = 0; by < 32; by += 8)
-      for (int bx = 0; bx < 48; bx += 8) {
-        double a = 0, c = 0, var = 0;
-        for (int y = by; y < by + 8; ++y)
-          for (int x = bx; x < bx + 8; ++x) {
-            const std::size_t i = static_cast<std::size_t>(y * 48 + x);
-            a += luminance(rgb(bt, i));
-            c += luminance(rgb(be, i));
-            var += vt[i] + ve[i];
-          }
-        ASSERT_GT(c, 0.0) << "every block of the room is lit";
-        const double z = std::abs(a - c) / std::sqrt(var);
-        worst = std::max(worst, z);
-        EXPECT_LT(z, 5.0) << (direct ? "direct" : "indirect") << " block " << bx << "," << by << ": " << a / 64 << " vs " << c / 64;
-        sumT += a;
-        sumE += c;
-      }
-    std::printf("%s: worst block z = %.2f, mean tree / every = %.4f\n", direct ? "direct" : "indirect", worst, sumT / sumE);
-  }
+  RenderStatistics st, sl, se;
+  const FrameBuffers ft = tt->render(0, cam, cam, nullptr, &st), fl = tl->render(0, cam, cam, nullptr, &sl),
+                     fe = te->render(0, cam, cam, nullptr, &se);
+  for (const auto& [name, frame] : {std::pair<const char*, const FrameBuffers*>{"tree", &ft}, {"learned", &fl}})
+    for (const bool direct : {true, false}) {
+      const auto& bt = direct ? frame->direct : frame->indirect;
+      const auto& be = direct ? fe.direct : fe.indirect;
+      const auto& vt = direct ? frame->directVariance : frame->indirectVariance;
+      const auto& ve = direct ? fe.directVariance : fe.indirectVariance;
+      double worst = 0, sumT = 0, sumE = 0;
+      for (int by = 0; by < 32; by += 8)
+        for (int bx = 0; bx < 48; bx += 8) {
+          double a = 0, c = 0, var = 0;
+          for (int y = by; y < by + 8; ++y)
+            for (int x = bx; x < bx + 8; ++x) {
+              const std::size_t i = static_cast<std::size_t>(y * 48 + x);
+              a += luminance(rgb(bt, i));
+              c += luminance(rgb(be, i));
+              var += vt[i] + ve[i];
+            }
+          ASSERT_GT(c, 0.0) << "every block of the room is lit";
+          const double z = std::abs(a - c) / std::sqrt(var);
+          worst = std::max(worst, z);
+          EXPECT_LT(z, 5.0) << name << (direct ? " direct" : " indirect") << " block " << bx << "," << by << ": " << a / 64 << " vs " << c / 64;
+          sumT += a;
+          sumE += c;
+        }
+      std::printf("%s %s: worst block z = %.2f, mean %s / every = %.4f\n", name, direct ? "direct" : "indirect", worst, name, sumT / sumE);
+    }
   // Every light is evaluated exactly without the tree: its direct light has no noise at all.
   for (std::size_t i = 0; i < fe.directVariance.size(); ++i) {
     const double l = luminance(rgb(fe.direct, i));
@@ -347,6 +357,13 @@ TEST(Render, ARoomLitByAHundredPointLightsRendersAsEvaluatingEveryLight) {
   ASSERT_GT(st.shadingPoints, 0u);
   EXPECT_LE(st.punctualEvaluated, 4 * st.shadingPoints);
   EXPECT_GT(static_cast<double>(se.punctualEvaluated) / static_cast<double>(se.shadingPoints), 30.0);
+  double directTree = 0, directLearned = 0;
+  for (std::size_t i = 0; i < ft.directVariance.size(); ++i) directTree += ft.directVariance[i], directLearned += fl.directVariance[i];
+  std::printf("lights a point: tree %.1f, learned %.1f, every %.1f; direct variance learned / tree %.3f\n",
+              static_cast<double>(st.punctualEvaluated) / static_cast<double>(st.shadingPoints),
+              static_cast<double>(sl.punctualEvaluated) / static_cast<double>(sl.shadingPoints),
+              static_cast<double>(se.punctualEvaluated) / static_cast<double>(se.shadingPoints), directLearned / directTree);
+  EXPECT_LT(directLearned, 0.5 * directTree) << "the learned selection sums the lights it saw arrive";
 }
 
 TEST(Render, SpotLightConeAndRangeWindow) {

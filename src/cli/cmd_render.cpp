@@ -226,6 +226,11 @@ void addRenderCommand(CLI::App& app, CommandRun& run) {
                   "more can reach the point; 0: every light, slow; docs/feature-buffers.md)")
       ->check(CLI::Range(0, 64))
       ->capture_default_str();
+  cmd->add_option("--every-light-up-to", o->job.settings.everyLightUpTo,
+                  "Where at most this many point and spot lights can reach a shading point, evaluate every one of them "
+                  "(exact); sample --lights-per-point only where more can (0: always sample; docs/feature-buffers.md)")
+      ->check(CLI::Range(0, 4096))
+      ->capture_default_str();
   cmd->add_option_function<std::string>(
          "--light-selection", [o](const std::string& name) { o->job.settings.learnedLightSelection = *render::parseLightSelection(name); },
          "How the light tree picks a point's lights: learned (its importance weighted by the visibility learned from a pilot "

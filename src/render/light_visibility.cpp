@@ -1,5 +1,6 @@
 #include "render/light_visibility.h"
 
+#include <algorithm>
 #include <cmath>
 #include <unordered_map>
 
@@ -42,6 +43,9 @@ void LightVisibility::learn(const LightSet& lights, std::span<const Point> point
   slotCells_.clear();
   points_.clear();
   factors_.clear();
+  seenBegin_.assign(1, 0);
+  seen_.clear();
+  typicalReaching_.clear();
   cellSize_ = cellSize;
   for (int level = 0; level < kLevels; ++level) levelSizes_[static_cast<std::size_t>(level)] = std::ldexp(cellSize, level);
   const LightTree& tree = lights.punctualTree();
@@ -87,10 +91,21 @@ void LightVisibility::learn(const LightSet& lights, std::span<const Point> point
     }
   }
   points_.resize(members.size());
-  for (std::size_t c = 0; c < members.size(); ++c) points_[c] = static_cast<std::uint32_t>(members[c].size());
+  typicalReaching_.assign(members.size(), 0);
+  std::vector<std::uint32_t> counts;
+  for (std::size_t c = 0; c < members.size(); ++c) {
+    points_[c] = static_cast<std::uint32_t>(members[c].size());
+    counts.clear();
+    for (const std::uint32_t i : members[c]) counts.push_back(static_cast<std::uint32_t>(seen[i].size()));
+    const auto middle = counts.begin() + static_cast<std::ptrdiff_t>(counts.size() / 2);
+    std::nth_element(counts.begin(), middle, counts.end());
+    typicalReaching_[c] = *middle;  // the upper median
+  }
   factors_.assign(members.size() * nodes_, 1.0f);
+  std::vector<std::vector<std::uint32_t>> seenLights(members.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, members.size(), 8), [&](const tbb::blocked_range<std::size_t>& range) {
-    std::vector<double> unoccluded(tree.size()), arriving(tree.size()), nodeUnoccluded(nodes_), nodeArriving(nodes_);
+    std::vector<double> unoccluded(tree.size()), arriving(tree.size()), unknown(tree.size()), occluded(tree.size());
+    std::vector<double> nodeUnknown(nodes_), nodeOccluded(nodes_);
     for (std::size_t c = range.begin(); c < range.end(); ++c) {
       std::fill(unoccluded.begin(), unoccluded.end(), 0.0);
       std::fill(arriving.begin(), arriving.end(), 0.0);
@@ -99,27 +114,40 @@ void LightVisibility::learn(const LightSet& lights, std::span<const Point> point
           unoccluded[s.light] += s.unoccluded;
           arriving[s.light] += s.arriving;
         }
-      tree.sumOverNodes(unoccluded, nodeUnoccluded);
-      tree.sumOverNodes(arriving, nodeArriving);
+      // Each light in one class: seen (arrived somewhere in the cell), unknown (reached no pilot
+      // point unoccluded), or occluded (reached some, arrived at none).
+      for (std::size_t l = 0; l < tree.size(); ++l) {
+        const bool seenHere = arriving[l] > 0;
+        if (seenHere) seenLights[c].push_back(static_cast<std::uint32_t>(l));
+        unknown[l] = !seenHere && !(unoccluded[l] > 0) ? 1.0 : 0.0;
+        occluded[l] = !seenHere && unoccluded[l] > 0 ? 1.0 : 0.0;
+      }
+      tree.sumOverNodes(unknown, nodeUnknown);
+      tree.sumOverNodes(occluded, nodeOccluded);
       float* f = &factors_[c * nodes_];
       for (std::size_t n = 0; n < nodes_; ++n)
-        if (nodeUnoccluded[n] > 0)
-          f[n] = static_cast<float>(kDefensiveShare + (1.0 - kDefensiveShare) * std::min(1.0, nodeArriving[n] / nodeUnoccluded[n]));
+        f[n] = nodeUnknown[n] > 0 ? 1.0f : nodeOccluded[n] > 0 ? static_cast<float>(kDefensiveShare) : 0.0f;
     }
   });
+  for (std::size_t c = 0; c < members.size(); ++c) {
+    seen_.insert(seen_.end(), seenLights[c].begin(), seenLights[c].end());
+    seenBegin_.push_back(static_cast<std::uint32_t>(seen_.size()));
+  }
 }
 
-const float* LightVisibility::factors(const glm::dvec3& point, const glm::dvec3& normal) const {
-  if (points_.empty()) return nullptr;
-  const float* coarse = nullptr;
+LightVisibility::Cell LightVisibility::cell(const glm::dvec3& point, const glm::dvec3& normal) const {
+  if (points_.empty()) return {};
+  std::int64_t coarse = -1;
   for (int level = 0; level < kLevels; ++level) {
-    const std::int64_t cell = find(key(point, normal, level));
-    if (cell < 0) continue;
-    const float* f = &factors_[static_cast<std::size_t>(cell) * nodes_];
-    if (points_[static_cast<std::size_t>(cell)] >= kMinPoints) return f;
-    coarse = f;
+    const std::int64_t c = find(key(point, normal, level));
+    if (c < 0) continue;
+    coarse = c;
+    if (points_[static_cast<std::size_t>(c)] >= kMinPoints) break;
   }
-  return coarse;
+  if (coarse < 0) return {};
+  const auto c = static_cast<std::size_t>(coarse);
+  return {&factors_[c * nodes_], std::span<const std::uint32_t>(seen_).subspan(seenBegin_[c], seenBegin_[c + 1] - seenBegin_[c]),
+          typicalReaching_[c]};
 }
 
 }  // namespace dynbench::render

@@ -3,16 +3,24 @@
 // node's lights would send a point with nothing in between; in id Tech 3 and Cube 2 maps, rooms and
 // corridors, most lights in reach by distance and orientation are behind a wall, so most of the
 // tree's picks were shadow rays that found nothing. A frame's LightVisibility learns, before the
-// frame is rendered, what share of that unoccluded light actually arrives, per cell of a hash grid
-// over surface points (and the axis their normal faces) and per node of the tree; the tree's
-// selection then multiplies each node's importance by
-//   f = s + (1 - s) A / U,
-// A the light of the node's lights that arrived at the cell's pilot points (shadow rays traced), U
-// the light they would have sent unoccluded, s = kDefensiveShare. Every f is at least s > 0, so every
-// light that can reach a point keeps a non-zero probability and the estimate stays unbiased (the
-// defensive mixture of Vévoda et al. 2018, "Bayesian online regression for adaptive direct
-// illumination sampling", whose per-cell learned contributions this is in a simpler, counted form);
-// a node that no pilot point of the cell could receive light from keeps f = 1 (nothing learned).
+// frame is rendered, which lights' light arrives, per cell of a hash grid over surface points (and
+// the axis their normal faces): a light is *seen* in a cell where its shadow ray arrived at one of
+// the cell's pilot points. At a shading point the direct light is then split in two sums over the
+// lights that can reach it (LightSet::selectPunctual):
+//   - the cell's seen lights, every one evaluated (probability 1: no selection noise where light
+//     is known to arrive, the bulk of it);
+//   - the others, sampled by the tree with each node's importance multiplied by
+//       f = 0 where every light below is seen (counted in the first sum),
+//           1 where some light below is unseen and reached no pilot point of the cell (nothing
+//             learned of it),
+//           s = kDefensiveShare otherwise (its light reached pilot points unoccluded, never arrived).
+// Every light not seen keeps a non-zero probability wherever it can reach a point, and each light
+// is in exactly one of the two sums, so the estimate stays unbiased: a defensive mixture in the
+// spirit of Vévoda et al. 2018, "Bayesian online regression for adaptive direct illumination
+// sampling", with the lights learned to arrive taken out of the sampling altogether. (Until
+// 2026-11-30 the seen lights were sampled too, by f = s + (1 - s) A / U: on v2's oa_dm1 frame 108
+// evaluating them instead cut the direct light's variance by a factor of many; docs/feature-buffers.md,
+// "Every light in reach".)
 //
 // Cells come in kLevels sizes, each twice the one before: a shading point takes the smallest cell
 // around it that holds at least kMinPoints pilot points (else the largest that holds any), so
@@ -55,9 +63,15 @@ class LightVisibility {
   // and side the normal mostly faces (the smallest level's; the others' are 2, 4, ... times it).
   void learn(const LightSet& lights, std::span<const Point> points, double cellSize, const Visible& visible);
 
-  // The node factors (LightTree::select's) of the cell holding a shading point, or nullptr where
-  // no pilot point fell in it (the tree's own importance).
-  const float* factors(const glm::dvec3& point, const glm::dvec3& normal) const;
+  // What was learned for the cell holding a shading point.
+  struct Cell {
+    const float* factors = nullptr;          // one per tree node (above); nullptr: no pilot point fell in a cell here
+    std::span<const std::uint32_t> seen;     // the seen lights (tree light indices, ascending)
+    std::uint32_t typicalReaching = 0;       // the median number of lights that reached its pilot points (U > 0)
+  };
+  Cell cell(const glm::dvec3& point, const glm::dvec3& normal) const;
+  // cell(point, normal).factors.
+  const float* factors(const glm::dvec3& point, const glm::dvec3& normal) const { return cell(point, normal).factors; }
   bool empty() const { return points_.empty(); }
   std::size_t cellCount() const { return points_.size(); }
 
@@ -80,6 +94,9 @@ class LightVisibility {
   int slotShift_ = 63;  // 64 - log2(slot count)
   std::vector<std::uint32_t> points_;                       // pilot points in cell c
   std::vector<float> factors_;                              // cell c's node n at c * nodes_ + n
+  std::vector<std::uint32_t> seenBegin_;                    // cell c's seen lights: seen_[seenBegin_[c] .. seenBegin_[c + 1])
+  std::vector<std::uint32_t> seen_;
+  std::vector<std::uint32_t> typicalReaching_;              // per cell
 };
 
 }  // namespace dynbench::render

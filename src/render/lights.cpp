@@ -223,10 +223,18 @@ Expected<void> LightSet::build(const scene::Scene& scene, const RayTracingScene&
 }
 
 void LightSet::selectPunctual(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights,
-                              std::vector<LightTree::Selected>& selected, const float* factors) const {
+                              std::vector<LightTree::Selected>& selected, const float* factors, int everyLightUpTo,
+                              std::span<const std::uint32_t> seen) const {
   if (maxLights > 0) {
-    tree_.select(point, normal, u, maxLights, selected, factors);
-    for (auto& s : selected) s.light = treeLight_[s.light];
+    if (everyLightUpTo > 0 && tree_.reachingLights(point, normal, everyLightUpTo, selected)) {
+      for (auto& s : selected) s.light = treeLight_[s.light];
+    } else {
+      // The tree samples among the lights not seen (their factors), and the seen ones are summed.
+      tree_.select(point, normal, u, maxLights, selected, factors);
+      for (auto& s : selected) s.light = treeLight_[s.light];
+      for (const std::uint32_t k : seen)
+        if (reaches(treeLight_[k], point, normal)) selected.push_back({treeLight_[k], 1.0});
+    }
   } else {
     // Every light that can reach the point, each with probability 1, found without the tree:
     // a light whose range ends before the point, or that is behind the surface, gives nothing.
@@ -324,12 +332,12 @@ void PairLights::build(const LightSet& now, const LightSet& before) {
 }
 
 void PairLights::select(int half, const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights,
-                        std::vector<LightTree::Selected>& selected) const {
+                        std::vector<LightTree::Selected>& selected, int everyLightUpTo) const {
   const LightSet& lights = *halves_[static_cast<std::size_t>(half)];
   const auto& sharedLight = sharedLight_[static_cast<std::size_t>(half)];
   selected.clear();
   if (maxLights > 0 && !shared_.empty()) {
-    shared_.select(point, normal, u, maxLights, selected);
+    shared_.select(point, normal, u, maxLights, selected, nullptr, everyLightUpTo);
     for (auto& s : selected) s.light = sharedLight[s.light];
   } else {
     for (const std::uint32_t l : sharedLight)

@@ -105,8 +105,13 @@ class LightSet {
   // slow: the independent estimator the tests compare the tree with).
   // `factors`: the tree's node factors learned for the point's cell (LightVisibility::factors), or
   // nullptr for the tree's own importance.
+  // `everyLightUpTo`: LightTree::select's (every light in reach, exactly, where at most that many
+  // can reach the point). `seen` (tree light indices; LightVisibility::Cell::seen, with `factors`
+  // zero on every node whose lights are all seen): lights evaluated wherever they reach the point,
+  // with probability 1, beside the tree's selection among the others.
   void selectPunctual(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights,
-                      std::vector<LightTree::Selected>& selected, const float* factors = nullptr) const;
+                      std::vector<LightTree::Selected>& selected, const float* factors = nullptr, int everyLightUpTo = 0,
+                      std::span<const std::uint32_t> seen = {}) const;
   // The light tree over the point and spot lights, and its light k's index among punctual lights
   // (LightVisibility learns on it).
   const LightTree& punctualTree() const { return tree_; }
@@ -219,7 +224,7 @@ class PairLights {
   // As LightSet::selectPunctual, for half 0 (`now`) or 1 (`before`): indices into that half's
   // lights. maxLights 0: every light in reach, shared or not.
   void select(int half, const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights,
-              std::vector<LightTree::Selected>& selected) const;
+              std::vector<LightTree::Selected>& selected, int everyLightUpTo = 0) const;
 
  private:
   std::array<const LightSet*, 2> halves_{nullptr, nullptr};

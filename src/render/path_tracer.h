@@ -46,6 +46,14 @@ namespace dynbench::render {
 inline constexpr int kPilotStride = 4;
 inline constexpr double kVisibilityCellsAcross = 128.0;
 
+// RenderSettings::everyLightUpTo's default (docs/feature-buffers.md, "Every light in reach").
+inline constexpr int kEveryLightUpTo = 16;
+// At a path's first vertex in a learned cell (RenderSettings::learnedLightSelection), the point and
+// spot lights not seen arriving there sampled beside the seen ones, which are all evaluated: on v2's
+// oa_dm1 frame 108, one of them gave the variance four gave (their light is a small part) at 0.9
+// times the time.
+inline constexpr int kUnseenLightsPerPoint = 1;
+
 struct RenderSettings {
   int width = 480, height = 270;
   int samplesPerPixel = 16;
@@ -61,6 +69,10 @@ struct RenderSettings {
   // (LightSet::selectPunctual: unbiased, no light skipped; exact where no more than this many can
   // reach the point). 0: every light that can reach it, without the tree (exact, slow).
   int lightsPerPoint = 4;
+  // Where at most this many point and spot lights can reach a shading point (in front of it and in
+  // range), every one of them is evaluated, exactly (LightTree::select's everyLightUpTo); only
+  // where more can are lightsPerPoint of them sampled. 0: always sample (as before; for comparison).
+  int everyLightUpTo = kEveryLightUpTo;
   // The tree's selection weighted by what was learned to arrive, per cell and tree node, from a
   // pilot before each frame (render/light_visibility.h; unbiased); false: the tree's own importance,
   // as before (`render --light-selection tree`, kept for comparison). Radiance-change pairs select

@@ -113,13 +113,17 @@ nlohmann::json renderRecord(const RenderJob& job) {
   if (s.pairs) r["pairs"] = {{"max_pairs", s.maxPairs}, {"first_pairs", frames::kFirstPairs}, {"z", frames::kChangeZ},
                              {"direct_threshold", s.directThresholdFraction}, {"indirect_threshold", s.indirectThresholdFraction},
                              {"lights", {{"sampler", "shared_tree"}, {"per_point", pairLightsPerPoint(s.lightsPerPoint)}}}};
+  if (s.pairs && s.everyLightUpTo > 0 && s.lightsPerPoint > 0) r["pairs"]["lights"]["every_light_up_to"] = s.everyLightUpTo;
   // Point and spot lights through the light tree (frames of the earlier cut-off are not reused), its
   // importance weighted by the learned visibility (render/light_visibility.h) and its parameters,
   // or not (frames of the tree alone are not taken for learned ones, nor the other way round).
   r["lights"] = {{"sampler", "tree"}, {"per_point", s.lightsPerPoint}};
+  // Every light in reach where few reach (frames that always sampled are not taken for these).
+  if (s.everyLightUpTo > 0 && s.lightsPerPoint > 0) r["lights"]["every_light_up_to"] = s.everyLightUpTo;
   if (s.learnedLightSelection)
     r["lights"]["learned_visibility"] = {{"pilot_stride", kPilotStride}, {"cells_across", kVisibilityCellsAcross},
-                                         {"defensive_share", LightVisibility::kDefensiveShare}};
+                                         {"defensive_share", LightVisibility::kDefensiveShare},
+                                         {"seen_lights", "summed at the first vertex"}, {"unseen_per_point", kUnseenLightsPerPoint}};
   if (s.jitter) r["jitter"] = "halton23x8";
   // --float32 is recorded, so such a job does not take half-stored frames as complete.
   if (job.float32) r["storage"] = "float32";

@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 
 constexpr std::array kKeys = {"dynbench_render_job", "dataset", "output", "engine", "fps", "frames", "camera", "animation", "threads", "float32",
                               "blender", "width", "height", "samples_per_pixel", "bounces", "seed", "environment", "jitter", "pixel_filter",
-                              "converge", "tolerance", "max_spp", "pairs", "max_pairs", "lights_per_point", "light_selection",
+                              "converge", "tolerance", "max_spp", "pairs", "max_pairs", "lights_per_point", "every_light_up_to", "light_selection",
                               "direct_threshold", "indirect_threshold"};
 
 }  // namespace
@@ -47,6 +47,7 @@ nlohmann::json renderJobJson(const RenderJob& job) {
                       {"pairs", s.pairs},
                       {"max_pairs", s.maxPairs},
                       {"lights_per_point", s.lightsPerPoint},
+                      {"every_light_up_to", s.everyLightUpTo},
                       {"light_selection", lightSelectionName(s.learnedLightSelection)},
                       {"direct_threshold", s.directThresholdFraction},
                       {"indirect_threshold", s.indirectThresholdFraction}};
@@ -80,7 +81,8 @@ Expected<RenderJob> parseRenderJob(const nlohmann::json& document, const fs::pat
                   r.number("/pixel_filter/width", s.pixelFilter.width, 1e-3, 8.0), r.boolean("/converge", s.converge),
                   r.number("/tolerance", s.tolerance, 1e-4, 10.0), r.integer("/max_spp", s.maxSamplesPerPixel, 1, INT_MAX),
                   r.boolean("/pairs", s.pairs), r.integer("/max_pairs", s.maxPairs, frames::kFirstPairs, 1 << 20),
-                  r.integer("/lights_per_point", s.lightsPerPoint, 0, 64), r.string("/light_selection", lightSelection), r.number("/direct_threshold", s.directThresholdFraction, 0.0, 10.0, true),
+                  r.integer("/lights_per_point", s.lightsPerPoint, 0, 64),
+                  r.integer("/every_light_up_to", s.everyLightUpTo, 0, 4096), r.string("/light_selection", lightSelection), r.number("/direct_threshold", s.directThresholdFraction, 0.0, 10.0, true),
                   r.number("/indirect_threshold", s.indirectThresholdFraction, 0.0, 10.0, true)})
     if (!ok) return std::unexpected(ok.error());
   if (dataset.empty()) return r.bad("/dataset", "a path, found \"\"");

@@ -31,7 +31,10 @@ inline constexpr int kRecordVersion = 1;
 // which commit made them, which is the build that can re-make them.
 // Version 2: OpenArena's map lights end at q3map2's envelope (fit version 9) and the references'
 // light selection learns visibility (render/light_visibility.h).
-inline constexpr int kNumbersVersion = 2;
+// Version 3: every point and spot light in reach is evaluated where at most 16 reach a point, and
+// at a path's first vertex the lights learned to arrive are summed (render/light_visibility.h);
+// the light tree's walks interleaved (the same bits). suites/results/v2 holds version 2's records.
+inline constexpr int kNumbersVersion = 3;
 
 // Which numbers versions a read accepts: this build's alone (a run that makes records beside them),
 // or any one (assembling or publishing tables of records already made: readRecords then requires
