@@ -226,7 +226,9 @@ void LightTree::descendAll(Walk* walks, int count, const glm::dvec3& point, cons
   }
 }
 
-bool LightTree::reachesNode(std::uint32_t n, const glm::dvec3& p, const glm::dvec3& normal) const {
+// Inlined into reachingLights, whose cost it is (perf on v2's calm frame 108: 11 % of the frame
+// as a call per visited node).
+[[gnu::always_inline]] inline bool LightTree::reachesNode(std::uint32_t n, const glm::dvec3& p, const glm::dvec3& normal) const {
   const Node& node = nodes_[n];
   const Box& box = boxes_[n];
   // importance()'s facing test, on the same precomputed centre and half extent.
@@ -240,20 +242,22 @@ bool LightTree::reachesNode(std::uint32_t n, const glm::dvec3& p, const glm::dve
 
 bool LightTree::reachingLights(const glm::dvec3& point, const glm::dvec3& normal, int limit, std::vector<Selected>& selected) const {
   selected.clear();
-  if (nodes_.empty()) return true;
+  if (nodes_.empty() || !reachesNode(0, point, normal)) return true;
+  // Depth first, the first child before the second; a node is pushed only once it reaches.
   std::uint32_t stack[64];
   int size = 0;
   stack[size++] = 0;
   while (size > 0) {
     const std::uint32_t n = stack[--size];
-    if (!reachesNode(n, point, normal)) continue;
     if (nodes_[n].count == 1) {
       if (static_cast<int>(selected.size()) == limit) return false;
       selected.push_back({nodes_[n].first, 1.0});
       continue;
     }
-    stack[size++] = nodes_[n].first;  // the second child, visited after the first
-    stack[size++] = n + 1;
+    const std::uint32_t a = n + 1, b = nodes_[n].first;
+    const bool reachesA = reachesNode(a, point, normal), reachesB = reachesNode(b, point, normal);
+    if (reachesB) stack[size++] = b;  // visited after the first child
+    if (reachesA) stack[size++] = a;
   }
   return true;
 }

@@ -95,10 +95,6 @@ class LightTree {
     std::uint32_t count = 0;            // lights below
   };
   static double importance(const Node& node, const glm::dvec3& point, const glm::dvec3& normal);
-  // Whether some light below node `n` can light the point: some point of the node's bounds is
-  // above the surface's plane and within the largest range of its lights. No square root or
-  // division: the test reachingLights makes at every node it visits.
-  bool reachesNode(std::uint32_t n, const glm::dvec3& point, const glm::dvec3& normal) const;
   std::span<const Node> nodes() const { return nodes_; }
   // importance() of two nodes (by index) at once, the same numbers bit for bit: the walks down and
   // the cut weigh both children of a node each step, and two lanes of SSE2 overlap the two chains
@@ -116,6 +112,10 @@ class LightTree {
   std::vector<Box> boxes_;   // one per node
   std::size_t lightCount_ = 0;
 
+  // Whether some light below node `n` can light the point: some point of the node's bounds is
+  // above the surface's plane and within the largest range of its lights. No square root or
+  // division: the test reachingLights makes at every node it visits.
+  bool reachesNode(std::uint32_t n, const glm::dvec3& point, const glm::dvec3& normal) const;
   std::uint32_t buildRange(std::vector<std::uint32_t>& order, std::span<const Light> lights, std::size_t begin, std::size_t end);
   // A walk from a node of the cut down to one light, chosen by importance (times `factors`, if
   // given): the node it is at, its uniform number (remapped at each step), the probability of the
