@@ -121,3 +121,44 @@ TEST(PixelFilter, AnEmissiveEdgeRendersAsTheFiltersShareOfEachPixel) {
 
 }  // namespace
 }  // namespace dynbench::render
+
+namespace dynbench::render {
+namespace {
+
+// stratifiedPoint is a (0,2)-sequence (unshifted): for every k up to 10, the first 2^k points put
+// exactly one point in each elementary interval [i / 2^a, (i + 1) / 2^a) x [j / 2^b, (j + 1) / 2^b)
+// with a + b = k (Niederreiter's definition), so no shape of cell of that area gets two; and the
+// shift moves every point by the same amount, modulo 1.
+TEST(PixelFilter, StratifiedPointsAreAZeroTwoSequenceShiftedTogether) {
+  for (int k = 0; k <= 10; ++k) {
+    const std::uint32_t n = 1u << k;
+    for (int a = 0; a <= k; ++a) {
+      const int b = k - a;
+      std::vector<int> count(n, 0);
+      for (std::uint32_t i = 0; i < n; ++i) {
+        const glm::dvec2 p = stratifiedPoint(i, glm::dvec2(0.0));
+        ASSERT_GE(p.x, 0.0);
+        ASSERT_LT(p.x, 1.0);
+        ASSERT_GE(p.y, 0.0);
+        ASSERT_LT(p.y, 1.0);
+        const auto cx = static_cast<std::uint32_t>(p.x * (1u << a)), cy = static_cast<std::uint32_t>(p.y * (1u << b));
+        ++count[(cy << a) | cx];
+      }
+      for (std::uint32_t c = 0; c < n; ++c) ASSERT_EQ(count[c], 1) << "k " << k << ", a " << a << ", cell " << c;
+    }
+  }
+  const glm::dvec2 shift(0.7, 0.45);
+  for (std::uint32_t i = 0; i < 64; ++i) {
+    const glm::dvec2 p = stratifiedPoint(i, glm::dvec2(0.0)), q = stratifiedPoint(i, shift);
+    EXPECT_NEAR(q.x, std::fmod(p.x + shift.x, 1.0), 1e-15);
+    EXPECT_NEAR(q.y, std::fmod(p.y + shift.y, 1.0), 1e-15);
+  }
+  // A few known points: 0, 1/2, then (1/4, 3/4), (3/4, 1/4).
+  EXPECT_EQ(stratifiedPoint(0, glm::dvec2(0.0)), glm::dvec2(0.0, 0.0));
+  EXPECT_EQ(stratifiedPoint(1, glm::dvec2(0.0)), glm::dvec2(0.5, 0.5));
+  EXPECT_EQ(stratifiedPoint(2, glm::dvec2(0.0)), glm::dvec2(0.25, 0.75));
+  EXPECT_EQ(stratifiedPoint(3, glm::dvec2(0.0)), glm::dvec2(0.75, 0.25));
+}
+
+}  // namespace
+}  // namespace dynbench::render

@@ -16,6 +16,11 @@
 namespace dynbench::render {
 
 namespace {
+// The stream of a pixel's filter shift (Random's `sample` key): no sample has this index.
+constexpr std::uint64_t kFilterShiftStream = 0xFFFFFFFFFFFFull;
+}  // namespace
+
+namespace {
 
 // Running sums of one pixel's samples.
 struct PixelSums {
@@ -255,10 +260,14 @@ class PathTracer::FrameSampler {
     return camera_.ray(px + 0.5 + jitter_.x, py + 0.5 + jitter_.y);
   }
   // With a pixel filter: a radiance sample's own camera ray, through the (jittered) pixel centre
-  // offset by the filter, from the first two numbers of the sample's random stream.
-  Ray filteredRay(std::size_t pixel, Random& rng) const {
+  // offset by the filter, at the sample's stratified point (stratifiedPoint, the pixel's shift
+  // from a stream of its own). The sample's stream still gives up its first two numbers, which
+  // drew the point before, so the rest of the path draws what it drew.
+  Ray filteredRay(std::size_t pixel, Random& rng, std::uint32_t sample) const {
     const int px = static_cast<int>(pixel % static_cast<std::size_t>(width_)), py = static_cast<int>(pixel / static_cast<std::size_t>(width_));
-    const glm::dvec2 offset = tracer_.filter_.offset(rng.uniform2());
+    (void)rng.uniform2();
+    Random shift(settings_.seed, frameIndex_, pixel, kFilterShiftStream);
+    const glm::dvec2 offset = tracer_.filter_.offset(stratifiedPoint(sample, shift.uniform2()));
     return camera_.ray(px + 0.5 + jitter_.x + offset.x, py + 0.5 + jitter_.y + offset.y);
   }
   // A pixel's samples up to `upTo`: at the pixel centre, one environment lookup where its camera
@@ -310,7 +319,7 @@ class PathTracer::FrameSampler {
         for (; v.next < v.upTo && n < batch; ++v.next, ++n) {
           paths[n].first = &v;
           paths[n].rng = Random(settings_.seed, frameIndex_, v.pixel, static_cast<std::uint64_t>(v.next));
-          paths[n].ray = v.hit ? v.ray : filteredRay(v.pixel, paths[n].rng);
+          paths[n].ray = v.hit ? v.ray : filteredRay(v.pixel, paths[n].rng, static_cast<std::uint32_t>(v.next));
         }
       }
       tracer_.tracePaths(paths, scratch);

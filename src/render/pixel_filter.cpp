@@ -6,6 +6,17 @@
 #include "core/math.h"
 
 namespace dynbench::render {
+
+glm::dvec2 stratifiedPoint(std::uint32_t sample, glm::dvec2 shift) {
+  // Column k of the radical inverse is bit 31 - k; column k of the Pascal matrix mod 2 is
+  // v_k = v_{k-1} xor (v_{k-1} >> 1) from v_0 = 2^31 (Sobol's second dimension).
+  std::uint32_t x = 0, y = 0, column = 1u << 31;
+  for (std::uint32_t i = sample, k = 0; i != 0; i >>= 1, ++k) {
+    if (i & 1u) x ^= 1u << (31 - k), y ^= column;
+    column ^= column >> 1;
+  }
+  return glm::fract(glm::dvec2(x * 0x1p-32, y * 0x1p-32) + shift);
+}
 namespace {
 
 constexpr int kTable = 4096;

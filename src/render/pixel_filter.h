@@ -41,6 +41,16 @@ Expected<PixelFilterType> parsePixelFilter(const std::string& name);
 // 1.5 for Blackman-Harris (Cycles' default), 1 for a box (the pixel's own square), 0 for the centre.
 double defaultPixelFilterWidth(PixelFilterType type);
 
+// Where a pixel's radiance samples fall in [0, 1)^2 before the filter maps them to offsets: sample
+// `sample`'s point of a (0,2)-sequence in base 2 (the first two dimensions of Sobol's sequence: the
+// index's radical inverse, and its image under the Pascal matrix mod 2), shifted toroidally by the
+// pixel's `shift` (Cranley-Patterson rotation). With a shift uniform in [0, 1)^2 each point is
+// uniform, so the pixel's mean still estimates the filtered radiance without bias; and the first
+// 2^k points of a pixel fall one in each elementary interval of area 2^-k, so the filter's spread
+// over textures and edges averages out faster than with independent points (two_towers frame 108
+// at 32 paths: the direct light's RMS difference between two seeds 23,500 -> 10,000 cd/m²).
+glm::dvec2 stratifiedPoint(std::uint32_t sample, glm::dvec2 shift);
+
 class PixelFilter {
  public:
   explicit PixelFilter(const PixelFilterSpec& spec);

@@ -104,7 +104,8 @@ nlohmann::json renderRecord(const RenderJob& job) {
                       // (docs/feature-buffers.md): frames of another kind are not reused.
                       {"radiance_at", s.pixelFilter.type == PixelFilterType::kCentre ? "pixel_centre" : "pixel_filter"}};
   if (s.pixelFilter.type != PixelFilterType::kCentre)
-    r["pixel_filter"] = {{"type", pixelFilterName(s.pixelFilter.type)}, {"width", s.pixelFilter.width}};
+    r["pixel_filter"] = {{"type", pixelFilterName(s.pixelFilter.type)}, {"width", s.pixelFilter.width},
+                         {"points", "sobol02_shifted"}};  // stratifiedPoint (frames of independent points not reused)
   if (s.converge) r["converge"] = {{"tolerance", s.tolerance}, {"max_spp", s.maxSamplesPerPixel},
                                    {"direct_threshold", s.directThresholdFraction}, {"indirect_threshold", s.indirectThresholdFraction}};
   // Radiance-change pairs (frames without them are not complete for a job that wants them).

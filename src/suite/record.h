@@ -33,7 +33,8 @@ inline constexpr int kRecordVersion = 1;
 // light selection learns visibility (render/light_visibility.h).
 // Version 3: every point and spot light in reach is evaluated where at most 16 reach a point, and
 // at a path's first vertex the lights learned to arrive are summed (render/light_visibility.h);
-// the light tree's walks interleaved (the same bits). suites/results/v2 holds version 2's records.
+// the light tree's walks interleaved (the same bits); the pixel filter's points are stratified
+// (render/pixel_filter.h, stratifiedPoint). suites/results/v2 holds version 2's records.
 inline constexpr int kNumbersVersion = 3;
 
 // Which numbers versions a read accepts: this build's alone (a run that makes records beside them),
