@@ -262,11 +262,11 @@ bool LightTree::reachingLights(const glm::dvec3& point, const glm::dvec3& normal
   return true;
 }
 
-void LightTree::select(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights, std::vector<Selected>& selected,
+bool LightTree::select(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights, std::vector<Selected>& selected,
                        const float* factors, int everyLightUpTo) const {
-  if (everyLightUpTo > 0 && reachingLights(point, normal, everyLightUpTo, selected)) return;
+  if (everyLightUpTo > 0 && reachingLights(point, normal, everyLightUpTo, selected)) return true;
   selected.clear();
-  if (nodes_.empty()) return;
+  if (nodes_.empty()) return false;
   // The cut: nodes that together hold every light that can reach the point, each to be sampled
   // once. Splitting is decided by the point alone (never by u), so each light's probability is
   // well defined and the estimate unbiased; the most important interior node is split first.
@@ -276,7 +276,7 @@ void LightTree::select(const glm::dvec3& point, const glm::dvec3& normal, double
   std::array<double, kMaxCut> weight;
   int size = 0;
   const double rootImportance = importance(nodes_[0], point, normal) * (factors ? factors[0] : 1.0);
-  if (!(rootImportance > 0)) return;
+  if (!(rootImportance > 0)) return false;
   cut[0] = 0;
   weight[0] = rootImportance;
   size = 1;
@@ -312,6 +312,7 @@ void LightTree::select(const glm::dvec3& point, const glm::dvec3& normal, double
   descendAll(walks.data(), size, point, normal, factors);
   for (int k = 0; k < size; ++k)
     if (walks[k].alive && walks[k].probability > 0) selected.push_back({nodes_[walks[k].node].first, walks[k].probability});
+  return false;
 }
 
 }  // namespace dynbench::render

@@ -52,7 +52,8 @@ class LightTree {
   // envelope) no point is reached by more than 16 lights, and 4 lights sampled from those left 180
   // times the variance of direct light that evaluating them all leaves, at 0.6 times the time
   // (docs/feature-buffers.md, "Every light in reach").
-  void select(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights, std::vector<Selected>& selected,
+  // Returns true where it took every light in reach (the caller then has the exact sum).
+  bool select(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights, std::vector<Selected>& selected,
               const float* factors = nullptr, int everyLightUpTo = 0) const;
 
   // The lights that can light the point (facing it and in range: reachesNode at every node down to

@@ -70,8 +70,6 @@ class LightVisibility {
     std::uint32_t typicalReaching = 0;       // the median number of lights that reached its pilot points (U > 0)
   };
   Cell cell(const glm::dvec3& point, const glm::dvec3& normal) const;
-  // cell(point, normal).factors.
-  const float* factors(const glm::dvec3& point, const glm::dvec3& normal) const { return cell(point, normal).factors; }
   bool empty() const { return points_.empty(); }
   std::size_t cellCount() const { return points_.size(); }
 

@@ -226,15 +226,13 @@ void LightSet::selectPunctual(const glm::dvec3& point, const glm::dvec3& normal,
                               std::vector<LightTree::Selected>& selected, const float* factors, int everyLightUpTo,
                               std::span<const std::uint32_t> seen) const {
   if (maxLights > 0) {
-    if (everyLightUpTo > 0 && tree_.reachingLights(point, normal, everyLightUpTo, selected)) {
-      for (auto& s : selected) s.light = treeLight_[s.light];
-    } else {
-      // The tree samples among the lights not seen (their factors), and the seen ones are summed.
-      tree_.select(point, normal, u, maxLights, selected, factors);
-      for (auto& s : selected) s.light = treeLight_[s.light];
+    // Where the tree did not take every light in reach, it sampled among the lights not seen
+    // (their factors), and the seen ones are summed.
+    const bool everyLight = tree_.select(point, normal, u, maxLights, selected, factors, everyLightUpTo);
+    for (auto& s : selected) s.light = treeLight_[s.light];
+    if (!everyLight)
       for (const std::uint32_t k : seen)
         if (reaches(treeLight_[k], point, normal)) selected.push_back({treeLight_[k], 1.0});
-    }
   } else {
     // Every light that can reach the point, each with probability 1, found without the tree:
     // a light whose range ends before the point, or that is behind the surface, gives nothing.

@@ -259,15 +259,16 @@ class PathTracer::FrameSampler {
     const int px = static_cast<int>(pixel % static_cast<std::size_t>(width_)), py = static_cast<int>(pixel / static_cast<std::size_t>(width_));
     return camera_.ray(px + 0.5 + jitter_.x, py + 0.5 + jitter_.y);
   }
+  // A pixel's shift of its stratified filter points, from a stream of its own.
+  glm::dvec2 filterShift(std::size_t pixel) const { return Random(settings_.seed, frameIndex_, pixel, kFilterShiftStream).uniform2(); }
   // With a pixel filter: a radiance sample's own camera ray, through the (jittered) pixel centre
-  // offset by the filter, at the sample's stratified point (stratifiedPoint, the pixel's shift
-  // from a stream of its own). The sample's stream still gives up its first two numbers, which
-  // drew the point before, so the rest of the path draws what it drew.
-  Ray filteredRay(std::size_t pixel, Random& rng, std::uint32_t sample) const {
+  // offset by the filter, at the sample's stratified point (stratifiedPoint, with the pixel's
+  // filterShift). The sample's stream still gives up its first two numbers, which drew the point
+  // before, so the rest of the path draws what it drew.
+  Ray filteredRay(std::size_t pixel, Random& rng, std::uint32_t sample, glm::dvec2 shift) const {
     const int px = static_cast<int>(pixel % static_cast<std::size_t>(width_)), py = static_cast<int>(pixel / static_cast<std::size_t>(width_));
     (void)rng.uniform2();
-    Random shift(settings_.seed, frameIndex_, pixel, kFilterShiftStream);
-    const glm::dvec2 offset = tracer_.filter_.offset(stratifiedPoint(sample, shift.uniform2()));
+    const glm::dvec2 offset = tracer_.filter_.offset(stratifiedPoint(sample, shift));
     return camera_.ray(px + 0.5 + jitter_.x + offset.x, py + 0.5 + jitter_.y + offset.y);
   }
   // A pixel's samples up to `upTo`: at the pixel centre, one environment lookup where its camera
@@ -316,10 +317,11 @@ class PathTracer::FrameSampler {
       std::size_t n = 0;
       for (std::size_t q = scratch.queueHead; n < batch; ++q) {
         FirstVertex& v = queue[q];
+        const glm::dvec2 shift = v.hit || v.next >= v.upTo ? glm::dvec2(0.0) : filterShift(v.pixel);
         for (; v.next < v.upTo && n < batch; ++v.next, ++n) {
           paths[n].first = &v;
           paths[n].rng = Random(settings_.seed, frameIndex_, v.pixel, static_cast<std::uint64_t>(v.next));
-          paths[n].ray = v.hit ? v.ray : filteredRay(v.pixel, paths[n].rng, static_cast<std::uint32_t>(v.next));
+          paths[n].ray = v.hit ? v.ray : filteredRay(v.pixel, paths[n].rng, static_cast<std::uint32_t>(v.next), shift);
         }
       }
       tracer_.tracePaths(paths, scratch);
