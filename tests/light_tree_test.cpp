@@ -223,7 +223,7 @@ TEST(LightTree, TheInterleavedWalksSelectWhatOneWalkAtATimeSelectsBitForBit) {
       const double u = k % 11 == 0 ? 0.0 : uniform(rng);
       const int budget = 1 + k % 8;
       const float* weights = k % 2 ? factors.data() : nullptr;
-      tree.select(p, n, u, budget, selected, weights);
+      tree.select(p, n, u, budget, selected, {.factors = weights});
       const auto expected = selectOneWalkAtATime(tree, p, n, u, budget, weights);
       ASSERT_EQ(selected.size(), expected.size()) << "trial " << trial << " point " << k;
       for (std::size_t s = 0; s < expected.size(); ++s) {
@@ -270,7 +270,7 @@ TEST(LightTree, EveryLightInReachIsTakenExactlyWhereFewReach) {
     EXPECT_TRUE(tree.reachingLights(p, n, count, reaching));
     const double u = uniform(rng);
     const int limit = 24;
-    tree.select(p, n, u, 4, selected, nullptr, limit);
+    tree.select(p, n, u, 4, selected, {.everyLightUpTo = limit});
     if (count <= limit) {
       ++few;
       ASSERT_EQ(selected.size(), expected.size());
@@ -287,6 +287,100 @@ TEST(LightTree, EveryLightInReachIsTakenExactlyWhereFewReach) {
   }
   EXPECT_GT(few, 40);
   EXPECT_GT(many, 40);
+}
+
+// A box's reach list (leavesReachingBox) holds every light that can light some point of the box,
+// and searching it (reachingLightsAmong) finds what the tree's walk finds, in its order, with the
+// same answer at every limit; a box far from every range lists nothing.
+TEST(LightTree, ABoxsReachListFindsWhatTheWalkFinds) {
+  const auto lights = randomLights(300, 41);
+  LightTree tree;
+  tree.build(lights);
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> coordinate(-14.0, 14.0), unit(0.0, 1.0);
+  std::vector<std::uint32_t> leaves;
+  std::vector<LightTree::Selected> walked, listed;
+  std::size_t shortest = lights.size(), compared = 0;
+  for (int box = 0; box < 60; ++box) {
+    const glm::dvec3 lower(coordinate(rng), coordinate(rng), coordinate(rng));
+    const double size = 0.25 + 2.0 * unit(rng);
+    tree.leavesReachingBox(lower, lower + size, leaves);
+    shortest = std::min(shortest, leaves.size());
+    ASSERT_TRUE(std::is_sorted(leaves.begin(), leaves.end())) << "the walk's depth-first order is the nodes' order";
+    for (int k = 0; k < 40; ++k) {
+      const glm::dvec3 p = lower + size * glm::dvec3(unit(rng), unit(rng), unit(rng));
+      const glm::dvec3 n = glm::normalize(glm::dvec3(coordinate(rng), coordinate(rng), coordinate(rng)));
+      for (const int limit : {1000, 8, 3}) {
+        const bool walkedAll = tree.reachingLights(p, n, limit, walked);
+        ASSERT_EQ(tree.reachingLightsAmong(leaves, p, n, limit, listed), walkedAll);
+        if (!walkedAll) continue;
+        ASSERT_EQ(listed.size(), walked.size()) << "box " << box << ", point " << k;
+        for (std::size_t s = 0; s < walked.size(); ++s) ASSERT_EQ(listed[s].light, walked[s].light);
+        ++compared;
+      }
+    }
+  }
+  std::size_t unbounded = 0;
+  for (const auto& l : lights) unbounded += !(l.range > 0);
+  EXPECT_GT(compared, 3000u);
+  EXPECT_LT(shortest, unbounded + (lights.size() - unbounded) / 2) << "the lists leave out lights whose range ends short of the box";
+  tree.leavesReachingBox(glm::dvec3(1000.0), glm::dvec3(1001.0), leaves);
+  EXPECT_EQ(leaves.size(), unbounded) << "only the lights without a range reach a box far away";
+}
+
+// Guide::keepFactors: where every light in reach is taken, a light whose leaf factor f is in
+// (0, 1) is kept in a share f of the u's and divided by f, the others always, each with
+// probability 1: over a fine grid of u the mean of sum c(l) / p(l) is the sum of c over every light
+// in reach, whatever the lights' contributions (the roulette's numbers are the same u offset per
+// light, so they are correlated; only each light's own share matters).
+TEST(LightTree, OccludedLightsKeptByRouletteSumToEveryLight) {
+  const auto lights = randomLights(200, 43);
+  LightTree tree;
+  tree.build(lights);
+  const auto nodes = tree.nodes();
+  std::vector<float> factors(nodes.size(), 1.0f);
+  std::mt19937 rng(14);
+  std::uniform_real_distribution<double> coordinate(-14.0, 14.0), unit(0.0, 1.0);
+  constexpr float kShares[] = {0.0f, 1.0f, 0.1f, 0.35f};
+  for (std::size_t n = 0; n < nodes.size(); ++n)
+    if (nodes[n].count == 1) factors[n] = kShares[nodes[n].first % 4];
+  int tested = 0;
+  std::vector<LightTree::Selected> selected;
+  for (int k = 0; k < 200 && tested < 30; ++k) {
+    const glm::dvec3 p(coordinate(rng), coordinate(rng), coordinate(rng));
+    const glm::dvec3 n = glm::normalize(glm::dvec3(coordinate(rng), coordinate(rng), coordinate(rng)));
+    double exact = 0.0;
+    std::map<std::uint32_t, double> contribution;
+    bool anyRoulette = false;
+    for (std::uint32_t l = 0; l < lights.size(); ++l)
+      if (canLight(lights[l], p, n)) {
+        contribution[l] = 0.5 + unit(rng);
+        exact += contribution[l];
+        anyRoulette = anyRoulette || l % 4 >= 2;
+      }
+    if (!anyRoulette || contribution.size() > 30) continue;
+    ++tested;
+    constexpr int kGrid = 1 << 14;
+    double sum = 0.0;
+    std::map<std::uint32_t, int> kept;
+    for (int g = 0; g < kGrid; ++g) {
+      ASSERT_TRUE(tree.select(p, n, (g + 0.5) / kGrid, 4, selected, {.everyLightUpTo = 64, .keepFactors = factors.data()}));
+      for (const auto& s : selected) {
+        ASSERT_TRUE(contribution.count(s.light)) << "a light that cannot reach the point";
+        const double f = kShares[s.light % 4];
+        EXPECT_EQ(s.probability, f > 0 && f < 1 ? static_cast<double>(f) : 1.0);
+        sum += contribution[s.light] / s.probability;
+        ++kept[s.light];
+      }
+    }
+    for (const auto& [l, c] : contribution) {
+      const double f = kShares[l % 4];
+      const double share = static_cast<double>(kept[l]) / kGrid;
+      EXPECT_NEAR(share, f > 0 && f < 1 ? f : 1.0, 2.0 / kGrid) << "light " << l;
+    }
+    EXPECT_NEAR(sum / kGrid, exact, 1e-3 * exact) << "point " << k;
+  }
+  EXPECT_GE(tested, 20);
 }
 
 // The two-lane importance is importance() itself, bit for bit (a reference's bytes depend on it):

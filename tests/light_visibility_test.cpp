@@ -117,7 +117,7 @@ TEST(LightVisibility, SeenLightsAreSummedAndTheOthersSampledWithoutBias) {
   std::array<int, 3> picked{};
   std::vector<LightTree::Selected> selected;
   for (int k = 0; k < grid; ++k) {
-    lights.selectPunctual(p, n, (k + 0.5) / grid, kUnseenLightsPerPoint, selected, cell.factors, 0, cell.seen);
+    lights.selectPunctual(p, n, (k + 0.5) / grid, kUnseenLightsPerPoint, selected, {.factors = cell.factors}, cell.seen);
     double estimate = 0;
     for (const auto& s : selected) {
       ++picked[s.light];

@@ -21,12 +21,16 @@ double boundedRange(double range) { return range > 0 && std::isfinite(range) ? r
 void LightTree::build(std::span<const Light> lights) {
   nodes_.clear();
   boxes_.clear();
+  leafOf_.clear();
   lightCount_ = lights.size();
   if (lights.empty()) return;
   nodes_.reserve(2 * lights.size());
   std::vector<std::uint32_t> order(lights.size());
   std::iota(order.begin(), order.end(), 0u);
   buildRange(order, lights, 0, order.size());
+  leafOf_.assign(lights.size(), 0);
+  for (std::size_t n = 0; n < nodes_.size(); ++n)
+    if (nodes_[n].count == 1) leafOf_[nodes_[n].first] = static_cast<std::uint32_t>(n);
   boxes_.resize(nodes_.size());
   for (std::size_t n = 0; n < nodes_.size(); ++n) {
     Box& box = boxes_[n];
@@ -262,9 +266,71 @@ bool LightTree::reachingLights(const glm::dvec3& point, const glm::dvec3& normal
   return true;
 }
 
+void LightTree::leavesReachingBox(const glm::dvec3& lower, const glm::dvec3& upper, std::vector<std::uint32_t>& leaves) const {
+  leaves.clear();
+  if (nodes_.empty()) return;
+  // A node reaches the box where the gap between its bounds and the box is shorter than its
+  // largest range.
+  const auto reaches = [&](std::uint32_t n) {
+    const Node& node = nodes_[n];
+    if (!std::isfinite(node.range)) return true;
+    const glm::dvec3 gap = glm::max(glm::max(lower - node.upper, node.lower - upper), glm::dvec3(0.0));
+    return glm::dot(gap, gap) < node.range * node.range;
+  };
+  if (!reaches(0)) return;
+  std::uint32_t stack[64];
+  int size = 0;
+  stack[size++] = 0;
+  while (size > 0) {
+    const std::uint32_t n = stack[--size];
+    if (nodes_[n].count == 1) {
+      leaves.push_back(n);
+      continue;
+    }
+    const std::uint32_t a = n + 1, b = nodes_[n].first;
+    const bool reachesA = reaches(a), reachesB = reaches(b);
+    if (reachesB) stack[size++] = b;  // the same order as reachingLights
+    if (reachesA) stack[size++] = a;
+  }
+}
+
+bool LightTree::reachingLightsAmong(std::span<const std::uint32_t> leaves, const glm::dvec3& point, const glm::dvec3& normal, int limit,
+                                    std::vector<Selected>& selected) const {
+  selected.clear();
+  for (const std::uint32_t n : leaves)
+    if (reachesNode(n, point, normal)) {
+      if (static_cast<int>(selected.size()) == limit) return false;
+      selected.push_back({nodes_[n].first, 1.0});
+    }
+  return true;
+}
+
+void LightTree::keepWithLeafFactors(std::vector<Selected>& selected, double u, const float* factors) const {
+  // u is not used by the exact sum, so it is independent of which lights reach the point; each
+  // light's own number u + k phi (mod 1), phi the golden ratio's conjugate, is uniform, and is all
+  // that light's expectation depends on (the lights' numbers are correlated with one another, which
+  // the sum's expectation does not see).
+  constexpr double kPhi = 0.6180339887498949;
+  std::size_t kept = 0;
+  for (const Selected& s : selected) {
+    const double f = factors[leafOf_[s.light]];
+    const double q = f > 0 && f < 1 ? f : 1.0;
+    const double v = u + kPhi * static_cast<double>(s.light);
+    if (q < 1.0 && !(v - std::floor(v) < q)) continue;
+    selected[kept++] = {s.light, q};
+  }
+  selected.resize(kept);
+}
+
 bool LightTree::select(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights, std::vector<Selected>& selected,
-                       const float* factors, int everyLightUpTo) const {
-  if (everyLightUpTo > 0 && reachingLights(point, normal, everyLightUpTo, selected)) return true;
+                       const Guide& guide) const {
+  const int everyLightUpTo = guide.everyLightUpTo;
+  if (everyLightUpTo > 0 && (guide.reachLeaves ? reachingLightsAmong(*guide.reachLeaves, point, normal, everyLightUpTo, selected)
+                                               : reachingLights(point, normal, everyLightUpTo, selected))) {
+    if (guide.keepFactors) keepWithLeafFactors(selected, u, guide.keepFactors);
+    return true;
+  }
+  const float* factors = guide.factors;
   selected.clear();
   if (nodes_.empty()) return false;
   // The cut: nodes that together hold every light that can reach the point, each to be sampled

@@ -13,12 +13,40 @@
 // is unbiased; where the cut reaches single lights (at most maxLights in reach) every probability
 // is 1 and the sum is exact, with no noise.
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 namespace dynbench::render {
+
+// What LightTree::select may know of a shading point beyond its position and normal
+// (LightVisibility's cell; every field optional).
+struct LightGuide {
+  // One per node, each >= 0 (LightVisibility::Cell::factors): each node's importance is
+  // multiplied by its factor, so that the cut and the walk down follow what was learned; a light
+  // keeps a non-zero probability wherever it can reach the point if its leaf's and its
+  // ancestors' factors are positive, and is never selected where one is zero (the caller sums
+  // such lights otherwise).
+  const float* factors = nullptr;
+  // > 0: where at most that many lights can light the point, every one of them with probability
+  // 1 (the exact sum; no cut, no walk), found by LightTree::reachingLights; the cut and walks only where more
+  // can. Which of the two a point takes depends on the point alone, so the estimate
+  // stays unbiased. On v2's OpenArena frames (fit 9: every light ends at its envelope) no point
+  // is reached by more than 16 lights, and 4 lights sampled from those left 180 times the
+  // variance of direct light that evaluating them all leaves, at 0.6 times the time
+  // (docs/feature-buffers.md, "Every light in reach").
+  int everyLightUpTo = 0;
+  // Where every light in reach is taken: one per node (LightVisibility::Cell::factors), a light
+  // whose leaf's factor f is in (0, 1) (its light reached the cell's pilot points unoccluded and
+  // never arrived) kept with probability f, u deciding (LightTree::keepWithLeafFactors), the
+  // others always.
+  const float* keepFactors = nullptr;
+  // leavesReachingBox of a box holding the point, searched instead of the tree (the same lights
+  // in the same order: LightTree::reachingLightsAmong).
+  std::optional<std::span<const std::uint32_t>> reachLeaves;
+};
 
 class LightTree {
  public:
@@ -37,24 +65,15 @@ class LightTree {
   bool empty() const { return nodes_.empty(); }
   std::size_t size() const { return lightCount_; }
 
+  using Guide = LightGuide;
+
   // The lights for shading point `point` whose surface faces `normal` (unit; lights behind its
   // plane give nothing there: the BSDFs reflect only above the geometric surface), chosen with one
-  // uniform number u in [0, 1). `selected` is cleared first. maxLights >= 1. `factors` (optional,
-  // one per node, each >= 0; LightVisibility::Cell::factors): each node's importance is multiplied
-  // by its factor, so that the cut and the walk down follow what was learned; a light keeps a
-  // non-zero probability wherever it can reach the point if its leaf's and its ancestors' factors
-  // are positive, and is never selected where one is zero (the caller sums such lights otherwise).
-  //
-  // `everyLightUpTo` > 0: where at most that many lights can light the point, every one of them
-  // with probability 1 (the exact sum; no cut, no walk, u unused), found by reachingLights; the
-  // cut and walks above only where more can. Which of the two a point takes depends on the point
-  // alone, so the estimate stays unbiased. On v2's OpenArena frames (fit 9: every light ends at its
-  // envelope) no point is reached by more than 16 lights, and 4 lights sampled from those left 180
-  // times the variance of direct light that evaluating them all leaves, at 0.6 times the time
-  // (docs/feature-buffers.md, "Every light in reach").
-  // Returns true where it took every light in reach (the caller then has the exact sum).
+  // uniform number u in [0, 1). `selected` is cleared first. maxLights >= 1. Returns true where it
+  // took every light in reach (Guide::everyLightUpTo; the caller then has the exact sum, or its
+  // roulette by Guide::keepFactors).
   bool select(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights, std::vector<Selected>& selected,
-              const float* factors = nullptr, int everyLightUpTo = 0) const;
+              const Guide& guide = {}) const;
 
   // The lights that can light the point (facing it and in range: reachesNode at every node down to
   // the light), in the tree's order, each with probability 1, into `selected` (cleared first);
@@ -62,6 +81,17 @@ class LightTree {
   // there is above zero (rounding can make importance() zero where a light's range ends exactly at
   // the point; such a light gives nothing there), so the sum over them is the exact sum.
   bool reachingLights(const glm::dvec3& point, const glm::dvec3& normal, int limit, std::vector<Selected>& selected) const;
+  // The leaves (node indices, in the order reachingLights visits them) of every light whose range
+  // reaches some point of the box [lower, upper], whatever the normal: at every point of the box a
+  // superset of the lights reachingLights finds. Cleared first.
+  void leavesReachingBox(const glm::dvec3& lower, const glm::dvec3& upper, std::vector<std::uint32_t>& leaves) const;
+  // reachingLights, testing only `leaves` (leavesReachingBox of a box holding the point) with the
+  // leaf's own test: the same lights in the same order wherever rounding does not make an ancestor's
+  // bound reject what its light's own test accepts, and either way every light that can light the
+  // point. The walk was 8-11 % of a v2 reference frame (perf, calm and colos); a cell's list is
+  // made once a frame (LightVisibility) and is a few lights long.
+  bool reachingLightsAmong(std::span<const std::uint32_t> leaves, const glm::dvec3& point, const glm::dvec3& normal, int limit,
+                           std::vector<Selected>& selected) const;
 
   // Every light whose importance at the point is above zero (the lights that can light it), in
   // the tree's order: `visit(light)`.
@@ -111,6 +141,7 @@ class LightTree {
   };
   std::vector<Node> nodes_;  // depth first: an interior node's first child follows it
   std::vector<Box> boxes_;   // one per node
+  std::vector<std::uint32_t> leafOf_;  // light -> its leaf node
   std::size_t lightCount_ = 0;
 
   // Whether some light below node `n` can light the point: some point of the node's bounds is
@@ -128,6 +159,8 @@ class LightTree {
     const double* firstImportances = nullptr;
     bool alive = true;  // false: no light below the node it reached can light the point
   };
+  // Guide::keepFactors' roulette over the lights select() found in reach, in place.
+  void keepWithLeafFactors(std::vector<Selected>& selected, double u, const float* factors) const;
   // Takes every walk down to a light, the walks' steps interleaved.
   void descendAll(Walk* walks, int count, const glm::dvec3& point, const glm::dvec3& normal, const float* factors) const;
 };

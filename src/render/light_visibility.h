@@ -34,6 +34,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -49,6 +50,7 @@ class LightVisibility {
   static constexpr double kDefensiveShare = 0.1;
   static constexpr int kLevels = 5;
   static constexpr std::uint32_t kMinPoints = 4;
+  static constexpr std::size_t kMaxReachLeaves = 64;
 
   // A pilot point: a surface point and the unit normal of its side facing the ray that found it.
   struct Point {
@@ -68,13 +70,23 @@ class LightVisibility {
     const float* factors = nullptr;          // one per tree node (above); nullptr: no pilot point fell in a cell here
     std::span<const std::uint32_t> seen;     // the seen lights (tree light indices, ascending)
     std::uint32_t typicalReaching = 0;       // the median number of lights that reached its pilot points (U > 0)
+    // LightTree::leavesReachingBox of the cell's cube (LightTree::select's `reachLeaves`); none where
+    // the list would be longer than kMaxReachLeaves (the tree's walk is then the quicker search) or
+    // the cell's key is shared with a cell 2^19 cells away (key()).
+    std::optional<std::span<const std::uint32_t>> reachLeaves;
   };
   Cell cell(const glm::dvec3& point, const glm::dvec3& normal) const;
   bool empty() const { return points_.empty(); }
   std::size_t cellCount() const { return points_.size(); }
 
  private:
-  std::uint64_t key(const glm::dvec3& point, const glm::dvec3& normal, int level) const;
+  // A point's cell coordinates at level 0, floor(point / cellSize); level l's are these >> l (the
+  // same integers as floor(point / (cellSize 2^l)): dividing by 2^l is exact, and
+  // floor(floor(y) / 2^l) = floor(y / 2^l)).
+  using Coords = std::array<std::int64_t, 3>;
+  Coords coords(const glm::dvec3& point) const;
+  static std::uint64_t facing(const glm::dvec3& normal);
+  static std::uint64_t key(const Coords& coords, std::uint64_t facing, int level);
   // The cell index of `key`, or -1. Every shading point looks up to kLevels cells, so the table is
   // flat: std::unordered_map's lookups (a division by its prime bucket count, then a node in its
   // own allocation) were 5 % of a reference frame's time, and no library the project already
@@ -95,6 +107,11 @@ class LightVisibility {
   std::vector<std::uint32_t> seenBegin_;                    // cell c's seen lights: seen_[seenBegin_[c] .. seenBegin_[c + 1])
   std::vector<std::uint32_t> seen_;
   std::vector<std::uint32_t> typicalReaching_;              // per cell
+  std::vector<Coords> cellCoords_;                          // per cell, at its own level
+  std::vector<std::uint8_t> cellLevel_;
+  std::vector<std::uint32_t> reachBegin_;                   // cell c's reach leaves: reach_[reachBegin_[c] .. reachBegin_[c + 1])
+  std::vector<std::uint32_t> reach_;
+  std::vector<std::uint8_t> reachKnown_;                    // per cell: its list is kept
 };
 
 }  // namespace dynbench::render

@@ -223,12 +223,12 @@ Expected<void> LightSet::build(const scene::Scene& scene, const RayTracingScene&
 }
 
 void LightSet::selectPunctual(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights,
-                              std::vector<LightTree::Selected>& selected, const float* factors, int everyLightUpTo,
+                              std::vector<LightTree::Selected>& selected, const LightTree::Guide& guide,
                               std::span<const std::uint32_t> seen) const {
   if (maxLights > 0) {
     // Where the tree did not take every light in reach, it sampled among the lights not seen
     // (their factors), and the seen ones are summed.
-    const bool everyLight = tree_.select(point, normal, u, maxLights, selected, factors, everyLightUpTo);
+    const bool everyLight = tree_.select(point, normal, u, maxLights, selected, guide);
     for (auto& s : selected) s.light = treeLight_[s.light];
     if (!everyLight)
       for (const std::uint32_t k : seen)
@@ -335,7 +335,7 @@ void PairLights::select(int half, const glm::dvec3& point, const glm::dvec3& nor
   const auto& sharedLight = sharedLight_[static_cast<std::size_t>(half)];
   selected.clear();
   if (maxLights > 0 && !shared_.empty()) {
-    shared_.select(point, normal, u, maxLights, selected, nullptr, everyLightUpTo);
+    shared_.select(point, normal, u, maxLights, selected, {.everyLightUpTo = everyLightUpTo});
     for (auto& s : selected) s.light = sharedLight[s.light];
   } else {
     for (const std::uint32_t l : sharedLight)

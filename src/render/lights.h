@@ -9,6 +9,7 @@
 // texture) as radiance. docs/feature-buffers.md repeats this.
 #include <array>
 #include <functional>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -103,14 +104,13 @@ class LightSet {
   // with probability 1, so a scene lit by few lights renders without noise from them). u: one
   // uniform number. maxLights 0: every light that can reach the point, without the tree (exact and
   // slow: the independent estimator the tests compare the tree with).
-  // `factors`: the tree's node factors learned for the point's cell (LightVisibility::factors), or
-  // nullptr for the tree's own importance.
-  // `everyLightUpTo`: LightTree::select's (every light in reach, exactly, where at most that many
-  // can reach the point). `seen` (tree light indices; LightVisibility::Cell::seen, with `factors`
-  // zero on every node whose lights are all seen): lights evaluated wherever they reach the point,
-  // with probability 1, beside the tree's selection among the others.
+  // `guide`: LightTree::select's (what the point's cell learned; every light in reach where at
+  // most guide.everyLightUpTo can reach the point). `seen` (tree light indices;
+  // LightVisibility::Cell::seen, with guide.factors zero on every node whose lights are all seen):
+  // lights evaluated wherever they reach the point, with probability 1, beside the tree's
+  // selection among the others (not where the tree took every light in reach: they are among them).
   void selectPunctual(const glm::dvec3& point, const glm::dvec3& normal, double u, int maxLights,
-                      std::vector<LightTree::Selected>& selected, const float* factors = nullptr, int everyLightUpTo = 0,
+                      std::vector<LightTree::Selected>& selected, const LightTree::Guide& guide = {},
                       std::span<const std::uint32_t> seen = {}) const;
   // The light tree over the point and spot lights, and its light k's index among punctual lights
   // (LightVisibility learns on it).

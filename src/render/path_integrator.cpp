@@ -191,12 +191,16 @@ bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const S
         const LightVisibility::Cell cell = scratch.visibility ? scratch.visibility->cell(hit.position, s.geometricNormal) : LightVisibility::Cell{};
         const int everyLightUpTo =
             cell.factors && cell.typicalReaching > static_cast<std::uint32_t>(settings_.everyLightUpTo) ? 0 : settings_.everyLightUpTo;
+        // Where every light in reach is taken, the cell's occluded lights are kept by roulette
+        // (LightTree::Guide::keepFactors), at every vertex.
+        const LightTree::Guide guide{.factors = depth == 0 ? cell.factors : nullptr,
+                                     .everyLightUpTo = everyLightUpTo,
+                                     .keepFactors = cell.factors,
+                                     .reachLeaves = cell.reachLeaves};
         if (depth == 0 && cell.factors)
-          scratch.lights->selectPunctual(hit.position, s.geometricNormal, uLight, kUnseenLightsPerPoint, scratch.selected, cell.factors,
-                                         everyLightUpTo, cell.seen);
+          scratch.lights->selectPunctual(hit.position, s.geometricNormal, uLight, kUnseenLightsPerPoint, scratch.selected, guide, cell.seen);
         else
-          scratch.lights->selectPunctual(hit.position, s.geometricNormal, uLight, settings_.lightsPerPoint, scratch.selected, nullptr,
-                                         everyLightUpTo);
+          scratch.lights->selectPunctual(hit.position, s.geometricNormal, uLight, settings_.lightsPerPoint, scratch.selected, guide);
       }
       scratch.punctualEvaluated += scratch.selected.size();
       if (!scratch.selected.empty()) {
@@ -206,7 +210,7 @@ bool PathTracer::scatter(PathState& p, int depth, const SurfaceHit& hit, const S
         for (const LightTree::Selected& selected : scratch.selected)
           if (scratch.lights->samplePunctual(selected.light, hit.position, punctual)) {
             punctual.pdf = selected.probability;
-            addLight(p, depth, punctual, bsdf.evaluate(view, punctual.direction), scratch);
+            addPunctualLight(p, depth, punctual, bsdf, view, scratch);
           }
       }
     }
@@ -235,6 +239,18 @@ void PathTracer::addLight(PathState& p, int depth, const LightSample& ls, const 
   const double w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, e.pdf);
   glm::dvec3& bucket = depth == 0 ? p.out.direct : p.out.indirect;  // light reaching this hit
   bucket += p.throughput * f * ls.radiance * (cosine * w / ls.pdf);
+}
+
+void PathTracer::addPunctualLight(PathState& p, int depth, const LightSample& ls, const Bsdf& bsdf, const Bsdf::View& view,
+                                  PathScratch& scratch) const {
+  const double tMax = std::isinf(ls.distance) ? 1e30 : ls.distance * (1.0 - 1e-4) - 3e-5;  // as addLight's
+  ++scratch.rays;
+  if (scratch.scene->occluded(p.origin, ls.direction, tMax)) return;
+  const glm::dvec3 f = bsdf.evaluate(view, ls.direction).value;
+  if (f == glm::dvec3(0.0)) return;
+  const double cosine = std::abs(glm::dot(p.shadingNormal, ls.direction));
+  glm::dvec3& bucket = depth == 0 ? p.out.direct : p.out.indirect;
+  bucket += p.throughput * f * ls.radiance * (cosine * 1.0 / ls.pdf);
 }
 
 bool PathTracer::bounce(PathState& p, int depth, PathScratch& scratch) const {

@@ -245,6 +245,12 @@ class PathTracer {
   bool bounce(PathState& path, int depth, PathScratch& scratch) const;
   // A light's contribution at the path's vertex, given the BSDF's value and pdf towards it.
   void addLight(PathState& path, int depth, const LightSample& light, const Bsdf::Evaluation& evaluation, PathScratch& scratch) const;
+  // addLight for a point, spot or directional light (a delta light, counted fully): the shadow ray first, then
+  // the BSDF, which an occluded light does not need (the same sum: the BSDF's value at an occluded
+  // light was never used). On v2's calm frame 108, evaluating the BSDF at every light in reach
+  // before its shadow ray was 11 % of the frame (perf).
+  void addPunctualLight(PathState& path, int depth, const LightSample& light, const Bsdf& bsdf, const Bsdf::View& view,
+                        PathScratch& scratch) const;
 
   const scene::Scene& scene_;
   RenderSettings settings_;
