@@ -335,7 +335,9 @@ void PairLights::select(int half, const glm::dvec3& point, const glm::dvec3& nor
   const auto& sharedLight = sharedLight_[static_cast<std::size_t>(half)];
   selected.clear();
   if (maxLights > 0 && !shared_.empty()) {
-    shared_.select(point, normal, u, maxLights, selected, {.everyLightUpTo = everyLightUpTo});
+    LightGuide guide;
+    guide.everyLightUpTo = everyLightUpTo;
+    shared_.select(point, normal, u, maxLights, selected, guide);
     for (auto& s : selected) s.light = sharedLight[s.light];
   } else {
     for (const std::uint32_t l : sharedLight)

@@ -125,6 +125,10 @@ nlohmann::json renderRecord(const RenderJob& job) {
     r["lights"]["learned_visibility"] = {{"pilot_stride", kPilotStride}, {"cells_across", kVisibilityCellsAcross},
                                          {"defensive_share", LightVisibility::kDefensiveShare},
                                          {"seen_lights", "summed at the first vertex"}, {"unseen_per_point", kUnseenLightsPerPoint}};
+  // Where every light in reach is evaluated, the cell's occluded lights traced by roulette
+  // (LightGuide::keepFactors; frames that traced every one are not taken for these).
+  if (s.learnedLightSelection && s.everyLightUpTo > 0 && s.lightsPerPoint > 0)
+    r["lights"]["learned_visibility"]["occluded_in_reach"] = "traced with probability defensive_share";
   if (s.jitter) r["jitter"] = "halton23x8";
   // --float32 is recorded, so such a job does not take half-stored frames as complete.
   if (job.float32) r["storage"] = "float32";
