@@ -246,52 +246,29 @@ void LightTree::descendAll(Walk* walks, int count, const glm::dvec3& point, cons
 
 bool LightTree::reachingLights(const glm::dvec3& point, const glm::dvec3& normal, int limit, std::vector<Selected>& selected) const {
   selected.clear();
-  if (nodes_.empty() || !reachesNode(0, point, normal)) return true;
-  // Depth first, the first child before the second; a node is pushed only once it reaches.
-  std::uint32_t stack[64];
-  int size = 0;
-  stack[size++] = 0;
-  while (size > 0) {
-    const std::uint32_t n = stack[--size];
-    if (nodes_[n].count == 1) {
-      if (static_cast<int>(selected.size()) == limit) return false;
-      selected.push_back({nodes_[n].first, 1.0});
-      continue;
-    }
-    const std::uint32_t a = n + 1, b = nodes_[n].first;
-    const bool reachesA = reachesNode(a, point, normal), reachesB = reachesNode(b, point, normal);
-    if (reachesB) stack[size++] = b;  // visited after the first child
-    if (reachesA) stack[size++] = a;
-  }
-  return true;
+  return walkDepthFirst([&](std::uint32_t n) { return reachesNode(n, point, normal); },
+                        [&](std::uint32_t leaf) {
+                          if (static_cast<int>(selected.size()) == limit) return false;
+                          selected.push_back({nodes_[leaf].first, 1.0});
+                          return true;
+                        });
 }
 
 void LightTree::leavesReachingBox(const glm::dvec3& lower, const glm::dvec3& upper, std::vector<std::uint32_t>& leaves) const {
   leaves.clear();
-  if (nodes_.empty()) return;
   // A node reaches the box where the gap between its bounds and the box is shorter than its
   // largest range.
-  const auto reaches = [&](std::uint32_t n) {
-    const Node& node = nodes_[n];
-    if (!std::isfinite(node.range)) return true;
-    const glm::dvec3 gap = glm::max(glm::max(lower - node.upper, node.lower - upper), glm::dvec3(0.0));
-    return glm::dot(gap, gap) < node.range * node.range;
-  };
-  if (!reaches(0)) return;
-  std::uint32_t stack[64];
-  int size = 0;
-  stack[size++] = 0;
-  while (size > 0) {
-    const std::uint32_t n = stack[--size];
-    if (nodes_[n].count == 1) {
-      leaves.push_back(n);
-      continue;
-    }
-    const std::uint32_t a = n + 1, b = nodes_[n].first;
-    const bool reachesA = reaches(a), reachesB = reaches(b);
-    if (reachesB) stack[size++] = b;  // the same order as reachingLights
-    if (reachesA) stack[size++] = a;
-  }
+  walkDepthFirst(
+      [&](std::uint32_t n) {
+        const Node& node = nodes_[n];
+        if (!std::isfinite(node.range)) return true;
+        const glm::dvec3 gap = glm::max(glm::max(lower - node.upper, node.lower - upper), glm::dvec3(0.0));
+        return glm::dot(gap, gap) < node.range * node.range;
+      },
+      [&](std::uint32_t leaf) {
+        leaves.push_back(leaf);
+        return true;
+      });
 }
 
 bool LightTree::reachingLightsAmong(std::span<const std::uint32_t> leaves, const glm::dvec3& point, const glm::dvec3& normal, int limit,

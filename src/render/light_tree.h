@@ -97,20 +97,11 @@ class LightTree {
   // the tree's order: `visit(light)`.
   template <class Visit>
   void forEachReaching(const glm::dvec3& point, const glm::dvec3& normal, Visit&& visit) const {
-    if (nodes_.empty()) return;
-    std::uint32_t stack[64];
-    int size = 0;
-    stack[size++] = 0;
-    while (size > 0) {
-      const std::uint32_t n = stack[--size];
-      if (!(importance(nodes_[n], point, normal) > 0)) continue;
-      if (nodes_[n].count == 1) {
-        visit(nodes_[n].first);
-        continue;
-      }
-      stack[size++] = nodes_[n].first;  // the second child, visited after the first
-      stack[size++] = n + 1;
-    }
+    walkDepthFirst([&](std::uint32_t n) { return importance(nodes_[n], point, normal) > 0; },
+                   [&](std::uint32_t leaf) {
+                     visit(nodes_[leaf].first);
+                     return true;
+                   });
   }
   // Node sums of per-light values: perNode[n] = the sum of perLight over the lights below node n.
   void sumOverNodes(std::span<const double> perLight, std::span<double> perNode) const;
@@ -144,6 +135,28 @@ class LightTree {
   std::vector<std::uint32_t> leafOf_;  // light -> its leaf node
   std::size_t lightCount_ = 0;
 
+  // The tree depth first, the first child before the second, entering a node only where
+  // `reaches(node)`: `leaf(node)` at each leaf entered, in that order (the lights' order every
+  // search of the tree keeps); false from it stops the walk, and the walk returns false.
+  template <class Reaches, class Leaf>
+  bool walkDepthFirst(Reaches&& reaches, Leaf&& leaf) const {
+    if (nodes_.empty() || !reaches(std::uint32_t{0})) return true;
+    std::uint32_t stack[64];
+    int size = 0;
+    stack[size++] = 0;
+    while (size > 0) {
+      const std::uint32_t n = stack[--size];
+      if (nodes_[n].count == 1) {
+        if (!leaf(n)) return false;
+        continue;
+      }
+      const std::uint32_t a = n + 1, b = nodes_[n].first;
+      const bool reachesA = reaches(a), reachesB = reaches(b);
+      if (reachesB) stack[size++] = b;  // visited after the first child
+      if (reachesA) stack[size++] = a;
+    }
+    return true;
+  }
   // Whether some light below node `n` can light the point: some point of the node's bounds is
   // above the surface's plane and within the largest range of its lights. No square root or
   // division: the test reachingLights makes at every node it visits.
