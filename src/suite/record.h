@@ -34,8 +34,11 @@ inline constexpr int kRecordVersion = 1;
 // Version 3: every point and spot light in reach is evaluated where at most 16 reach a point, and
 // at a path's first vertex the lights learned to arrive are summed (render/light_visibility.h);
 // the light tree's walks interleaved (the same bits); the pixel filter's points are stratified
-// (render/pixel_filter.h, stratifiedPoint). suites/results/v2 holds version 2's records.
-inline constexpr int kNumbersVersion = 3;
+// (render/pixel_filter.h, stratifiedPoint). Commits 0e27888 to 4385b1c; no record of it was
+// published.
+// Version 4: where every light in reach is evaluated, the lights a learned cell saw occluded are
+// traced by roulette (LightGuide::keepFactors). suites/results/v2 holds version 2's records.
+inline constexpr int kNumbersVersion = 4;
 
 // Which numbers versions a read accepts: this build's alone (a run that makes records beside them),
 // or any one (assembling or publishing tables of records already made: readRecords then requires
