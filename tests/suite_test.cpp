@@ -548,13 +548,22 @@ TEST(Suite, PublishedResultsAreTheirRecordsAssembled) {
   std::size_t checked = 0;
   std::error_code ec;
   for (const auto& folder : fs::directory_iterator(results, ec)) {
-    const std::string name = folder.path().filename().string();
+    // A folder is named after its suite, or SUITE@numbers-N for the records of numbers version N
+    // being made beside the suite's published set (docs/suite.md, "Publishing").
+    const std::string folderName = folder.path().filename().string();
+    const std::string name = folderName.substr(0, folderName.find('@'));
     auto manifest = suite::readManifest(fs::path(DYNBENCH_SOURCE_DIR) / "suites" / (name + ".json"));
     ASSERT_TRUE(manifest) << name << ": " << manifest.error().message;
     // published results of an earlier numbers version still assemble (all of one version)
     auto records = suite::readRecords(folder.path() / "records", *manifest, suite::NumbersVersions::kAnyOne);
     ASSERT_TRUE(records) << records.error().message;
     ASSERT_FALSE(records->empty()) << name;
+    if (name != folderName) {
+      const std::string version = folderName.substr(name.size());
+      ASSERT_EQ(version.rfind("@numbers-", 0), 0u) << folderName << ": SUITE@numbers-N";
+      for (const auto& [dataset, record] : *records)
+        EXPECT_EQ(fmt::format("@numbers-{}", record.numbersVersion), version) << folderName << ": " << dataset;
+    }
     ++checked;
     if (records->size() < manifest->datasets.size()) {
       EXPECT_FALSE(fs::exists(folder.path() / "suite.json")) << name << ": tables of a set still being run";
