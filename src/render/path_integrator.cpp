@@ -233,7 +233,7 @@ void PathTracer::addLight(PathState& p, int depth, const LightSample& ls, const 
   const glm::dvec3& f = e.value;
   if (f == glm::dvec3(0.0)) return;
   const double cosine = std::abs(glm::dot(p.shadingNormal, ls.direction));
-  const double tMax = std::isinf(ls.distance) ? 1e30 : ls.distance * (1.0 - 1e-4) - 3e-5;
+  const double tMax = shadowRayEnd(ls.distance);
   ++scratch.rays;
   if (scratch.scene->occluded(p.origin, ls.direction, tMax)) return;
   const double w = ls.delta ? 1.0 : powerHeuristic(ls.pdf, e.pdf);
@@ -243,14 +243,14 @@ void PathTracer::addLight(PathState& p, int depth, const LightSample& ls, const 
 
 void PathTracer::addPunctualLight(PathState& p, int depth, const LightSample& ls, const Bsdf& bsdf, const Bsdf::View& view,
                                   PathScratch& scratch) const {
-  const double tMax = std::isinf(ls.distance) ? 1e30 : ls.distance * (1.0 - 1e-4) - 3e-5;  // as addLight's
+  const double tMax = shadowRayEnd(ls.distance);
   ++scratch.rays;
   if (scratch.scene->occluded(p.origin, ls.direction, tMax)) return;
   const glm::dvec3 f = bsdf.evaluate(view, ls.direction).value;
   if (f == glm::dvec3(0.0)) return;
   const double cosine = std::abs(glm::dot(p.shadingNormal, ls.direction));
   glm::dvec3& bucket = depth == 0 ? p.out.direct : p.out.indirect;
-  bucket += p.throughput * f * ls.radiance * (cosine * 1.0 / ls.pdf);
+  bucket += p.throughput * f * ls.radiance * (cosine / ls.pdf);
 }
 
 bool PathTracer::bounce(PathState& p, int depth, PathScratch& scratch) const {

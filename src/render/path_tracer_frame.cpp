@@ -16,11 +16,9 @@
 namespace dynbench::render {
 
 namespace {
+
 // The stream of a pixel's filter shift (Random's `sample` key): no sample has this index.
 constexpr std::uint64_t kFilterShiftStream = 0xFFFFFFFFFFFFull;
-}  // namespace
-
-namespace {
 
 // Running sums of one pixel's samples.
 struct PixelSums {
@@ -94,9 +92,7 @@ LightVisibility PathTracer::learnLightVisibility(const RenderCamera& camera, std
     if (found[s]) points.push_back(slots[s]);
   const double cellSize = 2.0 * sceneRadius_.value_or(1.0) / kVisibilityCellsAcross;
   visibility.learn(lights_, points, cellSize, [this](const LightVisibility::Point& p, const LightSample& sample) {
-    // the shadow ray as addLight traces it
-    const double tMax = std::isinf(sample.distance) ? 1e30 : sample.distance * (1.0 - 1e-4) - 3e-5;
-    return !rayTracing_->occluded(offsetOrigin(p.position, p.normal), sample.direction, tMax);
+    return !rayTracing_->occluded(offsetOrigin(p.position, p.normal), sample.direction, shadowRayEnd(sample.distance));
   });
   return visibility;
 }
@@ -384,9 +380,7 @@ std::vector<std::uint8_t> PathTracer::lightReach(const RenderCamera& camera) con
         const glm::dvec3 normal = glm::dot(hit.geometricNormal, ray.direction) < 0 ? hit.geometricNormal : -hit.geometricNormal;
         const glm::dvec3 origin = offsetOrigin(hit.position, normal);
         reach[pixel] = lights_.anyLightReaches(hit.position, normal, [&](const glm::dvec3& direction, double distance) {
-          // As addLight's shadow ray, which stops short of the light.
-          const double tMax = std::isinf(distance) ? 1e30 : distance * (1.0 - 1e-4) - 3e-5;
-          return !rayTracing_->occluded(origin, direction, tMax);
+          return !rayTracing_->occluded(origin, direction, shadowRayEnd(distance));
         });
       }
   });

@@ -27,6 +27,10 @@ inline glm::dvec3 offsetOrigin(const glm::dvec3& p, const glm::dvec3& normalTowa
   return p + normalTowardsRay * (3e-5 * scale);
 }
 
+// Where a shadow ray towards a light `distance` away stops: short of the light, by a relative and
+// an absolute margin (the light may sit on a surface), and at 1e30 for light from infinitely far.
+inline double shadowRayEnd(double distance) { return std::isinf(distance) ? 1e30 : distance * (1.0 - 1e-4) - 3e-5; }
+
 inline bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 inline void put3(std::vector<float>& buffer, std::size_t pixel, const glm::dvec3& v) {
